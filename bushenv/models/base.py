@@ -1,0 +1,260 @@
+"""The one protocol every bushing force model follows, the name registry, and save/load.
+
+A model is a small stateful object for ONE axis in SI units (m, m/s, N) at a fixed sample time
+``dt`` (the papers' 204.8 Hz by default). Its memory (past inputs, past outputs, internal
+states) lives in ``self.state``, an array of shape (n_state, B) for B independent histories.
+
+Every model implements ``_advance(x, v, out)`` on arrays of shape (T, B): it runs its compiled
+kernel over T samples, updating ``self.state`` in place. ``step`` (one sample, scalar or (B,))
+and ``simulate`` (a whole (T,) or (T, B) profile, free run from reset) both call it, so looped
+and batched results agree to the last bit.
+
+Model files are ``.npz`` archives read with ``allow_pickle=False`` (loading never runs code):
+one array per parameter plus ``__meta__``, a JSON string with the registry name, the format
+version, dt, and each parameter's shape.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+import zipfile
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+FORMAT_VERSION = 1
+PAPER_DT = 1.0 / 204.8  # s; RPC III at 204.8 Hz (seed 000 §4.1, seed 001 §3.2.2)
+DT_TOLERANCE = 1e-9  # relative; two dt values closer than this are the same rate
+
+MODEL_REGISTRY: dict[str, type[BushingModel]] = {}
+
+
+class ModelError(ValueError):
+    """A model file or a model argument is wrong; the message names the file and the problem."""
+
+
+def register(cls: type[BushingModel]) -> type[BushingModel]:
+    """Class decorator: make ``cls`` resolvable by its ``name`` (``model="nn"``)."""
+    if not getattr(cls, "name", None):
+        raise TypeError(f"{cls.__name__} has no registry name")
+    MODEL_REGISTRY[cls.name] = cls
+    return cls
+
+
+class BushingModel:
+    """Base class: state handling, step/simulate over one kernel, parameters, save/load.
+
+    Subclasses set ``name``, ``param_names`` (the arrays that define the model; floats are
+    stored as 0-d arrays), ``n_state`` (rows of the state array, may depend on parameters) and
+    implement ``_advance``. They keep their constructor arguments in ``params`` (a dict of
+    numpy arrays / floats) so ``save``/``load`` need nothing else.
+    """
+
+    name: ClassVar[str] = ""
+    param_names: ClassVar[tuple[str, ...]] = ()
+
+    def __init__(self, dt: float = PAPER_DT) -> None:
+        if not (np.isfinite(dt) and dt > 0):
+            raise ModelError(f"dt must be a positive number of seconds, got {dt!r}")
+        self.dt = float(dt)
+        self.batch_size = 1
+        self.state = np.zeros((self.n_state, 1))
+        self._x1 = np.zeros((1, 1))
+        self._v1 = np.zeros((1, 1))
+        self._f1 = np.zeros((1, 1))
+
+    # ----- what subclasses provide -----------------------------------------------------
+    @property
+    def n_state(self) -> int:
+        return 0
+
+    def initial_state(self, batch_size: int) -> np.ndarray:
+        """State at rest (zero deflection, zero force) for ``batch_size`` histories."""
+        return np.zeros((self.n_state, batch_size))
+
+    def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Run T samples of (T, B) C-contiguous float64 ``x``, ``v`` into ``out``, updating state."""
+        raise NotImplementedError
+
+    @property
+    def params(self) -> dict[str, Any]:
+        return {k: getattr(self, k) for k in self.param_names}
+
+    # ----- the protocol ------------------------------------------------------------------
+    def reset(self, batch_size: int = 1) -> None:
+        """Forget all history; prepare ``batch_size`` independent histories at rest."""
+        if int(batch_size) < 1:
+            raise ModelError(f"batch_size must be >= 1, got {batch_size}")
+        self.batch_size = int(batch_size)
+        self.state = np.ascontiguousarray(self.initial_state(self.batch_size), dtype=np.float64)
+        self._x1 = np.zeros((1, self.batch_size))
+        self._v1 = np.zeros((1, self.batch_size))
+        self._f1 = np.zeros((1, self.batch_size))
+
+    def step(self, x: float | np.ndarray, v: float | np.ndarray) -> float | np.ndarray:
+        """Advance one sample. Scalars in -> float out (B == 1); (B,) arrays in -> (B,) out."""
+        if np.ndim(x) == 0:
+            if self.batch_size != 1:
+                raise ModelError(
+                    f"{self.name}: scalar step on a batch of {self.batch_size}; pass (B,) arrays"
+                )
+            self._x1[0, 0] = x
+            self._v1[0, 0] = v
+            self._advance(self._x1, self._v1, self._f1)
+            return float(self._f1[0, 0])
+        x = np.asarray(x, dtype=np.float64)
+        if x.shape != (self.batch_size,):
+            raise ModelError(
+                f"{self.name}: step got x of shape {x.shape}, expected ({self.batch_size},)"
+            )
+        self._x1[0] = x
+        self._v1[0] = v
+        self._advance(self._x1, self._v1, self._f1)
+        return self._f1[0].copy()
+
+    def simulate(self, x: np.ndarray, v: np.ndarray | None = None) -> np.ndarray:
+        """Free run from rest over a whole profile: (T,) -> (T,) or (T, B) -> (T, B).
+
+        ``v`` defaults to the central-difference velocity of ``x`` (``np.gradient``). The model
+        is reset to ``B`` histories first and keeps its final state afterwards.
+        """
+        x = np.asarray(x, dtype=np.float64)
+        one_d = x.ndim == 1
+        x2 = x[:, None] if one_d else x
+        if x2.ndim != 2 or x2.shape[0] < 1:
+            raise ModelError(f"{self.name}: simulate expects (T,) or (T, B), got {x.shape}")
+        if v is None:
+            v2 = velocity_of(x2, self.dt)
+        else:
+            v2 = np.asarray(v, dtype=np.float64)
+            v2 = v2[:, None] if v2.ndim == 1 else v2
+            if v2.shape != x2.shape:
+                raise ModelError(f"{self.name}: v shape {v2.shape} differs from x {x2.shape}")
+        x2 = np.ascontiguousarray(x2)
+        v2 = np.ascontiguousarray(v2)
+        self.reset(x2.shape[1])
+        out = np.empty_like(x2)
+        self._advance(x2, v2, out)
+        return out[:, 0] if one_d else out
+
+    # ----- files -------------------------------------------------------------------------
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write the model to one ``.npz`` file atomically (temp file, then rename)."""
+        path = Path(path)
+        arrays = {k: np.asarray(v, dtype=np.float64) for k, v in self.params.items()}
+        meta = {
+            "format": "bushenv-model",
+            "version": FORMAT_VERSION,
+            "model": self.name,
+            "dt": self.dt,
+            "shapes": {k: list(a.shape) for k, a in arrays.items()},
+            "extra": self.extra_meta(),
+        }
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.savez(fh, __meta__=np.array(json.dumps(meta)), **arrays)
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        return path
+
+    def extra_meta(self) -> dict[str, Any]:
+        """Non-array settings a subclass needs to rebuild itself (plain JSON values)."""
+        return {}
+
+    @classmethod
+    def from_params(
+        cls, params: dict[str, np.ndarray], dt: float, extra: dict[str, Any]
+    ) -> BushingModel:
+        return cls(dt=dt, **{k: params[k] for k in cls.param_names}, **extra)
+
+    def copy(self) -> BushingModel:
+        """A fresh model with the same parameters (own state)."""
+        return type(self).from_params(
+            {k: np.array(v, dtype=np.float64) for k, v in self.params.items()},
+            self.dt,
+            self.extra_meta(),
+        )
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(dt={self.dt:.6g})"
+
+
+def velocity_of(x: np.ndarray, dt: float) -> np.ndarray:
+    """Central-difference velocity of prescribed displacement, (T, ...) -> (T, ...)."""
+    if x.shape[0] < 2:
+        return np.zeros_like(x)
+    return np.gradient(x, dt, axis=0)
+
+
+def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel:
+    """Read a model file written by ``BushingModel.save``.
+
+    Refuses, naming the file: not an npz archive, a truncated file, another format or version,
+    an unknown model name, missing or wrongly shaped parameters, and (when ``dt`` is given) a
+    sample time other than ``dt``.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ModelError(f"{path}: no such model file")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            files = {k: z[k] for k in z.files}
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
+        raise ModelError(
+            f"{path}: not a bushenv model file (expected an .npz archive): {exc}"
+        ) from None
+    if "__meta__" not in files:
+        raise ModelError(f"{path}: not a bushenv model file (no __meta__ entry)")
+    try:
+        meta = json.loads(str(files.pop("__meta__")))
+    except json.JSONDecodeError as exc:
+        raise ModelError(f"{path}: corrupt __meta__ entry: {exc}") from None
+    if not isinstance(meta, dict) or meta.get("format") != "bushenv-model":
+        raise ModelError(f"{path}: not a bushenv model file (format tag missing)")
+    if meta.get("version") != FORMAT_VERSION:
+        raise ModelError(
+            f"{path}: model file format version {meta.get('version')!r}, "
+            f"this bushenv reads version {FORMAT_VERSION}"
+        )
+    name = meta.get("model")
+    if name not in MODEL_REGISTRY:
+        raise ModelError(f"{path}: unknown model {name!r}; known: {sorted(MODEL_REGISTRY)}")
+    cls = MODEL_REGISTRY[name]
+    file_dt = float(meta.get("dt", float("nan")))
+    if not (np.isfinite(file_dt) and file_dt > 0):
+        raise ModelError(f"{path}: invalid dt {meta.get('dt')!r}")
+    if dt is not None and abs(file_dt - dt) > DT_TOLERANCE * dt:
+        raise ModelError(
+            f"{path}: model sampled at {1 / file_dt:.6g} Hz (dt={file_dt:.6g} s), "
+            f"expected {1 / dt:.6g} Hz (dt={dt:.6g} s)"
+        )
+    for key in cls.param_names:
+        if key not in files:
+            raise ModelError(f"{path}: {name} model file lacks parameter {key!r}")
+        want = meta.get("shapes", {}).get(key)
+        if want is not None and list(files[key].shape) != list(want):
+            raise ModelError(
+                f"{path}: parameter {key!r} has shape {list(files[key].shape)}, "
+                f"the file's header says {want}"
+            )
+        if not np.all(np.isfinite(files[key])):
+            raise ModelError(f"{path}: parameter {key!r} holds NaN or inf")
+    try:
+        return cls.from_params(files, file_dt, meta.get("extra", {}))
+    except ModelError as exc:
+        raise ModelError(f"{path}: {exc}") from None
+    except (TypeError, ValueError) as exc:
+        raise ModelError(f"{path}: parameters do not fit a {name} model: {exc}") from None
+
+
+def file_hash(path: str | os.PathLike) -> str:
+    """sha256 of a model file (regression cases record which model they judged)."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
