@@ -1,0 +1,425 @@
+"""Measured or simulated test records as CSV files: load, validate, save, resample.
+
+The format (one record per file):
+
+    time,displacement,force
+    0.0,0.0,0.0
+    0.0048828125,1.2e-05,4.61
+    ...
+
+- The header is exactly ``time,displacement,force`` (spaces around names are tolerated, nothing
+  else: no extra columns, no units in the names, no other order). Columns are s, m, N.
+- Values are decimal numbers (anything Python's ``float`` reads except NaN and inf), comma
+  separated, one sample per line; blank lines are allowed only at the end.
+- Time strictly increases with a uniform step, at any rate: the step dt is read from the time
+  column (the median step). Every step must be within ``STEP_RTOL`` (1 %) of dt plus
+  ``STEP_ATOL_S`` (1e-9 s). At least two samples.
+- Plausibility: ``max |displacement| <= MAX_PLAUSIBLE_DISPLACEMENT_M`` (0.1 m, eight times the
+  test machine's stroke; larger values are almost always millimetres) and
+  ``max |force| <= MAX_PLAUSIBLE_FORCE_N`` (1 MN, forty times the machine's 25 kN).
+- Files larger than ``MAX_RECORD_BYTES`` (256 MiB, about five million samples) are refused
+  before reading; below that the file is parsed line by line into compact arrays.
+
+Every problem raises ``RecordError`` (a ``ValueError``) naming the file, the line and the value,
+e.g. ``train.csv line 17: time goes backwards (0.123 after 0.1235)``. ``save_csv`` applies the
+same checks before writing, so whatever it writes ``load_csv`` reads back bit for bit (floats
+are written with Python's shortest round-trip ``repr``). Saving is atomic (temp file, then
+rename) and refuses to replace an existing file unless ``overwrite=True``.
+"""
+
+from __future__ import annotations
+
+import array
+import csv
+import difflib
+import io
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+HEADER = ("time", "displacement", "force")
+HEADER_TEXT = ",".join(HEADER)
+STEP_RTOL = 0.01  # a step may differ from dt by 1 % of dt ...
+STEP_ATOL_S = 1e-9  # ... plus 1 ns (printed times lose digits)
+MAX_PLAUSIBLE_DISPLACEMENT_M = 0.1
+MAX_PLAUSIBLE_FORCE_N = 1.0e6
+MAX_RECORD_BYTES = 256 * 2**20
+_SNIFF_BYTES = 8192
+
+
+class RecordError(ValueError):
+    """A record file or record array is invalid; the message names file, line and value."""
+
+
+@dataclass(eq=False)
+class Record:
+    """One uniformly sampled record: ``time`` (s), ``displacement`` (m), ``force`` (N), all (T,).
+
+    ``name`` labels it in messages (defaults to the file stem on load); ``path`` is the file it
+    came from, if any; ``info`` carries notes that are not written to the CSV (e.g. the machine's
+    force-limit flag).
+    """
+
+    time: np.ndarray
+    displacement: np.ndarray
+    force: np.ndarray
+    name: str = ""
+    path: Path | None = None
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        arrays = {}
+        for key in HEADER:
+            a = np.ascontiguousarray(getattr(self, key), dtype=np.float64)
+            if a.ndim != 1:
+                raise RecordError(f"{self.label}: {key} has shape {a.shape}, expected (T,)")
+            arrays[key] = a
+        lengths = {k: a.size for k, a in arrays.items()}
+        if len(set(lengths.values())) != 1:
+            raise RecordError(f"{self.label}: columns differ in length: {lengths}")
+        self.time, self.displacement, self.force = (arrays[k] for k in HEADER)
+
+    @classmethod
+    def from_arrays(
+        cls,
+        displacement: np.ndarray,
+        force: np.ndarray,
+        dt: float,
+        t0: float = 0.0,
+        name: str = "",
+        info: dict[str, Any] | None = None,
+    ) -> Record:
+        """A record with time ``t0 + i * dt`` for the (T,) ``displacement`` and ``force``."""
+        if not (np.isfinite(dt) and dt > 0):
+            raise RecordError(f"{name or 'record'}: dt must be a positive number, got {dt!r}")
+        n = np.asarray(displacement).shape[0] if np.ndim(displacement) else 0
+        return cls(
+            time=t0 + np.arange(n) * float(dt),
+            displacement=displacement,
+            force=force,
+            name=name,
+            info=dict(info or {}),
+        )
+
+    @property
+    def label(self) -> str:
+        if self.path is not None:
+            return str(self.path)
+        return self.name or "record"
+
+    def __len__(self) -> int:
+        return int(self.time.size)
+
+    @property
+    def dt(self) -> float:
+        """Mean sample time, s: (last time - first time) / (T - 1)."""
+        if self.time.size < 2:
+            raise RecordError(f"{self.label}: fewer than two samples, no sample time")
+        return float((self.time[-1] - self.time[0]) / (self.time.size - 1))
+
+    @property
+    def sample_rate_hz(self) -> float:
+        return 1.0 / self.dt
+
+    @property
+    def duration_s(self) -> float:
+        """T * dt: the span the samples stand for (last time - first time + dt)."""
+        return len(self) * self.dt
+
+    def validate(self) -> Record:
+        """Apply the file format's checks to the arrays; raise ``RecordError`` or return self."""
+        _check_columns(
+            self.time,
+            self.displacement,
+            self.force,
+            self.label,
+            where=lambda i: f"{self.label} sample {i}",
+        )
+        return self
+
+
+# ----- checks shared by load and save ----------------------------------------------------------
+def _check_columns(t: np.ndarray, x: np.ndarray, f: np.ndarray, label: str, where) -> None:
+    """Semantic checks; ``where(i)`` names sample i (a file line or a sample index)."""
+    if t.size < 2:
+        raise RecordError(f"{label}: {t.size} sample(s); need at least 2 to know the sample time")
+    for key, a in zip(HEADER, (t, x, f), strict=True):
+        bad = ~np.isfinite(a)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise RecordError(f"{where(i)}: {key} is {float(a[i])!r}, expected a finite number")
+    steps = np.diff(t)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0)) + 1
+        if t[i] == t[i - 1]:
+            raise RecordError(f"{where(i)}: time repeats ({float(t[i])!r} twice)")
+        raise RecordError(
+            f"{where(i)}: time goes backwards ({float(t[i])!r} after {float(t[i - 1])!r})"
+        )
+    dt = float(np.median(steps))
+    tol = STEP_RTOL * dt + STEP_ATOL_S
+    off = np.abs(steps - dt) > tol
+    if off.any():
+        i = int(np.argmax(off)) + 1
+        raise RecordError(
+            f"{where(i)}: time step {float(steps[i - 1])!r} s "
+            f"({float(t[i - 1])!r} to {float(t[i])!r}) differs from the record's step "
+            f"{dt!r} s by more than the tolerance {tol:.3g} s "
+            f"({STEP_RTOL:.0%} of dt + {STEP_ATOL_S:g} s); records must be uniformly sampled"
+        )
+    ax = np.abs(x)
+    if ax.max() > MAX_PLAUSIBLE_DISPLACEMENT_M:
+        i = int(np.argmax(ax))
+        raise RecordError(
+            f"{where(i)}: displacement {float(x[i])!r} exceeds {MAX_PLAUSIBLE_DISPLACEMENT_M} m; "
+            "looks like millimetres (the column must be metres)"
+        )
+    af = np.abs(f)
+    if af.max() > MAX_PLAUSIBLE_FORCE_N:
+        i = int(np.argmax(af))
+        raise RecordError(
+            f"{where(i)}: force {float(f[i])!r} N exceeds {MAX_PLAUSIBLE_FORCE_N:g} N "
+            "(40 times the test machine's 25 kN); wrong units (the column must be newtons) "
+            "or a diverged run"
+        )
+
+
+def _header_problem(fields: list[str]) -> str | None:
+    """None if ``fields`` is the header, else what is wrong with it."""
+    names = [s.strip() for s in fields]
+    if tuple(names) == HEADER:
+        return None
+    shown = ",".join(fields)
+    expected = f"expected exactly '{HEADER_TEXT}'"
+    if len(names) == 1 and ";" in names[0]:
+        return f"header '{shown}' looks ';'-separated; {expected} (comma separated)"
+    if len(names) == 1 and "\t" in names[0]:
+        return f"header '{shown}' looks tab-separated; {expected} (comma separated)"
+    numeric = 0
+    for s in names:
+        try:
+            float(s)
+            numeric += 1
+        except ValueError:
+            pass
+    if numeric == len(names) and names:
+        return f"the first line '{shown}' is data, not a header; {expected}"
+    missing = [h for h in HEADER if h not in names]
+    unknown = [s for s in names if s not in HEADER]
+    if missing and unknown:
+        parts = []
+        for s in unknown:
+            close = difflib.get_close_matches(s.lower(), missing, n=1, cutoff=0.6)
+            if close:
+                parts.append(f"column '{s}' should be '{close[0]}'")
+            else:
+                parts.append(f"unknown column '{s}'")
+        still_missing = [
+            m
+            for m in missing
+            if not any(difflib.get_close_matches(s.lower(), [m], n=1, cutoff=0.6) for s in unknown)
+        ]
+        parts += [f"missing column '{m}'" for m in still_missing]
+        return f"header '{shown}': {'; '.join(parts)}; {expected}"
+    if missing:
+        return (
+            f"header '{shown}': missing column(s) {', '.join(repr(m) for m in missing)}; {expected}"
+        )
+    if unknown:
+        return (
+            f"header '{shown}': extra column(s) {', '.join(repr(u) for u in unknown)} "
+            f"(extra columns are not allowed); {expected}"
+        )
+    return f"header '{shown}': columns repeated or out of order; {expected}"
+
+
+# ----- load ------------------------------------------------------------------------------------
+def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Record:
+    """Read and validate one record file; refuse anything off-format with ``RecordError``.
+
+    The file is parsed line by line (memory ~ 32 bytes per sample); files above ``max_bytes``
+    are refused before reading.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise RecordError(f"{path}: no such record file")
+    if not path.is_file():
+        raise RecordError(f"{path}: not a regular file")
+    size = path.stat().st_size
+    if size > max_bytes:
+        raise RecordError(
+            f"{path}: {size / 2**20:.1f} MiB is larger than the {max_bytes / 2**20:.0f} MiB limit "
+            "for one record; split it into shorter records"
+        )
+    if size == 0:
+        raise RecordError(f"{path}: empty file; expected the header '{HEADER_TEXT}' and data")
+    with open(path, "rb") as fh:
+        head = fh.read(_SNIFF_BYTES)
+    nul = head.find(b"\x00")
+    if nul >= 0:
+        raise RecordError(f"{path}: binary data (NUL byte at byte {nul}); expected a text CSV file")
+
+    t, x, f = array.array("d"), array.array("d"), array.array("d")
+    lines = array.array("q")
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as fh:
+            _parse(fh, path, t, x, f, lines)
+    except UnicodeDecodeError as exc:
+        raise RecordError(
+            f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start} of a read block); "
+            "expected a text CSV file"
+        ) from None
+    except csv.Error as exc:
+        raise RecordError(f"{path}: not a readable CSV file: {exc}") from None
+
+    record = Record(
+        time=np.frombuffer(t, dtype=np.float64).copy(),
+        displacement=np.frombuffer(x, dtype=np.float64).copy(),
+        force=np.frombuffer(f, dtype=np.float64).copy(),
+        name=path.stem,
+        path=path,
+    )
+    line_of = np.frombuffer(lines, dtype=np.int64)
+    if len(record) < 2:
+        raise RecordError(
+            f"{path}: {'header only, no data' if len(record) == 0 else 'only one data row'}; "
+            "need at least 2 samples to know the sample time"
+        )
+    _check_columns(
+        record.time,
+        record.displacement,
+        record.force,
+        str(path),
+        where=lambda i: f"{path} line {int(line_of[i])}",
+    )
+    return record
+
+
+def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> None:
+    reader = csv.reader(fh, strict=True)
+    header = None
+    for row in reader:
+        if not row or all(not s.strip() for s in row):
+            continue
+        header = row
+        break
+    if header is None:
+        raise RecordError(
+            f"{path}: no header and no data (only blank lines); expected '{HEADER_TEXT}'"
+        )
+    if reader.line_num != 1:
+        raise RecordError(f"{path} line {reader.line_num}: blank lines before the header")
+    problem = _header_problem(header)
+    if problem:
+        raise RecordError(f"{path} line 1: {problem}")
+    blank_at = 0
+    columns = (t, x, f)
+    last_line = 1
+    for row in reader:
+        line = reader.line_num
+        if line != last_line + 1:
+            raise RecordError(f"{path} line {last_line + 1}: a quoted value spans several lines")
+        last_line = line
+        if not row or all(not s.strip() for s in row):
+            blank_at = blank_at or line
+            continue
+        if blank_at:
+            raise RecordError(f"{path} line {blank_at}: blank line inside the data")
+        if len(row) != 3:
+            raise RecordError(
+                f"{path} line {line}: {len(row)} value(s) {','.join(row)!r}, expected 3 "
+                f"({HEADER_TEXT})"
+            )
+        for key, column, text in zip(HEADER, columns, row, strict=True):
+            try:
+                value = float(text)
+            except ValueError:
+                raise RecordError(
+                    f"{path} line {line}: {key} {text.strip()!r} is not a number"
+                ) from None
+            if not np.isfinite(value):
+                raise RecordError(
+                    f"{path} line {line}: {key} is {text.strip()!r}, expected a finite number"
+                )
+            column.append(value)
+        if len(t) >= 2 and t[-1] <= t[-2]:
+            if t[-1] == t[-2]:
+                raise RecordError(f"{path} line {line}: time repeats ({t[-1]!r} twice)")
+            raise RecordError(
+                f"{path} line {line}: time goes backwards ({t[-1]!r} after {t[-2]!r})"
+            )
+        lines.append(line)
+
+
+# ----- save ------------------------------------------------------------------------------------
+def save_csv(record: Record, path: str | os.PathLike, overwrite: bool = False) -> Path:
+    """Validate ``record`` and write it to ``path`` atomically; returns the path.
+
+    Refuses (``RecordError``) a record ``load_csv`` would refuse, and an existing ``path``
+    unless ``overwrite=True``. The data go to a temporary file in the same folder first, so a
+    crash never leaves a half-written record under the final name.
+    """
+    path = Path(path)
+    record.validate()
+    if path.exists() and not overwrite:
+        raise RecordError(f"{path} already exists; refusing to overwrite it (pass overwrite=True)")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(HEADER_TEXT + "\n")
+            # tolist() gives Python floats, whose repr is the shortest exact round-trip text.
+            rows = zip(
+                record.time.tolist(),
+                record.displacement.tolist(),
+                record.force.tolist(),
+                strict=True,
+            )
+            fh.writelines(f"{a!r},{b!r},{c!r}\n" for a, b, c in rows)
+        if overwrite:
+            os.replace(tmp, path)
+        else:
+            try:
+                os.link(tmp, path)  # fails if path appeared meanwhile: never replace silently
+            except FileExistsError:
+                raise RecordError(
+                    f"{path} already exists; refusing to overwrite it (pass overwrite=True)"
+                ) from None
+            Path(tmp).unlink()
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+# ----- resample --------------------------------------------------------------------------------
+def resample(record: Record, dt: float) -> Record:
+    """The record linearly interpolated onto times t0, t0 + dt, ... up to its last time.
+
+    For matching the rates of two records before comparing them. No anti-alias filter: when
+    going to a coarser step, low-pass the record first if it holds content above the new
+    Nyquist frequency.
+    """
+    if not (np.isfinite(dt) and dt > 0):
+        raise RecordError(f"{record.label}: resample dt must be a positive number, got {dt!r}")
+    if len(record) < 2:
+        raise RecordError(f"{record.label}: fewer than two samples, cannot resample")
+    t0, t1 = float(record.time[0]), float(record.time[-1])
+    n = int(np.floor((t1 - t0) / dt + 1e-9)) + 1
+    if n < 2:
+        raise RecordError(
+            f"{record.label}: lasts {t1 - t0:.6g} s, shorter than one step of the new dt={dt!r}"
+        )
+    t = t0 + np.arange(n) * float(dt)
+    t[-1] = min(t[-1], t1)
+    return Record(
+        time=t,
+        displacement=np.interp(t, record.time, record.displacement),
+        force=np.interp(t, record.time, record.force),
+        name=record.name,
+        info=dict(record.info),
+    )
