@@ -171,21 +171,29 @@ def _check_columns(t: np.ndarray, x: np.ndarray, f: np.ndarray, label: str, wher
             f"{dt!r} s by more than the tolerance {tol:.3g} s "
             f"({STEP_RTOL:.0%} of dt + {STEP_ATOL_S:g} s); records must be uniformly sampled"
         )
-    ax = np.abs(x)
-    if ax.max() > MAX_PLAUSIBLE_DISPLACEMENT_M:
-        i = int(np.argmax(ax))
-        raise RecordError(
-            f"{where(i)}: displacement {float(x[i])!r} exceeds {MAX_PLAUSIBLE_DISPLACEMENT_M} m; "
-            "looks like millimetres (the column must be metres)"
-        )
-    af = np.abs(f)
-    if af.max() > MAX_PLAUSIBLE_FORCE_N:
-        i = int(np.argmax(af))
-        raise RecordError(
-            f"{where(i)}: force {float(f[i])!r} N exceeds {MAX_PLAUSIBLE_FORCE_N:g} N "
-            "(40 times the test machine's 25 kN); wrong units (the column must be newtons) "
-            "or a diverged run"
-        )
+    plausible = (
+        (
+            "displacement",
+            x,
+            MAX_PLAUSIBLE_DISPLACEMENT_M,
+            "m",
+            "looks like millimetres (the column must be metres)",
+        ),
+        (
+            "force",
+            f,
+            MAX_PLAUSIBLE_FORCE_N,
+            "N",
+            "that is 40 times the test machine's 25 kN: wrong units (the column must be "
+            "newtons) or a diverged run",
+        ),
+    )
+    for key, a, limit, unit, hint in plausible:
+        i = int(np.argmax(np.abs(a)))
+        if abs(a[i]) > limit:
+            raise RecordError(
+                f"{where(i)}: {key} {float(a[i])!r} {unit} exceeds {limit:g} {unit}; {hint}"
+            )
 
 
 def _header_problem(fields: list[str]) -> str | None:
