@@ -4,9 +4,10 @@ The papers identified a linear bushing (seed 000 Table 1) from an RPC random rec
 n = 1 (peak |x| = 2 mm) and judged it on an unseen record at n = 1.5 (Table 2: RMS ratio 9.8 %
 axial, 11.9 % radial). ``calibration_numbers(axis)`` repeats that on the reference bushing:
 
-1. drive it with a band-limited random record (``random_drive``; 0.5-20 Hz, 204.8 Hz, peak
-   n * 2 mm) at n = 1 and fit F ~ k x + c v by least squares (``linear_fit``);
-2. run that linear model on a different record at n = 1.5 and compute ``rms_ratio``.
+1. drive it with the RPC-like random record of ``bushenv.excitation.random_rpc`` (durability
+   spectrum, 0.5-20 Hz, 204.8 Hz, peak n * 2 mm) at n = 1, 40 s, and fit F ~ k x + c v by least
+   squares (``linear_fit``), as ``bushenv.machine.papers_programme`` records it;
+2. run that linear model on the unseen n = 1.5 record (20 s, next seed); ``rms_ratio``.
 
 Run ``python -m bushenv.reference.calibration`` to print the numbers for both axes (they are
 recorded in ``rubber.py`` and docs/reference.md).
@@ -19,41 +20,13 @@ import sys
 
 import numpy as np
 
+from bushenv.excitation import random_rpc, sine, step_hold
 from bushenv.metrics import max_error_ratio, rms, rms_ratio
 from bushenv.models.base import PAPER_DT, velocity_of
 from bushenv.reference.rubber import RubberBushing
 
 TABLE1 = {"axial": (379.68e3, 4.4e3), "radial": (1518.73e3, 15.0e3)}  # seed 000, SI
 TABLE2_LINEAR_RMS = {"axial": 0.098, "radial": 0.119}  # seed 000 Table 2
-PEAK_PER_INDEX_M = 2.0e-3  # seed 002 §3: peak amplitude 2 mm at n = 1
-
-
-def random_drive(
-    n_index: float,
-    duration_s: float,
-    dt: float = PAPER_DT,
-    seed: int = 0,
-    band_hz: tuple[float, float] = (0.5, 20.0),
-) -> np.ndarray:
-    """Band-limited Gaussian displacement (T,), m: flat spectrum in ``band_hz``, peak n * 2 mm.
-
-    Stands in for an RPC drive file: white noise, zeroed outside the band in the frequency
-    domain, faded in and out over 0.25 s, scaled so max |x| = n_index * 2 mm.
-    """
-    if n_index <= 0 or duration_s <= 0:
-        raise ValueError(f"need n_index > 0 and duration_s > 0, got {n_index}, {duration_s}")
-    n = int(round(duration_s / dt))
-    rng = np.random.default_rng(seed)
-    spec = np.fft.rfft(rng.standard_normal(n))
-    f = np.fft.rfftfreq(n, dt)
-    spec[(f < band_hz[0]) | (f > band_hz[1])] = 0.0
-    x = np.fft.irfft(spec, n)
-    ramp = min(n // 4, int(round(0.25 / dt)))
-    if ramp > 0:
-        w = 0.5 - 0.5 * np.cos(np.pi * np.arange(ramp) / ramp)
-        x[:ramp] *= w
-        x[n - ramp :] *= w[::-1]
-    return x * (n_index * PEAK_PER_INDEX_M / np.max(np.abs(x)))
 
 
 def linear_fit(x: np.ndarray, v: np.ndarray, f: np.ndarray) -> tuple[float, float]:
@@ -66,8 +39,9 @@ def linear_fit(x: np.ndarray, v: np.ndarray, f: np.ndarray) -> tuple[float, floa
 def calibration_numbers(
     axis: str,
     model: RubberBushing | None = None,
-    duration_s: float = 30.0,
     seed: int = 0,
+    identification_s: float = 40.0,
+    verification_s: float = 20.0,
     dt: float = PAPER_DT,
 ) -> dict[str, float]:
     """Linear fit on an n = 1 record, judged on an unseen n = 1.5 record (seed 000 §4).
@@ -77,8 +51,8 @@ def calibration_numbers(
     largest |F| at n = 1.5.
     """
     m = RubberBushing.preset(axis, dt=dt) if model is None else model
-    x1 = random_drive(1.0, duration_s, dt, seed=seed)
-    x15 = random_drive(1.5, duration_s, dt, seed=seed + 1)
+    x1 = random_rpc(1.0, identification_s, dt, seed)
+    x15 = random_rpc(1.5, verification_s, dt, seed + 1)
     v1, v15 = velocity_of(x1, dt), velocity_of(x15, dt)
     f1 = m.simulate(x1, v1)
     f15 = m.simulate(x15, v15)
@@ -97,10 +71,88 @@ def calibration_numbers(
     }
 
 
+SINE_FREQS_HZ = (1.0, 5.0, 10.0, 15.0, 20.0)  # seed 001 §3.2.1
+SINE_AMPS_M = (0.5e-3, 1.0e-3, 2.0e-3, 3.0e-3, 4.0e-3)
+
+
+def behaviour_numbers(axis: str, dt: float = PAPER_DT) -> dict[str, object]:
+    """What the papers report, measured on the specimen alone (no measurement effects).
+
+    - ``step_force_n``: force after a held 4 mm step (seed 000 §5.2) at 0.1, 1, 5, 10, 20 s;
+    - ``heating``: temperature rise and drop of the force amplitude (last 10 Hz cycle against
+      the cycle at 1 s; includes ~0.3 % of slow Maxwell settling) after 10 s and 60 s of a 4 mm
+      10 Hz sine, and after 10 s at 0.5 mm 1 Hz;
+    - ``stroke_force_n``: largest |F| of a 12.5 mm sine at 0.1 and 1 Hz (machine: 25 kN);
+    - ``kdyn_n_per_mm`` / ``loop_energy_j``: peak-to-peak force over twice the amplitude, and
+      the work per cycle, on the last cycle of 3 s sines, rows SINE_AMPS_M, columns SINE_FREQS_HZ.
+    """
+    m = RubberBushing.preset(axis, dt=dt, measurement=False)
+    pre = 0.5
+    f = m.simulate(step_hold(4e-3, 20.0, dt, pre_s=pre))
+    step = {s: float(f[int(round((pre + s) / dt))]) for s in (0.1, 1.0, 5.0, 10.0, 19.9)}
+    heating = {}
+    for name, amp, freq, dur in (
+        ("4mm_10Hz_10s", 4e-3, 10.0, 10.0),
+        ("4mm_10Hz_60s", 4e-3, 10.0, 60.0),
+        ("0.5mm_1Hz_10s", 0.5e-3, 1.0, 10.0),
+    ):
+        f = m.simulate(sine(freq, amp, dur, dt))
+        n = int(round(1.0 / freq / dt))
+        first = np.ptp(f[int(round(1.0 / dt)) : int(round(1.0 / dt)) + n])
+        heating[name] = {
+            "dT_k": float(m.state[2, 0]),
+            "amplitude_drop": float(1.0 - np.ptp(f[-n:]) / first),
+        }
+    stroke = {}
+    for freq in (0.1, 1.0):
+        stroke[f"{freq:g}Hz"] = float(np.max(np.abs(m.simulate(sine(freq, 12.5e-3, 2 / freq, dt)))))
+    kdyn = np.zeros((len(SINE_AMPS_M), len(SINE_FREQS_HZ)))
+    energy = np.zeros_like(kdyn)
+    for i, amp in enumerate(SINE_AMPS_M):
+        for j, freq in enumerate(SINE_FREQS_HZ):
+            x = sine(freq, amp, 3.0, dt)
+            f = m.simulate(x)
+            n = int(round(1.0 / freq / dt))
+            kdyn[i, j] = np.ptp(f[-n:]) / (2 * amp) / 1e3
+            energy[i, j] = np.sum(0.5 * (f[-n:] + f[-n - 1 : -1]) * np.diff(x[-n - 1 :]))
+    return {
+        "step_force_n": step,
+        "heating": heating,
+        "stroke_force_n": stroke,
+        "kdyn_n_per_mm": kdyn,
+        "loop_energy_j": energy,
+    }
+
+
+def _print_behaviour(axis: str) -> None:
+    b = behaviour_numbers(axis)
+    print(f"\n{axis}: held 4 mm step, force [N] at t after the step")
+    print(" ".join(f"{t:g}s: {v:.0f}" for t, v in b["step_force_n"].items()))
+    print(f"{axis}: self-heating")
+    for name, h in b["heating"].items():
+        print(
+            f"  {name}: dT {h['dT_k']:.2f} K, "
+            f"force amplitude drop {100 * h['amplitude_drop']:.2f} %"
+        )
+    print(
+        f"{axis}: largest |F| of a 12.5 mm sine: "
+        + ", ".join(f"{k} {v / 1e3:.1f} kN" for k, v in b["stroke_force_n"].items())
+    )
+    for key, unit in (("kdyn_n_per_mm", "dynamic stiffness [N/mm]"), ("loop_energy_j", "J/cycle")):
+        print(f"{axis}: {unit}, rows amplitude [mm], columns frequency [Hz]")
+        print("| mm | " + " | ".join(f"{f:g} Hz" for f in SINE_FREQS_HZ) + " |")
+        print("|---" * (len(SINE_FREQS_HZ) + 1) + "|")
+        for amp, row in zip(SINE_AMPS_M, b[key], strict=True):
+            fmt = "{:.0f}" if key == "kdyn_n_per_mm" else "{:.3g}"
+            print(f"| {amp * 1e3:g} | " + " | ".join(fmt.format(v) for v in row) + " |")
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--duration", type=float, default=30.0, help="record length, s")
+    p.add_argument("--identification-s", type=float, default=40.0, help="n = 1 record, s")
+    p.add_argument("--verification-s", type=float, default=20.0, help="n = 1.5 record, s")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--behaviour", action="store_true", help="also step, heating, sine grid")
     args = p.parse_args(argv)
     print(
         "| axis | k fit [N/mm] (T1) | c fit [N s/mm] (T1) | RMS n=1 | RMS n=1.5 (T2) | MAX n=1.5 |"
@@ -108,7 +160,12 @@ def main(argv: list[str] | None = None) -> int:
     print("|---|---|---|---|---|---|")
     for axis in ("axial", "radial"):
         print(f"measuring {axis} ...", file=sys.stderr, flush=True)
-        r = calibration_numbers(axis, duration_s=args.duration, seed=args.seed)
+        r = calibration_numbers(
+            axis,
+            seed=args.seed,
+            identification_s=args.identification_s,
+            verification_s=args.verification_s,
+        )
         k_ref, c_ref = TABLE1[axis]
         print(
             f"| {axis} | {r['k_fit_n_per_m'] / 1e3:.1f} ({k_ref / 1e3:.2f}) "
@@ -117,6 +174,10 @@ def main(argv: list[str] | None = None) -> int:
             f"| {100 * r['rms_ratio_n15']:.1f} % ({100 * TABLE2_LINEAR_RMS[axis]:.1f} %) "
             f"| {100 * r['max_ratio_n15']:.1f} % |"
         )
+    if args.behaviour:
+        for axis in ("axial", "radial"):
+            print(f"measuring {axis} behaviour ...", file=sys.stderr, flush=True)
+            _print_behaviour(axis)
     return 0
 
 
