@@ -1,8 +1,9 @@
 """The ``bushenv`` command: parses arguments, hands them to a library module, prints.
 
 Each sub-command lives in the module named below, which provides ``add_arguments(parser)`` and
-``run(args) -> int``. Modules are imported only when their command runs, so ``bushenv --help``
-is fast and one broken optional part cannot take the others down.
+``run(args) -> int`` (or ``cli_run(args)`` where the module's ``run`` is a library function).
+Modules are imported only when their command runs, so ``bushenv --help`` is fast and one
+broken optional part cannot take the others down.
 """
 
 from __future__ import annotations
@@ -14,9 +15,9 @@ import sys
 COMMANDS = {
     # name: (module, one-line help)
     "reproduce": ("bushenv.reproduce", "identify every model and reproduce the papers' tables"),
-    "attack": ("bushenv.search.campaign", "adversarial campaign: find excitations that break a model"),
-    "campaign": ("bushenv.search.matrix", "a matrix of campaigns (models x axes x searchers x seeds)"),
-    "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far it shrinks"),
+    "attack": ("bushenv.search.campaign", "adversarial campaign: excitations that break a model"),
+    "campaign": ("bushenv.search.matrix", "campaign matrix: models x axes x searchers x seeds"),
+    "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
     "measure": ("bushenv.machine", "run a test programme on a model and write CSV records"),
 }
@@ -60,8 +61,9 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 2
     mod = importlib.import_module(COMMANDS[args.command][0])
+    runner = getattr(mod, "cli_run", None) or mod.run  # cli_run where run() means something else
     try:
-        return int(mod.run(args) or 0)
+        return int(runner(args) or 0)
     except KeyboardInterrupt:
         print("bushenv: interrupted; results written so far are kept", file=sys.stderr)
         return 130

@@ -177,24 +177,12 @@ def _record(name: str, x: np.ndarray, force: np.ndarray, dt: float) -> Record:
     return Record.from_arrays(x, force, dt, name=name, info=info)
 
 
-def run(
-    model: BushingModel | argparse.Namespace, x: np.ndarray | None = None, name: str = "excitation"
-) -> Record | int:
+def run(model: BushingModel, x: np.ndarray, name: str = "excitation") -> Record:
     """Drive ``model`` with displacement ``x`` (T,) in m at ``model.dt``; returns the Record.
 
     Refuses (``MachineError``) anything outside the machine's stroke or velocity; flags a force
     above 25 kN in ``record.info`` and with a ``MachineWarning``.
-
-    ``run(args)`` with the parsed arguments of ``bushenv measure`` (an ``argparse.Namespace``,
-    no ``x``) is the command line's entry point instead (``bushenv.cli`` calls ``module.run``):
-    it returns the exit code.
     """
-    if isinstance(model, argparse.Namespace):
-        if x is not None:
-            raise MachineError("run(args) is the command line entry; it takes no excitation")
-        return run_cli(model)
-    if x is None:
-        raise MachineError(f"{name}: run(model, x) needs the displacement x")
     a = check_excitation(x, model.dt, name)
     if a.ndim != 1:
         raise MachineError(f"{name}: run takes one profile (T,); use run_programme for several")
@@ -330,7 +318,7 @@ def programme_items(args: argparse.Namespace, dt: float) -> list[ProgrammeItem]:
     return papers_programme(dt, seed=args.seed)
 
 
-def run_cli(args: argparse.Namespace) -> int:
+def cli_run(args: argparse.Namespace) -> int:
     from bushenv.models import get_model
 
     start = time.monotonic()
