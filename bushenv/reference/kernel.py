@@ -63,42 +63,47 @@ def hardening_force(x, k, law, x_h):  # pragma: no cover - compiled
     )
 
 
+# Packed parameters (fewer arguments make a one-sample call from Python cheaper).
+F_K, F_C, F_FMAX, F_K0, F_HARD_X, F_TH_DECAY, F_TH_R, F_TH_AK, F_TH_AC = range(9)
+F_DELAY_FRAC, F_M_FIX, F_DT = 9, 10, 11
+N_FPAR = 12
+I_FRIC_LAW, I_HARD_LAW, I_DELAY_INT, I_N_DELAY, I_NOISE_ON = range(5)
+N_IPAR = 5
+
+
 @nb.njit(**JIT)
-def rubber_kernel(  # pragma: no cover - compiled
-    x,
-    v,
-    noise,
-    state,
-    k,
-    c,
-    relax_k,
-    relax_decay,
-    relax_gain,
-    relax_eta,
-    fric_law,
-    fric_fmax,
-    fric_k0,
-    iwan_k,
-    iwan_f,
-    hard_law,
-    hard_x,
-    th_decay,
-    th_r,
-    th_ak,
-    th_ac,
-    delay_int,
-    delay_frac,
-    n_delay,
-    m_fix,
-    noise_on,
-    dt,
-    out,
-):
+def rubber_kernel(x, v, noise, state, fpar, ipar, relax, iwan, out):  # pragma: no cover
     """Advance (T, B) samples; see the module docstring for the state rows.
 
-    relax_decay = exp(-dt/tau_i), relax_gain = tau_i (1 - exp(-dt/tau_i)),
-    relax_eta = k_i tau_i (dashpot of branch i, N s/m); th_decay = exp(-dt/(R C)).
+    ``fpar`` (float64, N_FPAR): k, c, friction F_fmax, friction stick stiffness F_fmax/x2,
+    hardening x_h, exp(-dt/(R_th C_th)), R_th, a_k, a_c, delay fraction, fixture mass, dt.
+    ``ipar`` (int64, N_IPAR): friction law, hardening law, whole delay samples, delay buffer
+    rows, noise on. ``relax`` (4, Nb): k_i, exp(-dt/tau_i), tau_i (1 - exp(-dt/tau_i)), k_i tau_i.
+    ``iwan`` (2, N): element stiffness and slip force (empty unless the law is iwan).
     """
+    k = fpar[F_K]
+    c = fpar[F_C]
+    fric_fmax = fpar[F_FMAX]
+    fric_k0 = fpar[F_K0]
+    hard_x = fpar[F_HARD_X]
+    th_decay = fpar[F_TH_DECAY]
+    th_r = fpar[F_TH_R]
+    th_ak = fpar[F_TH_AK]
+    th_ac = fpar[F_TH_AC]
+    delay_frac = fpar[F_DELAY_FRAC]
+    m_fix = fpar[F_M_FIX]
+    dt = fpar[F_DT]
+    fric_law = ipar[I_FRIC_LAW]
+    hard_law = ipar[I_HARD_LAW]
+    delay_int = ipar[I_DELAY_INT]
+    n_delay = ipar[I_N_DELAY]
+    noise_on = ipar[I_NOISE_ON] != 0
+    relax_k = relax[0]
+    relax_decay = relax[1]
+    relax_gain = relax[2]
+    relax_eta = relax[3]
+    iwan_k = iwan[0]
+    iwan_f = iwan[1]
     T, B = x.shape
     nb_ = relax_k.shape[0]
     r_fric = 3 + nb_
@@ -220,9 +225,8 @@ def rubber_kernel(  # pragma: no cover - compiled
 def warm_up() -> None:
     """Compile (or load from cache) the kernel once."""
     z = np.zeros((2, 1))
-    e = np.zeros(0)
-    st = np.zeros((3, 1))
+    fpar = np.ones(N_FPAR)
     rubber_kernel(
-        z, z, z, st, 1.0, 1.0, e, e, e, e, 0, 1.0, 1.0, e, e, 0, 1.0, 1.0, 0.0, 0.0, 0.0,
-        0, 0.0, 0, 0.0, False, 0.01, np.empty_like(z),
+        z, z, z, np.zeros((3, 1)), fpar, np.zeros(N_IPAR, dtype=np.int64), np.zeros((4, 0)),
+        np.zeros((2, 0)), np.empty_like(z),
     )  # fmt: skip

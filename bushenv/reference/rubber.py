@@ -95,12 +95,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
-from bushenv.reference.kernel import (
-    FRICTION_LAWS,
-    HARDENING_LAWS,
-    friction_rows,
-    rubber_kernel,
-)
+from bushenv.reference import kernel
+from bushenv.reference.kernel import FRICTION_LAWS, HARDENING_LAWS, friction_rows, rubber_kernel
 
 EFFECTS = ("relaxation", "friction", "hardening", "thermal", "delay", "inertia", "noise")
 PHYSICAL_EFFECTS = ("relaxation", "friction", "hardening", "thermal")
@@ -384,31 +380,28 @@ class RubberBushing(BushingModel):
         self._n_fric = friction_rows(law, self.friction_elements)
         self._n_branches = rk.size
         self._n_delay = n_delay
-        self._args = (
-            self.k_n_per_m,
-            self.c_ns_per_m,
-            rk,
-            decay,
-            gain,
-            eta,
-            law,
-            fmax,
-            k0,
-            iwan_k,
-            iwan_f,
-            hard,
-            hard_x,
-            th_decay,
-            th_r,
-            th_ak,
-            th_ac,
-            d_int,
-            d_frac,
-            n_delay,
-            m_fix,
-            self._noise_on,
-            dt,
-        )
+        fpar = np.zeros(kernel.N_FPAR)
+        fpar[kernel.F_K] = self.k_n_per_m
+        fpar[kernel.F_C] = self.c_ns_per_m
+        fpar[kernel.F_FMAX] = fmax
+        fpar[kernel.F_K0] = k0
+        fpar[kernel.F_HARD_X] = hard_x
+        fpar[kernel.F_TH_DECAY] = th_decay
+        fpar[kernel.F_TH_R] = th_r
+        fpar[kernel.F_TH_AK] = th_ak
+        fpar[kernel.F_TH_AC] = th_ac
+        fpar[kernel.F_DELAY_FRAC] = d_frac
+        fpar[kernel.F_M_FIX] = m_fix
+        fpar[kernel.F_DT] = dt
+        ipar = np.zeros(kernel.N_IPAR, dtype=np.int64)
+        ipar[kernel.I_FRIC_LAW] = law
+        ipar[kernel.I_HARD_LAW] = hard
+        ipar[kernel.I_DELAY_INT] = d_int
+        ipar[kernel.I_N_DELAY] = n_delay
+        ipar[kernel.I_NOISE_ON] = int(self._noise_on)
+        relax = np.ascontiguousarray(np.stack([rk, decay, gain, eta]).reshape(4, rk.size))
+        iwan = np.ascontiguousarray(np.stack([iwan_k, iwan_f]).reshape(2, iwan_k.size))
+        self._args = (fpar, ipar, relax, iwan)
         self._no_noise = np.zeros((1, 1))
 
     @property
@@ -432,7 +425,8 @@ class RubberBushing(BushingModel):
             noise *= self.noise_std_n
         else:
             noise = self._no_noise
-        rubber_kernel(x, v, noise, self.state, *self._args, out)
+        fpar, ipar, relax, iwan = self._args
+        rubber_kernel(x, v, noise, self.state, fpar, ipar, relax, iwan, out)
 
     # ----- parameters and files ----------------------------------------------------------
     def extra_meta(self) -> dict[str, Any]:
