@@ -331,6 +331,32 @@ class RubberBushing(BushingModel):
         """A copy without the measurement effects (delay, inertia, noise): the bushing alone."""
         return self.without_effects(MEASUREMENT_EFFECTS)
 
+    def stiffness_bound_n_per_m(self, x_max_m: float = 12.5e-3) -> float:
+        """Upper bound of the specimen's tangent stiffness dF/dx within |x| <= ``x_max_m``.
+
+        k g'(x_max) + sum k_i (Maxwell springs, at frequencies >> 1/tau_i) + the friction
+        element's largest slope (F_fmax/x2 right after a reversal; twice that for Dahl). For
+        the stability margin of explicit couplings (omega = sqrt(bound / mass)); the damper adds
+        ``c_ns_per_m`` on top. Measurement effects are not included.
+        """
+        on = set(self.effects)
+        u = x_max_m / self.hardening_x_m if "hardening" in on else 0.0
+        if "hardening" not in on:
+            slope = 1.0
+        elif self.hardening_law == "cubic":
+            slope = 1.0 + 3.0 * u * u
+        elif self.hardening_law == "tangent":
+            slope = 1.0 / np.cos(min(u, kernel.TANGENT_U_MAX)) ** 2
+        else:
+            slope = float(np.cosh(min(u, kernel.EXPONENTIAL_U_MAX)))
+        bound = self.k_n_per_m * slope
+        if "relaxation" in on:
+            bound += float(self.relax_k_n_per_m.sum())
+        if "friction" in on:
+            k0 = self.friction_fmax_n / self.friction_x2_m
+            bound += 2.0 * k0 if self.friction_law == "dahl" else k0
+        return float(bound)
+
     # ----- kernel arguments --------------------------------------------------------------
     def _build_kernel_args(self) -> None:
         dt = self.dt

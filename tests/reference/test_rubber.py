@@ -408,3 +408,87 @@ def test_kernel_stays_bounded_on_wild_inputs_at_any_rate(dt, axis, law):
     bound = 3 * k_all * 12.5e-3 + m.c_ns_per_m * 1.3 + m.friction_fmax_n
     assert np.max(np.abs(f)) < bound
     assert np.all(m.state[2] >= 0)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    n_branches=st.integers(0, 6),
+    law=st.sampled_from(LAWS),
+    hardening=st.sampled_from(["cubic", "tangent", "exponential"]),
+    delay_samples=st.floats(0.0, 10.0),
+    dt=st.sampled_from([1 / 2048, PAPER_DT, 1 / 100]),
+    batch=st.integers(1, 4),
+    T=st.integers(1, 60),
+    seed=st.integers(0, 2**31 - 1),
+)
+def test_any_configuration_runs_batched_equal_to_looped(
+    n_branches, law, hardening, delay_samples, dt, batch, T, seed
+):
+    rng = np.random.default_rng(seed)
+    m = RubberBushing(
+        k_n_per_m=5e5,
+        c_ns_per_m=5e3,
+        relax_k_n_per_m=rng.uniform(1e4, 3e5, n_branches),
+        relax_tau_s=rng.uniform(1e-3, 10.0, n_branches),
+        friction_fmax_n=200.0,
+        friction_x2_m=3e-4,
+        hardening_x_m=12e-3,
+        thermal_r_k_per_w=0.1,
+        thermal_c_j_per_k=300.0,
+        thermal_ak_per_k=0.003,
+        thermal_ac_per_k=0.006,
+        delay_s=delay_samples * dt,
+        fixture_mass_kg=1.0,
+        noise_std_n=2.0,
+        friction_law=law,
+        hardening_law=hardening,
+        seed=seed,
+        dt=dt,
+    )
+    x = rng.uniform(-12.5e-3, 12.5e-3, size=(T, batch))
+    v = rng.uniform(-1.3, 1.3, size=(T, batch))
+    batched = m.simulate(x, v)
+    m.reset(batch)
+    looped = np.array([m.step(x[t], v[t]) for t in range(T)])
+    assert np.array_equal(batched, looped)
+    assert np.all(np.isfinite(batched))
+
+
+def test_effects_default_to_those_with_parameters():
+    m = RubberBushing(k_n_per_m=1e5, c_ns_per_m=1e3, friction_fmax_n=10.0, friction_x2_m=1e-4)
+    assert m.active_effects == ("friction",)
+    bare = RubberBushing(k_n_per_m=1e5, c_ns_per_m=1e3)
+    assert bare.active_effects == ()
+    x = random_rpc(1.0, 2.0, PAPER_DT, 0)
+    v = velocity_of(x, PAPER_DT)
+    assert np.allclose(bare.simulate(x, v), 1e5 * x + 1e3 * v, rtol=0, atol=1e-9)
+
+
+def test_copies_do_not_share_state():
+    m = RubberBushing.preset("radial")
+    c = m.copy()
+    m.simulate(random_rpc(1.0, 2.0, PAPER_DT, 0))
+    assert not np.any(c.state)
+    assert c.active_effects == m.active_effects and c.seed == m.seed
+
+
+@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("axis", ["axial", "radial"])
+def test_stiffness_bound_covers_the_steepest_slope_seen(axis, law):
+    m = RubberBushing.preset(axis, friction_law=law, c_ns_per_m=0.0, measurement=False)
+    bound = m.stiffness_bound_n_per_m()
+    assert bound > TABLE1[axis][0]  # small-amplitude, high-frequency stiffness beats Table 1
+    # big slow swings to saturate the friction, then fast tiny reversals near the stroke end
+    dt = 1 / 2048
+    m = RubberBushing.preset(
+        axis, dt=dt, friction_law=law, c_ns_per_m=0.0, measurement=False
+    )  # fmt: skip
+    x = np.concatenate([sine(12.5e-3, 1.0, 1.25, dt), 12.5e-3 + sine(2e-5, 200.0, 0.05, dt)])
+    f = m.simulate(x, np.zeros_like(x))
+    dx, df = np.diff(x), np.diff(f)
+    # Maxwell branches also relax between samples, independently of dx: at most F_i dt / tau_i
+    relaxing = np.sum(m.relax_k_n_per_m * 12.5e-3 * 2 * dt / m.relax_tau_s)
+    assert np.all(np.abs(df) <= bound * np.abs(dx) * 1.001 + relaxing)
+    dither = slice(len(x) - int(0.04 / dt), len(x) - 1)
+    fast = np.abs(dx[dither]) > 5e-6
+    assert np.max(np.abs(df[dither][fast] / dx[dither][fast])) > 0.5 * bound  # not loose
