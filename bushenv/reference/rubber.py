@@ -57,7 +57,8 @@ exactly for P held over a sample.
 **Delay** (measurement): the force channel lags the displacement channel by tau_d = ``delay_s``
 (fractional samples, linear interpolation in a buffer of past forces held in the state).
 **Inertia** (measurement): the load cell also carries the fixture mass m_fix; acceleration is
-the backward difference of the velocity input. **Noise** (measurement): Gaussian, std
+the backward difference of the velocity input (m_fix may be negative: an over-compensated
+fixture). **Noise** (measurement): Gaussian, std
 ``noise_std_n``, drawn from ``numpy.random.default_rng(seed)`` at every ``reset``; the draws are
 made in (T, B) C order, so a batched ``simulate`` and T looped ``step`` calls agree bit for bit.
 
@@ -67,7 +68,8 @@ own history); the damper and the fixture see the velocity input v.
 Calibration (``python -m bushenv.reference.calibration --behaviour``): the drive is
 ``bushenv.excitation.random_rpc`` (durability spectrum, 0.5-20 Hz, 204.8 Hz, peak |x| = n * 2 mm);
 linear least-squares fit F ~ k x + c v on n = 1 (40 s, seed s), judged on n = 1.5 (20 s, seed
-s + 1), measurement effects on. Seed 0, and in brackets the range over seeds 0, 10, ..., 90:
+s + 1), measurement effects on. Seed 0 (in brackets: the papers), and the range over seeds
+0, 10, ..., 90 as deviations from Table 1 or as the spread of the ratios:
 
 | axis   | k fit N/mm (Table 1) | c fit N s/mm (T. 1) | RMS n=1.5 (Table 2)   | MAX n=1.5    |
 |--------|----------------------|---------------------|-----------------------|--------------|
@@ -85,7 +87,10 @@ peaks at 4.1 kN axial, 20.2 kN radial (machine: 25 kN). Dynamic stiffness falls 
 1 Hz, 2114 at 20 Hz); docs/reference.md has the whole sine grid.
 
 Stability: every update is exact or algebraic (see ``kernel.py``), so the kernel is stable for
-any input; tested for +-12.5 mm, |v| up to 1.3 m/s and dt from 1/2048 s to 1/100 s.
+any input; tested for +-12.5 mm, |v| up to 1.3 m/s and dt from 1/2048 s to 1/100 s. For an
+explicit coupling to a mass, ``stiffness_bound_n_per_m()`` bounds the tangent stiffness (radial
+preset: 4.7e6 N/m at the stroke end, 3.1e6 N/m within 4 mm; axial 0.91e6 / 0.72e6 N/m), about
+three times Table 1 because friction and the Maxwell springs are stiff right after a reversal.
 """
 
 from __future__ import annotations
