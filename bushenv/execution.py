@@ -91,9 +91,7 @@ class RayBackend:
         try:
             import ray
         except ImportError:
-            raise BackendError(
-                "the Ray backend needs Ray: pip install 'bushenv[ray]'"
-            ) from None
+            raise BackendError("the Ray backend needs Ray: pip install 'bushenv[ray]'") from None
         self._ray = ray
         self._started_here = False
         if not ray.is_initialized():
@@ -105,7 +103,9 @@ class RayBackend:
             try:
                 ray.init(**kwargs)
             except Exception as exc:  # ray raises many types; say which cluster failed
-                raise BackendError(f"cannot start or reach Ray ({address or 'local'}): {exc}") from None
+                raise BackendError(
+                    f"cannot start or reach Ray ({address or 'local'}): {exc}"
+                ) from None
             self._started_here = True
         self.workers = int(ray.cluster_resources().get("CPU", 1))
         self._remote_cache: dict[Callable, Any] = {}
