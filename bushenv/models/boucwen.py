@@ -137,7 +137,7 @@ class BoucWenBushing(BushingModel):
         self._p_batch = np.ascontiguousarray(np.repeat(self._p, self.batch_size, axis=1))
 
     def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        n_bad = boucwen_kernel(x, v, self.state, self._p_batch, self.dt, out)
+        n_bad = boucwen_kernel(x, v, self.state, self._p_batch, self.dt, BW_MAX_SUBSTEPS, out)
         if n_bad:
             raise BoucWenError(
                 f"boucwen: {n_bad} of {x.shape[1]} histories needed more than "
@@ -160,12 +160,17 @@ class BoucWenBushing(BushingModel):
 
 
 def simulate_population(
-    vectors: np.ndarray, x: np.ndarray, v: np.ndarray, dt: float = PAPER_DT
+    vectors: np.ndarray,
+    x: np.ndarray,
+    v: np.ndarray,
+    dt: float = PAPER_DT,
+    max_substeps: int = BW_MAX_SUBSTEPS,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Free-run P parameter sets (P, 16) on one record (T,) at once: forces (T, P), bad (P,).
 
-    Columns whose integration failed hold NaN and are flagged in ``bad`` (no error raised: the
-    identification treats them as infeasible).
+    Columns whose integration failed (more than ``max_substeps`` RK4 sub-steps in a sample, or
+    non-finite) hold NaN and are flagged in ``bad``; no error is raised: the identification
+    treats them as infeasible.
     """
     vectors = np.asarray(vectors, dtype=np.float64)
     P = vectors.shape[0]
@@ -174,6 +179,6 @@ def simulate_population(
     vv = np.ascontiguousarray(np.repeat(np.asarray(v, dtype=np.float64)[:, None], P, axis=1))
     state = np.zeros((BW_N_STATE, P))
     out = np.empty_like(xx)
-    boucwen_kernel(xx, vv, state, p, dt, out)
+    boucwen_kernel(xx, vv, state, p, dt, int(max_substeps), out)
     bad = ~np.all(np.isfinite(out), axis=0)
     return out, bad

@@ -210,14 +210,15 @@ def _bw_rate(p, b, xx, u, y, w, z1, z2):  # pragma: no cover - compiled
 
 
 @nb.njit(**JIT)
-def boucwen_kernel(x, v, state, p, dt, out):  # pragma: no cover - compiled
+def boucwen_kernel(x, v, state, p, dt, max_substeps, out):  # pragma: no cover - compiled
     """Integrate seed 002 eqs. 1-4 over each sample with RK4 sub-steps; F by eq. 5.
 
     Inside a sample x and its rate u are interpolated linearly between the previous and the
     current sample. Sub-steps: before each one, h = remaining / ceil(remaining * rate / 2.0)
     with ``rate`` from ``_bw_rate``, so every sub-step sits inside RK4's stability interval and
     the last one ends exactly on the sample. Returns the number of columns that needed more than
-    BW_MAX_SUBSTEPS in one sample (their output is NaN from then on; the caller raises).
+    ``max_substeps`` in one sample (their output is NaN from then on; the model raises, the
+    identification scores them infeasible).
     """
     T, B = x.shape
     n_bad = 0
@@ -244,7 +245,7 @@ def boucwen_kernel(x, v, state, p, dt, out):  # pragma: no cover - compiled
                 n_left = math.ceil(remaining * rate / RK4_STABLE_FRACTION)
                 if n_left < 1:
                     n_left = 1
-                if n_sub + n_left > BW_MAX_SUBSTEPS:
+                if n_sub + n_left > max_substeps:
                     ok = False
                     break
                 h = remaining / n_left
@@ -326,4 +327,4 @@ def warm_up() -> None:
             np.empty_like(z),
         )
     p = np.ones((len(BW_ORDER), 1))
-    boucwen_kernel(z, z, np.zeros((BW_N_STATE, 1)), p, 1e-3, np.empty_like(z))
+    boucwen_kernel(z, z, np.zeros((BW_N_STATE, 1)), p, 1e-3, BW_MAX_SUBSTEPS, np.empty_like(z))

@@ -28,19 +28,19 @@ def standin_force(x: np.ndarray, dt: float = DT) -> np.ndarray:
     """Force (T,) in N of the stand-in bushing for displacement x (T,) in m."""
     k, c, k3 = 300e3, 800.0, 1.0e10
     branches = ((100e3, 0.01), (60e3, 0.2))  # (k_i N/m, tau_i s) Maxwell
-    f_slip, k_f = 80.0, 2.0e6  # smooth friction: F_f' = k_f (v - |v| F_f / f_slip)
+    f_slip, k_f = 80.0, 2.0e6  # smooth friction: F_f' = k_f (v - |v| F_f / f_slip), exact
+
     v = np.gradient(x, dt)
     fm = np.zeros(len(branches))
     ff = 0.0
     out = np.empty_like(x)
-    n_sub = 8
-    h = dt / n_sub
     for t in range(len(x)):
         vt = v[t]
         for i, (ki, tau) in enumerate(branches):
             a = np.exp(-dt / tau)
             fm[i] = a * fm[i] + ki * tau * (1.0 - a) * vt
-        for _ in range(n_sub):
-            ff += h * k_f * (vt - abs(vt) * ff / f_slip)
+        if vt != 0.0:
+            f_eq = np.sign(vt) * f_slip
+            ff = f_eq + (ff - f_eq) * np.exp(-k_f * abs(vt) * dt / f_slip)
         out[t] = k * x[t] + c * vt + k3 * x[t] ** 3 + fm.sum() + ff
     return out

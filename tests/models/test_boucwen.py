@@ -100,7 +100,7 @@ def reference_solution(m, x, v, dt):
 
 
 def test_rk4_substeps_match_a_tight_implicit_solver():
-    x = random_2mm(seed=1, duration_s=20.0)[:80]
+    x = random_2mm(seed=1, duration_s=20.0)[:40]
     v = np.gradient(x, DT)
     m = BoucWenBushing.preset()
     f = m.simulate(x, v)
