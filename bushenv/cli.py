@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 COMMANDS = {
@@ -28,14 +29,21 @@ class CliError(Exception):
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The parser; only the module of ``only`` (the command being run) is imported.
+
+    Without a command (``bushenv --help``, a typo) no command module is imported, so the
+    top-level help is fast and works even when one command's module is missing or broken.
+    Raises ``CliError`` when the module of ``only`` cannot be imported.
+    """
     parser = argparse.ArgumentParser(
         prog="bushenv",
         description="Stress-test rubber-bushing force models (see README.md).",
+        epilog="Run 'bushenv COMMAND --help' for a command's options and an example.",
         allow_abbrev=False,
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name, (module, help_text) in COMMANDS.items():
-        if only is not None and name != only:
+    for name, (_module, help_text) in COMMANDS.items():
+        if name != only:
             sub.add_parser(name, help=help_text, add_help=False)
             continue
         p = sub.add_parser(
@@ -45,22 +53,42 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             formatter_class=argparse.RawDescriptionHelpFormatter,
             allow_abbrev=False,
         )
-        mod = importlib.import_module(module)
+        mod = _command_module(name)
         mod.add_arguments(p)
         if getattr(mod, "EXAMPLE", None):
             p.epilog = "example:\n  " + mod.EXAMPLE
     return parser
 
 
+def _command_module(name: str):
+    module = COMMANDS[name][0]
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        # A command whose module is absent from this install (or needs a missing package)
+        # must not take the others down, nor print a traceback.
+        raise CliError(f"this command is not available in this install ({module}: {exc})") from None
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; returns the exit code (0 ok, 2 bad input, 130 interrupted).
+
+    Every failure is one line on stderr: ``bushenv COMMAND: error: ...``. An unexpected
+    exception (a bug) is also one line, naming its type; set ``BUSHENV_DEBUG=1`` for the full
+    traceback.
+    """
     argv = list(sys.argv[1:] if argv is None else argv)
     only = argv[0] if argv and argv[0] in COMMANDS else None
-    parser = build_parser(only)
+    try:
+        parser = build_parser(only)
+    except CliError as exc:
+        print(f"bushenv {only}: error: {exc}", file=sys.stderr)
+        return 2
     args = parser.parse_args(argv)
     if args.command is None:
         parser.print_help()
         return 2
-    mod = importlib.import_module(COMMANDS[args.command][0])
+    mod = _command_module(args.command)
     runner = getattr(mod, "cli_run", None) or mod.run  # cli_run where run() means something else
     try:
         return int(runner(args) or 0)
@@ -72,8 +100,24 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except (ValueError, OSError) as exc:
         # Our loaders raise ValueError subclasses with file/line/value in the message.
-        print(f"bushenv {args.command}: error: {exc}", file=sys.stderr)
+        print(f"bushenv {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except Exception as exc:
+        if os.environ.get("BUSHENV_DEBUG"):
+            raise
+        print(
+            f"bushenv {args.command}: internal error: {type(exc).__name__}: {_one_line(exc)} "
+            "(a bug: please report it; BUSHENV_DEBUG=1 shows the traceback)",
+            file=sys.stderr,
+        )
+        return 1
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc) or type(exc).__name__
+    if isinstance(exc, OSError) and exc.filename is not None and str(exc.filename) not in text:
+        text = f"{exc.filename}: {text}"
+    return " ".join(text.split())
 
 
 if __name__ == "__main__":

@@ -49,6 +49,19 @@ MAX_PLAUSIBLE_DISPLACEMENT_M = 0.1
 MAX_PLAUSIBLE_FORCE_N = 1.0e6
 MAX_RECORD_BYTES = 256 * 2**20
 _SNIFF_BYTES = 8192
+# First bytes of files people hand over by mistake, so the message can say what it is.
+_BINARY_MAGIC = (
+    (b"PK\x03\x04", "a zip archive (an .npz model, an .xlsx workbook or a zipped CSV?)"),
+    (b"\x89PNG", "a PNG image"),
+    (b"\xff\xd8\xff", "a JPEG image"),
+    (b"%PDF", "a PDF document"),
+    (b"\x1f\x8b", "a gzip-compressed file (decompress it first)"),
+    (b"PAR1", "a Parquet file"),
+    (b"\x93NUMPY", "a NumPy .npy array"),
+    (b"\xd0\xcf\x11\xe0", "an old Excel/Office file"),
+    (b"\xff\xfe", "UTF-16 text (save it as UTF-8)"),
+    (b"\xfe\xff", "UTF-16 text (save it as UTF-8)"),
+)
 
 
 class RecordError(ValueError):
@@ -267,6 +280,9 @@ def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Reco
         raise RecordError(f"{path}: empty file; expected the header '{HEADER_TEXT}' and data")
     with open(path, "rb") as fh:
         head = fh.read(_SNIFF_BYTES)
+    for magic, what in _BINARY_MAGIC:
+        if head.startswith(magic):
+            raise RecordError(f"{path}: binary data ({what}); expected a text CSV file")
     nul = head.find(b"\x00")
     if nul >= 0:
         raise RecordError(f"{path}: binary data (NUL byte at byte {nul}); expected a text CSV file")

@@ -64,6 +64,8 @@ def get_model(
     if axis not in AXES:
         raise ModelError(f"unknown axis {axis!r}; known: {list(AXES)}")
     text = os.fspath(spec)
+    if not text.strip():
+        raise ModelError(f"empty model name; known names: {sorted(MODEL_REGISTRY)} or a .npz file")
     if text in MODEL_REGISTRY:
         if text in TRAINED:
             path = default_model_path(text, axis)
@@ -77,7 +79,9 @@ def get_model(
         return model
     if text.endswith(".npz") or Path(text).exists():
         return load_model(text, dt=dt)
-    raise ModelError(f"unknown model {text!r}; known names: {sorted(MODEL_REGISTRY)} or a .npz file")
+    raise ModelError(
+        f"unknown model {text!r}; known names: {sorted(MODEL_REGISTRY)} or a .npz file"
+    )
 
 
 __all__ = [

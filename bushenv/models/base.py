@@ -77,7 +77,7 @@ class BushingModel:
         return np.zeros((self.n_state, batch_size))
 
     def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        """Run T samples of (T, B) C-contiguous float64 ``x``, ``v`` into ``out``, updating state."""
+        """Run T samples of (T, B) C-contiguous float64 ``x``, ``v`` into ``out``; update state."""
         raise NotImplementedError
 
     @property
@@ -194,27 +194,87 @@ def velocity_of(x: np.ndarray, dt: float) -> np.ndarray:
     return np.gradient(x, dt, axis=0)
 
 
+ZIP_MAGIC = b"PK\x03\x04"
+_KNOWN_MAGIC = (
+    (b"\x93NUMPY", "a single .npy array, not an .npz archive"),
+    (b"\x80", "a Python pickle (bushenv never loads pickles: they can run code)"),
+    (b"\x89PNG", "a PNG image"),
+    (b"\x1f\x8b", "a gzip file"),
+    (b"%PDF", "a PDF document"),
+)
+
+
+def _not_npz_reason(head: bytes) -> str:
+    """What a file that is not a zip archive looks like, from its first bytes."""
+    if not head:
+        return "empty file"
+    for magic, what in _KNOWN_MAGIC:
+        if head.startswith(magic):
+            return what
+    if b"\x00" not in head:
+        try:
+            head.decode("utf-8")
+            return "a text file"
+        except UnicodeDecodeError:
+            pass
+    return f"unknown binary data (starts with {head[:8]!r})"
+
+
+def _ensure_registry() -> None:
+    # A model file names its class; make sure every model module has registered itself.
+    from bushenv.models import _load_registry
+
+    _load_registry()
+
+
 def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel:
     """Read a model file written by ``BushingModel.save``.
 
-    Refuses, naming the file: not an npz archive, a truncated file, another format or version,
-    an unknown model name, missing or wrongly shaped parameters, and (when ``dt`` is given) a
-    sample time other than ``dt``.
+    Refuses with ``ModelError``, naming the file and what was expected: a missing file, a
+    folder, anything that is not an npz archive (text, an image, a pickle, a lone .npy), a
+    truncated or damaged archive, object (pickled) entries -- never unpickled --, another
+    format or version, an unknown model name, a corrupt header, missing, non-numeric or
+    wrongly shaped parameters, and (when ``dt`` is given) a sample time other than ``dt``.
     """
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise ModelError(f"{path}: no such model file")
+    if not path.is_file():
+        raise ModelError(f"{path}: not a regular file; expected a bushenv model file (.npz)")
+    with open(path, "rb") as fh:
+        head = fh.read(16)
+    if not head.startswith(ZIP_MAGIC):
+        raise ModelError(
+            f"{path}: not a bushenv model file: {_not_npz_reason(head)}; expected an .npz "
+            "archive written by BushingModel.save"
+        )
     try:
         with np.load(path, allow_pickle=False) as z:
             files = {k: z[k] for k in z.files}
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
+    except ValueError as exc:
+        if "allow_pickle" in str(exc) or "pickled" in str(exc):
+            raise ModelError(
+                f"{path}: holds pickled (object) data, which bushenv never loads (it could run "
+                "code); expected numeric arrays written by BushingModel.save"
+            ) from None
+        raise ModelError(f"{path}: damaged .npz archive: {exc}") from None
+    except (zipfile.BadZipFile, OSError, EOFError, KeyError, TypeError) as exc:
         raise ModelError(
-            f"{path}: not a bushenv model file (expected an .npz archive): {exc}"
+            f"{path}: damaged or truncated .npz archive ({type(exc).__name__}: {exc}); "
+            "expected a file written by BushingModel.save"
         ) from None
+    except Exception as exc:  # zlib.error and the like from a damaged member
+        raise ModelError(f"{path}: damaged .npz archive ({type(exc).__name__}: {exc})") from None
     if "__meta__" not in files:
         raise ModelError(f"{path}: not a bushenv model file (no __meta__ entry)")
+    raw = files.pop("__meta__")
+    if raw.shape != () or raw.dtype.kind != "U":
+        raise ModelError(
+            f"{path}: corrupt __meta__ entry (a {raw.dtype} array of shape {list(raw.shape)}, "
+            "expected one JSON string)"
+        )
     try:
-        meta = json.loads(str(files.pop("__meta__")))
+        meta = json.loads(str(raw))
     except json.JSONDecodeError as exc:
         raise ModelError(f"{path}: corrupt __meta__ entry: {exc}") from None
     if not isinstance(meta, dict) or meta.get("format") != "bushenv-model":
@@ -225,10 +285,14 @@ def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel
             f"this bushenv reads version {FORMAT_VERSION}"
         )
     name = meta.get("model")
-    if name not in MODEL_REGISTRY:
+    _ensure_registry()
+    if not isinstance(name, str) or name not in MODEL_REGISTRY:
         raise ModelError(f"{path}: unknown model {name!r}; known: {sorted(MODEL_REGISTRY)}")
     cls = MODEL_REGISTRY[name]
-    file_dt = float(meta.get("dt", float("nan")))
+    file_dt = meta.get("dt")
+    if isinstance(file_dt, bool) or not isinstance(file_dt, int | float):
+        raise ModelError(f"{path}: invalid dt {file_dt!r} in the header, expected seconds")
+    file_dt = float(file_dt)
     if not (np.isfinite(file_dt) and file_dt > 0):
         raise ModelError(f"{path}: invalid dt {meta.get('dt')!r}")
     if dt is not None and abs(file_dt - dt) > DT_TOLERANCE * dt:
@@ -236,22 +300,31 @@ def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel
             f"{path}: model sampled at {1 / file_dt:.6g} Hz (dt={file_dt:.6g} s), "
             f"expected {1 / dt:.6g} Hz (dt={dt:.6g} s)"
         )
+    shapes = meta.get("shapes", {})
+    extra = meta.get("extra", {})
+    if not isinstance(shapes, dict) or not isinstance(extra, dict):
+        raise ModelError(f"{path}: corrupt __meta__ entry ('shapes' and 'extra' must be objects)")
     for key in cls.param_names:
         if key not in files:
             raise ModelError(f"{path}: {name} model file lacks parameter {key!r}")
-        want = meta.get("shapes", {}).get(key)
-        if want is not None and list(files[key].shape) != list(want):
+        a = files[key]
+        if a.dtype.kind not in "biuf":
             raise ModelError(
-                f"{path}: parameter {key!r} has shape {list(files[key].shape)}, "
+                f"{path}: parameter {key!r} holds {a.dtype} data, expected real numbers"
+            )
+        want = shapes.get(key)
+        if want is not None and list(a.shape) != list(want):
+            raise ModelError(
+                f"{path}: parameter {key!r} has shape {list(a.shape)}, "
                 f"the file's header says {want}"
             )
-        if not np.all(np.isfinite(files[key])):
+        if not np.all(np.isfinite(a)):
             raise ModelError(f"{path}: parameter {key!r} holds NaN or inf")
     try:
-        return cls.from_params(files, file_dt, meta.get("extra", {}))
+        return cls.from_params(files, file_dt, extra)
     except ModelError as exc:
         raise ModelError(f"{path}: {exc}") from None
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, KeyError) as exc:
         raise ModelError(f"{path}: parameters do not fit a {name} model: {exc}") from None
 
 
