@@ -1,0 +1,410 @@
+"""BushRig-v0: the one-axis bushing test rig (seed 001 §4, Fig. 11) as a Gymnasium env."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import pymunk
+from gymnasium import spaces
+
+from bushenv.rigs.common import (
+    Canvas,
+    ForceDeviationReward,
+    RigError,
+    Trace,
+    call_reset,
+    check_hook,
+    force_observation,
+    model_label,
+    per_axis,
+    plot_traces,
+    positive,
+    positive_int,
+    resolve_model,
+    resolve_reference,
+    spec_kwargs,
+    unit_action,
+)
+
+ENV_ID = "BushRig-v0"
+AXES = ("axial", "radial")
+ACTUATOR_MASS_KG = 10.0  # piston and fixture; drawn only, the motion is prescribed
+
+
+def check_excitation(profile: Any, max_displacement_m: float, max_step_m: float) -> np.ndarray:
+    """A replayable displacement profile: finite (T,) or (T, N), within the stroke, and each
+    sample (the rig starting at rest at 0) at most ``max_step_m`` from the previous one."""
+    x = np.array(profile, dtype=np.float64)
+    if x.ndim not in (1, 2) or x.shape[0] < 1:
+        raise RigError(f"excitation must have shape (T,) or (T, N) with T >= 1, got {x.shape}")
+    bad = ~np.isfinite(x)
+    if bad.any():
+        i = np.argwhere(bad)[0]
+        raise RigError(f"excitation sample {int(i[0])} is {x[tuple(i)]!r}, not finite")
+    tol = 1 + 1e-9
+    over = np.abs(x) > max_displacement_m * tol
+    if over.any():
+        i = tuple(np.argwhere(over)[0])
+        raise RigError(
+            f"excitation sample {i[0]}: |x| = {abs(x[i]):.6g} m exceeds the stroke limit "
+            f"{max_displacement_m:.6g} m"
+        )
+    steps = np.abs(np.diff(x, axis=0, prepend=np.zeros((1,) + x.shape[1:])))
+    fast = steps > max_step_m * tol
+    if fast.any():
+        i = tuple(np.argwhere(fast)[0])
+        raise RigError(
+            f"excitation sample {i[0]}: a step of {steps[i]:.6g} m exceeds the velocity limit "
+            f"({max_step_m:.6g} m per step; the rig starts at rest at x = 0)"
+        )
+    return x
+
+
+class RigParameters:
+    """The spec's kwargs checked and converted; shared by ``BushRigEnv`` and the vector env."""
+
+    def __init__(self, kwargs: dict[str, Any]) -> None:
+        self.axis = kwargs["axis"]
+        if self.axis not in AXES:
+            raise RigError(f"{ENV_ID}: axis must be one of {AXES}, got {self.axis!r}")
+        self.dt = positive("dt_s", kwargs["dt_s"])
+        self.substeps = positive_int("physics_substeps", kwargs["physics_substeps"])
+        self.episode_steps = positive_int("episode_steps", kwargs["episode_steps"])
+        self.history = positive_int("history", kwargs["history"])
+        self.max_x = positive("max_displacement_m", kwargs["max_displacement_m"])
+        self.max_v = positive("max_velocity_m_per_s", kwargs["max_velocity_m_per_s"])
+        self.force_limit = positive("force_limit_n", kwargs["force_limit_n"])
+        self.force_scale = per_axis("force_scale_n", kwargs["force_scale_n"], self.axis)
+        self.reward_cap = positive("reward_cap", kwargs["reward_cap"])
+        self.max_step = self.max_v * self.dt  # largest displacement change per step, m
+        self.model = resolve_model(kwargs["model"], self.axis, self.dt)
+        self.reference = resolve_reference(kwargs["reference"], self.axis, self.dt)
+        self.model_name = model_label(self.model, kwargs["model"])
+        self.reference_name = model_label(self.reference, kwargs["reference"])
+
+    def spaces(self) -> tuple[spaces.Box, spaces.Box]:
+        action = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
+        observation = spaces.Box(-1.0, 1.0, shape=(3 * self.history,), dtype=np.float32)
+        return action, observation
+
+
+class BushRigEnv(gym.Env):
+    """
+    ## Description
+
+    The bushing test rig of seed 001 §4 (Fig. 11, built there in ADAMS): an actuator body
+    slides on a groove (translational) joint to ground and drives one end of the bushing; the
+    other end sits on the ground through a load cell. The model under test (``model``) and the
+    reference rubber bushing (``reference``, the "real" specimen) are driven by the same
+    motion side by side, and the agent looks for motions that make them disagree or make the
+    model diverge. One step is one sample of the bushing model (``dt_s``, 204.8 Hz).
+
+    The actuator is in displacement control: its motion is *prescribed* (as the papers imposed
+    the random input on the translational joint), its velocity set each step so it reaches the
+    commanded x at the end of the step. So the bushing deflection is the commanded displacement
+    itself and no bushing force feeds back into the motion: this rig needs no coupling
+    stabilisation (the trap of DESIGN-NOTES cannot arise), and the bushing force only goes to
+    the load cell. The models are fed the commanded x (not pymunk's read-back) and the
+    velocity (x_k - x_{k-1}) / dt of the actuator over the step.
+
+    ## Action Space
+
+    ``Box(-1, 1, (1,), float32)``: the change of the actuator's commanded displacement this
+    step, as a fraction of the largest change the machine allows (seed 002 Table 1)::
+
+        x_k = clip(x_{k-1} + a * v_max * dt, -x_max, x_max)     v_max = 1.2566 m/s, x_max = 12.5 mm
+
+    so |a| = 1 is the velocity limit (6.14 mm per step at 204.8 Hz). NaN counts as 0, values
+    beyond +-1 (also +-inf) as +-1. Nothing raises.
+
+    ## Observation Space
+
+    ``Box(-1, 1, (3 H,), float32)``, H = ``history`` (4 by default), newest sample first:
+
+    | index          | observation                                   | min | max |
+    |----------------|-----------------------------------------------|-----|-----|
+    | 0 .. H-1       | displacement x_{k-i} / x_max                  | -1  | 1   |
+    | H .. 2H-1      | model force F_model,k-i / force_limit_n       | -1  | 1   |
+    | 2H .. 3H-1     | reference force F_ref,k-i / force_limit_n     | -1  | 1   |
+
+    Forces are clipped to [-1, 1] (beyond is a divergence or a machine-limit end anyway); a
+    NaN force shows as 0.
+
+    ## Rewards
+
+    ``ForceDeviationReward``: r = min(|F_model - F_ref| / force_scale_n, reward_cap), and
+    reward_cap when that is not finite. ``force_scale_n`` is the Table-1 stiffness times the
+    stroke for the axis (4.7 kN axial, 19 kN radial). Replace it with ``reward_fn(info)`` (e.g.
+    an STL robustness from ``bushenv.search``).
+
+    ## Starting State
+
+    At rest: x = 0, both models reset (zero deflection, zero force), observation all zeros.
+    Nothing is random, so every seed gives the same episode for the same actions.
+
+    ## Episode End
+
+    Termination (the model's verdict, ``info["diverged"]``): the model's force is not finite or
+    the model raised an error; |F_model| > ``force_limit_n`` (25 kN, the machine's dynamic
+    force) while the reference stays within it; or ``divergence_monitor(info)`` is truthy.
+    Truncation: ``episode_steps`` steps (2048 = 10 s) or the end of a replayed excitation; or
+    the reference itself needs more than the machine's 25 kN (``info["machine_limit"]``: the
+    motion cannot be run on the real rig, so it judges nothing).
+
+    ## Info
+
+    ``time_s``, ``step``, ``displacement_m``, ``velocity_m_per_s``, ``force_model_n``,
+    ``force_reference_n``, ``error_n`` (model minus reference), ``model_force_finite``,
+    ``model_over_force_limit``, ``reference_over_force_limit``, ``monitor_verdict``,
+    ``diverged``, ``machine_limit``, ``divergence_reason`` ("" if none). Plain Python values.
+
+    ## Arguments
+
+    Every key of ``envs/BushRig-v0.toml`` ``[kwargs]`` (``model``, ``axis``, ``reference``,
+    ``dt_s``, ``physics_substeps``, ``episode_steps``, ``history``, ``max_displacement_m``,
+    ``max_velocity_m_per_s``, ``force_limit_n``, ``reward_cap``, ``force_scale_n``) plus
+    ``reward_fn``, ``divergence_monitor`` (see ``bushenv.rigs.common``) and ``render_mode``::
+
+        env = gym.make("BushRig-v0", model="nn", axis="radial")
+        env = gym.make("BushRig-v0", model="fits/axial_nn.npz")
+        obs, info = env.reset(options={"excitation": x})  # replay x exactly; actions ignored
+
+    ## Vectorized environment
+
+    ``gym.make_vec("BushRig-v0", num_envs=N, vectorization_mode="vector_entry_point")`` gives
+    ``BushRigVectorEnv``: N rigs as arrays through the models' batched step, the same kernels
+    and arithmetic, bit for bit equal to N single envs (next-step autoreset).
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
+
+    def __init__(
+        self,
+        *,
+        render_mode: str | None = None,
+        reward_fn=None,
+        divergence_monitor=None,
+        **spec_overrides: Any,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise RigError(f"render_mode must be one of {self.metadata['render_modes']}")
+        p = RigParameters(spec_kwargs(ENV_ID, spec_overrides))
+        self.params = p
+        self.render_mode = render_mode
+        self.model, self.reference = p.model, p.reference
+        self.action_space, self.observation_space = p.spaces()
+        self.reward_fn = check_hook("reward_fn", reward_fn) or ForceDeviationReward(
+            p.force_scale, p.reward_cap
+        )
+        self.divergence_monitor = check_hook("divergence_monitor", divergence_monitor)
+        self._dt, self._h = p.dt, p.dt / p.substeps
+        self._obs = np.zeros((3, p.history), dtype=np.float32)
+        self._x = 0.0
+        self._t = 0
+        self._replay: np.ndarray | None = None
+        self._end = p.episode_steps
+        self._build_space()
+        self._canvas: Canvas | None = None
+        self._trace = Trace(3) if render_mode else None
+        self._last = (0.0, 0.0, 0.0)
+
+    # ----- pymunk ------------------------------------------------------------------------
+    def _build_space(self) -> None:
+        self.space = pymunk.Space()
+        self.ground = self.space.static_body
+        # The actuator piston: a dynamic body in displacement control. Its velocity is set every
+        # step so it arrives at the commanded x at the end of the step; the servo supplies the
+        # force that takes, so the bushing's reaction never feeds back into the motion.
+        self.actuator = pymunk.Body(ACTUATOR_MASS_KG, math.inf)
+        self.actuator.position = (0.0, 0.0)
+        self.space.add(self.actuator)
+        # the groove: the translational joint of Fig. 11, the actuator slides along x
+        self.groove = pymunk.GrooveJoint(
+            self.ground, self.actuator, (-0.05, 0.0), (0.05, 0.0), (0.0, 0.0)
+        )
+        self.space.add(self.groove)
+
+    # ----- gymnasium -----------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        p = self.params
+        self._replay = None
+        self._end = p.episode_steps
+        if options and options.get("excitation") is not None:
+            x = check_excitation(options["excitation"], p.max_x, p.max_step)
+            if x.ndim != 1:
+                raise RigError(f"excitation for one rig must be (T,), got {x.shape}")
+            self._replay = x
+            self._end = x.shape[0]
+        self.model.reset(1)
+        self.reference.reset(1)
+        call_reset(self.reward_fn)
+        call_reset(self.divergence_monitor)
+        self._obs[:] = 0.0
+        self._x = 0.0
+        self._t = 0
+        self.actuator.position = (0.0, 0.0)
+        self.actuator.velocity = (0.0, 0.0)
+        self._last = (0.0, 0.0, 0.0)
+        if self._trace is not None:
+            self._trace.clear()
+        info = self._info(0.0, 0.0, 0.0, 0.0, True, False, False, False, "")
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.ravel().copy(), info
+
+    def step(self, action):
+        p = self.params
+        x0 = self._x
+        if self._replay is None:
+            x = x0 + unit_action(action) * p.max_step
+            if x > p.max_x:
+                x = p.max_x
+            elif x < -p.max_x:
+                x = -p.max_x
+        else:
+            x = float(self._replay[min(self._t, self._end - 1)])
+        v = (x - x0) / self._dt
+        self._x = x
+        self._t += 1
+
+        reason = ""
+        try:
+            f_m = self.model.step(x, v)
+        except ValueError as exc:  # a model refusing to go on (e.g. Bouc-Wen blow-up)
+            f_m = math.nan
+            reason = f"model raised {type(exc).__name__}: {exc}"
+        f_r = self.reference.step(x, v)
+
+        self.actuator.velocity = (v, 0.0)
+        for _ in range(p.substeps):
+            self.space.step(self._h)
+
+        obs = self._obs
+        obs[:, 1:] = obs[:, :-1]
+        obs[0, 0] = x / p.max_x
+        obs[1, 0] = force_observation(f_m, p.force_limit)
+        obs[2, 0] = force_observation(f_r, p.force_limit)
+
+        finite = math.isfinite(f_m)
+        ref_over = not (abs(f_r) <= p.force_limit)
+        model_over = finite and abs(f_m) > p.force_limit and not ref_over
+        terminated = truncated = False
+        if not finite:
+            terminated = True
+            reason = reason or "model force is not finite"
+        elif ref_over:
+            truncated = True
+        elif model_over:
+            terminated = True
+            reason = f"|F_model| = {abs(f_m):.6g} N exceeds {p.force_limit:.6g} N"
+        info = self._info(x, v, f_m, f_r, finite, model_over, ref_over, False, reason)
+        if self.divergence_monitor is not None and not terminated:
+            verdict = self.divergence_monitor(info)
+            if verdict:
+                terminated = True
+                info["monitor_verdict"] = True
+                info["divergence_reason"] = (
+                    verdict if isinstance(verdict, str) else "divergence monitor"
+                )
+        info["diverged"] = terminated
+        if self._t >= self._end:
+            truncated = True
+        reward = float(self.reward_fn(info))
+        self._last = (x, f_m, f_r)
+        if self._trace is not None:
+            self._trace.push(x, f_m, f_r)
+        if self.render_mode == "human":
+            self.render()
+        return obs.ravel().copy(), reward, terminated, truncated, info
+
+    def _info(self, x, v, f_m, f_r, finite, model_over, ref_over, monitor, reason):
+        return {
+            "time_s": self._t * self._dt,
+            "step": self._t,
+            "displacement_m": x,
+            "velocity_m_per_s": v,
+            "force_model_n": f_m,
+            "force_reference_n": f_r,
+            "error_n": f_m - f_r,
+            "model_force_finite": finite,
+            "model_over_force_limit": model_over,
+            "reference_over_force_limit": ref_over,
+            "monitor_verdict": monitor,
+            "diverged": False,  # set by step once the monitor has spoken
+            "machine_limit": ref_over,
+            "divergence_reason": reason,
+        }
+
+    # ----- drawing ---------------------------------------------------------------------------
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn(
+                "render() without a render_mode; pass render_mode='rgb_array' to gym.make"
+            )
+            return None
+        if self._canvas is None:
+            self._canvas = Canvas(600, 400, self.render_mode, self.metadata["render_fps"], ENV_ID)
+        c, p = self._canvas, self.params
+        x, f_m, f_r = self._last
+        self.actuator.position = (x, 0.0)
+        c.clear()
+        c.text(
+            f"{ENV_ID}  axis={p.axis}  model={p.model_name}  reference={p.reference_name}",
+            (10, 8),
+        )
+        c.text(f"t = {self._t * self._dt:6.3f} s   x = {x * 1e3:+7.3f} mm", (10, 28), small=True)
+        # scale: the stroke +-x_max spans +-60 px
+        px_per_m = 60.0 / p.max_x
+        y = 130.0
+        # ground wall and load cell (left)
+        c.rect(20, y - 60, 16, 120, (120, 120, 120))
+        for k in range(8):
+            c.line((20, y - 60 + 15 * k), (8, y - 48 + 15 * k), (120, 120, 120), 2)
+        c.rect(36, y - 22, 40, 44, (70, 110, 160))
+        c.text("load cell", (30, y + 26), small=True)
+        # bushing: outer sleeve on the load cell, rubber, inner sleeve moves with x
+        xc = 150.0
+        bushing_x = xc + float(self.actuator.position.x) * px_per_m
+        c.line((76, y), (xc - 36, y), (60, 60, 60), 6)
+        c.rect(xc - 36, y - 36, 72, 72, (40, 40, 40), 4)
+        c.rect(xc - 32, y - 32, 64, 64, (60, 60, 60))
+        c.rect(bushing_x - 14, y - 14, 28, 28, (200, 200, 200))
+        # actuator rod, piston and groove (right)
+        c.line((bushing_x, y), (bushing_x + 150, y), (90, 90, 90), 8)
+        c.rect(bushing_x + 150, y - 26, 70, 52, (190, 140, 60))
+        c.line((xc + 150 - 60, y + 40), (xc + 150 + 140, y + 40), (120, 120, 120), 3)
+        c.text("actuator on groove", (xc + 150, y + 46), small=True)
+        # stroke marks
+        for s in (-1, 1):
+            c.line((xc + s * 60, y - 48), (xc + s * 60, y - 40), (200, 0, 0), 2)
+        # force arrows on the load cell (force the bushing puts on the ground)
+        scale = 100.0 / p.force_limit
+        for f, col, dy in ((f_m, (200, 40, 40), -6), (f_r, (40, 70, 200), 6)):
+            if math.isfinite(f):
+                fx = max(-100.0, min(100.0, f * scale))
+                c.arrow((56, y + dy), (56 + fx, y + dy), col, 3)
+        # bars
+        c.force_bar(330, 70, 250, 16, f_m, p.force_limit, (200, 40, 40), "F model")
+        c.force_bar(330, 110, 250, 16, f_r, p.force_limit, (40, 70, 200), "F reference")
+        c.force_bar(330, 150, 250, 16, x, p.max_x, (60, 150, 60), "displacement")
+        c.text(f"{f_m / 1e3:+8.3f} kN", (500, 52), (200, 40, 40), small=True)
+        c.text(f"{f_r / 1e3:+8.3f} kN", (500, 92), (40, 70, 200), small=True)
+        if self._trace is not None:
+            plot_traces(
+                c,
+                (20, 230, 560, 150),
+                self._trace,
+                (p.max_x, p.force_limit, p.force_limit),
+                ((60, 150, 60), (200, 40, 40), (40, 70, 200)),
+                ("x / x_max", "F model / 25 kN", "F reference / 25 kN"),
+            )
+        return c.frame()
+
+    def close(self) -> None:
+        if self._canvas is not None:
+            self._canvas.close()
+            self._canvas = None

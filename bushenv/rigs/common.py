@@ -1,0 +1,455 @@
+"""What every rig shares: spec files, model resolution, action clean-up, reward and divergence
+verdicts, the fixed-rate split coupling of a bushing into pymunk, and drawing.
+
+Spec files
+    ``envs/<id>.toml`` (shipped in the wheel as the resource package ``bushenv.envs``; in a
+    source checkout read from ``envs/`` beside the package). ``[kwargs]`` holds every default an
+    environment takes; the constructors refuse keys the spec does not name.
+
+Hooks (the same contract for every rig, single and vectorised)
+    ``reward_fn(info) -> float`` and ``divergence_monitor(info) -> bool | str``: called once per
+    step with the step's ``info`` dict (plain floats in a single env; (N,) arrays in a vector
+    env, where they return (N,) arrays). A monitor's truthy answer ends the episode as a
+    divergence; a string answer is used as the reason. If the callable has a ``reset()``
+    method it is called at every ``reset``; a vector env calls ``reset_columns(mask)`` when it
+    auto-resets some of its sub-environments (and ``reset()`` if that is absent).
+
+Fixed-rate coupling (seed 001 §2: the network ran at 204.8 Hz beside ADAMS)
+    The bushing model steps at its sample time ``dt``; pymunk sub-steps in between. Holding the
+    sampled force over ``dt`` is an explicit scheme, unstable once omega * dt nears 1 (see
+    ../shared/DESIGN-NOTES.md). ``SplitBushing`` therefore applies a linear spring-damper
+    (``k_in``, ``c_in``) inside every pymunk sub-step and holds only the remainder::
+
+        F(t) = k_in x(t) + c_in v(t) + [F_model(x_k, v_k) - k_in x_k - c_in v_k],  t_k <= t < t_k+1
+
+    At the sample instants F equals the model's force exactly; for a linear model with k_in,
+    c_in the held remainder is exactly zero and the coupling is the continuous system.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import os
+import tomllib
+from collections.abc import Callable
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bushenv.models import MODEL_REGISTRY, BushingModel, get_model, model_names
+
+SPEC_PACKAGE = "bushenv.envs"
+SOURCE_SPEC_DIR = Path(__file__).resolve().parents[2] / "envs"
+
+
+class RigError(ValueError):
+    """A rig argument, spec file or excitation is wrong; the message names it and the value."""
+
+
+# ----- spec files --------------------------------------------------------------------------
+def spec_directory() -> Any:
+    """The folder holding the env specs: the installed ``bushenv.envs`` resource package, or
+    ``envs/`` of a source checkout. Returns a ``Traversable`` (``Path`` in a checkout)."""
+    try:
+        root = resources.files(SPEC_PACKAGE)
+        if any(p.name.endswith(".toml") for p in root.iterdir()):
+            return root
+    except (ModuleNotFoundError, FileNotFoundError, NotADirectoryError, TypeError):
+        pass
+    return SOURCE_SPEC_DIR
+
+
+def spec_files() -> list[Any]:
+    """Every ``*.toml`` spec, sorted by name."""
+    root = spec_directory()
+    return sorted((p for p in root.iterdir() if p.name.endswith(".toml")), key=lambda p: p.name)
+
+
+def read_spec(source: Any) -> dict[str, Any]:
+    """Parse one spec file (a path or ``Traversable``) and check its required keys."""
+    name = getattr(source, "name", str(source))
+    try:
+        spec = tomllib.loads(source.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise RigError(f"{name}: not valid TOML: {exc}") from None
+    for key in ("id", "entry_point", "kwargs"):
+        if key not in spec:
+            raise RigError(f"{name}: spec lacks the required key {key!r}")
+    if name != f"{spec['id']}.toml":
+        raise RigError(f"{name}: file name does not match its id {spec['id']!r}")
+    return spec
+
+
+def load_spec(env_id: str) -> dict[str, Any]:
+    """The parsed spec of ``env_id`` (e.g. ``"BushRig-v0"``)."""
+    for f in spec_files():
+        if f.name == f"{env_id}.toml":
+            return read_spec(f)
+    raise RigError(f"no spec file {env_id}.toml in {spec_directory()}")
+
+
+def spec_kwargs(env_id: str, overrides: dict[str, Any]) -> dict[str, Any]:
+    """The spec's ``[kwargs]`` updated by ``overrides``; an unknown key is refused."""
+    kwargs = dict(load_spec(env_id)["kwargs"])
+    unknown = sorted(set(overrides) - set(kwargs))
+    if unknown:
+        raise RigError(f"{env_id}: unknown argument(s) {unknown}; the spec knows {sorted(kwargs)}")
+    kwargs.update(overrides)
+    return kwargs
+
+
+def positive(name: str, value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise RigError(f"{name} must be a number, got {value!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise RigError(f"{name} must be a positive finite number, got {value!r}")
+    return v
+
+
+def positive_int(name: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+        raise RigError(f"{name} must be a positive integer, got {value!r}")
+    return int(value)
+
+
+def per_axis(name: str, value: Any, axis: str) -> float:
+    """A number, or a table ``{axial = ..., radial = ...}`` indexed by ``axis``."""
+    if isinstance(value, dict):
+        if axis not in value:
+            raise RigError(f"{name} has no entry for axis {axis!r}: {value!r}")
+        value = value[axis]
+    return positive(f"{name}[{axis}]", value)
+
+
+# ----- models --------------------------------------------------------------------------------
+def resolve_model(spec: Any, axis: str, dt: float) -> BushingModel:
+    """The model under test: a registered name, a ``.npz`` path or a model object (copied, so
+    two environments never share one model's state)."""
+    if isinstance(spec, BushingModel):
+        model = get_model(spec, axis=axis, dt=dt).copy()
+    else:
+        model = get_model(spec, axis=axis, dt=dt)
+    model.reset(1)
+    return model
+
+
+def resolve_reference(spec: Any, axis: str, dt: float) -> BushingModel:
+    """The reference bushing. ``"rubber"`` is the calibrated specimen without the load cell's
+    measurement effects (no delay, fixture inertia or noise): the bushing alone. If the rubber
+    reference is not available in this install, the linear Table-1 bushing stands in."""
+    if isinstance(spec, str) and spec == "rubber":
+        model_names()  # fills the registry
+        cls = MODEL_REGISTRY.get("rubber")
+        if cls is None:
+            model = MODEL_REGISTRY["linear"].preset(axis=axis, dt=dt)
+        elif "measurement" in inspect.signature(cls.preset).parameters:
+            model = cls.preset(axis=axis, dt=dt, measurement=False)
+        else:
+            model = cls.preset(axis=axis, dt=dt)
+        model.reset(1)
+        return model
+    return resolve_model(spec, axis, dt)
+
+
+def model_label(model: BushingModel, spec: Any) -> str:
+    if isinstance(spec, str | os.PathLike) and not isinstance(spec, BushingModel):
+        text = os.fspath(spec)
+        return text if text in MODEL_REGISTRY else Path(text).name
+    return model.name
+
+
+def reset_columns(model: BushingModel, mask: np.ndarray) -> None:
+    """Return the histories ``mask`` of a batched model to rest, leaving the others."""
+    n = int(mask.sum())
+    if n:
+        model.state[:, mask] = model.initial_state(n)
+
+
+# ----- actions ------------------------------------------------------------------------------
+def unit_action(action: Any) -> float:
+    """A normalised scalar action as a float in [-1, 1]: NaN -> 0, +-inf and beyond -> +-1."""
+    try:
+        a = float(action[0])
+    except (TypeError, IndexError):
+        a = float(action)
+    if a != a:
+        return 0.0
+    if a > 1.0:
+        return 1.0
+    if a < -1.0:
+        return -1.0
+    return a
+
+
+def unit_actions(actions: Any, n: int) -> np.ndarray:
+    """(N,) or (N, 1) normalised actions as float64 (N,), cleaned like ``unit_action``."""
+    a = np.array(actions, dtype=np.float64).reshape(n)
+    a[np.isnan(a)] = 0.0
+    np.clip(a, -1.0, 1.0, out=a)
+    return a
+
+
+# ----- reward ---------------------------------------------------------------------------------
+class ForceDeviationReward:
+    """The adversarial objective: how far the model's force is from the reference's.
+
+        r = min(|F_model - F_reference| / force_scale_n, cap);   r = cap if not finite
+
+    ``force_scale_n`` is the reference-sized force of the rig (spec ``force_scale_n``), so r is
+    a dimensionless deviation, 0 when the model is perfect. Works on a single env's info
+    (floats) and a vector env's (arrays). Reads ``info["error_n"]``.
+    """
+
+    def __init__(self, force_scale_n: float, cap: float) -> None:
+        self.force_scale_n = positive("force_scale_n", force_scale_n)
+        self.cap = positive("reward_cap", cap)
+
+    def __call__(self, info: dict[str, Any]) -> Any:
+        e = info["error_n"]
+        if isinstance(e, np.ndarray):
+            r = np.abs(e) / self.force_scale_n
+            np.minimum(r, self.cap, out=r)
+            r[~np.isfinite(r)] = self.cap
+            return r
+        r = abs(e) / self.force_scale_n
+        if not (r <= self.cap):  # also catches NaN
+            return self.cap
+        return r
+
+
+def call_reset(hook: Any) -> None:
+    reset = getattr(hook, "reset", None)
+    if callable(reset):
+        reset()
+
+
+def call_reset_columns(hook: Any, mask: np.ndarray) -> None:
+    fn = getattr(hook, "reset_columns", None)
+    if callable(fn):
+        fn(mask)
+    else:
+        call_reset(hook)
+
+
+def check_hook(name: str, hook: Callable | None) -> Callable | None:
+    if hook is not None and not callable(hook):
+        raise RigError(f"{name} must be callable(info) or None, got {hook!r}")
+    return hook
+
+
+def force_observation(f: float, limit: float) -> float:
+    """F / limit clipped to [-1, 1]; NaN -> 0 (the episode ends on it anyway)."""
+    r = f / limit
+    if r != r:
+        return 0.0
+    if r > 1.0:
+        return 1.0
+    if r < -1.0:
+        return -1.0
+    return r
+
+
+def force_observations(f: np.ndarray, limit: float) -> np.ndarray:
+    r = f / limit
+    r[np.isnan(r)] = 0.0
+    np.clip(r, -1.0, 1.0, out=r)
+    return r
+
+
+# ----- split coupling --------------------------------------------------------------------------
+# A pymunk DampedSpring acts along the line between its anchors. Anchoring one end LONG_ARM_M
+# away along the bushing direction makes it a one-direction spring: a perpendicular offset d
+# changes its length by d^2 / (2 LONG_ARM_M) (1e-9 m for d = 10 mm), and its damping (which
+# chipmunk applies as an exact exponential decay of the relative velocity, hence stable for any
+# c / m) acts on the velocity along that direction only.
+LONG_ARM_M = 50.0
+
+
+class SplitBushing:
+    """One axis of a bushing between pymunk bodies ``a`` (holds the bushing frame) and ``b``.
+
+    ``direction`` is a unit vector fixed in ``a``'s frame (``a`` must not rotate); ``anchor_a``,
+    ``anchor_b`` are the coincident bushing centres in each body's local frame at rest. The
+    linear part k_in x + c_in v is a pymunk DampedSpring (inside every sub-step); ``hold(F)``
+    sets the held remainder applied as an external force for the coming model step.
+    """
+
+    def __init__(self, space, a, b, anchor_a, anchor_b, direction, k_in, c_in) -> None:
+        import pymunk
+
+        self.a, self.b = a, b
+        self.k_in, self.c_in = float(k_in), float(c_in)
+        self.direction = (float(direction[0]), float(direction[1]))
+        self.anchor_a = (float(anchor_a[0]), float(anchor_a[1]))
+        self.anchor_b = (float(anchor_b[0]), float(anchor_b[1]))
+        far = (
+            self.anchor_a[0] - LONG_ARM_M * self.direction[0],
+            self.anchor_a[1] - LONG_ARM_M * self.direction[1],
+        )
+        self.spring = pymunk.DampedSpring(a, b, far, self.anchor_b, LONG_ARM_M, k_in, c_in)
+        space.add(self.spring)
+        self.held_n = 0.0
+
+    def deflection(self) -> tuple[float, float]:
+        """(x, v): b's bushing centre relative to a's, along ``direction`` (m, m/s)."""
+        pa = self.a.local_to_world(self.anchor_a)
+        pb = self.b.local_to_world(self.anchor_b)
+        va = self.a.velocity_at_local_point(self.anchor_a)
+        vb = self.b.velocity_at_local_point(self.anchor_b)
+        n0, n1 = self.direction
+        return (pb.x - pa.x) * n0 + (pb.y - pa.y) * n1, (vb.x - va.x) * n0 + (vb.y - va.y) * n1
+
+    def hold(self, force_n: float, x: float, v: float) -> float:
+        """Hold the remainder of the sampled model force ``force_n`` at deflection (x, v)."""
+        self.held_n = force_n - (self.k_in * x + self.c_in * v)
+        return self.held_n
+
+    def apply_held(self) -> None:
+        """Apply the held remainder for one sub-step (pymunk clears forces after each step)."""
+        f = self.held_n
+        if f != 0.0:
+            n0, n1 = self.direction
+            fx, fy = f * n0, f * n1
+            # the bushing pushes b back (restoring force -F on b) and a forward
+            self.b.apply_force_at_local_point((-fx, -fy), self.anchor_b)
+            self.a.apply_force_at_local_point((fx, fy), self.anchor_a)
+
+
+# ----- drawing -------------------------------------------------------------------------------
+class Canvas:
+    """A pygame surface for ``rgb_array`` frames, or a window for ``human``."""
+
+    def __init__(self, width: int, height: int, render_mode: str, fps: int, title: str) -> None:
+        import pygame
+
+        self.pygame = pygame
+        self.width, self.height = width, height
+        self.render_mode = render_mode
+        self.fps = fps
+        pygame.font.init()
+        self.font = pygame.font.Font(None, 20)
+        self.small = pygame.font.Font(None, 16)
+        if render_mode == "human":
+            pygame.display.init()
+            pygame.display.set_caption(title)
+            self.window = pygame.display.set_mode((width, height))
+            self.clock = pygame.time.Clock()
+        else:
+            self.window = None
+            self.clock = None
+        self.surface = pygame.Surface((width, height))
+
+    def clear(self) -> None:
+        self.surface.fill((250, 250, 247))
+
+    def line(self, p, q, color, width=2) -> None:
+        self.pygame.draw.line(self.surface, color, _ipt(p), _ipt(q), width)
+
+    def lines(self, points, color, width=1) -> None:
+        if len(points) > 1:
+            self.pygame.draw.lines(self.surface, color, False, [_ipt(p) for p in points], width)
+
+    def rect(self, x, y, w, h, color, width=0) -> None:
+        self.pygame.draw.rect(self.surface, color, (int(x), int(y), int(w), int(h)), width)
+
+    def circle(self, c, r, color, width=0) -> None:
+        self.pygame.draw.circle(self.surface, color, _ipt(c), int(r), width)
+
+    def polygon(self, points, color, width=0) -> None:
+        self.pygame.draw.polygon(self.surface, color, [_ipt(p) for p in points], width)
+
+    def text(self, s, p, color=(30, 30, 30), small=False) -> None:
+        font = self.small if small else self.font
+        self.surface.blit(font.render(s, True, color), _ipt(p))
+
+    def arrow(self, p, q, color, width=3) -> None:
+        """An arrow from p to q (pixels); nothing if shorter than 2 px."""
+        dx, dy = q[0] - p[0], q[1] - p[1]
+        n = math.hypot(dx, dy)
+        if n < 2:
+            return
+        ux, uy = dx / n, dy / n
+        head = min(10.0, 0.5 * n)
+        self.line(p, q, color, width)
+        left = (q[0] - head * ux + 0.5 * head * uy, q[1] - head * uy - 0.5 * head * ux)
+        right = (q[0] - head * ux - 0.5 * head * uy, q[1] - head * uy + 0.5 * head * ux)
+        self.polygon([q, left, right], color)
+
+    def force_bar(self, x, y, w, h, value, limit, color, label) -> None:
+        """A horizontal bar centred at x + w/2: value / limit of the half width, clipped."""
+        self.rect(x, y, w, h, (225, 225, 222))
+        mid = x + w / 2
+        frac = value / limit if math.isfinite(value) else (1.0 if value > 0 else -1.0)
+        frac = max(-1.0, min(1.0, frac)) if math.isfinite(frac) else 0.0
+        length = frac * w / 2
+        self.rect(min(mid, mid + length), y, abs(length), h, color)
+        self.line((mid, y - 2), (mid, y + h + 2), (90, 90, 90), 1)
+        self.text(label, (x, y - 16), small=True)
+
+    def frame(self) -> np.ndarray | None:
+        pygame = self.pygame
+        if self.render_mode == "human":
+            pygame.event.pump()
+            self.window.blit(self.surface, (0, 0))
+            pygame.display.flip()
+            self.clock.tick(self.fps)
+            return None
+        return np.transpose(np.array(pygame.surfarray.pixels3d(self.surface)), (1, 0, 2)).copy()
+
+    def close(self) -> None:
+        if self.window is not None:
+            self.pygame.display.quit()
+            self.window = None
+
+
+def _ipt(p) -> tuple[int, int]:
+    return int(round(p[0])), int(round(p[1]))
+
+
+class Trace:
+    """A fixed-size ring of the last ``n`` samples of a few channels (for drawing only), so a
+    long rollout keeps memory flat."""
+
+    def __init__(self, channels: int, n: int = 256) -> None:
+        self.buf = np.zeros((channels, n))
+        self.n = n
+        self.count = 0
+
+    def clear(self) -> None:
+        self.buf[:] = 0.0
+        self.count = 0
+
+    def push(self, *values: float) -> None:
+        i = self.count % self.n
+        for c, v in enumerate(values):
+            self.buf[c, i] = v
+        self.count += 1
+
+    def ordered(self) -> np.ndarray:
+        """(channels, m) oldest first, m = min(count, n)."""
+        m = min(self.count, self.n)
+        if self.count <= self.n:
+            return self.buf[:, :m]
+        i = self.count % self.n
+        return np.concatenate([self.buf[:, i:], self.buf[:, :i]], axis=1)
+
+
+def plot_traces(canvas: Canvas, box, trace: Trace, scales, colors, labels) -> None:
+    """Draw trace channels in a box (x, y, w, h), each scaled to +-scale of the half height."""
+    x0, y0, w, h = box
+    canvas.rect(x0, y0, w, h, (238, 238, 234))
+    canvas.line((x0, y0 + h / 2), (x0 + w, y0 + h / 2), (180, 180, 180), 1)
+    data = trace.ordered()
+    m = data.shape[1]
+    if m >= 2:
+        xs = x0 + np.arange(m) * (w / (trace.n - 1))
+        for c in range(data.shape[0]):
+            ys = y0 + h / 2 - np.clip(np.nan_to_num(data[c] / scales[c]), -1, 1) * (h / 2 - 2)
+            canvas.lines(list(zip(xs, ys, strict=True)), colors[c], 2)
+    for i, (lab, col) in enumerate(zip(labels, colors, strict=True)):
+        canvas.text(lab, (x0 + 6 + 150 * i, y0 + 4), col, small=True)

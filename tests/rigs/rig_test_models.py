@@ -1,0 +1,56 @@
+"""Helper models and names for the rig tests (imported by the test modules)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bushenv.models import PAPER_DT, BushingModel, ModelError, default_model_path
+
+ALL_MODELS = ("linear", "nn", "hybrid", "boucwen", "rubber")
+TRAINED = ("nn", "hybrid", "boucwen")
+
+
+def model_or_skip(name: str, axis: str = "axial") -> str:
+    """``name`` if its default model exists in this checkout, else skip the test saying why."""
+    if name in TRAINED and not default_model_path(name, axis).is_file():
+        pytest.skip(
+            f"no default {name!r} model file {default_model_path(name, axis)} yet "
+            "(scripts/train_default_models.py writes it)"
+        )
+    return name
+
+
+class NanAfter(BushingModel):
+    """Test double: a spring k x that returns NaN from sample ``after`` on."""
+
+    name = "nan_after_test_double"
+    param_names = ()
+
+    def __init__(self, after: int = 5, k: float = 1.0e5, dt: float = PAPER_DT) -> None:
+        self.after, self.k = int(after), float(k)
+        super().__init__(dt)
+
+    @property
+    def n_state(self) -> int:
+        return 1
+
+    def _advance(self, x, v, out):
+        for t in range(x.shape[0]):
+            self.state[0] += 1
+            out[t] = np.where(self.state[0] > self.after, np.nan, self.k * x[t])
+
+    def copy(self):
+        return NanAfter(self.after, self.k, self.dt)
+
+
+class RaisesAfter(NanAfter):
+    name = "raises_after_test_double"
+
+    def _advance(self, x, v, out):
+        super()._advance(x, v, out)
+        if not np.isfinite(out).all():
+            raise ModelError("test double gave up")
+
+    def copy(self):
+        return RaisesAfter(self.after, self.k, self.dt)

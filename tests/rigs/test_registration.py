@@ -1,0 +1,131 @@
+"""Env specs in envs/: registration with Gymnasium, and shipping them inside the wheel."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import tomllib
+import zipfile
+from pathlib import Path
+
+import gymnasium as gym
+import pytest
+from setuptools import find_namespace_packages
+
+import bushenv
+from bushenv.rigs.common import SOURCE_SPEC_DIR, RigError, read_spec, spec_directory, spec_files
+from bushenv.rigs.registration import register_all
+
+ROOT = Path(__file__).resolve().parents[2]
+SPEC_IDS = sorted(p.stem for p in (ROOT / "envs").glob("*.toml"))
+
+
+def test_every_spec_file_is_registered_with_its_kwargs_on_import():
+    assert "BushRig-v0" in SPEC_IDS
+    for env_id in SPEC_IDS:
+        spec = tomllib.loads((ROOT / "envs" / f"{env_id}.toml").read_text())
+        registered = gym.spec(env_id)
+        assert registered.entry_point == spec["entry_point"]
+        assert registered.kwargs == spec["kwargs"]
+        assert registered.vector_entry_point == spec.get("vector_entry_point")
+    assert gym.spec("BushRig-v0").vector_entry_point == "bushenv.rigs.vector:BushRigVectorEnv"
+
+
+def test_register_all_can_run_twice_and_returns_the_ids():
+    assert sorted(register_all()) == SPEC_IDS
+    assert sorted(register_all()) == SPEC_IDS
+
+
+def test_a_checkout_reads_specs_from_the_envs_folder():
+    assert Path(str(spec_directory())) == SOURCE_SPEC_DIR == ROOT / "envs"
+    assert [p.name for p in spec_files()] == [f"{i}.toml" for i in SPEC_IDS]
+
+
+def test_a_spec_whose_name_differs_from_its_id_is_refused(tmp_path):
+    bad = tmp_path / "Other-v0.toml"
+    bad.write_text('id = "BushRig-v0"\nentry_point = "x:y"\n[kwargs]\n')
+    with pytest.raises(RigError, match="does not match"):
+        read_spec(bad)
+    (tmp_path / "Broken-v0.toml").write_text("id = \n")
+    with pytest.raises(RigError, match="not valid TOML"):
+        read_spec(tmp_path / "Broken-v0.toml")
+
+
+def test_pyproject_lists_every_bushenv_subpackage():
+    """setuptools gets an explicit package list (so envs/ can ship as bushenv.envs)."""
+    listed = set(
+        tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    )
+    found = set(find_namespace_packages(where=str(ROOT), include=["bushenv*"]))
+    found = {p for p in found if "__pycache__" not in p}
+    assert found - listed == set(), "add these to [tool.setuptools] packages in pyproject.toml"
+    assert "bushenv.envs" in listed
+
+
+def _install_like_a_wheel(site: Path) -> None:
+    """The installed layout: bushenv/ with the specs as bushenv/envs/ (what the wheel holds)."""
+    shutil.copytree(
+        Path(bushenv.__file__).parent,
+        site / "bushenv",
+        ignore=shutil.ignore_patterns("__pycache__", "*.npz"),
+    )
+    shutil.copytree(ROOT / "envs", site / "bushenv" / "envs")
+
+
+def test_an_installed_package_finds_its_specs_through_importlib_resources(tmp_path):
+    site = tmp_path / "site"
+    _install_like_a_wheel(site)
+    code = (
+        "import gymnasium as gym, bushenv\n"
+        "from bushenv.rigs.common import spec_files\n"
+        "print(spec_files()[0])\n"
+        f"print(sorted(k for k in gym.registry if k in {SPEC_IDS!r}))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=tmp_path,
+        env={"PYTHONPATH": str(site), "PATH": "/usr/bin:/bin"},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert out.returncode == 0, out.stderr
+    where, ids = out.stdout.strip().splitlines()
+    assert Path(where).parent == site / "bushenv" / "envs"
+    assert ids == str(SPEC_IDS)
+
+
+@pytest.mark.slow
+def test_built_wheel_contains_the_env_specs(tmp_path):
+    src = tmp_path / "src"
+    src.mkdir()
+    for name in ("pyproject.toml", "README.md"):
+        if (ROOT / name).exists():
+            shutil.copy(ROOT / name, src / name)
+    shutil.copytree(ROOT / "bushenv", src / "bushenv", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(ROOT / "envs", src / "envs")
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            ".",
+            "--no-deps",
+            "--no-build-isolation",
+            "-w",
+            str(tmp_path / "dist"),
+            "-q",
+        ],
+        cwd=src,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert out.returncode == 0, out.stderr
+    (wheel,) = (tmp_path / "dist").glob("bushenv-*.whl")
+    names = zipfile.ZipFile(wheel).namelist()
+    for env_id in SPEC_IDS:
+        assert f"bushenv/envs/{env_id}.toml" in names
+    assert "bushenv/rigs/registration.py" in names

@@ -1,0 +1,123 @@
+"""BushRigVectorEnv: N rigs as arrays, equal to N single envs bit for bit."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from rig_test_models import ALL_MODELS, NanAfter, model_or_skip
+
+from bushenv.rigs.common import RigError, resolve_reference
+from bushenv.rigs.vector import BushRigVectorEnv
+
+KEYS = ("displacement_m", "velocity_m_per_s", "force_model_n", "force_reference_n", "diverged")
+
+
+def make_vec(n, **kw):
+    return gym.make_vec("BushRig-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
+
+
+def single_rollout(actions, seed, **kw):
+    """One BushRigEnv driven like a next-step autoreset vector column."""
+    env = gym.make("BushRig-v0", **kw)
+    obs, _ = env.reset(seed=seed)
+    rows, done = [], False
+    for a in actions:
+        if done:
+            obs, info = env.reset()
+            rows.append((obs, 0.0, False, False, None))
+            done = False
+            continue
+        obs, r, term, trunc, info = env.step(a)
+        rows.append((obs, r, term, trunc, info))
+        done = term or trunc
+    return rows
+
+
+def test_make_vec_with_vector_entry_point_gives_the_array_env():
+    env = make_vec(3)
+    assert isinstance(env.unwrapped, BushRigVectorEnv)
+    obs, info = env.reset(seed=0)
+    assert obs.shape == (3, 12) and obs.dtype == np.float32
+    assert env.observation_space.contains(obs)
+    obs, r, term, trunc, info = env.step(env.action_space.sample())
+    assert r.shape == term.shape == trunc.shape == (3,)
+    assert info["force_model_n"].shape == (3,) and info["_force_model_n"].all()
+
+
+@pytest.mark.parametrize("axis", ["axial", "radial"])
+@pytest.mark.parametrize("name", ALL_MODELS)
+def test_vector_columns_equal_single_envs_bit_for_bit(name, axis):
+    model_or_skip(name, axis)
+    if name == "rubber":
+        # get_model("rubber") includes the load cell's noise, drawn per batch layout; the
+        # equality holds for the deterministic specimen
+        name = resolve_reference("rubber", axis, 1.0 / 204.8)
+    n, steps = 4, 150
+    rng = np.random.default_rng(11)
+    actions = rng.uniform(-1.3, 1.3, size=(steps, n, 1)).astype(np.float32)
+    actions[3, 0, 0] = np.nan
+    actions[4, 1, 0] = np.inf
+    kw = dict(model=name, axis=axis, episode_steps=60)
+    venv = make_vec(n, **kw)
+    venv.reset(seed=5)
+    vec = [venv.step(a) for a in actions]
+    for j in range(n):
+        single = single_rollout(actions[:, j], 5, **kw)
+        for t, (obs, r, term, trunc, info) in enumerate(single):
+            v_obs, v_r, v_term, v_trunc, v_info = vec[t]
+            assert np.array_equal(obs, v_obs[j]), (j, t)
+            assert r == v_r[j] and term == v_term[j] and trunc == v_trunc[j], (j, t)
+            if info is not None:
+                for k in KEYS:
+                    assert info[k] == v_info[k][j] or (info[k] != info[k]), (k, j, t)
+
+
+def test_vector_autoreset_is_next_step_and_restarts_from_rest():
+    env = make_vec(2, episode_steps=5)
+    env.reset(seed=0)
+    a = np.ones((2, 1), np.float32)
+    for _ in range(4):
+        env.step(a)
+    obs, r, term, trunc, _ = env.step(a)
+    assert trunc.all() and not term.any()
+    obs, r, term, trunc, info = env.step(a)
+    assert (obs == 0).all() and (r == 0).all() and not (term | trunc).any()
+    assert (info["displacement_m"] == 0).all()
+    _, _, _, _, info = env.step(a)
+    assert info["displacement_m"] == pytest.approx(np.full(2, env.unwrapped.params.max_step))
+
+
+def test_vector_replays_one_excitation_per_column():
+    t = np.arange(1, 101) / 204.8
+    x = np.stack([2e-3 * np.sin(2 * np.pi * 5 * t), -3e-3 * np.sin(2 * np.pi * 3 * t)], axis=1)
+    env = make_vec(2)
+    env.reset(seed=0, options={"excitation": x})
+    xs = []
+    for _ in range(100):
+        _, _, term, trunc, info = env.step(np.ones((2, 1), np.float32))
+        xs.append(info["displacement_m"])
+    np.testing.assert_array_equal(np.array(xs), x)
+    assert trunc.all()
+    with pytest.raises(RigError, match="columns"):
+        env.reset(options={"excitation": np.zeros((10, 3))})
+
+
+def test_vector_marks_only_the_nan_column_as_diverged():
+    env = BushRigVectorEnv(num_envs=3, model=NanAfter(after=4))
+    env.reset(seed=0)
+    a = np.array([[0.5], [0.5], [0.5]], np.float32)
+    for _ in range(4):
+        _, _, term, _, _ = env.step(a)
+        assert not term.any()
+    _, r, term, _, info = env.step(a)
+    assert term.all() and info["diverged"].all() and (r == 10.0).all()
+    assert info["divergence_reason"][0] == "model force is not finite"
+
+
+def test_vector_render_gives_a_frame_of_rig_zero():
+    env = BushRigVectorEnv(num_envs=2, render_mode="rgb_array")
+    env.reset(seed=0)
+    env.step(np.ones((2, 1), np.float32))
+    (frame,) = env.render()
+    assert frame.shape == (400, 600, 3)
