@@ -11,8 +11,8 @@ rate apply at another.
 |------------|-------------------------------------------------------|----------|-------------|
 | relaxation | sum_i k_i h_i,  h_i' = v - h_i / tau_i (Maxwell)      | k_i >= 0 | tau grid    |
 | friction   | sum_j F_j z_j,  dz_j/dx = (sgn(dx) - z_j) / x_j (Dahl)| F_j >= 0 | x_j grid    |
-| hardening  | a3 (x/s)^3 + a5 (x/s)^5,  s = sigma_x(TRAIN)          | a3 >= 0  | none        |
-| thermal    | theta (b_k x + b_c v),  theta' = v^2 - theta / tau_th | free     | tau_th      |
+| hardening  | a3 (x/s)^3 + a5 (x/s)^5,  s = sigma_x(TRAIN)          | a3,a5>=0 | none        |
+| thermal    | -theta (b_k x + b_c v), theta' = v^2 - theta / tau_th | b >= 0   | tau_th      |
 | delay      | the whole predicted force at t - d (fractional shift) | none     | d, refined  |
 | inertia    | m a,  a = d2x/dt2                                     | m >= 0   | none        |
 
@@ -222,7 +222,7 @@ class Hardening(Candidate):
         return 2
 
     def lower(self, shape, scales):
-        return np.array([0.0, -np.inf])
+        return np.zeros(2)  # stiffening: both terms add force in the direction of x
 
 
 # ----- thermal ---------------------------------------------------------------------------
@@ -247,10 +247,14 @@ class Thermal(Candidate):
 
     def columns(self, s, shape, scales):
         theta = heating_state(s.v, s.dt, shape)
-        return np.stack([theta * s.x, theta * s.v], axis=1)
+        # heating softens rubber: the columns are the force lost, weights >= 0
+        return np.stack([-theta * s.x, -theta * s.v], axis=1)
 
     def columns_count(self, shape, scales):
         return 2
+
+    def lower(self, shape, scales):
+        return np.zeros(2)
 
     def describe(self, shape):
         return f"thermal (tau_th={shape:g} s)"
