@@ -112,12 +112,18 @@ class Recorder:
         self.best = np.inf
 
     def record(
-        self, batch: BatchResult, families: list[str], params: list[list[float] | None]
+        self,
+        batch: BatchResult,
+        families: list[str],
+        params: list[list[float] | None],
+        limit: int | None = None,
     ) -> None:
+        """Book the first ``limit`` (default: all) profiles of ``batch``."""
         v = batch.verdict
         res = self.result
         now = time.perf_counter() - self.t0
-        for b in range(len(families)):
+        n = len(families) if limit is None else min(len(families), int(limit))
+        for b in range(n):
             res.evaluations += 1
             rob = float(v.robustness[b])
             div = bool(v.diverged[b])
@@ -142,7 +148,7 @@ class Recorder:
                     res.first_failure = cand
                 if len(res.failures) < MAX_KEPT_FAILURES:
                     res.failures.append(cand)
-        self.best = min(self.best, float(np.min(v.robustness)))
+        self.best = min(self.best, float(np.min(v.robustness[:n])))
         res.history.append((res.evaluations, self.best))
         res.seconds = now
 

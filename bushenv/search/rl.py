@@ -1,0 +1,255 @@
+"""Reinforcement-learning searchers: stable-baselines3 PPO and SAC acting in BushRig-v0.
+
+The agent drives the rig sample by sample (action: the displacement change this step as a
+fraction of the machine's velocity limit, see ``BushRigEnv``), so it is free to invent any
+drivable motion, not only the families' shapes. It runs ``N_ENVS`` (32) rigs at once through the
+rig's vector env (``gym.make_vec(..., vectorization_mode="vector_entry_point")``: the models'
+batched kernels, ~40 us per rig-step instead of ~600 us for a wrapped single env), adapted to
+SB3's ``VecEnv`` by ``RigVecEnv`` below.
+
+Reward (``DivergenceReward``, the env's ``reward_fn`` hook):
+
+- every step, a dense shaping term: ``min(|F_model - F_ref| / scale_so_far, 5) / steps``,
+  scale_so_far the reference's running peak |F| (floored at ``FORCE_FLOOR_N``), the same
+  normalisation as ``divergence.py``;
+- at the end of every episode, the episode's whole displacement profile is evaluated ONCE by
+  the ``BatchEvaluator`` (the prescribed-motion path and ``divergence.judge``, the single
+  definition of divergence) and the agent gets ``-clip(robustness, -10, 10)``: the STL
+  robustness is the objective; the shaping only helps early exploration.
+
+An episode is one model evaluation: the budget is the number of episodes, and the evaluator's
+verdicts on those profiles are what the result records (so a "failure" found by an agent
+means exactly what it means for random search). The rig itself ends an episode early only
+for non-finite or > 25 kN model forces; the profile up to there is judged the same way.
+
+Seeded: SB3's ``seed``, ``torch.set_num_threads(1)`` and a deterministic CPU run give the same
+episodes for the same seed. The vector env auto-resets on the step after an episode ends
+("next-step" mode); SB3 sees that step as one extra no-op transition from the rest state
+(observation zeros, reward 0), which is harmless: the rig truly is at rest then.
+
+QuarterCar-v0 is not driven by the agents yet (see docs/search.md): road searches use random
+search and CMA-ES over the bump and pothole families.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bushenv.search.divergence import FORCE_FLOOR_N
+from bushenv.search.searchers import Searcher, SearchError
+
+N_ENVS = 32  # one policy call serves 32 rigs: SB3's per-call cost dominates below that
+EPISODE_S = 10.0  # the rig's default episode: the papers' 10 s records (seed 001)
+DENSE_CAP = 5.0
+ROBUSTNESS_CLIP = 10.0
+
+
+class DivergenceReward:
+    """``reward_fn`` hook: dense deviation shaping + terminal -robustness from the evaluator.
+
+    Keeps each rig's episode (x, F_model, F_ref so far) and, when episodes end, evaluates
+    their profiles in one batch and hands the result to ``on_episodes(batch)``.
+    """
+
+    def __init__(self, n_envs, episode_steps, evaluator, on_episodes) -> None:
+        self.n = n_envs
+        self.episode_steps = episode_steps
+        self.evaluator = evaluator
+        self.on_episodes = on_episodes
+        self.reset()
+
+    def reset(self) -> None:
+        self.xs: list[list[float]] = [[] for _ in range(self.n)]
+        self.peak = np.full(self.n, FORCE_FLOOR_N)
+        # judged already; the env's next-step autoreset calls us once more before resetting
+        self.finished = np.zeros(self.n, dtype=bool)
+
+    def reset_columns(self, mask) -> None:
+        for i in np.flatnonzero(mask):
+            self.xs[i] = []
+            self.peak[i] = FORCE_FLOOR_N
+            self.finished[i] = False
+
+    def __call__(self, info) -> np.ndarray:
+        x = np.asarray(info["displacement_m"], dtype=np.float64)
+        fm = np.asarray(info["force_model_n"], dtype=np.float64)
+        fr = np.asarray(info["force_reference_n"], dtype=np.float64)
+        for i in np.flatnonzero(~self.finished):
+            self.xs[i].append(float(x[i]))
+        np.maximum(self.peak, np.abs(fr), out=self.peak)
+        with np.errstate(invalid="ignore"):
+            dense = np.abs(fm - fr) / self.peak
+        dense = np.where(np.isfinite(dense), np.minimum(dense, DENSE_CAP), DENSE_CAP)
+        reward = dense / self.episode_steps
+        ended = (
+            np.asarray(info["diverged"], dtype=bool)
+            | np.asarray(info["machine_limit"], dtype=bool)
+            | (np.asarray(info["step"]) >= self.episode_steps)
+        )
+        idx = np.flatnonzero(ended & ~self.finished)
+        self.finished |= ended
+        if idx.size:
+            profiles = [np.r_[0.0, self.xs[i]] for i in idx]  # the rig starts at rest at 0
+            batch = self.evaluator.evaluate(profiles)
+            rob = np.clip(batch.verdict.robustness, -ROBUSTNESS_CLIP, ROBUSTNESS_CLIP)
+            reward[idx] += -rob
+            self.on_episodes(batch)
+        return reward
+
+
+def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward):
+    import gymnasium as gym
+
+    import bushenv  # noqa: F401  (registers BushRig-v0)
+
+    return gym.make_vec(
+        "BushRig-v0",
+        num_envs=n_envs,
+        vectorization_mode="vector_entry_point",
+        model=model,
+        reference=reference,
+        axis=axis,
+        episode_steps=episode_steps,
+        reward_fn=reward,
+    )
+
+
+def _sb3_vec_env(venv):
+    """SB3 ``VecEnv`` over a next-step-autoreset gymnasium vector env."""
+    from stable_baselines3.common.vec_env.base_vec_env import VecEnv
+
+    class RigVecEnv(VecEnv):
+        def __init__(self, inner) -> None:
+            self.inner = inner
+            super().__init__(
+                inner.num_envs, inner.single_observation_space, inner.single_action_space
+            )
+            self._actions = None
+            self._seed = None
+
+        def reset(self):
+            obs, _ = self.inner.reset(seed=self._seed)
+            self._seed = None
+            return obs
+
+        def step_async(self, actions) -> None:
+            self._actions = np.asarray(actions, dtype=np.float32).reshape(self.num_envs, -1)
+
+        def step_wait(self):
+            obs, rew, term, trunc, info = self.inner.step(self._actions)
+            done = term | trunc
+            infos = [{} for _ in range(self.num_envs)]
+            for i in np.flatnonzero(done):
+                infos[i]["terminal_observation"] = obs[i].copy()
+                infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
+                obs[i] = 0.0  # the rest state the rig returns to (next-step autoreset)
+            return obs, rew.astype(np.float32), done, infos
+
+        def close(self) -> None:
+            self.inner.close()
+
+        def seed(self, seed=None):
+            self._seed = seed
+            return [seed] * self.num_envs
+
+        def get_attr(self, attr_name, indices=None):
+            return [getattr(self.inner, attr_name, None)] * self.num_envs
+
+        def set_attr(self, attr_name, value, indices=None) -> None:
+            setattr(self.inner, attr_name, value)
+
+        def env_method(self, method_name, *args, indices=None, **kwargs):
+            return [None] * self.num_envs
+
+        def env_is_wrapped(self, wrapper_class, indices=None):
+            return [False] * self.num_envs
+
+    return RigVecEnv(venv)
+
+
+class RLSearch(Searcher):
+    """PPO or SAC in BushRig-v0; the budget counts episodes (one profile each)."""
+
+    def __init__(self, algo: str, n_envs: int = N_ENVS, episode_s: float = EPISODE_S) -> None:
+        if algo not in ("ppo", "sac"):
+            raise SearchError(f"RL searcher must be 'ppo' or 'sac', got {algo!r}")
+        self.name = algo
+        self.n_envs = int(n_envs)
+        self.episode_s = float(episode_s)
+
+    def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
+        if evaluator.env != "rig":
+            raise SearchError(
+                f"{self.name}: only BushRig-v0 is driven by agents; use random or cma for roads"
+            )
+        import torch
+        from stable_baselines3 import PPO, SAC
+        from stable_baselines3.common.callbacks import BaseCallback
+
+        torch.set_num_threads(1)
+        episode_steps = int(round(self.episode_s / evaluator.dt))
+        n_envs = max(1, min(self.n_envs, budget))
+        state = {"episodes": 0}
+
+        def on_episodes(batch) -> None:
+            k = len(batch.lengths)
+            room = budget - state["episodes"]
+            if room <= 0:
+                return
+            state["episodes"] += min(k, room)
+            recorder.record(batch, [f"agent-{self.name}"] * k, [None] * k, limit=room)
+            progress(
+                f"{self.name} {state['episodes']}/{budget} episodes, "
+                f"best robustness {recorder.best:.3g}"
+            )
+
+        reward = DivergenceReward(n_envs, episode_steps, evaluator, on_episodes)
+        venv = _rig_vec_env(
+            evaluator.model.copy(),
+            evaluator.reference.copy(),
+            evaluator.axis,
+            n_envs,
+            episode_steps,
+            reward,
+        )
+        env = _sb3_vec_env(venv)
+
+        class StopAtBudget(BaseCallback):
+            def _on_step(self) -> bool:
+                return state["episodes"] < budget
+
+        policy_kwargs = {"net_arch": [64, 64]}
+        if self.name == "ppo":
+            agent = PPO(
+                "MlpPolicy",
+                env,
+                n_steps=128,
+                batch_size=1024,
+                n_epochs=4,
+                learning_rate=3e-4,
+                gamma=0.995,
+                seed=int(seed),
+                device="cpu",
+                policy_kwargs=policy_kwargs,
+                verbose=0,
+            )
+        else:
+            agent = SAC(
+                "MlpPolicy",
+                env,
+                buffer_size=200_000,
+                learning_starts=256 * n_envs,
+                batch_size=256,
+                train_freq=16,
+                gradient_steps=4,
+                gamma=0.995,
+                seed=int(seed),
+                device="cpu",
+                policy_kwargs=policy_kwargs,
+                verbose=0,
+            )
+        total = (budget // n_envs + 2) * episode_steps * n_envs
+        try:
+            agent.learn(total_timesteps=total, callback=StopAtBudget())
+        finally:
+            env.close()

@@ -1,0 +1,197 @@
+"""Shrinking: reduce a failing profile to the simplest one that still fails.
+
+Like a property-based test shrinking its counterexample (Hypothesis, QuickCheck), each round
+builds candidate simplifications of the current profile, evaluates them all in ONE batch and
+keeps the simplest candidate that still diverges; it stops when no candidate is simpler and
+still failing, or when the evaluation budget is spent.
+
+Simplicity is the tuple ``(segments, length, peak)`` compared in that order: fewer segments
+first (maximal runs in which the profile holds, rises or falls: a held step has three), then
+shorter, then a smaller peak |x| (rounded to a micrometre). Segments come first because a
+reader understands a three-segment step failing at 2.7 s faster than a fifteen-segment wiggle
+failing at 2.6 s; the length stays near its minimum anyway, since every accepted candidate is
+cut right after its own failure. Candidate moves:
+
+- truncate right after the first failure sample (free: models are causal, so the prefix fails
+  at the same sample; applied after every accepted step);
+- delete a chunk (halves, quarters, ... down to ~50 ms) and join the two sides with a
+  velocity-limited half-cosine move;
+- flatten a chunk: hold the value before it, then move to the value after it (same length,
+  fewer segments);
+- collapse the start (one move straight to the value at 1/8, 2/8, ... of the profile) or hold
+  from there to the end;
+- scale the whole profile by 0.5, 0.7, 0.85 or 0.95 (smaller amplitude).
+
+Each candidate is judged with a ``TAIL_S`` hold appended and then cut after its own failure,
+so a simplification that fails a little later than the original still counts if it is simpler
+once cut. Rig candidates pass ``excitation.clip_to_limits`` (they stay drivable) and start at rest.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from bushenv import excitation as ex
+from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.families import VMAX
+
+SCALES = (0.5, 0.7, 0.85, 0.95)
+MIN_CHUNK_S = 0.05
+MAX_CANDIDATES_PER_ROUND = 48
+TAIL_S = 2.0  # hold appended to candidates while judging them
+
+
+def n_segments(x: np.ndarray) -> int:
+    """Maximal runs of holding / rising / falling (sign of the sample-to-sample change)."""
+    x = np.asarray(x, dtype=np.float64)
+    if x.size < 2:
+        return 1
+    d = np.diff(x)
+    s = np.where(np.abs(d) < 1e-9, 0, np.sign(d)).astype(int)
+    return 1 + int(np.count_nonzero(s[1:] != s[:-1]))
+
+
+def complexity(x: np.ndarray) -> tuple[int, int, int]:
+    """(segments, length, peak in micrometres): smaller is simpler, compared in order."""
+    x = np.asarray(x)
+    return (n_segments(x), int(x.size), int(round(float(np.max(np.abs(x))) * 1e6)))
+
+
+@dataclass
+class ShrinkResult:
+    profile: np.ndarray
+    verdict: dict
+    evaluations: int
+    rounds: int
+    original: tuple[int, int, int]
+    final: tuple[int, int, int]
+
+    def summary(self) -> dict:
+        return {
+            "evaluations": self.evaluations,
+            "rounds": self.rounds,
+            "original": dict(zip(("segments", "samples", "peak_um"), self.original, strict=True)),
+            "final": dict(zip(("segments", "samples", "peak_um"), self.final, strict=True)),
+        }
+
+
+def _join(a: float, b: float, dt: float) -> np.ndarray:
+    """Half-cosine move from a (excluded) to b (included) at half the velocity limit."""
+    dist = abs(b - a)
+    if dist < 1e-12:
+        return np.zeros(0)
+    n = max(1, math.ceil(dist * math.pi / 2 / (0.5 * VMAX * dt)))
+    s = np.arange(1, n + 1) / n
+    return a + (b - a) * 0.5 * (1.0 - np.cos(np.pi * s))
+
+
+def _candidates(x: np.ndarray, dt: float, rig: bool) -> list[np.ndarray]:
+    T = x.size
+    out: list[np.ndarray] = []
+    for k in range(1, 8):  # collapse the start: one move straight to where the profile is at a
+        a = k * T // 8
+        if 1 < a < T - 1:
+            out.append(np.concatenate([[0.0], _join(0.0, x[a], dt), x[a + 1 :]]))
+            out.append(np.concatenate([x[:a], np.full(T - a, x[a - 1])]))  # hold from a on
+    min_chunk = max(2, int(round(MIN_CHUNK_S / dt)))
+    chunk = T // 2
+    while chunk >= min_chunk and len(out) < MAX_CANDIDATES_PER_ROUND:
+        for a in range(1, T - 1, chunk):
+            b = min(T - 1, a + chunk)
+            if b <= a:
+                continue
+            join = _join(x[a - 1], x[b], dt)
+            out.append(np.concatenate([x[:a], join[:-1], x[b:]]))  # delete [a, b)
+            n_join = join.size
+            if b - a > n_join:  # flatten [a, b): hold, then move to x[b]
+                held = np.full(b - a - n_join + 1, x[a - 1])
+                out.append(np.concatenate([x[:a], held, join[:-1], x[b:]]))
+        chunk //= 2
+    out = out[: MAX_CANDIDATES_PER_ROUND - len(SCALES)]
+    out.extend(x * s for s in SCALES)
+    fixed = []
+    for c in out:
+        if c.size < 2:
+            continue
+        c = c.copy()
+        c[0] = 0.0
+        if rig:
+            c = ex.clip_to_limits(c, dt)
+        fixed.append(c)
+    return fixed
+
+
+def shrink(
+    profile: np.ndarray,
+    evaluator: BatchEvaluator,
+    budget: int = 256,
+    still_fails: Callable[[dict], bool] | None = None,
+) -> ShrinkResult:
+    """Simplest profile, reachable by the moves above, on which ``evaluator``'s model diverges.
+
+    ``still_fails(verdict_row)`` decides whether a candidate counts as failing (default: it
+    diverged by any criterion). The input profile must fail; otherwise ValueError.
+    """
+    still_fails = still_fails or (lambda row: row["diverged"])
+    rig = evaluator.env == "rig"
+    dt = evaluator.dt
+    x = np.asarray(profile, dtype=np.float64).copy()
+    start_evals = evaluator.n_evaluations
+    first = evaluator.evaluate([x])
+    row = first.verdict.row(0)
+    if not still_fails(row):
+        raise ValueError("shrink: the profile to shrink does not fail on this model")
+    original = complexity(x)
+
+    def _truncate(c: np.ndarray, r: dict) -> np.ndarray:
+        t = r.get("first_time_s")
+        if t is None:
+            return c
+        n = int(round(t / dt)) + 1
+        return c[: max(2, n)]
+
+    x = _truncate(x, row)
+    row = evaluator.evaluate([x]).verdict.row(0)
+    if not still_fails(row):  # cannot happen for a causal model; keep the original then
+        x = np.asarray(profile, dtype=np.float64).copy()
+        row = first.verdict.row(0)
+    rounds = 0
+    while evaluator.n_evaluations - start_evals < budget - 1:  # one kept for the final check
+        cands = _candidates(x, dt, rig)
+        room = budget - 1 - (evaluator.n_evaluations - start_evals)
+        cands = [c for c in cands if complexity(c) < complexity(x)][:room]
+        if not cands:
+            break
+        # a hold appended to each: a simplification may fail a little later than the original
+        # did (truncation cut right after its failure); the prefix is truncated again below
+        tail = int(round(TAIL_S / dt))
+        cands = [np.concatenate([c, np.full(tail, c[-1])]) for c in cands]
+        batch = evaluator.evaluate(cands)
+        best, best_row = None, None
+        for b, c in enumerate(cands):
+            r = batch.verdict.row(b)
+            if not still_fails(r):
+                continue
+            c = _truncate(c, r)
+            if best is None or complexity(c) < complexity(best):
+                best, best_row = c, r
+        rounds += 1
+        if best is None or complexity(best) >= complexity(x):
+            break
+        x, row = best, best_row
+    # the final profile is judged as it stands (after the last truncation)
+    final_row = evaluator.evaluate([x]).verdict.row(0)
+    if still_fails(final_row):
+        row = final_row
+    return ShrinkResult(
+        profile=x,
+        verdict=row,
+        evaluations=evaluator.n_evaluations - start_evals,
+        rounds=rounds,
+        original=original,
+        final=complexity(x),
+    )
