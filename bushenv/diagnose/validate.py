@@ -209,6 +209,7 @@ def judge_case(case: Case, result: dict[str, Any]) -> dict[str, Any]:
         truth = case.label[0] if case.label else "none"
         row["kind"] = "single"
         row["right"] = first == truth
+        row["exact"] = named == truth
     else:
         row["kind"] = "pair"
         row["right"] = set(result["top_two"]) == set(case.label) and named != "none"
@@ -229,6 +230,9 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "single_cases": len(singles),
         "pair_cases": len(pairs),
         "single_top1_rate": float(np.mean([r["right"] for r in singles])) if singles else None,
+        "single_named_exactly_rate": (
+            float(np.mean([r["exact"] for r in singles])) if singles else None
+        ),
         "pair_hit_rate": float(np.mean([r["right"] for r in pairs])) if pairs else None,
         "pair_named_exactly_rate": (
             float(np.mean([r["pair_named"] for r in pairs])) if pairs else None
@@ -282,7 +286,8 @@ def report_text(summary: dict[str, Any], seed: int) -> str:
             confusion_table(summary),
             "",
             f"- top-1 on single-effect cases (incl. none): {pct(summary['single_top1_rate'])} "
-            f"of {summary['single_cases']}",
+            f"of {summary['single_cases']} (named exactly, no second effect added: "
+            f"{pct(summary['single_named_exactly_rate'])})",
             f"- two-effect cases, both in the top two: {pct(summary['pair_hit_rate'])} of "
             f"{summary['pair_cases']} (pair named exactly: "
             f"{pct(summary['pair_named_exactly_rate'])})",
