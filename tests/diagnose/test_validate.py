@@ -1,0 +1,72 @@
+import json
+
+import numpy as np
+
+from bushenv.cli import main
+from bushenv.diagnose.validate import CLASSES, case_label, make_case, summarise
+
+
+def test_case_mix_cycles_through_all_classes_and_puts_a_pair_in_every_fourth_case():
+    rng = np.random.default_rng(0)
+    labels = [case_label(i, rng) for i in range(28)]
+    singles = [lab[0] if lab else "none" for i, lab in enumerate(labels) if i % 4 != 3]
+    assert sorted(set(singles)) == sorted(CLASSES)
+    assert all(len(labels[i]) == 2 and labels[i][0] != labels[i][1] for i in range(3, 28, 4))
+
+
+def test_cases_are_deterministic_and_the_records_carry_no_label():
+    a = make_case(5, 2)
+    b = make_case(5, 2)
+    assert a.label == b.label
+    assert np.array_equal(a.train.force, b.train.force)
+    assert np.array_equal(a.tests[1].displacement, b.tests[1].displacement)
+    names = [a.train.name] + [t.name for t in a.tests]
+    assert names == ["train", "test1", "test2"]
+    assert not a.train.info
+
+
+def test_fast_blind_slice_names_single_effects_and_prints_a_confusion_matrix(tmp_path, capsys):
+    out = tmp_path / "val"
+    assert (
+        main(["diagnose-validate", "--cases", "7", "--seed", "0", "--out", str(out), "--quiet"])
+        == 0
+    )
+    printed = capsys.readouterr().out
+    assert "| true \\ named | none | relaxation" in printed
+    data = json.loads((out / "validation.json").read_text())
+    summary = data["summary"]
+    assert summary["cases"] == 7 and summary["single_cases"] == 6
+    assert sum(map(sum, summary["confusion"])) == 6
+    assert summary["single_top1_rate"] >= 5 / 6
+    assert (out / "validation.md").read_text().startswith("`bushenv diagnose-validate")
+
+
+def test_summary_counts_a_pair_hit_only_when_both_effects_are_in_the_top_two():
+    rows = [
+        {
+            "kind": "pair",
+            "label": "friction+delay",
+            "right": True,
+            "pair_named": True,
+            "shrink": 0.8,
+        },
+        {
+            "kind": "pair",
+            "label": "friction+delay",
+            "right": False,
+            "pair_named": False,
+            "shrink": 0.5,
+        },
+        {
+            "kind": "single",
+            "label": "none",
+            "top1": "none",
+            "right": True,
+            "exact": True,
+            "shrink": 0.0,
+        },
+    ]
+    s = summarise(rows)
+    assert s["pair_hit_rate"] == 0.5
+    assert s["single_top1_rate"] == 1.0
+    assert s["median_shrink_named_right"] == 0.8  # 'none' cases do not count toward shrink
