@@ -109,7 +109,9 @@ def amplitude_envelope(x: np.ndarray, dt: float, window_s: float = 1.0) -> np.nd
 def residual_spectrum(r: np.ndarray, x: np.ndarray, dt: float):
     """Welch PSD of ``r`` (N^2/Hz) and its coherence with ``x``: (freq, psd, coherence)."""
     fs = 1.0 / dt
-    nper = int(min(r.size, 2 ** int(np.round(np.log2(max(8.0 * fs, 16))))))
+    # at least ~8 averaged segments: with one segment the coherence is 1 whatever the signals
+    nper = int(min(2 ** int(np.round(np.log2(max(4.0 * fs, 16)))), max(r.size // 8, 16)))
+    nper = min(nper, r.size)
     f, p = signal.welch(r, fs=fs, nperseg=nper)
     if np.ptp(x) == 0 or np.ptp(r) == 0:
         coh = np.zeros_like(f)

@@ -84,3 +84,35 @@ def test_candidate_columns_have_one_weight_bound_each():
 def test_unknown_candidate_is_a_clear_error():
     with pytest.raises(ValueError, match="unknown candidate effect 'creep'"):
         get_candidate("creep")
+
+
+def _fake_identify(monkeypatch, calls):
+    import bushenv.identify as identify
+    from bushenv.models.linear import LinearBushing
+
+    def fit_model(name, x, f, dt, seed):
+        calls.append((name, x.size, dt, seed))
+        v = np.gradient(x, dt)
+        k, c = np.linalg.lstsq(np.stack([x, v], axis=1), f, rcond=None)[0]
+        return LinearBushing(k, c, dt=dt)
+
+    monkeypatch.setattr(identify, "fit_model", fit_model, raising=False)
+
+
+def test_other_baselines_come_from_the_identify_dispatcher_and_are_augmented(monkeypatch):
+    calls = []
+    _fake_identify(monkeypatch, calls)
+    train = record(8, "inertia", noise=0.002, duration_s=20.0)
+    result = diagnose(train, [record(9, "inertia", noise=0.002, name="t")], baseline="boucwen")
+    assert calls == [("boucwen", train.force.size, train.dt, 0)]
+    assert result["baseline"] == "boucwen"
+    assert result["effect"] == "inertia"
+    assert result["shrink"] > 0.6
+
+
+def test_other_baselines_refuse_a_test_at_another_rate(monkeypatch):
+    _fake_identify(monkeypatch, [])
+    train = record(8, "none", dt=1 / 204.8, duration_s=10.0)
+    test = record(9, "none", dt=1 / 512, duration_s=10.0, name="fast")
+    with pytest.raises(ValueError, match=r"TEST fast: sampled at 512 Hz but TRAIN at 204\.8 Hz"):
+        diagnose(train, [test], baseline="nn")

@@ -40,3 +40,16 @@ def test_where_puts_a_reversal_residual_near_reversals_and_shares_add_up():
     assert abs(sum(b["energy_share"] for b in w["frequency"]["bands"]) - 1) < 0.05
     assert abs(sum(w["time"]["thirds"]) - 1) < 1e-9
     assert w["summary"]
+
+
+def test_coherence_separates_a_linear_residual_from_independent_noise():
+    from bushenv.diagnose.regimes import residual_spectrum
+
+    rng = np.random.default_rng(0)
+    dt = 1 / 204.8
+    x = rng.normal(size=8192)
+    lagged = np.convolve(x, [0.5, 0.3, 0.2])[: x.size]  # a linear filter of x
+    _, _, coh_linear = residual_spectrum(lagged, x, dt)
+    _, _, coh_noise = residual_spectrum(rng.normal(size=x.size), x, dt)
+    assert np.median(coh_linear) > 0.95
+    assert np.median(coh_noise) < 0.2
