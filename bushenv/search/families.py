@@ -26,6 +26,8 @@ input stops is judged, seed 000 §5.2) and lasts at most ``max_s`` seconds. Road
 | bump        | 4 | road bump length 0.2-2 m, height 5-150 mm, speed 1-30 m/s, rest after       |
 | pothole     | 5 | length 0.2-2 m, depth 5-150 mm, speed 1-30 m/s, edge 10-45 % of length,     |
 |             |   | rest after                                                                   |
+|             |   | (road speeds are capped so the road height changes at most 9.7 m/s,         |
+|             |   | inside QuarterCar-v0's 0.05 m per step)                                      |
 
 ``family.profile(u, dt)`` returns the (T,) profile; ``family.describe(u)`` its physical
 parameters as a dict (for reports and the corpus). Both are pure functions of ``u``.
@@ -47,7 +49,10 @@ MIN_HOLD_S = 0.5
 SPEED_MARGIN = 0.98  # stay 2 % inside the machine's velocity limit
 VMAX = ex.MAX_VELOCITY_M_PER_S * SPEED_MARGIN
 XMAX = ex.MAX_DISPLACEMENT_M
-ROAD_MAX_HEIGHT_M = 0.15  # a kerb-sized obstacle; the quarter car's suspension stroke bounds it
+ROAD_MAX_HEIGHT_M = 0.15  # QuarterCar-v0's max_road_height_m: kerbs, potholes, the papers' bumps
+# QuarterCar-v0 lets the road move at most max_road_step_m = 0.05 m per 1/204.8 s step
+# (10.24 m/s); road profiles stay 5 % inside that so the env can replay them.
+ROAD_MAX_RATE_M_PER_S = 0.95 * 0.05 * 204.8
 
 
 class FamilyError(ValueError):
@@ -246,7 +251,8 @@ def _sequence(u, dt, max_s):
 def _bump(u, dt, max_s):
     length = _lin(u[0], 0.2, 2.0)
     height = _lin(u[1], 0.005, ROAD_MAX_HEIGHT_M)
-    speed = _log(u[2], 1.0, 30.0)
+    # (1 - cos) bump: peak road rate pi h V / L
+    speed = min(_log(u[2], 1.0, 30.0), ROAD_MAX_RATE_M_PER_S * length / (math.pi * height))
     post = _lin(u[3], 1.0, max(1.0, max_s - 0.5 - length / speed))
     x = ex.bump(length, height, speed, dt, pre_s=0.5, post_s=post)
     return x, {"length_m": length, "height_m": height, "speed_m_per_s": speed, "post_s": post}
@@ -255,8 +261,9 @@ def _bump(u, dt, max_s):
 def _pothole(u, dt, max_s):
     length = _lin(u[0], 0.2, 2.0)
     depth = _lin(u[1], 0.005, ROAD_MAX_HEIGHT_M)
-    speed = _log(u[2], 1.0, 30.0)
     edge = _lin(u[3], 0.1, 0.45) * length
+    # half-cosine edge: peak road rate pi d V / (2 edge)
+    speed = min(_log(u[2], 1.0, 30.0), ROAD_MAX_RATE_M_PER_S * 2 * edge / (math.pi * depth))
     post = _lin(u[4], 1.0, max(1.0, max_s - 0.5 - length / speed))
     x = ex.pothole(length, depth, speed, dt, edge_m=edge, pre_s=0.5, post_s=post)
     return x, {

@@ -43,6 +43,7 @@ SCALES = (0.5, 0.7, 0.85, 0.95)
 MIN_CHUNK_S = 0.05
 MAX_CANDIDATES_PER_ROUND = 48
 TAIL_S = 2.0  # hold appended to candidates while judging them
+MARGIN = 0.1  # robustness a shrunk failure must keep below zero (10 % of a threshold)
 
 
 def n_segments(x: np.ndarray) -> int:
@@ -133,16 +134,26 @@ def shrink(
 ) -> ShrinkResult:
     """Simplest profile, reachable by the moves above, on which ``evaluator``'s model diverges.
 
-    ``still_fails(verdict_row)`` decides whether a candidate counts as failing (default: it
-    diverged by any criterion). The input profile must fail; otherwise ValueError.
+    ``still_fails(verdict_row)`` decides whether a candidate counts as failing. By default it
+    must diverge with robustness below ``-min(MARGIN, |r0| / 2)``, r0 the original's: shrinking
+    walks towards the failure boundary, and a case sitting exactly on it would flip with the
+    last bit of rounding (e.g. the corpus's float32 storage). The input must fail; otherwise
+    ValueError.
     """
-    still_fails = still_fails or (lambda row: row["diverged"])
     rig = evaluator.env == "rig"
     dt = evaluator.dt
     x = np.asarray(profile, dtype=np.float64).copy()
     start_evals = evaluator.n_evaluations
     first = evaluator.evaluate([x])
     row = first.verdict.row(0)
+    if still_fails is None:
+        r0 = row["robustness"]
+        margin = MARGIN if r0 is None else min(MARGIN, abs(r0) / 2)
+
+        def still_fails(r: dict) -> bool:
+            rob = r["robustness"]
+            return bool(r["diverged"]) and (rob is None or rob < -margin)
+
     if not still_fails(row):
         raise ValueError("shrink: the profile to shrink does not fail on this model")
     original = complexity(x)

@@ -12,6 +12,7 @@ from bushenv.search.families import (
     RIG_FAMILIES,
     ROAD_FAMILIES,
     ROAD_MAX_HEIGHT_M,
+    ROAD_MAX_RATE_M_PER_S,
     FamilyError,
     get_family,
     pad_batch,
@@ -40,6 +41,7 @@ def test_road_profiles_start_flat_and_stay_within_obstacle_height(name, u):
     h = fam.profile(np.asarray(u[: fam.dim]))
     assert h[0] == 0.0 and h[-1] == 0.0
     assert np.all(np.isfinite(h)) and np.max(np.abs(h)) <= ROAD_MAX_HEIGHT_M + 1e-12
+    assert np.max(np.abs(np.diff(h))) <= ROAD_MAX_RATE_M_PER_S * DT * (1 + 1e-9)
 
 
 def test_step_family_reaches_the_papers_4mm_step():

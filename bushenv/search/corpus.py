@@ -1,0 +1,344 @@
+"""The regression corpus: every kept divergence as a small JSON file, replayed by the tests.
+
+A case file (``tests/regressions/corpus/<name>.json``) holds:
+
+| key           | meaning                                                                     |
+|---------------|-----------------------------------------------------------------------------|
+| format, version | ``"bushenv-divergence-case"``, 1                                          |
+| name          | file stem: ``<model>-<axis>-<env>-<family>-<sha8 of the profile>``          |
+| env, axis, dt | ``"rig"`` (prescribed bushing displacement) or ``"quartercar"`` (road       |
+|               | height), the bushing axis, the sample time in s                             |
+| profile       | ``{"encoding": "f32-diff-zlib-b64", "n_samples": T, "data": ...}``: the     |
+|               | sample-to-sample differences as float32, zlib-compressed, base64; decoded   |
+|               | by a float64 cumulative sum from 0 (holds stay exactly constant)            |
+| family, params| the excitation family and its physical parameters (or the agent's name)     |
+| found_by      | searcher, seed, model name and the sha256 of the model file it was found on |
+| expect        | per model name: ``diverged`` (bool), the ``criterion`` it fired (or null),  |
+|               | ``sha256`` of the model file the verdict was recorded with                  |
+| reference     | the reference bushing (``rubber``, measurement effects off) and a sha256 of |
+|               | its parameters                                                              |
+| shrink        | what shrinking did (segments / samples / peak before and after)            |
+
+The verdicts in ``expect`` are measured on the DECODED profile when the case is made (float32
+rounding cannot make a recorded verdict wrong). ``replay`` re-runs a case on the current
+models and reference; ``check`` lists every changed verdict with the case name and says when
+the model file or the reference changed since the case was recorded. Cases are never
+overwritten unless ``force=True``.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import json
+import os
+import tempfile
+import zlib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bushenv.models import TRAINED, BushingModel, default_model_path, file_hash, get_model
+from bushenv.models.base import PAPER_DT
+
+CASE_FORMAT = "bushenv-divergence-case"
+CASE_VERSION = 1
+ENCODING = "f32-diff-zlib-b64"
+DEFAULT_CORPUS = Path("tests") / "regressions" / "corpus"
+
+
+class CorpusError(ValueError):
+    """A corrupt or mismatching case file; the message names the file."""
+
+
+# ----- profile encoding --------------------------------------------------------------------------
+def encode_profile(x: np.ndarray) -> dict[str, Any]:
+    x = np.asarray(x, dtype=np.float64).reshape(-1)
+    diffs = np.diff(np.r_[0.0, x]).astype(np.float32)
+    data = base64.b64encode(zlib.compress(diffs.tobytes(), 9)).decode("ascii")
+    return {"encoding": ENCODING, "n_samples": int(x.size), "data": data}
+
+
+def decode_profile(d: dict[str, Any], where: str = "profile") -> np.ndarray:
+    if not isinstance(d, dict) or d.get("encoding") != ENCODING:
+        raise CorpusError(f"{where}: profile encoding must be {ENCODING!r}")
+    try:
+        raw = zlib.decompress(base64.b64decode(d["data"], validate=True))
+    except (KeyError, ValueError, zlib.error) as exc:
+        raise CorpusError(f"{where}: profile data is not valid {ENCODING}: {exc}") from None
+    diffs = np.frombuffer(raw, dtype=np.float32)
+    if diffs.size != d.get("n_samples"):
+        raise CorpusError(
+            f"{where}: profile has {diffs.size} samples, header says {d.get('n_samples')}"
+        )
+    x = np.cumsum(diffs.astype(np.float64))
+    if not np.all(np.isfinite(x)):
+        raise CorpusError(f"{where}: profile holds NaN or inf")
+    return x
+
+
+def profile_sha(x: np.ndarray) -> str:
+    return hashlib.sha256(np.asarray(x, dtype=np.float64).tobytes()).hexdigest()
+
+
+# ----- model and reference identity -------------------------------------------------------------
+def model_sha(name: str, axis: str) -> str | None:
+    """sha256 of the shipped file behind a registered trained name (None for presets)."""
+    if name in TRAINED:
+        path = default_model_path(name, axis)
+        return file_hash(path) if path.is_file() else None
+    return None
+
+
+def params_sha(model: BushingModel) -> str:
+    """sha256 of a model's parameters and settings (for presets such as the reference)."""
+    blob = {
+        "class": type(model).__name__,
+        "dt": model.dt,
+        "params": {k: np.asarray(v, dtype=np.float64).tolist() for k, v in model.params.items()},
+        "extra": model.extra_meta(),
+    }
+    return hashlib.sha256(json.dumps(blob, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def truth_reference(axis: str, dt: float = PAPER_DT) -> BushingModel:
+    """The "real" bushing every verdict is measured against: the rubber specimen alone."""
+    from bushenv.reference.rubber import RubberBushing
+
+    return RubberBushing.preset(axis, dt=dt, measurement=False)
+
+
+# ----- cases -------------------------------------------------------------------------------------
+@dataclass
+class Case:
+    name: str
+    env: str
+    axis: str
+    dt: float
+    profile: np.ndarray
+    family: str
+    params: Any
+    found_by: dict[str, Any]
+    expect: dict[str, dict[str, Any]]
+    reference: dict[str, Any]
+    shrink: dict[str, Any] | None = None
+    notes: str = ""
+    path: Path | None = field(default=None, compare=False)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "format": CASE_FORMAT,
+            "version": CASE_VERSION,
+            "name": self.name,
+            "env": self.env,
+            "axis": self.axis,
+            "dt": self.dt,
+            "profile": encode_profile(self.profile),
+            "family": self.family,
+            "params": self.params,
+            "found_by": self.found_by,
+            "expect": self.expect,
+            "reference": self.reference,
+            "shrink": self.shrink,
+            "notes": self.notes,
+        }
+
+
+Resolver = Callable[[str, str, float], BushingModel]
+
+
+def _default_resolver(name: str, axis: str, dt: float) -> BushingModel:
+    return get_model(name, axis=axis, dt=dt)
+
+
+def judge_profile(
+    profile: np.ndarray,
+    models: dict[str, BushingModel],
+    env: str,
+    axis: str,
+    reference: BushingModel,
+) -> dict[str, dict[str, Any]]:
+    """Verdict row of ``profile`` for each model (prescribed-motion or quarter-car path)."""
+    from bushenv.search.evaluate import BatchEvaluator
+
+    out = {}
+    for name, model in models.items():
+        ev = BatchEvaluator(model, reference, env=env, axis=axis)
+        out[name] = ev.evaluate([profile]).verdict.row(0)
+    return out
+
+
+def make_case(
+    profile: np.ndarray,
+    *,
+    env: str,
+    axis: str,
+    family: str,
+    params: Any,
+    found_by: dict[str, Any],
+    models: dict[str, BushingModel],
+    reference: BushingModel,
+    shas: dict[str, str | None] | None = None,
+    shrink: dict[str, Any] | None = None,
+    notes: str = "",
+) -> Case:
+    """A case whose ``expect`` holds what each model does on the decoded profile now."""
+    x = decode_profile(encode_profile(profile))
+    rows = judge_profile(x, models, env, axis, reference)
+    shas = shas or {}
+    expect = {
+        name: {
+            "diverged": bool(row["diverged"]),
+            "criterion": row["first_criterion"],
+            "first_time_s": row["first_time_s"],
+            "sha256": shas.get(name),
+        }
+        for name, row in rows.items()
+    }
+    target = found_by.get("model", next(iter(models)))
+    name = f"{_slug(target)}-{axis}-{env}-{_slug(family)}-{profile_sha(x)[:8]}"
+    return Case(
+        name=name,
+        env=env,
+        axis=axis,
+        dt=float(reference.dt),
+        profile=x,
+        family=family,
+        params=params,
+        found_by=found_by,
+        expect=expect,
+        reference={"name": "rubber", "measurement": False, "params_sha256": params_sha(reference)},
+        shrink=shrink,
+        notes=notes,
+    )
+
+
+def _slug(text: str) -> str:
+    keep = "".join(c if c.isalnum() else "_" for c in Path(str(text)).stem)
+    return keep.strip("_") or "model"
+
+
+def save_case(case: Case, directory: str | os.PathLike, force: bool = False) -> Path | None:
+    """Write ``case`` atomically as ``directory/<name>.json``; None if it exists (unless force)."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    path = directory / f"{case.name}.json"
+    if path.exists() and not force:
+        return None
+    text = json.dumps(case.to_json(), indent=1, sort_keys=False) + "\n"
+    fd, tmp = tempfile.mkstemp(dir=directory, prefix=path.name, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    case.path = path
+    return path
+
+
+def load_case(path: str | os.PathLike) -> Case:
+    path = Path(path)
+    try:
+        d = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise CorpusError(f"{path}: not a readable JSON case file: {exc}") from None
+    if not isinstance(d, dict) or d.get("format") != CASE_FORMAT:
+        raise CorpusError(f"{path}: not a bushenv divergence case (format tag missing)")
+    if d.get("version") != CASE_VERSION:
+        raise CorpusError(f"{path}: case version {d.get('version')!r}, expected {CASE_VERSION}")
+    for key in ("name", "env", "axis", "dt", "profile", "expect", "found_by"):
+        if key not in d:
+            raise CorpusError(f"{path}: case lacks {key!r}")
+    if d["env"] not in ("rig", "quartercar"):
+        raise CorpusError(f"{path}: env must be 'rig' or 'quartercar', got {d['env']!r}")
+    if not isinstance(d["expect"], dict) or not d["expect"]:
+        raise CorpusError(f"{path}: 'expect' must name at least one model")
+    for name, e in d["expect"].items():
+        if not isinstance(e, dict) or not isinstance(e.get("diverged"), bool):
+            raise CorpusError(f"{path}: expect[{name!r}] needs a boolean 'diverged'")
+    return Case(
+        name=d["name"],
+        env=d["env"],
+        axis=d["axis"],
+        dt=float(d["dt"]),
+        profile=decode_profile(d["profile"], where=str(path)),
+        family=d.get("family", ""),
+        params=d.get("params"),
+        found_by=d["found_by"],
+        expect=d["expect"],
+        reference=d.get("reference", {}),
+        shrink=d.get("shrink"),
+        notes=d.get("notes", ""),
+        path=path,
+    )
+
+
+def case_files(directory: str | os.PathLike = DEFAULT_CORPUS) -> list[Path]:
+    return sorted(Path(directory).glob("*.json"))
+
+
+@dataclass
+class Replay:
+    model: str
+    expected: bool
+    diverged: bool
+    row: dict[str, Any]
+    sha_recorded: str | None
+    sha_now: str | None
+
+    @property
+    def ok(self) -> bool:
+        return self.expected == self.diverged
+
+
+def replay(case: Case, resolve: Resolver | None = None) -> list[Replay]:
+    """Run the case on every model it names, today's files; one ``Replay`` per model."""
+    resolve = resolve or _default_resolver
+    reference = truth_reference(case.axis, case.dt)
+    models = {name: resolve(name, case.axis, case.dt) for name in case.expect}
+    rows = judge_profile(case.profile, models, case.env, case.axis, reference)
+    return [
+        Replay(
+            model=name,
+            expected=bool(case.expect[name]["diverged"]),
+            diverged=bool(rows[name]["diverged"]),
+            row=rows[name],
+            sha_recorded=case.expect[name].get("sha256"),
+            sha_now=model_sha(name, case.axis) if resolve is _default_resolver else None,
+        )
+        for name in case.expect
+    ]
+
+
+def check(case: Case, resolve: Resolver | None = None) -> list[str]:
+    """Messages for every changed verdict (empty when the case still holds)."""
+    problems = []
+    results = replay(case, resolve)
+    ref_now = params_sha(truth_reference(case.axis, case.dt))
+    ref_changed = case.reference.get("params_sha256") not in (None, ref_now)
+    for r in results:
+        if r.ok:
+            continue
+        want = "diverge" if r.expected else "stay bounded"
+        got = (
+            f"diverged ({r.row['first_criterion']} at {r.row['first_time_s']:.3f} s)"
+            if r.diverged
+            else f"stayed bounded (robustness {r.row['robustness']})"
+        )
+        msg = f"case {case.name}: {r.model} was expected to {want} but {got}"
+        if r.sha_recorded and r.sha_now and r.sha_recorded != r.sha_now:
+            msg += (
+                f"; the {r.model} model file changed since the case was recorded "
+                f"(sha256 {r.sha_recorded[:12]} -> {r.sha_now[:12]})"
+            )
+        elif r.sha_recorded and r.sha_now is None and resolve is None:
+            msg += f"; the {r.model} model file is missing"
+        if ref_changed:
+            msg += "; the reference rubber bushing's parameters changed since then"
+        problems.append(msg)
+    return problems
