@@ -296,9 +296,18 @@ class Replay:
         return self.expected == self.diverged
 
 
-def replay(case: Case, resolve: Resolver | None = None) -> list[Replay]:
-    """Run the case on every model it names, today's files; one ``Replay`` per model."""
+def replay(
+    case: Case,
+    resolve: Resolver | None = None,
+    sha_of: Callable[[str, str], str | None] | None = None,
+) -> list[Replay]:
+    """Run the case on every model it names, today's files; one ``Replay`` per model.
+
+    ``resolve(name, axis, dt)`` gives the model (default: ``get_model``); ``sha_of(name,
+    axis)`` the sha256 of its file today (default: the shipped file, ``model_sha``).
+    """
     resolve = resolve or _default_resolver
+    sha_of = sha_of or model_sha
     reference = truth_reference(case.axis, case.dt)
     models = {name: resolve(name, case.axis, case.dt) for name in case.expect}
     rows = judge_profile(case.profile, models, case.env, case.axis, reference)
@@ -309,16 +318,20 @@ def replay(case: Case, resolve: Resolver | None = None) -> list[Replay]:
             diverged=bool(rows[name]["diverged"]),
             row=rows[name],
             sha_recorded=case.expect[name].get("sha256"),
-            sha_now=model_sha(name, case.axis) if resolve is _default_resolver else None,
+            sha_now=sha_of(name, case.axis),
         )
         for name in case.expect
     ]
 
 
-def check(case: Case, resolve: Resolver | None = None) -> list[str]:
+def check(
+    case: Case,
+    resolve: Resolver | None = None,
+    sha_of: Callable[[str, str], str | None] | None = None,
+) -> list[str]:
     """Messages for every changed verdict (empty when the case still holds)."""
     problems = []
-    results = replay(case, resolve)
+    results = replay(case, resolve, sha_of)
     ref_now = params_sha(truth_reference(case.axis, case.dt))
     ref_changed = case.reference.get("params_sha256") not in (None, ref_now)
     for r in results:
@@ -336,8 +349,8 @@ def check(case: Case, resolve: Resolver | None = None) -> list[str]:
                 f"; the {r.model} model file changed since the case was recorded "
                 f"(sha256 {r.sha_recorded[:12]} -> {r.sha_now[:12]})"
             )
-        elif r.sha_recorded and r.sha_now is None and resolve is None:
-            msg += f"; the {r.model} model file is missing"
+        elif r.sha_recorded and r.sha_recorded == r.sha_now:
+            msg += f"; the {r.model} model file is the one the case was recorded with"
         if ref_changed:
             msg += "; the reference rubber bushing's parameters changed since then"
         problems.append(msg)
