@@ -3,8 +3,9 @@
     python scripts/diagnose_validate.py                      # the documented full run
     python scripts/diagnose_validate.py --cases 14 --seed 3 --out /tmp/v
 
-Same as ``bushenv diagnose-validate``; defaults to the documented run (200 cases, seed 1,
-out validation-diagnose/). Seed 0 was used while developing the diagnosis; seed 1 was not.
+Same as ``bushenv diagnose-validate``; defaults to the documented run (200 cases, seed 3,
+out validation-diagnose/). Seeds 0 and 2 were used while developing the diagnosis (and seed 1
+once, before its last two changes); seed 3 was not looked at before the documented run.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import sys
 
 from bushenv.cli import main
 
-DEFAULTS = ["--cases", "200", "--seed", "1", "--out", "validation-diagnose"]
+DEFAULTS = ["--cases", "200", "--seed", "3", "--out", "validation-diagnose"]
 
 if __name__ == "__main__":
     args = sys.argv[1:]

@@ -20,7 +20,7 @@ rate apply at another.
   branches at once, non-negative weights (a discrete relaxation spectrum).
 - x_j grid: sigma_x(TRAIN) * {0.002, 0.006, 0.02, 0.06, 0.2}; all elements at once with
   non-negative weights (a discrete Iwan-like distribution of Dahl elements).
-- tau_th in {10, 100, inf} s (inf: cumulative v^2), chosen by TRAIN error.
+- tau_th in {10, 30, 100, 300, inf} s (inf: cumulative v^2), chosen by TRAIN error.
 - d: 13 values from 0.25 to 40 ms, the best refined by a bounded 1-D search on TRAIN error.
 
 The shapes are deliberately not the reference bushing's own laws (Berg/Iwan friction, its
@@ -226,7 +226,7 @@ class Hardening(Candidate):
 
 
 # ----- thermal ---------------------------------------------------------------------------
-THERMAL_TAUS_S = (10.0, 100.0, np.inf)
+THERMAL_TAUS_S = (10.0, 30.0, 100.0, 300.0, np.inf)
 
 
 def heating_state(v: np.ndarray, dt: float, tau: float) -> np.ndarray:

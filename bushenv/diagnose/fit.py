@@ -39,6 +39,10 @@ searched jointly); the best pair replaces ``A`` when it closes at least ``PAIR_G
 (25 %) of the gap that ``A`` leaves and passes rule 2 with its own ``p``. The member that is
 the better single comes first in the pair's name.
 
+``top_two``: the named pair's members; for a named single ``A``, ``A`` and the effect that
+closes most of the gap when fitted together with ``A`` (``A``'s pairs are always fitted for
+this ranking, even when none may be named); for ``none``, the two best singles.
+
 Rates: candidate columns are continuous-time, and the linear baseline is too, so a TEST at
 another sample rate than TRAIN is handled (columns are recomputed at the TEST's dt). Other
 baselines are discrete-time models identified at TRAIN's rate; a TEST at another rate is
@@ -286,6 +290,16 @@ def best_shapes(
             combo = list(best[0].shapes)
             combo[i] = float(np.exp(res.x))
             best = fit_augmentation(effects, combo, train, linear_base, cache)
+            # the other effects' grid choices were made at a grid delay: choose them again
+            for j in range(len(effects)):
+                if j == i or len(grids[j]) < 2:
+                    continue
+                for shape in grids[j]:
+                    combo = list(best[0].shapes)
+                    combo[j] = shape
+                    trial = fit_augmentation(effects, combo, train, linear_base, cache)
+                    if trial[1] < best[1]:
+                        best = trial
     return best
 
 
@@ -472,10 +486,14 @@ def diagnose(
     best = singles[0]
     named = best if best["passes"] else None
     pairs: list[dict[str, Any]] = []
-    if named is not None and best["gap_after"] > PAIR_TRY_IF_LEFT * gap_null:
+    if named is not None:
         order = [r["effect"] for r in singles]
+        # pairs that may be named: one of the PAIR_LEADS best singles with any other effect,
+        # tried when the best single leaves a large part of the gap; the best single's pairs
+        # are always fitted, to rank the runner-up by what it adds to the first effect
+        leads = PAIR_LEADS if best["gap_after"] > PAIR_TRY_IF_LEFT * gap_null else 1
         tried_pairs = set()
-        for first in order[:PAIR_LEADS]:
+        for first in order[:leads]:
             for other in order:
                 key = frozenset((first, other))
                 if other == first or key in tried_pairs:
@@ -488,7 +506,8 @@ def diagnose(
         pairs.sort(key=lambda r: r["gap_after"])
         for r in pairs:
             r["passes"] = bool(
-                r["gap_after"] <= (1.0 - PAIR_GAIN_MIN) * best["gap_after"]
+                leads > 1
+                and r["gap_after"] <= (1.0 - PAIR_GAIN_MIN) * best["gap_after"]
                 and r["beats_noise_margin"]
             )
         winners = [r for r in pairs if r["passes"]]
@@ -502,7 +521,13 @@ def diagnose(
     else:
         effect = named["effect"]
         aug_final = named["_aug"]
-        top_two = effect.split("+") if "+" in effect else [r["effect"] for r in singles[:2]]
+        if "+" in effect:
+            top_two = effect.split("+")
+        else:
+            # runner-up: the effect that adds most to the named one (its best pair)
+            with_best = [r for r in pairs if best["effect"] in r["effect"].split("+")]
+            partner = [m for m in with_best[0]["effect"].split("+") if m != best["effect"]]
+            top_two = [best["effect"], partner[0]]
     say(f"named effect: {effect}")
 
     predictions = []
