@@ -11,7 +11,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
+import threading
 
 COMMANDS = {
     # name: (module, one-line help)
@@ -90,11 +92,13 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     mod = _command_module(args.command)
     runner = getattr(mod, "cli_run", None) or mod.run  # cli_run where run() means something else
+    previous = _handle_sigterm()
     try:
         return int(runner(args) or 0)
-    except KeyboardInterrupt:
-        print("bushenv: interrupted; results written so far are kept", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        how = "terminated" if isinstance(exc, Terminated) else "interrupted"
+        print(f"bushenv {args.command}: {how}; results written so far are kept", file=sys.stderr)
+        return 143 if isinstance(exc, Terminated) else 130
     except CliError as exc:
         print(f"bushenv {args.command}: error: {exc}", file=sys.stderr)
         return 2
@@ -111,6 +115,24 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 1
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill PID``) arrived: unwind like Ctrl-C so every command's clean-up runs."""
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise Terminated()
+
+
+def _handle_sigterm():
+    """Make SIGTERM unwind like Ctrl-C (main thread only); returns the previous handler."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGTERM, _raise_terminated)
 
 
 def _one_line(exc: BaseException) -> str:
@@ -121,4 +143,8 @@ def _one_line(exc: BaseException) -> str:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # Run the imported module's main, not this __main__ copy: command modules raise
+    # bushenv.cli.CliError, which must be the class main() catches.
+    from bushenv.cli import main as _main
+
+    sys.exit(_main())

@@ -69,6 +69,7 @@ ACQUISITION_RATE_HZ = 6.0e3
 # fastest the actuator moves; it also admits the whole papers' programme (20 Hz x 4 mm: 0.50 m/s).
 MAX_VELOCITY_M_PER_S = 2.0 * math.pi * MAX_FREQUENCY_HZ * (0.1 * STROKE_M)
 _LIMIT_RTOL = 1e-9  # a signal exactly at a limit is within it despite rounding
+MAX_SIGNAL_SAMPLES = 10_000_000  # 13.6 h at 204.8 Hz, 80 MB as float64: ample for any test
 
 PEAK_M_AT_N1 = 2.0e-3  # seed 002 §2: random drive peak amplitude 2 mm (at n = 1)
 DURABILITY_PEAK_HZ = (10.0, 15.0)  # seed 001 §3.2.1: proving-ground load PSD peaks here
@@ -94,10 +95,21 @@ def _check_nonneg(name: str, value: float) -> float:
 
 
 def n_samples(duration_s: float, dt: float) -> int:
-    """Number of samples T = round(duration_s / dt) of a signal lasting ``duration_s``."""
+    """Number of samples T = round(duration_s / dt) of a signal lasting ``duration_s``.
+
+    Refuses more than ``MAX_SIGNAL_SAMPLES`` (a typo such as ``--duration 1e9`` must be a clear
+    error, not an attempt to allocate hundreds of GiB).
+    """
     _check_dt(dt)
     _check_nonneg("duration_s", duration_s)
-    return int(round(duration_s / dt))
+    count = duration_s / dt
+    if count > MAX_SIGNAL_SAMPLES:
+        raise ExcitationError(
+            f"duration_s={duration_s!r} at dt={dt:.6g} s is {count:.4g} samples, more than the "
+            f"{MAX_SIGNAL_SAMPLES:.0e} one signal may hold ({MAX_SIGNAL_SAMPLES * dt / 3600:.3g} h "
+            "at this dt); split it into shorter runs"
+        )
+    return int(round(count))
 
 
 def time_axis(duration_s: float, dt: float) -> np.ndarray:

@@ -6,8 +6,9 @@ given its item (seeds travel inside the items), so every backend returns identic
 
 - ``LocalBackend(workers)``: ``workers == 1`` runs in this process (no pickling, no start-up);
   otherwise a ``ProcessPoolExecutor`` over the local cores.
-- ``RayBackend(address=None, num_cpus=None)``: ``ray.init`` on an existing cluster (``address``,
-  e.g. ``"auto"`` or ``"ray://head:10001"``) or a local instance; needs ``pip install bushenv[ray]``.
+- ``RayBackend(address=None, num_cpus=None)``: ``ray.init`` on an existing cluster
+  (``address``, e.g. ``"auto"`` or ``"ray://head:10001"``) or a local instance; needs
+  ``pip install bushenv[ray]``.
 
 ``imap_unordered`` streams ``(index, result)`` pairs as they finish, so a caller can write each
 result to disk at once and an interrupted run loses nothing already finished.
@@ -32,6 +33,28 @@ def local_cores() -> int:
         return os.cpu_count() or 1
 
 
+def _die_with_parent() -> None:
+    """Worker initialiser: on Linux, ask the kernel to SIGTERM this worker when its parent dies.
+
+    Without it a ``kill -9`` of a campaign leaves its pool workers behind for good: each one
+    waits on a task pipe whose write end its siblings still hold, so it never sees EOF.
+    """
+    try:
+        import ctypes
+        import signal
+
+        # A SIGTERM handler inherited from the parent (bushenv.cli installs one) would turn the
+        # kernel's signal into an exception the pool worker survives: restore the default.
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        libc = ctypes.CDLL(None, use_errno=True)
+        pr_set_pdeathsig = 1
+        libc.prctl(pr_set_pdeathsig, signal.SIGTERM)
+        if os.getppid() == 1:  # the parent died before prctl took effect
+            os._exit(1)
+    except (OSError, AttributeError):  # pragma: no cover - not Linux
+        pass
+
+
 class LocalBackend:
     name = "local"
 
@@ -44,7 +67,7 @@ class LocalBackend:
 
     def _executor(self) -> ProcessPoolExecutor:
         if self._pool is None:
-            self._pool = ProcessPoolExecutor(max_workers=self.workers)
+            self._pool = ProcessPoolExecutor(max_workers=self.workers, initializer=_die_with_parent)
         return self._pool
 
     def map(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
@@ -77,11 +100,30 @@ class LocalBackend:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
 
+    def abort(self) -> None:
+        """Stop at once: cancel queued items and end the worker processes (their running items
+        are lost; whatever the caller already wrote stays)."""
+        if self._pool is None:
+            return
+        pool, self._pool = self._pool, None
+        # ProcessPoolExecutor has no public kill: without it an interrupted campaign would
+        # wait for every running cell to finish, which can take minutes.
+        workers = list(getattr(pool, "_processes", {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for proc in workers:
+            if proc.is_alive():
+                proc.terminate()
+        for proc in workers:
+            proc.join(timeout=5)
+
     def __enter__(self) -> LocalBackend:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, exc_type: object, *exc: object) -> None:
+        if exc_type is not None and issubclass(exc_type, KeyboardInterrupt):  # type: ignore[arg-type]
+            self.abort()
+        else:
+            self.close()
 
 
 class RayBackend:

@@ -329,6 +329,8 @@ def cli_run(args: argparse.Namespace) -> int:
 
     if not (np.isfinite(args.rate) and args.rate > 0):
         raise MachineError(f"--rate must be a positive number of Hz, got {args.rate!r}")
+    if args.seed < 0:
+        raise MachineError(f"--seed must be >= 0, got {args.seed}")
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise MachineError(f"--out {out}: exists and is not a folder")

@@ -60,6 +60,9 @@ def parse_seeds(text: str) -> list[int]:
         raise MatrixError(f"--seeds {text!r}: expected e.g. 0-9 or 1,4,7") from None
     if not seeds:
         raise MatrixError(f"--seeds {text!r} names no seed")
+    negative = [s for s in seeds if s < 0]
+    if negative:
+        raise MatrixError(f"--seeds {text!r}: seeds must be >= 0, got {negative[0]}")
     return seeds
 
 
@@ -108,26 +111,59 @@ def comparable(row: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def read_results(path: Path) -> dict[str, dict[str, Any]]:
-    """Finished cells by key; drops a torn final line, refuses corruption elsewhere."""
+RESULT_KEYS = ("diverged", "evaluations", "evaluations_to_failure")
+
+
+def read_results(path: Path, require_results: bool = False) -> dict[str, dict[str, Any]]:
+    """Finished cells by key; drops a torn final line, refuses corruption elsewhere.
+
+    A line is a finished cell when it is a JSON object holding the cell's keys (``CELL_KEYS``)
+    and, with ``require_results`` (as ``run_matrix`` reads), the result fields
+    ``RESULT_KEYS``. Only the last line may be torn (a kill mid-write): it is dropped and cut
+    from the file, so the cell runs again on resume. A complete last line that lost only its
+    newline is kept and the newline restored, so the next append starts a line of its own.
+    """
     done: dict[str, dict[str, Any]] = {}
     if not path.exists():
         return done
-    lines = path.read_text().splitlines()
+    if not path.is_file():
+        raise MatrixError(f"{path}: not a regular file")
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise MatrixError(
+            f"{path}: not a results file (not UTF-8 text at byte {exc.start}); "
+            "move it away or pass another --out"
+        ) from None
+    lines = text.splitlines()
     for i, line in enumerate(lines, start=1):
         if not line.strip():
             continue
-        try:
-            row = json.loads(line)
-            key = cell_key(row)
-        except (json.JSONDecodeError, KeyError, TypeError):
+        row = _result_row(line, require_results)
+        if row is None:
             if i == len(lines):
                 print(f"{path} line {i}: incomplete last line (interrupted write) dropped")
                 _truncate_last_line(path)
                 continue
             raise MatrixError(f"{path} line {i}: corrupt result line; fix or remove it") from None
-        done[key] = row
+        done[cell_key(row)] = row
+    if text and not text.endswith("\n") and path.read_bytes() == raw:
+        with path.open("a") as fh:
+            fh.write("\n")
     return done
+
+
+def _result_row(line: str, require_results: bool) -> dict[str, Any] | None:
+    """The row a results line holds, or None when it is not a complete result."""
+    try:
+        row = json.loads(line)
+    except json.JSONDecodeError:
+        return None
+    needed = (*CELL_KEYS, *RESULT_KEYS) if require_results else CELL_KEYS
+    if not isinstance(row, dict) or any(k not in row for k in needed):
+        return None
+    return row
 
 
 def _truncate_last_line(path: Path) -> None:
@@ -161,7 +197,7 @@ def run_matrix(
     """Run every cell not yet in ``out/cells.jsonl``; returns all rows in cell order."""
     out.mkdir(parents=True, exist_ok=True)
     results_path = out / "cells.jsonl"
-    done = read_results(results_path) if resume else {}
+    done = read_results(results_path, require_results=True) if resume else {}
     if not resume and results_path.exists():
         raise MatrixError(f"{results_path} exists; pass --resume to continue or --out elsewhere")
     todo = [c for c in cells if cell_key(c) not in done]
@@ -223,11 +259,13 @@ def write_summary(out: Path, summary: dict[str, Any]) -> None:
                 + (f", median {med:.0f} evals" if med is not None else "")
             )
         lines.append(f"| {model} | " + " | ".join(cells) + " |")
-    (out / "summary.md").write_text(
+    tmp = out / "summary.md.tmp"
+    tmp.write_text(
         "Divergence rate and median evaluations to failure, per model and searcher\n\n"
         + "\n".join(lines)
         + "\n"
     )
+    os.replace(tmp, out / "summary.md")
     import matplotlib
 
     matplotlib.use("Agg")
@@ -296,11 +334,25 @@ def run(args: argparse.Namespace) -> int:
     for s in searchers:
         if s not in (*SEARCHERS, "ppo", "sac"):
             raise CliError(f"unknown searcher {s!r}; known: {sorted(SEARCHERS) + ['ppo', 'sac']}")
+    for what, names in (("--models", models), ("--axes", axes), ("--searchers", searchers)):
+        if not names:
+            raise CliError(f"{what} {getattr(args, what[2:])!r} names nothing")
     try:
         seeds = parse_seeds(args.seeds)
     except MatrixError as exc:
         raise CliError(str(exc)) from None
+    # Resolve every model now: a missing default file must stop the matrix before it starts,
+    # not fail in a worker after the output folder exists.
+    from bushenv.models import ModelError, get_model
+
+    for m, a in product(models, axes):
+        try:
+            get_model(m, axis=a)
+        except ModelError as exc:
+            raise CliError(f"model {m!r} ({a}): {exc}") from None
     out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise CliError(f"--out {out}: exists and is not a folder")
     cells = make_cells(models, axes, searchers, seeds, args.budget, args.env)
     try:
         backend = get_backend(
