@@ -185,9 +185,11 @@ def cumulative_work(x: np.ndarray, f: np.ndarray) -> np.ndarray:
     return w
 
 
-def _signals(x, fm, fr, dt, valid):
+def _signals(x, fm, fr, dt, valid, x_ref=None, hold_input=None):
     """The normalised pointwise robustness signals every criterion and the STL formula share."""
     T, B = x.shape
+    x_ref = x if x_ref is None else x_ref
+    hold_input = x if hold_input is None else hold_input
     scale = force_scale(fr, valid)
     finite = np.isfinite(fm) | ~valid
     with np.errstate(invalid="ignore", over="ignore"):
@@ -196,17 +198,21 @@ def _signals(x, fm, fr, dt, valid):
         dev = np.where(finite, np.abs(fm - fr), np.inf) / scale
         r_force = (force_bound(scale) - abs_fm) / scale
         r_dev = DEVIATION_FRACTION - dev
-        late, anchor = hold_windows(x, dt)
+        late, anchor = hold_windows(hold_input, dt)
         drift_m = np.abs(fm_safe - np.take_along_axis(fm_safe, anchor, axis=0))
         drift_r = np.abs(fr - np.take_along_axis(fr, anchor, axis=0))
         r_hold = SETTLE_FRACTION - (drift_m - drift_r) / scale
         r_hold = np.where(late, r_hold, np.inf)
         w_m = cumulative_work(x, fm_safe)
-        w_r = cumulative_work(x, fr)
+        w_r = cumulative_work(x_ref, fr)
         w_r_valid = np.where(valid, w_r, np.inf)
+        dx_r = np.zeros_like(x)
+        dx_r[1:] = np.diff(x_ref, axis=0)
+        abs_work = np.sum(
+            np.where(valid, np.abs(0.5 * (fr + np.roll(fr, 1, axis=0)) * dx_r), 0), axis=0
+        )
         dx = np.zeros_like(x)
         dx[1:] = np.diff(x, axis=0)
-        abs_work = np.sum(np.where(valid, np.abs(0.5 * (fr + np.roll(fr, 1, axis=0)) * dx), 0), 0)
         travel = np.sum(np.where(valid, np.abs(dx), 0.0), axis=0)
         e_tol = np.maximum(ENERGY_TOLERANCE_FRACTION * abs_work, FORCE_FLOOR_N * travel)
         e_tol = np.where(e_tol > 0, e_tol, 1.0)
@@ -264,11 +270,26 @@ def judge(
     f_ref: np.ndarray,
     dt: float,
     lengths: np.ndarray | None = None,
+    x_ref: np.ndarray | None = None,
+    hold_input: np.ndarray | None = None,
 ) -> Verdict:
-    """Decide, per profile, whether the model diverged (see the module docstring)."""
+    """Decide, per profile, whether the model diverged (see the module docstring).
+
+    In a closed loop (the quarter car) the model's and the reference's bushings deflect
+    differently: ``x`` is the model's deflection, ``x_ref`` (default ``x``) the reference's
+    (for its work), and ``hold_input`` (default ``x``) the prescribed input whose constancy
+    defines a hold (the road height).
+    """
     x, fm, fr, lengths, valid = _prepare(x, f_model, f_ref, lengths)
     T, B = x.shape
-    sig, scale, dev = _signals(x, fm, fr, dt, valid)
+    extra = []
+    for name, a in (("x_ref", x_ref), ("hold_input", hold_input)):
+        if a is not None:
+            a = np.asarray(a, dtype=np.float64).reshape(x.shape)
+            if not np.all(np.isfinite(a[valid])):
+                raise DivergenceInputError(f"{name} holds NaN or inf")
+        extra.append(a)
+    sig, scale, dev = _signals(x, fm, fr, dt, valid, *extra)
     width = max(1, int(round(DEVIATION_MIN_S / dt)))
 
     first: dict[str, np.ndarray] = {}
