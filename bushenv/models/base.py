@@ -159,6 +159,7 @@ class BushingModel:
         try:
             with os.fdopen(fd, "wb") as fh:
                 np.savez(fh, __meta__=np.array(json.dumps(meta)), **arrays)
+            os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a saved model is shareable
             os.replace(tmp, path)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
@@ -185,6 +186,12 @@ class BushingModel:
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(dt={self.dt:.6g})"
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def velocity_of(x: np.ndarray, dt: float) -> np.ndarray:
