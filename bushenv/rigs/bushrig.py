@@ -357,7 +357,7 @@ class BushRigEnv(gym.Env):
             (10, 8),
         )
         c.text(f"t = {self._t * self._dt:6.3f} s   x = {x * 1e3:+7.3f} mm", (10, 28), small=True)
-        # scale: the stroke +-x_max spans +-60 px
+        # scale: the stroke +-x_max spans +-60 px (the inner sleeve's motion is exaggerated)
         px_per_m = 60.0 / p.max_x
         y = 130.0
         # ground wall and load cell (left)
@@ -378,18 +378,20 @@ class BushRigEnv(gym.Env):
         c.rect(bushing_x + 150, y - 26, 70, 52, (190, 140, 60))
         c.line((xc + 150 - 60, y + 40), (xc + 150 + 140, y + 40), (120, 120, 120), 3)
         c.text("actuator on groove", (xc + 150, y + 46), small=True)
-        # stroke marks
-        for s in (-1, 1):
-            c.line((xc + s * 60, y - 48), (xc + s * 60, y - 40), (200, 0, 0), 2)
+        # stroke marks: where the inner sleeve sits at x = -+x_max
+        for sgn in (-1, 1):
+            c.line((xc + sgn * 60, y - 48), (xc + sgn * 60, y - 40), (200, 0, 0), 2)
+        c.text("stroke", (xc - 18, y - 62), (200, 0, 0), small=True)
         # force arrows on the load cell (force the bushing puts on the ground)
-        scale = 100.0 / p.force_limit
+        scale = 50.0 / p.force_scale
         for f, col, dy in ((f_m, (200, 40, 40), -6), (f_r, (40, 70, 200), 6)):
             if math.isfinite(f):
                 fx = max(-100.0, min(100.0, f * scale))
                 c.arrow((56, y + dy), (56 + fx, y + dy), col, 3)
         # bars
-        c.force_bar(330, 70, 250, 16, f_m, p.force_limit, (200, 40, 40), "F model")
-        c.force_bar(330, 110, 250, 16, f_r, p.force_limit, (40, 70, 200), "F reference")
+        fs = 2 * p.force_scale  # bars and traces span +-2 force_scale_n
+        c.force_bar(330, 70, 250, 16, f_m, fs, (200, 40, 40), f"F model (+-{fs / 1e3:.1f} kN)")
+        c.force_bar(330, 110, 250, 16, f_r, fs, (40, 70, 200), "F reference")
         c.force_bar(330, 150, 250, 16, x, p.max_x, (60, 150, 60), "displacement")
         c.text(f"{f_m / 1e3:+8.3f} kN", (500, 52), (200, 40, 40), small=True)
         c.text(f"{f_r / 1e3:+8.3f} kN", (500, 92), (40, 70, 200), small=True)
@@ -398,9 +400,9 @@ class BushRigEnv(gym.Env):
                 c,
                 (20, 230, 560, 150),
                 self._trace,
-                (p.max_x, p.force_limit, p.force_limit),
+                (p.max_x, fs, fs),
                 ((60, 150, 60), (200, 40, 40), (40, 70, 200)),
-                ("x / x_max", "F model / 25 kN", "F reference / 25 kN"),
+                ("x / x_max", "F model", "F reference"),
             )
         return c.frame()
 

@@ -9,7 +9,8 @@ env equals a ``BushRigEnv`` given the same actions, bit for bit (tests/rigs/test
 
 Autoreset is next-step (``metadata["autoreset_mode"]``): the step after a sub-environment's
 episode ended returns its reset observation, reward 0 and no termination; its models' columns
-are returned to rest with ``initial_state``.
+are returned to rest with ``initial_state``, except rows shared by all columns (a ring-buffer
+position the kernel reads from column 0; ``common.shared_state_rows``).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from bushenv.rigs.common import (
     force_observations,
     positive_int,
     reset_columns,
+    shared_state_rows,
     spec_kwargs,
     unit_actions,
 )
@@ -80,6 +82,7 @@ class BushRigVectorEnv(VectorEnv):
         self._overrides = dict(spec_overrides)
         self.render_mode = render_mode
         self.model, self.reference = p.model, p.reference
+        self._shared = (shared_state_rows(self.model), shared_state_rows(self.reference))
         self.single_action_space, self.single_observation_space = p.spaces()
         self.action_space = batch_space(self.single_action_space, n)
         self.observation_space = batch_space(self.single_observation_space, n)
@@ -177,8 +180,8 @@ class BushRigVectorEnv(VectorEnv):
 
         done = self._prev_done
         if done.any():  # next-step autoreset of the rigs whose episode ended last step
-            reset_columns(self.model, done)
-            reset_columns(self.reference, done)
+            reset_columns(self.model, done, self._shared[0])
+            reset_columns(self.reference, done, self._shared[1])
             call_reset_columns(self.reward_fn, done)
             call_reset_columns(self.divergence_monitor, done)
             obs[done] = 0.0

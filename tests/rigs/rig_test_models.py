@@ -43,6 +43,9 @@ class NanAfter(BushingModel):
     def copy(self):
         return NanAfter(self.after, self.k, self.dt)
 
+    def reset_columns(self, mask):  # its sample counter is per history
+        self.state[:, mask] = 0.0
+
 
 class RaisesAfter(NanAfter):
     name = "raises_after_test_double"
