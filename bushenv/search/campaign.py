@@ -75,6 +75,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--resume", action="store_true", help="continue an interrupted campaign")
     p.add_argument("--force", action="store_true", help="overwrite an existing report/cases")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    p.add_argument(
+        "--paper-step",
+        action="store_true",
+        help="also judge the papers' 4 mm step held 10 s (seed 000 §5.2) and keep it as a case",
+    )
 
 
 # ----- small helpers ---------------------------------------------------------------------------
@@ -85,6 +90,7 @@ def write_json_atomic(path: Path, obj: Any) -> None:
         with os.fdopen(fd, "w") as fh:
             json.dump(obj, fh, indent=1, default=_json_default)
             fh.write("\n")
+        os.chmod(tmp, 0o644)  # mkstemp makes 0600; these are ordinary shared files
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -121,6 +127,7 @@ def save_profiles(path: Path, profiles: list[np.ndarray], meta: list[dict]) -> N
                 count=np.array(n),
                 meta=np.array(json.dumps(meta, default=_json_default)),
             )
+        os.chmod(tmp, 0o644)  # mkstemp makes 0600; these are ordinary shared files
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -425,13 +432,14 @@ class Campaign:
         return picks
 
     def shrink_and_save(self) -> None:
-        from bushenv.search.corpus import make_case, model_sha, save_case
+        from bushenv.search.corpus import make_case, model_sha, profile_sha, save_case
         from bushenv.search.shrink import shrink
 
         if self.report["shrunk"]:
             self.log("shrink: done earlier (resumed)")
             return
         shrunk = []
+        seen: set[str] = set()
         for i, (key, profile, meta) in enumerate(self._shrink_choices()):
             with self.evaluator(key) as ev:
                 try:
@@ -439,6 +447,11 @@ class Campaign:
                 except ValueError as exc:
                     self.log(f"shrink {i}: {exc}")
                     continue
+            digest = profile_sha(res.profile)
+            if digest in seen:  # two failures shrank to the same simplest profile
+                self.log(f"shrink: {key}/{meta['family']} shrank to a profile already kept")
+                continue
+            seen.add(digest)
             shas = {k: model_sha(self.specs[k], self.args.axis) for k in self.models}
             case = make_case(
                 res.profile,
@@ -485,8 +498,55 @@ class Campaign:
                 else:
                     self.log(f"corpus: added {saved}")
                     self.report["corpus"].append(str(saved))
+        if self.args.paper_step and self.args.env == "rig":
+            shrunk.append(self._paper_step(shas_fn=model_sha))
         self.report["shrunk"] = shrunk
         self.save()
+
+    def _paper_step(self, shas_fn) -> dict[str, Any]:
+        """The papers' own case: a 4 mm step held 10 s, NN said to diverge after 7.3 s."""
+        from bushenv import excitation as ex
+        from bushenv.search.corpus import make_case, save_case
+
+        x = ex.step_hold(4e-3, 10.0, self.reference.dt, pre_s=0.5)
+        shas = {k: shas_fn(self.specs[k], self.args.axis) for k in self.models}
+        case = make_case(
+            x,
+            env="rig",
+            axis=self.args.axis,
+            family="step",
+            params={"size_m": 4e-3, "hold_s": 10.0, "pre_s": 0.5, "rise_s": 0.0},
+            found_by={
+                "searcher": "paper (seed 000 §5.2)",
+                "seed": None,
+                "model": self.specs[self.target],
+                "model_sha256": shas[self.target],
+            },
+            models={self.specs[k]: m for k, m in self.models.items()},
+            reference=self.reference,
+            shas={self.specs[k]: shas[k] for k in self.models},
+            notes="seed 000 §5.2: the papers' NN diverges after 7.3 s of this step; the "
+            "verdicts recorded here are what the shipped models do",
+        )
+        path = save_case(case, self.out / "cases", force=True)
+        verdicts = ", ".join(
+            f"{m} {'DIVERGES' if e['diverged'] else 'bounded'}" for m, e in case.expect.items()
+        )
+        self.log(f"paper step (4 mm, 10 s hold): {verdicts}")
+        if self.args.save:
+            saved = save_case(case, Path(self.args.corpus), force=self.args.force)
+            if saved is not None:
+                self.log(f"corpus: added {saved}")
+                self.report["corpus"].append(str(saved))
+        return {
+            "failed_model": None,
+            "family": "step",
+            "searcher": "paper",
+            "shrink": None,
+            "verdicts": case.expect,
+            "case_file": str(path.relative_to(self.out)),
+            "name": case.name,
+        }
 
     # ----- plots and table ------------------------------------------------------------------
     def plots(self) -> None:
@@ -613,6 +673,13 @@ class Campaign:
             lines.append("")
             lines.append("shrunk failures (segments, samples, peak um) and verdicts:")
             for e in self.report["shrunk"]:
+                if e["shrink"] is None:
+                    v = ", ".join(
+                        f"{m}: {'DIVERGES' if x['diverged'] else 'bounded'}"
+                        for m, x in e["verdicts"].items()
+                    )
+                    lines.append(f"  the papers' 4 mm step held 10 s: {v}")
+                    continue
                 fin = e["shrink"]["final"]
                 v = ", ".join(
                     f"{m}: {'DIVERGES' if x['diverged'] else 'bounded'}"
