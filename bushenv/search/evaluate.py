@@ -86,7 +86,7 @@ class BatchEvaluator:
     def _run_chunk(self, k: int, x: np.ndarray, lengths: np.ndarray):
         model, ref = self._copies[k]
         if self.env == "rig":
-            fm = model.simulate(x)
+            fm = simulate_or_nan(model, x)
             fr = self._reference_rig(ref, x, lengths)
             return judge(x, fm, fr, self.dt, lengths=lengths), x, fm, fr, None
         from bushenv.search.roads import quarter_car_responses
@@ -149,6 +149,35 @@ class BatchEvaluator:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def simulate_or_nan(model: BushingModel, x: np.ndarray) -> np.ndarray:
+    """``model.simulate(x)`` for (T, B) ``x``; a model that refuses (raises ValueError, e.g.
+    Bouc-Wen's step-size control) gives NaN from the sample it refused on, in the histories that
+    made it refuse -- a non-finite output, which ``judge`` calls a divergence."""
+    try:
+        return model.simulate(x)
+    except ValueError:
+        pass
+    from bushenv.models.base import velocity_of
+
+    out = np.empty_like(x)
+    for b in range(x.shape[1]):
+        col = np.ascontiguousarray(x[:, b])
+        try:
+            out[:, b] = model.simulate(col)
+            continue
+        except ValueError:
+            pass
+        v = velocity_of(col, model.dt)  # the velocity simulate would have used
+        model.reset(1)
+        out[:, b] = np.nan
+        for t in range(col.size):
+            try:
+                out[t, b] = model.step(col[t], v[t])
+            except ValueError:
+                break
+    return out
 
 
 def _merge_verdicts(parts: list[Verdict]) -> Verdict:

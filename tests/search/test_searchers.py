@@ -5,6 +5,8 @@ from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.families import get_family
 from bushenv.search.searchers import CMASearch, RandomSearch, SearchError, get_searcher
 
+from .conftest import UnstableHoldBushing
+
 
 @pytest.mark.parametrize("searcher", [RandomSearch(batch_size=32), CMASearch()])
 def test_searcher_finds_the_held_step_divergence_of_an_unstable_model(
@@ -66,3 +68,25 @@ def test_budget_and_searcher_names_are_checked(linear_axial, reference_axial):
         RandomSearch().run(ev, 0)
     with pytest.raises(SearchError, match="unknown searcher 'nope'"):
         get_searcher("nope")
+
+
+class _Refusing(UnstableHoldBushing):
+    """Raises (like Bouc-Wen's step control) once |x| passed 10 mm."""
+
+    def _advance(self, x, v, out):
+        for t in range(x.shape[0]):
+            if np.any(np.abs(x[t]) > 10e-3):
+                raise ValueError("refused")
+            super()._advance(x[t : t + 1], v[t : t + 1], out[t : t + 1])
+
+
+def test_a_model_that_refuses_some_histories_gives_nan_there_and_diverges(reference_axial):
+    fam = get_family("step")
+    small = fam.profile(np.array([0.6, 0.0, 0.0, 0.1]))  # +2.5 mm
+    large = fam.profile(np.array([1.0, 0.0, 0.0, 0.1]))  # +12.5 mm
+    res = BatchEvaluator(_Refusing(), reference_axial).evaluate([small, large])
+    assert list(res.verdict.diverged) == [False, True]
+    assert res.verdict.first_criterion[1] == "non_finite"
+    first_bad = int(np.argmax(np.abs(large) > 10e-3))
+    assert np.all(np.isfinite(res.f_model[:first_bad, 1]))
+    assert np.isnan(res.f_model[first_bad, 1])
