@@ -57,3 +57,27 @@ class RaisesAfter(NanAfter):
 
     def copy(self):
         return RaisesAfter(self.after, self.k, self.dt)
+
+
+class DiffKV(BushingModel):
+    """Kelvin-Voigt with its velocity from the displacement history, k x_k + c (x_k - x_k-1)/dt,
+    ignoring the v input (as a NARX network does)."""
+
+    name = "diffkv_test_double"
+    param_names = ()
+
+    def __init__(self, k: float, c: float, dt: float = PAPER_DT) -> None:
+        self.k, self.c = float(k), float(c)
+        super().__init__(dt)
+
+    @property
+    def n_state(self) -> int:
+        return 1
+
+    def _advance(self, x, v, out):
+        for t in range(x.shape[0]):
+            out[t] = self.k * x[t] + self.c * (x[t] - self.state[0]) / self.dt
+            self.state[0] = x[t]
+
+    def copy(self):
+        return DiffKV(self.k, self.c, self.dt)
