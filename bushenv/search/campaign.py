@@ -173,6 +173,14 @@ class _Throttled:
             self.log(self.prefix + msg)
 
 
+def _near(a: np.ndarray, b: np.ndarray) -> bool:
+    """Same length and within 5 % of the larger peak everywhere: one case is enough."""
+    if a.size != b.size:
+        return False
+    peak = max(float(np.max(np.abs(a))), float(np.max(np.abs(b))), 1e-9)
+    return float(np.max(np.abs(a - b))) <= 0.05 * peak
+
+
 def _label(spec: str) -> str:
     return Path(spec).stem if spec.endswith(".npz") else spec
 
@@ -432,14 +440,14 @@ class Campaign:
         return picks
 
     def shrink_and_save(self) -> None:
-        from bushenv.search.corpus import make_case, model_sha, profile_sha, save_case
+        from bushenv.search.corpus import make_case, model_sha, save_case
         from bushenv.search.shrink import shrink
 
         if self.report["shrunk"]:
             self.log("shrink: done earlier (resumed)")
             return
         shrunk = []
-        seen: set[str] = set()
+        seen: list[np.ndarray] = []
         for i, (key, profile, meta) in enumerate(self._shrink_choices()):
             with self.evaluator(key) as ev:
                 try:
@@ -447,11 +455,11 @@ class Campaign:
                 except ValueError as exc:
                     self.log(f"shrink {i}: {exc}")
                     continue
-            digest = profile_sha(res.profile)
-            if digest in seen:  # two failures shrank to the same simplest profile
+            if any(_near(res.profile, other) for other in seen):
+                # two failures shrank to (nearly) the same simplest profile: keep one
                 self.log(f"shrink: {key}/{meta['family']} shrank to a profile already kept")
                 continue
-            seen.add(digest)
+            seen.append(res.profile)
             shas = {k: model_sha(self.specs[k], self.args.axis) for k in self.models}
             case = make_case(
                 res.profile,
