@@ -1,0 +1,332 @@
+"""bushenv benchmark: every speed and memory figure, measured side by side in ONE run.
+
+    python scripts/bench.py                      # full run, writes docs/benchmarks.md
+    python scripts/bench.py --quick              # CI: small sizes, checks each figure is produced
+    python scripts/bench.py --json bench.json    # every figure: name, value, unit, target, met
+
+Figures: batched free-run throughput of each model at B = 1, 64, 1024; single-step latency;
+env steps/s of BushRig-v0 and QuarterCar-v0 (single and vectorised) beside CartPole-v1 (single
+and its numpy-vectorised form); the papers' verification task (6.44 s at 204.8 Hz) and
+identification times; a campaign's evaluations/s and time to the first NN divergence; peak
+memory of a 10^6-step rollout and of a B = 1024 batch. This machine is shared and noisy:
+compare ratios measured in the same run, not absolute figures across runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import json
+import os
+import sys
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+ROOT = Path(__file__).resolve().parents[1]
+MODELS = ("linear", "nn", "hybrid", "boucwen", "rubber")
+
+
+class Figures:
+    def __init__(self) -> None:
+        self.rows: list[dict] = []
+
+    def add(self, name, value, unit, target=None, better="higher", note=""):
+        row = {"name": name, "value": float(value), "unit": unit, "note": note}
+        if target is not None:
+            met = value >= target if better == "higher" else value <= target
+            row.update(target=float(target), better=better, met=bool(met))
+            row["ratio_to_target"] = float(value / target) if target else None
+        self.rows.append(row)
+        t = ""
+        if target is not None:
+            t = f"  target {'>=' if better == 'higher' else '<='} {target:.4g}: "
+            t += "met" if row["met"] else "NOT met"
+        print(f"  {name:58s} {value:14.4g} {unit:14s}{t}", flush=True)
+        return value
+
+    def get(self, name):
+        return next(r["value"] for r in self.rows if r["name"] == name)
+
+
+def _time_per_call(fn, min_time: float, min_reps: int = 3) -> float:
+    fn()  # warm
+    reps, t0 = 0, time.perf_counter()
+    while reps < min_reps or time.perf_counter() - t0 < min_time:
+        fn()
+        reps += 1
+    return (time.perf_counter() - t0) / reps
+
+
+def bench_models(fig: Figures, quick: bool) -> None:
+    from bushenv.excitation import random_rpc
+    from bushenv.models import get_model
+
+    print("\n== models: batched free run (model-steps/s) and single-step latency")
+    T = 512 if quick else 4096
+    min_time = 0.05 if quick else 0.5
+    for name in MODELS:
+        model = get_model(name, axis="axial")
+        for B in (1, 64, 1024):
+            x = np.stack([random_rpc(1.0, T * model.dt, model.dt, seed=b) for b in range(B)], 1)
+            v = np.gradient(x, model.dt, axis=0)
+            sec = _time_per_call(lambda: model.simulate(x, v), min_time)  # noqa: B023
+            target = None
+            if B == 1024 and name == "nn":
+                target = 50e6
+            if B == 1024 and name == "boucwen":
+                target = 30e6
+            fig.add(f"free_run.{name}.B{B}", T * B / sec, "steps/s", target)
+        model.reset(1)
+        xs = random_rpc(1.0, 2.0, model.dt, seed=0)
+        vs = np.gradient(xs, model.dt)
+        n = len(xs)
+
+        def loop(m=model, xs=xs, vs=vs, n=n):
+            m.reset(1)
+            for i in range(n):
+                m.step(xs[i], vs[i])
+
+        sec = _time_per_call(loop, min_time)
+        fig.add(f"step_latency.{name}", 1e6 * sec / n, "us/step", better="lower")
+
+
+def bench_envs(fig: Figures, quick: bool) -> None:
+    import gymnasium as gym
+
+    import bushenv  # noqa: F401  registers the envs
+
+    print("\n== environments: env steps/s beside CartPole-v1 (same run)")
+    n_single = 2000 if quick else 20000
+
+    def rate_single(env, n):
+        env.reset(seed=0)
+        actions = np.stack([env.action_space.sample() for _ in range(256)])
+        t0 = time.perf_counter()
+        for i in range(n):
+            _, _, term, trunc, _ = env.step(actions[i % 256])
+            if term or trunc:
+                env.reset()
+        return n / (time.perf_counter() - t0)
+
+    cart = gym.make("CartPole-v1").unwrapped
+    cart.action_space.seed(0)
+    cart_rate = fig.add("env.CartPole-v1.single", rate_single(cart, n_single), "steps/s")
+    cart_us = 1e6 / cart_rate
+    nvec = 1024
+    cart_vec = gym.make_vec("CartPole-v1", num_envs=nvec, vectorization_mode="vector_entry_point")
+    cart_vec.reset(seed=0)
+    acts = np.stack([cart_vec.action_space.sample() for _ in range(16)])
+    steps = 50 if quick else 300
+    t0 = time.perf_counter()
+    for i in range(steps):
+        cart_vec.step(acts[i % 16])
+    fig.add("env.CartPole-v1.vector1024", steps * nvec / (time.perf_counter() - t0), "env-steps/s")
+
+    for env_id in ("BushRig-v0", "QuarterCar-v0"):
+        for name in MODELS:
+            try:
+                env = gym.make(env_id, model=name).unwrapped
+            except Exception as exc:  # report, never hide
+                print(f"  {env_id} {name}: cannot make: {exc}")
+                continue
+            env.action_space.seed(0)
+            r = rate_single(env, n_single // (4 if env_id == "QuarterCar-v0" else 1))
+            target = None
+            if env_id == "BushRig-v0" and name == "nn":
+                # at most 2.5x CartPole's per-step time
+                target = cart_rate / 2.5
+            fig.add(f"env.{env_id}.{name}.single", r, "steps/s", target)
+            fig.add(
+                f"env.{env_id}.{name}.single_us_over_cartpole_us",
+                (1e6 / r) / cart_us,
+                "ratio",
+                2.5 if target else None,
+                better="lower",
+            )
+        if env_id != "BushRig-v0":
+            continue
+        for name in MODELS:
+            try:
+                venv = gym.make_vec(
+                    env_id, num_envs=nvec, vectorization_mode="vector_entry_point", model=name
+                )
+            except Exception as exc:
+                print(f"  {env_id} vector {name}: cannot make: {exc}")
+                continue
+            venv.reset(seed=0)
+            acts = np.stack([venv.action_space.sample() for _ in range(16)])
+            t0 = time.perf_counter()
+            for i in range(steps):
+                venv.step(acts[i % 16])
+            rate = steps * nvec / (time.perf_counter() - t0)
+            fig.add(f"env.{env_id}.{name}.vector{nvec}", rate, "env-steps/s")
+            if name == "nn":
+                fig.add(
+                    f"env.{env_id}.nn.vector{nvec}_speedup_vs_cartpole_single",
+                    rate / cart_rate,
+                    "x",
+                    5.0,
+                )
+            venv.close()
+
+
+def bench_paper_tasks(fig: Figures, quick: bool) -> None:
+    from bushenv.excitation import random_rpc
+    from bushenv.identify import fit_model
+    from bushenv.machine import random_test
+    from bushenv.models import get_model
+
+    print("\n== the papers' tasks (theirs: verification 22 min NN / 4 s BW; ident 263 / 725 min)")
+    for name, theirs in (("nn", 22 * 60.0), ("boucwen", 4.0)):
+        model = get_model(name, axis="radial")
+        x = random_rpc(1.5, 6.44, model.dt, seed=3)
+        sec = _time_per_call(lambda m=model, x=x: m.simulate(x), 0.2)
+        fig.add(
+            f"verification_6.44s.{name}",
+            1e3 * sec,
+            "ms",
+            1.0 if name == "nn" else None,
+            better="lower",
+            note=f"theirs {theirs:g} s; speedup {theirs / sec:.3g}x",
+        )
+    if quick:
+        print("  (quick: identification timed on a 5 s record with a small budget)")
+    ref = get_model("rubber", axis="radial")
+    rec = random_test(ref, n_index=1.0, duration_s=5.0 if quick else 40.0, seed=0)
+    for name, target in (("nn", 60.0), ("boucwen", 120.0)):
+        opts = {"quick": True} if quick else {}
+        t0 = time.perf_counter()
+        try:
+            fit_model(name, rec.displacement, rec.force, rec.dt, seed=0, progress=False, **opts)
+        except TypeError:
+            fit_model(name, rec.displacement, rec.force, rec.dt, seed=0, progress=False)
+        fig.add(
+            f"identification.{name}",
+            time.perf_counter() - t0,
+            "s",
+            None if quick else target,
+            better="lower",
+            note="theirs 263 min" if name == "nn" else "theirs 725 min",
+        )
+
+
+def bench_campaign(fig: Figures, quick: bool) -> None:
+    print("\n== adversarial search: evaluations/s and time to the first NN divergence")
+    from bushenv.search import campaign
+
+    res = campaign.benchmark_search(budget=64 if quick else 512, seed=0)
+    fig.add("campaign.evaluations_per_s", res["evaluations_per_s"], "evals/s")
+    fig.add(
+        "campaign.nn.seconds_to_first_divergence", res["seconds_to_failure"], "s", better="lower"
+    )
+    fig.add("campaign.nn.evaluations_to_first_divergence", res["evaluations_to_failure"], "evals")
+
+
+def bench_memory(fig: Figures, quick: bool) -> None:
+    import gymnasium as gym
+
+    import bushenv  # noqa: F401
+    from bushenv.excitation import random_rpc
+    from bushenv.models import get_model
+
+    print("\n== memory (tracemalloc peak of Python + numpy allocations)")
+    n = 20_000 if quick else 1_000_000
+    env = gym.make("BushRig-v0", model="nn")
+    env.reset(seed=0)
+    actions = np.zeros((1024,) + env.action_space.shape, dtype=env.action_space.dtype)
+    gc.collect()
+    tracemalloc.start()
+    for i in range(n):
+        _, _, term, trunc, _ = env.step(actions[i % 1024])
+        if term or trunc:
+            env.reset()
+        if i == n // 10:
+            early = tracemalloc.get_traced_memory()[0]
+    late, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    fig.add(f"memory.rollout_{n}_steps.peak", peak / 2**20, "MiB")
+    fig.add(f"memory.rollout_{n}_steps.growth_after_10pct", (late - early) / 2**20, "MiB")
+    model = get_model("nn", axis="axial")
+    T = 2048 if not quick else 512
+    x = np.stack([random_rpc(1.0, T * model.dt, model.dt, seed=b) for b in range(1024)], 1)
+    gc.collect()
+    tracemalloc.start()
+    model.simulate(x)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    fig.add(f"memory.batch_B1024_T{T}.peak", peak / 2**20, "MiB", note="input itself excluded")
+
+
+SECTIONS = {
+    "models": bench_models,
+    "envs": bench_envs,
+    "paper": bench_paper_tasks,
+    "campaign": bench_campaign,
+    "memory": bench_memory,
+}
+
+
+def write_markdown(fig: Figures, path: Path, quick: bool) -> None:
+    lines = [
+        "# Benchmarks",
+        "",
+        f"Measured by `python scripts/bench.py{' --quick' if quick else ''}` in one run on "
+        f"{os.cpu_count()} cores ({time.strftime('%Y-%m-%d')}). Noisy shared machine: "
+        "compare ratios within this table.",
+        "",
+        "| figure | value | unit | target | met | note |",
+        "|---|---:|---|---:|---|---|",
+    ]
+    for r in fig.rows:
+        tgt = ""
+        if "target" in r:
+            tgt = f"{'>=' if r['better'] == 'higher' else '<='} {r['target']:.4g}"
+        met = "" if "met" not in r else ("yes" if r["met"] else "**no**")
+        lines.append(
+            f"| {r['name']} | {r['value']:.4g} | {r['unit']} | {tgt} | {met} | {r['note']} |"
+        )
+    path.write_text("\n".join(lines) + "\n")
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    p.add_argument("--quick", action="store_true", help="small sizes; checks figures exist")
+    p.add_argument("--json", type=Path, help="write every figure to this JSON file")
+    p.add_argument("--only", help="comma list of sections: " + ",".join(SECTIONS))
+    p.add_argument("--markdown", type=Path, default=None, help="table file (default docs/)")
+    args = p.parse_args(argv)
+    import torch
+
+    torch.set_num_threads(1)
+    from bushenv.models.kernels import warm_up
+
+    warm_up()
+    fig = Figures()
+    chosen = args.only.split(",") if args.only else list(SECTIONS)
+    failed = []
+    for name in chosen:
+        try:
+            SECTIONS[name](fig, args.quick)
+        except Exception as exc:  # a missing figure is a failure, reported by name
+            print(f"  section {name} FAILED: {type(exc).__name__}: {exc}")
+            failed.append(name)
+    if args.json:
+        args.json.write_text(json.dumps({"quick": args.quick, "figures": fig.rows}, indent=2))
+    md = args.markdown or (
+        ROOT / "docs" / ("benchmarks-quick.md" if args.quick else "benchmarks.md")
+    )
+    if not args.quick or args.markdown:
+        write_markdown(fig, md, args.quick)
+        print(f"\nwrote {md}")
+    if failed:
+        print(f"sections that produced no figures: {failed}")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
