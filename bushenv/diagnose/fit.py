@@ -529,6 +529,13 @@ def diagnose(
             partner = [m for m in with_best[0]["effect"].split("+") if m != best["effect"]]
             top_two = [best["effect"], partner[0]]
     say(f"named effect: {effect}")
+    notes = [
+        f"TEST {p.name} is the TRAIN record itself: its gap is not held out."
+        for p in te
+        if p.force.size == n_train
+        and np.array_equal(p.force, tr[0].force)
+        and np.array_equal(p.signals.x, tr[0].signals.x)
+    ]
 
     predictions = []
     for p, b in zip(te, base_pred, strict=True):
@@ -582,6 +589,7 @@ def diagnose(
             ],
         },
         "parameters": _parameters(aug_final, scales),
+        "notes": notes,
         "derivative_stencil": stencil,
         "train_fit_band_hz": noise_band_edge(tr[0].signals.x, tr[0].dt),
         "predictions": predictions,

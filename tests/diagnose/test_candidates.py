@@ -116,3 +116,9 @@ def test_other_baselines_refuse_a_test_at_another_rate(monkeypatch):
     test = record(9, "none", dt=1 / 512, duration_s=10.0, name="fast")
     with pytest.raises(ValueError, match=r"TEST fast: sampled at 512 Hz but TRAIN at 204\.8 Hz"):
         diagnose(train, [test], baseline="nn")
+
+
+def test_a_test_equal_to_train_is_flagged_as_not_held_out():
+    train = record(10, "none", duration_s=8.0)
+    result = diagnose(train, [train], test_names=["same"])
+    assert result["notes"] == ["TEST same is the TRAIN record itself: its gap is not held out."]
