@@ -37,6 +37,7 @@ from bushenv.rigs.common import (
 ENV_ID = "QuarterCar-v0"
 AXES = ("radial", "axial")  # radial: vertical at the arm's inner end; axial: along the arm
 OBS_SIZE = 12
+DAMPING_ANGLE_STEP = 0.005  # rad; see Car.update_damping
 
 
 def axis_models(spec: Any, dt: float, reference: bool) -> dict[str, BushingModel]:
@@ -212,10 +213,17 @@ class Car:
             body.angular_velocity = 0.0
         self.radial.release()
         self.axial.release()
-        self.update_damping()
+        self._damping_angle = 0.0
+        self.update_damping(force=True)
 
-    def update_damping(self) -> None:
-        """Implicit-Euler dampers for the current configuration (once per model step)."""
+    def update_damping(self, force: bool = False) -> None:
+        """Implicit-Euler dampers for the current configuration. The effective masses they use
+        change only with the arm's angle, so they are recomputed when it has moved by more
+        than ``DAMPING_ANGLE_STEP`` (0.3 degree) since the last time (or when ``force``)."""
+        angle = self.unsprung.angle
+        if not force and abs(angle - self._damping_angle) < DAMPING_ANGLE_STEP:
+            return
+        self._damping_angle = angle
         self.radial.update_damping()
         self.axial.update_damping()
         top = self.chassis.local_to_world(self.coil_top)
