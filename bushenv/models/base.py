@@ -320,6 +320,13 @@ def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel
                 f"{path}: parameter {key!r} holds {a.dtype} data, expected real numbers"
             )
         want = shapes.get(key)
+        if want is not None and not (
+            isinstance(want, list) and all(type(n) is int and n >= 0 for n in want)
+        ):
+            raise ModelError(
+                f"{path}: corrupt __meta__ entry (shape of {key!r} is {want!r}, "
+                "expected a list of sizes)"
+            )
         if want is not None and list(a.shape) != list(want):
             raise ModelError(
                 f"{path}: parameter {key!r} has shape {list(a.shape)}, "

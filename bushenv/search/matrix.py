@@ -34,6 +34,7 @@ EXAMPLE = (
 )
 WALL_CLOCK_FIELDS = ("seconds", "seconds_to_failure", "wall_s", "worker_backend")
 CELL_KEYS = ("model", "axis", "searcher", "seed", "budget", "env")
+MAX_SEEDS = 100_000  # a typo like 0-1000000000 must not build a billion cells
 
 
 class MatrixError(ValueError):
@@ -51,6 +52,11 @@ def parse_seeds(text: str) -> list[int]:
                 a, b = int(lo), int(hi)
                 if b < a:
                     raise MatrixError(f"seed range {part!r} runs backwards")
+                if b - a + 1 + len(seeds) > MAX_SEEDS:
+                    raise MatrixError(
+                        f"--seeds {text!r} names {b - a + 1 + len(seeds)} seeds, more than "
+                        f"{MAX_SEEDS} (one search run each)"
+                    )
                 seeds.extend(range(a, b + 1))
             elif part:
                 seeds.append(int(part))
@@ -90,12 +96,12 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
 
     torch.set_num_threads(1)
     from bushenv.models import get_model
-    from bushenv.reference.rubber import RubberBushing
+    from bushenv.search.corpus import truth_reference
     from bushenv.search.evaluate import BatchEvaluator
     from bushenv.search.searchers import get_searcher
 
-    model = get_model(cell["model"], axis=cell["axis"])
-    reference = RubberBushing.preset(cell["axis"], dt=model.dt, measurement=False)
+    reference = truth_reference(cell["axis"])
+    model = get_model(cell["model"], axis=cell["axis"], dt=reference.dt)
     t0 = time.perf_counter()
     with BatchEvaluator(model, reference, env=cell["env"], threads=1, axis=cell["axis"]) as ev:
         result = get_searcher(cell["searcher"]).run(ev, cell["budget"], seed=cell["seed"])
