@@ -515,6 +515,13 @@ def check_bushrig_nan_model(case) -> None:
 
     start, values = case
     env = gym.make("BushRig-v0", model=NanFrom(start), reference="linear")
+    try:
+        _nan_model_episode(env, start, values)
+    finally:
+        env.close()
+
+
+def _nan_model_episode(env, start: int, values) -> None:
     env.reset(seed=0)
     for k, value in enumerate(values, start=1):
         obs, reward, term, trunc, info = env.step(as_action(value, "float32"))
@@ -584,17 +591,21 @@ TARGETS = {
 }
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _close_cached_envs():
+def close_cached_envs() -> None:
     """Free the envs (and their pymunk spaces) while pymunk is still importable: a space
     freed during interpreter shutdown prints an ignored-exception traceback."""
-    yield
     import gc
 
     for env in _ENVS.values():
         env.close()
     _ENVS.clear()
     gc.collect()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _close_cached_envs():
+    yield
+    close_cached_envs()
 
 
 # ===== the fast-suite tests =====================================================================
@@ -667,3 +678,24 @@ def test_fuzz_targets_cover_every_loader_and_action_space():
 def test_seed_model_files_load_untouched(name):
     assert isinstance(load_model_bytes(model_files()[name]), BushingModel)
     assert zipfile.is_zipfile(_as_file(model_files()[name]))
+
+
+def test_fuzz_script_counts_crashes_and_keeps_going(monkeypatch):
+    import importlib.util
+
+    from hypothesis import strategies as hs
+
+    path = Path(__file__).resolve().parents[1] / "scripts" / "fuzz.py"
+    spec = importlib.util.spec_from_file_location("fuzz_script", path)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+
+    def odd_fails(n: int) -> None:
+        if n % 2:
+            raise ValueError(f"odd {n}\nsecond line")
+
+    monkeypatch.setitem(TARGETS, "odd", (hs.integers(0, 10**6), odd_fails))
+    stats = script.run_target("odd", 200, run_seed=0)
+    assert stats["examples"] == 200
+    assert 0 < stats["crashes"] < 200
+    assert all(line.startswith("ValueError: odd ") for line in stats["errors"])
