@@ -44,10 +44,6 @@ def available(name: str, axes=("axial", "radial")) -> bool:
 REPEATS = 3
 
 
-def best_of(fn, *args) -> float:
-    return min(fn(*args) for _ in range(REPEATS))
-
-
 def time_single(env, actions) -> float:
     """Seconds per env step over ``actions`` (resets on episode end are included)."""
     env.reset(seed=0)
@@ -112,56 +108,54 @@ def main(argv: list[str] | None = None) -> int:
     n = args.num_envs
     rows = []
 
-    def report(r):
-        rows.append(r)
-        print(
-            f"  {r['env']:<14} {r['model']:<8} {r['mode']:<18} N={r['num_envs']:<5} "
-            f"{r['us_per_env_step']:9.3f} us/env-step  x{r['x_cartpole_single']:.2f}",
-            flush=True,
-        )
-
-    print("CartPole-v1 (yardstick)", flush=True)
-    cp_actions = rng.integers(0, 2, args.steps)
-    cp = best_of(time_single, gym.make("CartPole-v1"), [int(a) for a in cp_actions])
-    cartpole_us = cp * 1e6
-    report(row("CartPole-v1", "-", "single", 1, cp, 0.0))
+    # every measurement is a job; the jobs run round-robin ``repeats`` times and each keeps
+    # its best, so a busy moment on the shared cores cannot skew one ratio against another
+    jobs = []  # (env, model, mode, num_envs, callable -> seconds per step)
+    cp_actions = [int(a) for a in rng.integers(0, 2, args.steps)]
+    cp = gym.make("CartPole-v1")
+    jobs.append(("CartPole-v1", "-", "single", 1, lambda: time_single(cp, cp_actions)))
     cpv = gym.make_vec("CartPole-v1", num_envs=n, vectorization_mode="vector_entry_point")
-    acts = rng.integers(0, 2, (args.vector_steps, n))
-    report(
-        row("CartPole-v1", "-", "vector (numpy)", n, best_of(time_vector, cpv, acts), cartpole_us)
-    )
+    cp_vacts = rng.integers(0, 2, (args.vector_steps, n))
+    jobs.append(("CartPole-v1", "-", "vector (numpy)", n, lambda: time_vector(cpv, cp_vacts)))
 
     models = [m for m in args.models if available(m)]
     missing = sorted(set(args.models) - set(models))
     if missing:
         print(f"models without a default file here (skipped): {missing}", flush=True)
-
-    print("BushRig-v0", flush=True)
     for m in models:
-        acts = rng.uniform(-1, 1, (args.steps, 1)).astype(np.float32)
+        acts = list(rng.uniform(-1, 1, (args.steps, 1)).astype(np.float32))
         env = gym.make("BushRig-v0", model=m)
-        report(
-            row("BushRig-v0", m, "single", 1, best_of(time_single, env, list(acts)), cartpole_us)
-        )
+        jobs.append(("BushRig-v0", m, "single", 1, lambda e=env, a=acts: time_single(e, a)))
         venv = gym.make_vec(
             "BushRig-v0", num_envs=n, vectorization_mode="vector_entry_point", model=m
         )
         vacts = rng.uniform(-1, 1, (args.vector_steps, n, 1)).astype(np.float32)
-        sec = best_of(time_vector, venv, vacts)
-        report(row("BushRig-v0", m, "vector (arrays)", n, sec, cartpole_us))
-
-    print("QuarterCar-v0", flush=True)
+        jobs.append(
+            ("BushRig-v0", m, "vector (arrays)", n, lambda e=venv, a=vacts: time_vector(e, a))
+        )
     for m in models:
-        acts = rng.uniform(-0.3, 0.3, (args.quartercar_steps, 1)).astype(np.float32)
+        acts = list(rng.uniform(-0.3, 0.3, (args.quartercar_steps, 1)).astype(np.float32))
         env = gym.make("QuarterCar-v0", model=m)
-        report(
-            row("QuarterCar-v0", m, "single (pymunk)", 1, time_single(env, list(acts)), cartpole_us)
+        jobs.append(
+            ("QuarterCar-v0", m, "single (pymunk)", 1, lambda e=env, a=acts: time_single(e, a))
         )
         batch = QuarterCarBatch(n, model=m)
         road = np.clip(np.cumsum(rng.uniform(-0.01, 0.01, (200, n)), axis=0), -0.1, 0.1)
         batch.simulate(road[:20])  # warm-up
-        sec = best_of(time_batch, batch, road)
-        report(row("QuarterCar-v0", m, "QuarterCarBatch", n, sec, cartpole_us))
+        jobs.append(
+            ("QuarterCar-v0", m, "QuarterCarBatch", n, lambda b=batch, r=road: time_batch(b, r))
+        )
+
+    best = [float("inf")] * len(jobs)
+    for rep in range(REPEATS):
+        print(f"round {rep + 1}/{REPEATS}", flush=True)
+        for k, (env_id, m, mode, num, fn) in enumerate(jobs):
+            best[k] = min(best[k], fn())
+            print(f"  {env_id:<14} {m:<8} {mode:<18} {best[k] * 1e6 / num:9.3f} us/env-step",
+                  flush=True)  # fmt: skip
+    cartpole_us = best[0] * 1e6
+    for (env_id, m, mode, num, _), sec in zip(jobs, best, strict=True):
+        rows.append(row(env_id, m, mode, num, sec, cartpole_us))
 
     print()
     print(f"{'env':<14} {'model':<8} {'mode':<18} {'N':>5} {'env-steps/s':>13} "

@@ -25,8 +25,10 @@ from bushenv.rigs.common import (
     positive_int,
     resolve_model,
     resolve_reference,
+    space_stepper,
     spec_kwargs,
     unit_action,
+    velocity_setter,
 )
 
 ENV_ID = "BushRig-v0"
@@ -226,6 +228,8 @@ class BushRigEnv(gym.Env):
             self.ground, self.actuator, (-0.05, 0.0), (0.05, 0.0), (0.0, 0.0)
         )
         self.space.add(self.groove)
+        self._space_step = space_stepper(self.space)
+        self._set_actuator_velocity = velocity_setter(self.actuator)
 
     # ----- gymnasium -----------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
@@ -279,9 +283,9 @@ class BushRigEnv(gym.Env):
             reason = f"model raised {type(exc).__name__}: {exc}"
         f_r = self.reference.step(x, v)
 
-        self.actuator.velocity = (v, 0.0)
+        self._set_actuator_velocity(v, 0.0)
         for _ in range(p.substeps):
-            self.space.step(self._h)
+            self._space_step(self._h)
 
         obs = self._obs
         obs[:, 1:] = obs[:, :-1]

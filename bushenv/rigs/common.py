@@ -401,6 +401,47 @@ class SplitBushing:
         self.spring.rest_length = LONG_ARM_M
 
 
+def space_stepper(space):
+    """``space.step`` without pymunk's per-call Python bookkeeping (it re-checks masses and
+    processes deferred additions; our spaces add nothing while stepping): calls chipmunk's
+    cpSpaceStep directly, 3-5 us less per sub-step. Falls back to ``space.step``."""
+    try:
+        from pymunk._chipmunk import lib
+
+        space.step(0.0)  # pymunk's one-off checks of the bodies, no motion
+        handle = space._space
+        cp_step = lib.cpSpaceStep
+
+        def step(dt: float) -> None:
+            cp_step(handle, dt)
+
+        return step
+    except (ImportError, AttributeError):  # another pymunk layout
+        return space.step
+
+
+def velocity_setter(body):
+    """``body.velocity = (vx, vy)`` through chipmunk directly (pymunk's attribute machinery
+    costs ~1 us a call); falls back to the attribute."""
+    try:
+        from pymunk._chipmunk import lib
+
+        handle = body._body
+        cp_set = lib.cpBodySetVelocity
+        cp_set(handle, (0.0, 0.0))
+
+        def set_velocity(vx: float, vy: float) -> None:
+            cp_set(handle, (vx, vy))
+
+        return set_velocity
+    except (ImportError, AttributeError, TypeError):
+
+        def set_velocity(vx: float, vy: float) -> None:
+            body.velocity = (vx, vy)
+
+        return set_velocity
+
+
 # ----- drawing -------------------------------------------------------------------------------
 class Canvas:
     """A pygame surface for ``rgb_array`` frames, or a window for ``human``."""
