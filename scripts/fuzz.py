@@ -25,14 +25,6 @@ sys.path.insert(0, str(ROOT))
 
 import test_fuzz  # noqa: E402  (the shared oracles)
 
-# Env targets run whole episodes: fewer examples for the same wall time.
-ENV_SHARE = {
-    "bushrig_actions": 1.0,
-    "bushrig_nan_model": 0.5,
-    "vector_actions": 1.0,
-    "quartercar_actions": 0.25,
-}
-
 
 def run_target(name: str, examples: int, run_seed: int) -> dict:
     strategy, check = test_fuzz.TARGETS[name]
@@ -64,7 +56,7 @@ def run_target(name: str, examples: int, run_seed: int) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--examples", type=int, default=3000, help="per loader target")
+    parser.add_argument("--examples", type=int, default=3000, help="per target")
     parser.add_argument("--seed", type=int, default=None, help="default: time-based")
     parser.add_argument("--only", default="", help="comma list of targets (default: all)")
     args = parser.parse_args(argv)
@@ -75,13 +67,12 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         parser.error(f"unknown target(s) {unknown}; known: {sorted(test_fuzz.TARGETS)}")
     run_seed = args.seed if args.seed is not None else int(time.time())
-    print(f"fuzz seed {run_seed}; {args.examples} examples per loader target", flush=True)
+    print(f"fuzz seed {run_seed}; {args.examples} examples per target", flush=True)
     print(f"{'target':20s} {'examples':>9s} {'crashes':>8s} {'seconds':>8s}", flush=True)
     total = {"examples": 0, "crashes": 0, "seconds": 0.0}
     errors: dict[str, dict[str, int]] = {}
     for name in names:
-        n = max(1, int(args.examples * ENV_SHARE.get(name, 1.0)))
-        stats = run_target(name, n, run_seed)
+        stats = run_target(name, args.examples, run_seed)
         print(
             f"{name:20s} {stats['examples']:9d} {stats['crashes']:8d} {stats['seconds']:8.1f}",
             flush=True,
