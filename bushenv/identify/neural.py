@@ -49,9 +49,9 @@ class NarxTrainingOptions:
     val_fraction: float = 0.2
     teacher_steps: int = 2000
     teacher_lr: float = 1e-2
-    window_lengths: tuple[int, ...] = (20, 60, 150)
-    iters_per_length: tuple[int, ...] = (150, 150, 300)
-    batch_windows: int = 32
+    window_lengths: tuple[int, ...] = (20, 100, 400)  # 0.1, 0.5, 2 s at 204.8 Hz
+    iters_per_length: tuple[int, ...] = (150, 150, 150)
+    batch_windows: int = 16
     free_run_lr: float = 3e-3
     grad_clip: float = 1.0
     weight_decay: float = 0.0
