@@ -432,3 +432,13 @@ def test_python_dash_m_catches_the_same_cli_errors_as_the_installed_command(tmp_
     assert done.stderr.strip() == (
         "bushenv campaign: error: --budget must be a positive number of evaluations, got 0"
     )
+
+
+@pytest.mark.parametrize("budget", ["0", "-3"])
+def test_attack_refuses_a_budget_below_one(tmp_path, capsys, budget):
+    module_or_skip("attack")
+    argv = ["attack", "--model", "linear", "--budget", budget, "--out", str(tmp_path / "a")]
+    code, _, err = run_cli(argv, capsys)
+    assert code == 2
+    assert_one_line_error(err, "attack", "--budget and --rl-budget must be >= 1")
+    assert not (tmp_path / "a").exists()
