@@ -40,9 +40,9 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_bad_inputs_envs import BadAfter  # NaN from sample after + 1 on
 
 from bushenv.models import BushingModel, ModelError, load_model
-from bushenv.models.base import PAPER_DT
 from bushenv.records import (
     MAX_PLAUSIBLE_DISPLACEMENT_M,
     MAX_PLAUSIBLE_FORCE_N,
@@ -486,35 +486,13 @@ def check_bushrig_actions(case) -> None:
             break
 
 
-class NanFrom(BushingModel):
-    """Test double: a spring k x that returns NaN from step ``start`` on (1-based)."""
-
-    name = ""
-
-    def __init__(self, start: int, dt: float = PAPER_DT):
-        self.start = int(start)
-        super().__init__(dt)
-
-    @property
-    def n_state(self) -> int:
-        return 1
-
-    def _advance(self, x, v, out):
-        for t in range(x.shape[0]):
-            self.state[0] += 1
-            out[t] = np.where(self.state[0] >= self.start, np.nan, 4e5 * x[t])
-
-    def copy(self):
-        return NanFrom(self.start, self.dt)
-
-
 def check_bushrig_nan_model(case) -> None:
     import gymnasium as gym
 
     import bushenv  # noqa: F401
 
     start, values = case
-    env = gym.make("BushRig-v0", model=NanFrom(start), reference="linear")
+    env = gym.make("BushRig-v0", model=BadAfter(after=start - 1), reference="linear")
     try:
         _nan_model_episode(env, start, values)
     finally:
