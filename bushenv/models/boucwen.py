@@ -26,7 +26,7 @@ Integration (``kernels.boucwen_kernel``): RK4 over each sample with x and x' int
 linearly inside it; before every sub-step the stiffest eigenvalue of eqs. 1-4 is estimated,
 |lambda| ~ (k0 + k1 + a1 G1)/c1 + (k2 + a2 G2)/(c0 + c2) + the |z|^n slope terms, with
 G = A + (|beta| + |gamma|) |z|^n, and the sub-step is chosen so that h |lambda| <= 2.0 (RK4's
-real-axis stability limit is 2.785). For the Table 3 preset that is ~20-60 sub-steps per
+real-axis stability limit is 2.785). For the Table 3 preset that is ~20-30 sub-steps per
 204.8 Hz sample on a 2 mm record, more on large fast inputs. Nothing is clamped: a parameter
 set that needs more than 200 000 sub-steps in one sample gives NaN and ``simulate`` raises.
 """
