@@ -143,6 +143,12 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if (out / "report.json").exists() and not args.force:
         raise CliError(f"{out}/report.json exists; pass --force to overwrite it")
+    if args.seed < 0:
+        raise CliError(f"--seed must be >= 0, got {args.seed}")
+    for name in ("identification_s", "verification_s"):
+        if not getattr(args, name) >= 6.44:
+            flag = "--" + name.replace("_", "-")
+            raise CliError(f"{flag} must be at least 6.44 s, got {getattr(args, name)}")
     axes = [a.strip() for a in args.axes.split(",") if a.strip()]
     for a in axes:
         if a not in AXES:

@@ -19,7 +19,7 @@ def quick_report(tmp_path_factory):
             "radial",
             "--shipped",
             "--identification-s",
-            "6",
+            "6.44",
             "--verification-s",
             "6.44",
         ]
@@ -53,3 +53,18 @@ def test_existing_report_is_not_overwritten(quick_report, capsys):
     code = main(["reproduce", "--out", str(quick_report), "--axes", "radial", "--shipped"])
     assert code == 2
     assert "exists; pass --force" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--seed", "-1"], "--seed must be >= 0"),
+        (["--identification-s", "1"], "--identification-s must be at least 6.44 s"),
+        (["--axes", "vertical"], "unknown axis 'vertical'"),
+    ],
+)
+def test_bad_arguments_are_refused_before_measuring(tmp_path, capsys, argv, message):
+    code = main(["reproduce", "--out", str(tmp_path / "r"), *argv])
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()
