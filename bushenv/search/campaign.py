@@ -207,10 +207,6 @@ class Campaign:
         bad = [s for s in searchers if s not in known]
         if bad or not searchers:
             raise CampaignError(f"--searchers: unknown {bad}; choose from {list(known)}")
-        if a.env == "quartercar" and any(s in RL_SEARCHERS for s in searchers):
-            raise CampaignError(
-                "--env quartercar: the RL agents drive BushRig-v0 only; use --searchers random,cma"
-            )
         self.searchers = searchers
         if self.report_path.exists() and not (a.resume or a.force):
             raise CampaignError(

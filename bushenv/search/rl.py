@@ -27,8 +27,11 @@ episodes for the same seed. The vector env auto-resets on the step after an epis
 ("next-step" mode); SB3 sees that step as one extra no-op transition from the rest state
 (observation zeros, reward 0), which is harmless: the rig truly is at rest then.
 
-QuarterCar-v0 is not driven by the agents yet (see docs/search.md): road searches use random
-search and CMA-ES over the bump and pothole families.
+For road searches (``env="quartercar"``) the agents drive QuarterCar-v0's car through
+``QuarterCarBatch``, its array integrator (the pymunk env itself costs milliseconds per step;
+there is no vector entry point), with QuarterCar-v0's 12 observations and a gentler action
+(``ROAD_ACTION_SCALE``, ``ROAD_DEAD_ZONE``); the episodes' roads are judged like any other
+road profile.
 """
 
 from __future__ import annotations
@@ -38,6 +41,12 @@ import numpy as np
 from bushenv.search.divergence import FORCE_FLOOR_N
 from bushenv.search.searchers import Searcher, SearchError
 
+# Road agents: QuarterCar-v0's full action (50 mm per 4.9 ms step, 10 m/s) on a random policy
+# throws the twin car against its bump stops within 0.1-0.3 s, after which nothing can be
+# judged; the agent's road step is a fifth of it (2 m/s road rate), and |a| < 0.1 holds the
+# road (a hold is where the free response is judged).
+ROAD_ACTION_SCALE = 0.2
+ROAD_DEAD_ZONE = 0.1
 N_ENVS = 32  # one policy call serves 32 rigs: SB3's per-call cost dominates below that
 EPISODE_S = 10.0  # the rig's default episode: the papers' 10 s records (seed 001)
 DENSE_CAP = 5.0
@@ -167,8 +176,122 @@ def _sb3_vec_env(venv):
     return RigVecEnv(venv)
 
 
+def _road_vec_env(evaluator, n_envs, episode_steps, on_episodes):
+    """SB3 ``VecEnv``: ``n_envs`` QuarterCar-v0 cars driven by the agent's road, as arrays.
+
+    The car is ``QuarterCarBatch`` (the QuarterCar-v0 car as one compiled array integrator,
+    agreement with the pymunk env tested in tests/rigs), the model under test on the attacked
+    axis and a twin on the rubber. Observations follow QuarterCar-v0's docstring (12 scaled
+    values); the action is the road height change per step as a fraction of
+    ``ROAD_ACTION_SCALE * max_road_step_m``, ``|a| < ROAD_DEAD_ZONE`` holding the road. All
+    cars run episodes of the same length and reset together; at the end the roads are judged
+    by ``evaluator`` (the same batched quarter-car path as random search).
+    """
+    from gymnasium import spaces
+    from stable_baselines3.common.vec_env.base_vec_env import VecEnv
+
+    from bushenv.search.roads import make_cars
+
+    axis = evaluator.axis
+
+    class RoadVecEnv(VecEnv):
+        def __init__(self) -> None:
+            self.car = make_cars(
+                evaluator.model, evaluator.reference, n_envs, evaluator.dt, axis, episode_steps
+            )
+            self.p = self.car.params
+            obs = spaces.Box(-1.0, 1.0, shape=(12,), dtype=np.float32)
+            act = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
+            super().__init__(n_envs, obs, act)
+            self._actions = None
+            self._restart()
+
+        def _restart(self) -> None:
+            self.car.reset()
+            self.h = np.zeros(self.num_envs)
+            self.roads: list[np.ndarray] = []
+            self.peak = np.full(self.num_envs, FORCE_FLOOR_N)
+
+        def reset(self):
+            self._restart()
+            return np.zeros((self.num_envs, 12), dtype=np.float32)
+
+        def step_async(self, actions) -> None:
+            self._actions = np.asarray(actions, dtype=np.float64).reshape(self.num_envs)
+
+        def _observe(self, out) -> np.ndarray:
+            p = self.p
+            cols = [
+                out["road_height_m"] / p.max_road,
+                out["chassis_y_m"] / p.max_body,
+                out["chassis_vy_m_per_s"] / p.v_scale,
+                out["wheel_y_m"] / p.max_body,
+                out["wheel_vy_m_per_s"] / p.v_scale,
+                out["radial_deflection_m"] / p.max_deflection,
+                out["axial_deflection_m"] / p.max_deflection,
+                out["force_radial_model_n"] / p.force_limit,
+                out["force_axial_model_n"] / p.force_limit,
+                out["force_radial_reference_n"] / p.force_limit,
+                out["force_axial_reference_n"] / p.force_limit,
+                (out["chassis_y_m"] - out["reference_chassis_y_m"]) / p.max_body,
+            ]
+            obs = np.nan_to_num(np.stack(cols, axis=1), nan=0.0, posinf=1.0, neginf=-1.0)
+            return np.clip(obs, -1.0, 1.0).astype(np.float32)
+
+        def step_wait(self):
+            p = self.p
+            a = np.clip(np.nan_to_num(self._actions, nan=0.0), -1.0, 1.0)
+            a = np.where(np.abs(a) < ROAD_DEAD_ZONE, 0.0, a)  # lets the agent hold the road
+            step = ROAD_ACTION_SCALE * p.max_road_step
+            self.h = np.clip(self.h + a * step, -p.max_road, p.max_road)
+            out = self.car.step(self.h)
+            self.roads.append(self.h.copy())
+            obs = self._observe(out)
+            fm = out[f"force_{axis}_model_n"]
+            fr = out[f"force_{axis}_reference_n"]
+            np.maximum(self.peak, np.abs(fr), out=self.peak)
+            with np.errstate(invalid="ignore"):
+                dense = np.abs(fm - fr) / self.peak
+            dense = np.where(np.isfinite(dense), np.minimum(dense, DENSE_CAP), DENSE_CAP)
+            reward = dense / episode_steps
+            dones = np.zeros(self.num_envs, dtype=bool)
+            infos = [{} for _ in range(self.num_envs)]
+            if len(self.roads) >= episode_steps:
+                road = np.stack(self.roads, axis=1)  # (n, T)
+                batch = evaluator.evaluate(list(road))
+                rob = np.clip(batch.verdict.robustness, -ROBUSTNESS_CLIP, ROBUSTNESS_CLIP)
+                reward = reward - rob
+                on_episodes(batch)
+                dones[:] = True
+                for i in range(self.num_envs):
+                    infos[i]["terminal_observation"] = obs[i].copy()
+                    infos[i]["TimeLimit.truncated"] = True
+                obs = self.reset()
+            return obs, reward.astype(np.float32), dones, infos
+
+        def close(self) -> None:
+            pass
+
+        def seed(self, seed=None):
+            return [seed] * self.num_envs
+
+        def get_attr(self, attr_name, indices=None):
+            return [getattr(self, attr_name, None)] * self.num_envs
+
+        def set_attr(self, attr_name, value, indices=None) -> None:
+            setattr(self, attr_name, value)
+
+        def env_method(self, method_name, *args, indices=None, **kwargs):
+            return [None] * self.num_envs
+
+        def env_is_wrapped(self, wrapper_class, indices=None):
+            return [False] * self.num_envs
+
+    return RoadVecEnv()
+
+
 class RLSearch(Searcher):
-    """PPO or SAC in BushRig-v0; the budget counts episodes (one profile each)."""
+    """PPO or SAC in BushRig-v0 (or the QuarterCar-v0 car); the budget counts episodes."""
 
     def __init__(self, algo: str, n_envs: int = N_ENVS, episode_s: float = EPISODE_S) -> None:
         if algo not in ("ppo", "sac"):
@@ -178,10 +301,6 @@ class RLSearch(Searcher):
         self.episode_s = float(episode_s)
 
     def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
-        if evaluator.env != "rig":
-            raise SearchError(
-                f"{self.name}: only BushRig-v0 is driven by agents; use random or cma for roads"
-            )
         import torch
         from stable_baselines3 import PPO, SAC
         from stable_baselines3.common.callbacks import BaseCallback
@@ -203,16 +322,19 @@ class RLSearch(Searcher):
                 f"best robustness {recorder.best:.3g}"
             )
 
-        reward = DivergenceReward(n_envs, episode_steps, evaluator, on_episodes)
-        venv = _rig_vec_env(
-            evaluator.model.copy(),
-            evaluator.reference.copy(),
-            evaluator.axis,
-            n_envs,
-            episode_steps,
-            reward,
-        )
-        env = _sb3_vec_env(venv)
+        if evaluator.env == "rig":
+            reward = DivergenceReward(n_envs, episode_steps, evaluator, on_episodes)
+            venv = _rig_vec_env(
+                evaluator.model.copy(),
+                evaluator.reference.copy(),
+                evaluator.axis,
+                n_envs,
+                episode_steps,
+                reward,
+            )
+            env = _sb3_vec_env(venv)
+        else:
+            env = _road_vec_env(evaluator, n_envs, episode_steps, on_episodes)
 
         class StopAtBudget(BaseCallback):
             def _on_step(self) -> bool:
@@ -224,7 +346,7 @@ class RLSearch(Searcher):
                 "MlpPolicy",
                 env,
                 n_steps=128,
-                batch_size=1024,
+                batch_size=min(1024, 128 * n_envs),
                 n_epochs=4,
                 learning_rate=3e-4,
                 gamma=0.995,

@@ -33,21 +33,9 @@ def quarter_car_responses(
 ):
     """(Verdict, x_model, f_model, f_ref, None) for (T, B) roads; see the module docstring."""
     from bushenv.rigs.quartercar import check_road
-    from bushenv.rigs.quartercar_batch import QuarterCarBatch
 
-    if axis not in AXES:
-        raise ValueError(f"axis must be one of {AXES}, got {axis!r}")
-    other = "axial" if axis == "radial" else "radial"
-    other_ref = _reference_for(other, dt)
     T, B = road.shape
-    car = QuarterCarBatch(
-        B,
-        with_reference=True,
-        model={axis: model.copy(), other: other_ref.copy()},
-        reference={axis: reference.copy(), other: other_ref.copy()},
-        dt_s=dt,
-        episode_steps=max(T, 1),
-    )
+    car = make_cars(model, reference, B, dt, axis, max(T, 1))
     p = car.params
     h = check_road(road, p.max_road, p.max_road_step)
     car.reset()
@@ -70,6 +58,25 @@ def quarter_car_responses(
     fm, fr = rows[keys[2]], rows[keys[3]]
     verdict = judge(x, fm, fr, dt, lengths=judged, x_ref=x_ref, hold_input=h)
     return verdict, x, fm, fr, None
+
+
+def make_cars(model, reference, n: int, dt: float, axis: str, episode_steps: int):
+    """``QuarterCarBatch`` of ``n`` cars: ``model`` on ``axis`` (the other axis the rubber),
+    each with a twin on the rubber bushing alone."""
+    from bushenv.rigs.quartercar_batch import QuarterCarBatch
+
+    if axis not in AXES:
+        raise ValueError(f"axis must be one of {AXES}, got {axis!r}")
+    other = "axial" if axis == "radial" else "radial"
+    other_ref = _reference_for(other, dt)
+    return QuarterCarBatch(
+        n,
+        with_reference=True,
+        model={axis: model.copy(), other: other_ref.copy()},
+        reference={axis: reference.copy(), other: other_ref.copy()},
+        dt_s=dt,
+        episode_steps=episode_steps,
+    )
 
 
 def _reference_for(axis: str, dt: float) -> BushingModel:

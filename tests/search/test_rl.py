@@ -32,9 +32,17 @@ def test_rl_searcher_finds_an_easy_divergence(reference_axial):
     assert res.first_failure.family == "agent-ppo"
 
 
-def test_rl_refuses_the_quarter_car_and_unknown_algorithms(linear_axial, reference_axial):
+def test_rl_refuses_unknown_algorithms():
     with pytest.raises(SearchError, match="ppo' or 'sac"):
         RLSearch("dqn")
-    ev = BatchEvaluator(linear_axial, reference_axial, env="quartercar")
-    with pytest.raises(SearchError, match="random or cma"):
-        RLSearch("ppo").run(ev, 4)
+
+
+def test_rl_drives_the_quarter_car_and_judges_its_roads(linear_axial, reference_axial):
+    runs = []
+    for _ in range(2):
+        ev = BatchEvaluator(linear_axial, reference_axial, env="quartercar")
+        runs.append(RLSearch("ppo", n_envs=4, episode_s=0.5).run(ev, budget=8, seed=1))
+    res = runs[0]
+    assert res.evaluations == 8 and not res.diverged  # the linear control stays clean
+    assert res.worst.family == "agent-ppo" and res.worst.profile.size == 102
+    assert np.array_equal(res.worst.profile, runs[1].worst.profile)
