@@ -10,9 +10,10 @@ the same thing for every searcher.
 
 Parallelism: the batch is split into ``threads`` contiguous chunks evaluated by a thread pool;
 each chunk uses its own copies of the models. The kernels are numba ``nogil`` and most of
-``judge`` is numpy, so threads overlap without pickling the models (processes would have to ship
-the models and the (T, B) arrays both ways, which costs more than the simulation). Columns are
-independent, so the result is the same for any ``threads`` -- bit for bit (tested).
+``judge`` is numpy, so threads overlap without pickling anything; two worker processes measured
+about the same (docs/search.md) but need the models shipped and cannot share the reference
+cache. Columns are independent, so the result is the same for any ``threads`` -- bit for bit
+(tested).
 
 The reference's response to a profile does not depend on the model, so it is cached by the
 profile's bytes (a campaign re-judges the same profiles on the hybrid and the linear control).
