@@ -37,9 +37,15 @@ def test_register_all_can_run_twice_and_returns_the_ids():
     assert sorted(register_all()) == SPEC_IDS
 
 
-def test_a_checkout_reads_specs_from_the_envs_folder():
-    assert Path(str(spec_directory())) == SOURCE_SPEC_DIR == ROOT / "envs"
-    assert [p.name for p in spec_files()] == [f"{i}.toml" for i in SPEC_IDS]
+def test_the_specs_found_are_the_envs_folder_of_this_checkout():
+    # From a checkout (editable install) they are envs/ itself; from an installed wheel they
+    # are its bushenv/envs copy. Either way: the same files with the same contents.
+    assert SOURCE_SPEC_DIR == ROOT / "envs" or not Path(bushenv.__file__).is_relative_to(ROOT)
+    found = spec_files()
+    assert [p.name for p in found] == [f"{i}.toml" for i in SPEC_IDS]
+    for p in found:
+        assert p.read_text() == (ROOT / "envs" / p.name).read_text()
+    assert spec_directory() is not None
 
 
 def test_a_spec_whose_name_differs_from_its_id_is_refused(tmp_path):
@@ -68,7 +74,7 @@ def _install_like_a_wheel(site: Path) -> None:
     shutil.copytree(
         Path(bushenv.__file__).parent,
         site / "bushenv",
-        ignore=shutil.ignore_patterns("__pycache__", "*.npz"),
+        ignore=shutil.ignore_patterns("__pycache__", "*.npz", "envs"),
     )
     shutil.copytree(ROOT / "envs", site / "bushenv" / "envs")
 
