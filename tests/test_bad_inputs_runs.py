@@ -293,7 +293,6 @@ def test_damaged_regression_case_is_refused_naming_the_file(tmp_path, content, m
         load_case(path)
 
 
-@pytest.mark.xfail(reason="defect: corpus.load_case lets UnicodeDecodeError through")
 def test_binary_regression_case_is_refused_naming_the_file(tmp_path):
     from bushenv.search.corpus import CorpusError, load_case
 
@@ -332,7 +331,6 @@ def test_attack_resume_refuses_a_report_of_another_format(tmp_path, capsys):
     assert (out / "report.json").read_text() == "{}"
 
 
-@pytest.mark.xfail(reason="defect: attack --resume on a half-written report does not name it")
 @pytest.mark.parametrize("content", ['{"format": "bushenv-att', "[1, 2]"], ids=["torn", "list"])
 def test_attack_resume_refuses_a_half_written_report_naming_it(tmp_path, capsys, content):
     from bushenv.cli import main

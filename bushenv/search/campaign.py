@@ -268,8 +268,14 @@ class Campaign:
             "seconds": 0.0,
         }
         if a.resume and self.report_path.exists():
-            old = json.loads(self.report_path.read_text())
-            if old.get("format") != REPORT_FORMAT:
+            try:
+                old = json.loads(self.report_path.read_text(encoding="utf-8"))
+            except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+                raise CampaignError(
+                    f"{self.report_path}: corrupt or half-written report ({exc}); "
+                    "use --force to start again"
+                ) from None
+            if not isinstance(old, dict) or old.get("format") != REPORT_FORMAT:
                 raise CampaignError(f"{self.report_path}: not a bushenv attack report")
             if old.get("arguments") != fresh["arguments"] or old.get("searchers") != searchers:
                 raise CampaignError(

@@ -245,8 +245,8 @@ def save_case(case: Case, directory: str | os.PathLike, force: bool = False) -> 
 def load_case(path: str | os.PathLike) -> Case:
     path = Path(path)
     try:
-        d = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+        d = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise CorpusError(f"{path}: not a readable JSON case file: {exc}") from None
     if not isinstance(d, dict) or d.get("format") != CASE_FORMAT:
         raise CorpusError(f"{path}: not a bushenv divergence case (format tag missing)")
