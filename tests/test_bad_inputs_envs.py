@@ -4,8 +4,10 @@ on after the end never raises, and memory stays flat over long rollouts.
 
 tests/rigs/ already covers NaN/inf/huge actions (hypothesis), a model returning NaN or raising
 a ModelError, replayed excitations beyond the limits and memory over 5e3/1e6 steps; this file
-adds what those do not try. Known defects are ``xfail`` tests naming the defect (non-strict, so
-a fix shows as XPASS). The catalogue is docs/bad-inputs.md.
+adds what those do not try. The defects it found (non-numeric and wrong-shape actions, options
+that are not a dict, text excitations, arithmetic errors from a model, a quarter-car model force
+beyond the limit reaching the twin) are fixed; their tests close the file. The catalogue is
+docs/bad-inputs.md.
 """
 
 from __future__ import annotations
@@ -247,8 +249,7 @@ def test_vector_env_memory_stays_flat_over_1e6_steps(request):
     assert grown < 64 * 1024
 
 
-# ----- known defects (reported; remove the xfail once fixed) -------------------------------------
-@pytest.mark.xfail(reason="defect: rigs/common.unit_action raises a bare TypeError/ValueError")
+# ----- defects found here, since fixed in bushenv/rigs (were xfail) -----------------------------
 @pytest.mark.parametrize("action", [None, "abc", np.array([]), 1 + 2j], ids=repr)
 def test_non_numeric_action_is_refused_with_a_rig_error_naming_the_action_space(action):
     env = rig()
@@ -257,7 +258,6 @@ def test_non_numeric_action_is_refused_with_a_rig_error_naming_the_action_space(
         env.step(action)
 
 
-@pytest.mark.xfail(reason="defect: an action of 3 values silently uses the first")
 def test_action_of_the_wrong_shape_is_refused():
     env = rig()
     env.reset(seed=0)
@@ -265,7 +265,6 @@ def test_action_of_the_wrong_shape_is_refused():
         env.step(np.array([0.1, 0.9, -0.9], np.float32))
 
 
-@pytest.mark.xfail(reason="defect: rigs/vector.py raises numpy's reshape ValueError")
 def test_vector_env_action_of_the_wrong_shape_is_refused_naming_the_expected_shape():
     venv = gym.make_vec("BushRig-v0", num_envs=3, vectorization_mode="vector_entry_point")
     venv.reset(seed=0)
@@ -273,19 +272,16 @@ def test_vector_env_action_of_the_wrong_shape_is_refused_naming_the_expected_sha
         venv.step(np.zeros((2, 1), np.float32))
 
 
-@pytest.mark.xfail(reason="defect: reset(options=5) raises AttributeError")
 def test_reset_options_that_are_not_a_dict_are_refused():
     with pytest.raises(RigError, match="options"):
         rig().reset(options=5)
 
 
-@pytest.mark.xfail(reason="defect: a text excitation raises numpy's ValueError, not RigError")
 def test_text_excitation_is_refused_with_a_rig_error():
     with pytest.raises(RigError, match="excitation"):
         rig().reset(options={"excitation": "abc"})
 
 
-@pytest.mark.xfail(reason="defect: only ValueError from a model ends the episode")
 @pytest.mark.parametrize("error", [ZeroDivisionError("k/0"), FloatingPointError("overflow")])
 def test_model_raising_an_arithmetic_error_ends_the_episode(error):
     env = rig(model=BadAfter(after=3, error=error))
@@ -294,7 +290,6 @@ def test_model_raising_an_arithmetic_error_ends_the_episode(error):
     assert term and info["diverged"] and type(error).__name__ in info["divergence_reason"]
 
 
-@pytest.mark.xfail(reason="defect: the model car's blow-up turns the reference car's state NaN")
 def test_quartercar_model_force_beyond_the_limit_is_a_verdict_not_a_harsh_road():
     env = gym.make(
         "QuarterCar-v0", model={"radial": BadAfter(after=3, value=1e300), "axial": "linear"}

@@ -11,14 +11,17 @@ import pymunk
 from gymnasium import spaces
 
 from bushenv.rigs.common import (
+    MODEL_ERRORS,
     Canvas,
     ForceDeviationReward,
     RigError,
     Trace,
     call_reset,
     check_hook,
+    check_options,
     force_observation,
     model_label,
+    numeric_profile,
     per_axis,
     plot_traces,
     positive,
@@ -34,12 +37,13 @@ from bushenv.rigs.common import (
 ENV_ID = "BushRig-v0"
 AXES = ("axial", "radial")
 ACTUATOR_MASS_KG = 10.0  # piston and fixture; drawn only, the motion is prescribed
+MAX_HISTORY = 10_000  # samples per channel in the observation (3 x 10 000 float32 = 120 kB)
 
 
 def check_excitation(profile: Any, max_displacement_m: float, max_step_m: float) -> np.ndarray:
     """A replayable displacement profile: finite (T,) or (T, N), within the stroke, and each
     sample (the rig starting at rest at 0) at most ``max_step_m`` from the previous one."""
-    x = np.array(profile, dtype=np.float64)
+    x = numeric_profile("excitation", profile)
     if x.ndim not in (1, 2) or x.shape[0] < 1:
         raise RigError(f"excitation must have shape (T,) or (T, N) with T >= 1, got {x.shape}")
     bad = ~np.isfinite(x)
@@ -76,6 +80,11 @@ class RigParameters:
         self.substeps = positive_int("physics_substeps", kwargs["physics_substeps"])
         self.episode_steps = positive_int("episode_steps", kwargs["episode_steps"])
         self.history = positive_int("history", kwargs["history"])
+        if self.history > MAX_HISTORY:
+            raise RigError(
+                f"history must be at most {MAX_HISTORY} samples, got {self.history} (the "
+                f"observation holds 3 x history values)"
+            )
         self.max_x = positive("max_displacement_m", kwargs["max_displacement_m"])
         self.max_v = positive("max_velocity_m_per_s", kwargs["max_velocity_m_per_s"])
         self.force_limit = positive("force_limit_n", kwargs["force_limit_n"])
@@ -120,7 +129,9 @@ class BushRigEnv(gym.Env):
         x_k = clip(x_{k-1} + a * v_max * dt, -x_max, x_max)     v_max = 1.2566 m/s, x_max = 12.5 mm
 
     so |a| = 1 is the velocity limit (6.14 mm per step at 204.8 Hz). NaN counts as 0, values
-    beyond +-1 (also +-inf) as +-1. Nothing raises.
+    beyond +-1 (also +-inf) as +-1: no number raises. An action that is not one real number
+    (text, None, complex, an array of another shape) is refused with a ``RigError`` naming
+    the action space and the expected shape (1,).
 
     ## Observation Space
 
@@ -150,8 +161,10 @@ class BushRigEnv(gym.Env):
     ## Episode End
 
     Termination (the model's verdict, ``info["diverged"]``): the model's force is not finite or
-    the model raised an error; |F_model| > ``force_limit_n`` (25 kN, the machine's dynamic
-    force) while the reference stays within it; or ``divergence_monitor(info)`` is truthy.
+    the model raised an error (a ``ValueError`` such as ``ModelError``, or an
+    ``ArithmeticError``: ``ZeroDivisionError``, ``FloatingPointError``, ``OverflowError``);
+    |F_model| > ``force_limit_n`` (25 kN, the machine's dynamic force) while the reference
+    stays within it; or ``divergence_monitor(info)`` is truthy.
     Truncation: ``episode_steps`` steps (2048 = 10 s) or the end of a replayed excitation; or
     the reference itself needs more than the machine's 25 kN (``info["machine_limit"]``: the
     motion cannot be run on the real rig, so it judges nothing).
@@ -237,7 +250,8 @@ class BushRigEnv(gym.Env):
         p = self.params
         self._replay = None
         self._end = p.episode_steps
-        if options and options.get("excitation") is not None:
+        options = check_options(ENV_ID, options)
+        if options.get("excitation") is not None:
             x = check_excitation(options["excitation"], p.max_x, p.max_step)
             if x.ndim != 1:
                 raise RigError(f"excitation for one rig must be (T,), got {x.shape}")
@@ -264,7 +278,7 @@ class BushRigEnv(gym.Env):
         p = self.params
         x0 = self._x
         if self._replay is None:
-            x = x0 + unit_action(action) * p.max_step
+            x = x0 + unit_action(action, ENV_ID) * p.max_step
             if x > p.max_x:
                 x = p.max_x
             elif x < -p.max_x:
@@ -278,7 +292,7 @@ class BushRigEnv(gym.Env):
         reason = ""
         try:
             f_m = self.model.step(x, v)
-        except ValueError as exc:  # a model refusing to go on (e.g. Bouc-Wen blow-up)
+        except MODEL_ERRORS as exc:  # a model refusing to go on (Bouc-Wen's guard), 1/0, ...
             f_m = math.nan
             reason = f"model raised {type(exc).__name__}: {exc}"
         f_r = self.reference.step(x, v)

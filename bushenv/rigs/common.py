@@ -30,9 +30,11 @@ from __future__ import annotations
 
 import inspect
 import math
+import numbers
 import os
+import reprlib
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -47,6 +49,12 @@ SOURCE_SPEC_DIR = Path(__file__).resolve().parents[2] / "envs"
 
 class RigError(ValueError):
     """A rig argument, spec file or excitation is wrong; the message names it and the value."""
+
+
+# What a model's step may raise that ends its episode as a divergence instead of escaping the
+# env: a ValueError (ModelError: the model refusing to go on, e.g. Bouc-Wen's guard) or an
+# ArithmeticError (ZeroDivisionError, FloatingPointError under np.seterr, OverflowError).
+MODEL_ERRORS = (ValueError, ArithmeticError)
 
 
 # ----- spec files --------------------------------------------------------------------------
@@ -186,7 +194,7 @@ def shared_state_rows(model: BushingModel, probe_steps: int = 24) -> np.ndarray:
     try:
         for t in range(probe_steps):
             probe.step(x[t], v[t])
-    except ValueError:
+    except MODEL_ERRORS:
         return mask
     st = probe.state
     if st.shape[0] == n:
@@ -214,12 +222,74 @@ def reset_columns(model: BushingModel, mask: np.ndarray, shared: np.ndarray | No
 
 
 # ----- actions ------------------------------------------------------------------------------
-def unit_action(action: Any) -> float:
-    """A normalised scalar action as a float in [-1, 1]: NaN -> 0, +-inf and beyond -> +-1."""
+ACTION_SPACE_TEXT = "Box(-1.0, 1.0, (1,), float32)"
+REAL_KINDS = "fiu"  # numpy dtype kinds taken as numbers: float, signed and unsigned int
+_F32 = np.dtype(np.float32)  # the action space's dtype: ``unit_action``'s fast path
+
+
+def describe(value: Any) -> str:
+    """A short, one-line description of a value for an error message."""
+    if isinstance(value, np.ndarray):
+        return f"<array of shape {value.shape}, dtype {value.dtype}>"
+    if value is None:
+        return "None"
+    text = reprlib.repr(value).replace("\n", " ")
+    return f"<{type(value).__name__} {text}>"
+
+
+def _real(value: Any) -> float | None:
+    """``value`` as a float if it is one real number (not bool, not text), else None."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+        return None
     try:
-        a = float(action[0])
-    except (TypeError, IndexError):
-        a = float(action)
+        return float(value)
+    except OverflowError:  # an int beyond float range
+        return math.inf if value > 0 else -math.inf
+    except (TypeError, ValueError):
+        return None
+
+
+def _array(value: Any) -> np.ndarray | None:
+    """``value`` as a real-valued array (object arrays of real numbers converted), else None."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError, OverflowError):  # ragged lists, odd __array__s
+        return None
+    if arr.dtype.kind in REAL_KINDS:
+        return arr
+    if arr.dtype.kind == "O":
+        flat = [_real(v) for v in arr.reshape(-1)]
+        if all(v is not None for v in flat):
+            return np.array(flat, dtype=np.float64).reshape(arr.shape)
+    return None
+
+
+def _checked_action(action: Any, env_id: str) -> float:
+    """The slow path of ``unit_action``: anything but a real (1,) ndarray."""
+    a = _real(action)
+    if a is not None:
+        return a
+    arr = _array(action)
+    if arr is None or arr.shape not in ((), (1,)):
+        raise RigError(
+            f"{env_id}: action {describe(action)} does not fit the action space "
+            f"{ACTION_SPACE_TEXT}: expected a real number or an array of shape (1,)"
+        )
+    return float(arr.reshape(1)[0])
+
+
+def unit_action(action: Any, env_id: str = "env") -> float:
+    """A normalised scalar action as a float in [-1, 1]: NaN -> 0, +-inf and beyond -> +-1.
+
+    Takes a real number or anything of shape (1,) holding one (an ndarray of any float or int
+    dtype, a list); anything else -- text, None, complex, dicts, empty or longer arrays -- is
+    refused with a ``RigError`` naming ``env_id``, the action space and the expected shape. A
+    float32 ndarray of shape (1,) (what agents send) takes a fast path of three cheap checks;
+    everything else goes through ``_checked_action``."""
+    if action.__class__ is np.ndarray and action.dtype is _F32 and action.shape == (1,):
+        a = action.item()
+    else:
+        a = _checked_action(action, env_id)
     if a != a:
         return 0.0
     if a > 1.0:
@@ -229,12 +299,43 @@ def unit_action(action: Any) -> float:
     return a
 
 
-def unit_actions(actions: Any, n: int) -> np.ndarray:
-    """(N,) or (N, 1) normalised actions as float64 (N,), cleaned like ``unit_action``."""
-    a = np.array(actions, dtype=np.float64).reshape(n)
+def unit_actions(actions: Any, n: int, env_id: str = "vector env") -> np.ndarray:
+    """(N, 1) or (N,) normalised actions as float64 (N,), cleaned like ``unit_action``; any
+    other shape or a non-numeric action is refused with a ``RigError`` naming (N, 1)."""
+    if actions.__class__ is np.ndarray and actions.dtype.kind in REAL_KINDS:
+        arr = actions
+    else:
+        arr = _array(actions)
+    if arr is None or arr.shape not in ((n, 1), (n,)):
+        raise RigError(
+            f"{env_id}: actions {describe(actions)} do not fit the action space "
+            f"Box(-1.0, 1.0, ({n}, 1), float32): expected real numbers in an array of shape "
+            f"({n}, 1)"
+        )
+    a = arr.astype(np.float64).reshape(n)
     a[np.isnan(a)] = 0.0
     np.clip(a, -1.0, 1.0, out=a)
     return a
+
+
+def check_options(env_id: str, options: Any) -> dict[str, Any]:
+    """``reset(options=...)``: None or a dict (mapping); returns a dict."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise RigError(
+            f"{env_id}: reset options must be a dict such as {{'excitation': profile}} or None, "
+            f"got {describe(options)}"
+        )
+    return options
+
+
+def numeric_profile(name: str, profile: Any) -> np.ndarray:
+    """A profile (excitation, road) as a float64 array; text or other non-numbers refused."""
+    arr = _array(profile)
+    if arr is None:
+        raise RigError(f"{name} must be numbers in a (T,) or (T, N) array, got {describe(profile)}")
+    return np.array(arr, dtype=np.float64)
 
 
 # ----- reward ---------------------------------------------------------------------------------

@@ -15,6 +15,7 @@ from bushenv.models import BushingModel
 from bushenv.models.linear import TABLE1
 from bushenv.rigs.common import (
     LONG_ARM_M,
+    MODEL_ERRORS,
     Canvas,
     ForceDeviationReward,
     RigError,
@@ -22,9 +23,11 @@ from bushenv.rigs.common import (
     Trace,
     call_reset,
     check_hook,
+    check_options,
     implicit_euler_damping,
     inverse_mass_along,
     model_label,
+    numeric_profile,
     plot_traces,
     positive,
     positive_int,
@@ -66,7 +69,7 @@ def axis_label(models: dict[str, BushingModel], spec: Any) -> str:
 def check_road(profile: Any, max_height_m: float, max_step_m: float) -> np.ndarray:
     """A replayable road: finite (T,) or (T, N), |h| <= max_height_m and each sample (the road
     starting at 0) at most ``max_step_m`` from the previous one."""
-    h = np.array(profile, dtype=np.float64)
+    h = numeric_profile("road excitation", profile)
     if h.ndim not in (1, 2) or h.shape[0] < 1:
         raise RigError(f"excitation must have shape (T,) or (T, N) with T >= 1, got {h.shape}")
     bad = ~np.isfinite(h)
@@ -299,7 +302,9 @@ class QuarterCarEnv(gym.Env):
         h_k = clip(h_{k-1} + a * max_road_step_m, -max_road_height_m, max_road_height_m)
 
     (50 mm per step and +-150 mm by default: curbs, potholes and the papers' bumps fit). The
-    road moves linearly within the step. NaN counts as 0; beyond +-1 (and +-inf) as +-1.
+    road moves linearly within the step. NaN counts as 0; beyond +-1 (and +-inf) as +-1. An
+    action that is not one real number (text, None, an array of another shape) is refused with
+    a ``RigError`` naming the action space and the expected shape (1,).
 
     ## Observation Space
 
@@ -337,7 +342,10 @@ class QuarterCarEnv(gym.Env):
     reference car does not -- non-finite state or force, |bushing force| > ``force_limit_n``,
     bushing deflection > ``max_bushing_deflection_m``, suspension travel >
     ``max_suspension_travel_m``, chassis or wheel beyond ``max_body_displacement_m`` -- or the
-    model raised an error, or ``divergence_monitor(info)`` is truthy. Truncation:
+    model raised an error (``ValueError`` or ``ArithmeticError``), or ``divergence_monitor(info)``
+    is truthy. A model force that is not finite or beyond ``force_limit_n`` is judged before it
+    is applied and is never applied, so the car's state stays finite; the twin runs in its own
+    pymunk space, so nothing the model car does reaches it. Truncation:
     ``episode_steps``, the end of a replayed road, or the reference car itself leaving its
     bounds (``info["physical_limit"]``: the road is too harsh to judge anything).
 
@@ -404,7 +412,8 @@ class QuarterCarEnv(gym.Env):
         p = self.params
         self._replay = None
         self._end = p.episode_steps
-        if options and options.get("excitation") is not None:
+        options = check_options(ENV_ID, options)
+        if options.get("excitation") is not None:
             h = check_road(options["excitation"], p.max_road, p.max_road_step)
             if h.ndim != 1:
                 raise RigError(f"road excitation for one car must be (T,), got {h.shape}")
@@ -428,33 +437,46 @@ class QuarterCarEnv(gym.Env):
         return self._obs.copy(), info
 
     def _build_cars(self) -> None:
-        """The model car and its twin in one space (they never touch)."""
-        self.space = pymunk.Space()
-        self.car = Car(self.params, self.space)
-        self.twin = Car(self.params, self.space)
-        self._space_step = space_stepper(self.space)
+        """The model car and its twin, each in its own pymunk space: nothing the model car
+        does (a blow-up, a NaN) can reach the twin through a shared solver or body."""
+        self.car = Car(self.params, pymunk.Space())
+        self.twin = Car(self.params, pymunk.Space())
+        self.space = self.car.space
+        self._space_steps = (space_stepper(self.car.space), space_stepper(self.twin.space))
 
     def _bushing_forces(self, car: Car, models: dict[str, BushingModel]):
-        """Sample the bushing, step both axis models, hold the remainders."""
+        """Sample the bushing, step both axis models and judge their forces *before* applying
+        them: a force that raised, is not finite or exceeds ``force_limit_n`` is the verdict
+        (returned as the reason) and is not applied -- the car keeps the last held remainder,
+        so its state stays finite. Otherwise hold the remainders for the coming step."""
         car.update_damping()
         xr, vr, xa, va = car.bushing_motion()
-        reason = ""
+        motion = (xr, vr, xa, va)
         try:
             fr = models["radial"].step(xr, vr)
             fa = models["axial"].step(xa, va)
-        except ValueError as exc:  # a model refusing to go on
-            fr = fa = math.nan
-            reason = f"model raised {type(exc).__name__}: {exc}"
-        if math.isfinite(fr) and math.isfinite(fa):
+        except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
+            return motion, (math.nan, math.nan), f"model raised {type(exc).__name__}: {exc}"
+        limit = self.params.force_limit
+        if abs(fr) <= limit and abs(fa) <= limit:  # also False for NaN
             car.radial.hold(fr, xr, vr)
             car.axial.hold(fa, xa, va)
-        return (xr, vr, xa, va), (fr, fa), reason
+            return motion, (fr, fa), ""
+        reason = ""
+        for axis, f in (("radial", fr), ("axial", fa)):
+            if not math.isfinite(f):
+                reason = f"{axis} bushing force {f!r} N is not finite"
+                break
+            if abs(f) > limit:
+                reason = f"|{axis} bushing force| = {abs(f):.6g} N exceeds {limit:.6g} N"
+                break
+        return motion, (fr, fa), reason
 
     def step(self, action):
         p = self.params
         h0 = self._road
         if self._replay is None:
-            h = h0 + unit_action(action) * p.max_road_step
+            h = h0 + unit_action(action, ENV_ID) * p.max_road_step
             if h > p.max_road:
                 h = p.max_road
             elif h < -p.max_road:
@@ -465,22 +487,27 @@ class QuarterCarEnv(gym.Env):
         self._t += 1
 
         # sample both bushings at t_k (the state the previous step left), then integrate
-        motion_m, force_m, raised = self._bushing_forces(self.car, self.models)
-        motion_r, force_r, _ = self._bushing_forces(self.twin, self.references)
+        motion_m, force_m, verdict_m = self._bushing_forces(self.car, self.models)
+        motion_r, force_r, verdict_r = self._bushing_forces(self.twin, self.references)
         road_v = (h - h0) / p.dt
         self.car.road.velocity = (0.0, road_v)
         self.twin.road.velocity = (0.0, road_v)
-        step, h_sub = self._space_step, p.h
-        for _ in range(p.substeps):
-            step(h_sub)
+        h_sub = p.h
+        for step in self._space_steps:
+            for _ in range(p.substeps):
+                step(h_sub)
         for car in (self.car, self.twin):  # exact road position, no drift from integrating
             car.road.position = (p.L, h)
             car.road.velocity = (0.0, 0.0)
         body_m = self.car.body_state()
         body_r = self.twin.body_state()
 
-        why_m = raised or out_of_bounds(p, body_m[0], body_m[2], motion_m[0], motion_m[2], *force_m)
-        why_r = out_of_bounds(p, body_r[0], body_r[2], motion_r[0], motion_r[2], *force_r)
+        why_m = verdict_m or out_of_bounds(
+            p, body_m[0], body_m[2], motion_m[0], motion_m[2], *force_m
+        )
+        why_r = verdict_r or out_of_bounds(
+            p, body_r[0], body_r[2], motion_r[0], motion_r[2], *force_r
+        )
         terminated = truncated = False
         reason = ""
         if why_r:

@@ -26,7 +26,7 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from bushenv.rigs.common import LONG_ARM_M, RigError, positive_int, spec_kwargs
+from bushenv.rigs.common import LONG_ARM_M, MODEL_ERRORS, RigError, positive_int, spec_kwargs
 from bushenv.rigs.quartercar import AXES, ENV_ID, CarParameters, axis_models, check_road
 
 # parameter vector layout for the kernel
@@ -210,12 +210,15 @@ class QuarterCarBatch:
             for row, axis, x, v in ((0, "radial", xr, vr), (1, "axial", xa, va)):
                 try:
                     f = np.asarray(models[axis].step(x[cols].copy(), v[cols].copy()))
-                except ValueError:
+                except MODEL_ERRORS:  # a model refusing to go on, 1/0, overflow, ...
                     f = np.full(n, np.nan)
                 forces[row, cols] = f
                 forces[row + 2, cols] = x[cols]
                 held = f - (p.k_in[axis] * x[cols] + p.c_in[axis] * v[cols])
-                self.held[row, cols] = np.where(np.isfinite(held), held, 0.0)
+                # a force beyond the limit (or not finite) is the verdict, never applied
+                with np.errstate(invalid="ignore", over="ignore"):
+                    ok = np.isfinite(held) & (np.abs(f) <= p.force_limit)
+                self.held[row, cols] = np.where(ok, held, 0.0)
         road_all = np.concatenate([road] * (2 if self.references is not None else 1))
         road_v = (road_all - self.road) / p.dt
         substeps_kernel(

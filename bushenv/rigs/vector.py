@@ -23,11 +23,13 @@ from gymnasium.vector.utils import batch_space
 
 from bushenv.rigs.bushrig import ENV_ID, BushRigEnv, RigParameters, check_excitation
 from bushenv.rigs.common import (
+    MODEL_ERRORS,
     ForceDeviationReward,
     RigError,
     call_reset,
     call_reset_columns,
     check_hook,
+    check_options,
     force_observations,
     positive_int,
     reset_columns,
@@ -105,7 +107,8 @@ class BushRigVectorEnv(VectorEnv):
         p, n = self.params, self.num_envs
         self._replay = None
         self._end[:] = p.episode_steps
-        if options and options.get("excitation") is not None:
+        options = check_options(ENV_ID, options)
+        if options.get("excitation") is not None:
             x = check_excitation(options["excitation"], p.max_x, p.max_step)
             if x.ndim == 1:
                 x = np.repeat(x[:, None], n, axis=1)
@@ -131,7 +134,7 @@ class BushRigVectorEnv(VectorEnv):
         p, n = self.params, self.num_envs
         x0 = self._x
         if self._replay is None:
-            x = x0 + unit_actions(actions, n) * p.max_step
+            x = x0 + unit_actions(actions, n, ENV_ID) * p.max_step
             np.clip(x, -p.max_x, p.max_x, out=x)
         else:
             x = self._replay[np.minimum(self._t, self._end - 1), self._columns]
@@ -142,13 +145,14 @@ class BushRigVectorEnv(VectorEnv):
         raised = ""
         try:
             f_m = np.array(self.model.step(x, v), dtype=np.float64)
-        except ValueError as exc:
+        except MODEL_ERRORS as exc:
             # The batched step refused as a whole; the histories that caused it show non-finite
             # forces in the model's output buffer (all columns are judged if none do).
             raised = f"model raised {type(exc).__name__}: {exc}"
-            f_m = np.array(self.model._f1[0], dtype=np.float64)
-            if np.isfinite(f_m).all():
-                f_m[:] = np.nan
+            buffer = getattr(self.model, "_f1", None)
+            f_m = np.array(buffer[0] if buffer is not None else np.full(n, np.nan), np.float64)
+            if f_m.shape != (n,) or np.isfinite(f_m).all():
+                f_m = np.full(n, np.nan)
         f_r = np.array(self.reference.step(x, v), dtype=np.float64)
 
         obs = self._obs

@@ -81,3 +81,25 @@ class DiffKV(BushingModel):
 
     def copy(self):
         return DiffKV(self.k, self.c, self.dt)
+
+
+class ValueAfter(NanAfter):
+    """Test double: a spring k x until sample ``after``, then ``value`` N -- or, with ``error``
+    (an exception instance), raises it instead of returning anything."""
+
+    name = "value_after_test_double"
+
+    def __init__(self, after=5, value=np.nan, error=None, k=1.0e5, dt=PAPER_DT) -> None:
+        self.value, self.error = float(value), error
+        super().__init__(after, k, dt)
+
+    def _advance(self, x, v, out):
+        for t in range(x.shape[0]):
+            self.state[0] += 1
+            late = self.state[0] > self.after
+            if late.any() and self.error is not None:
+                raise self.error
+            out[t] = np.where(late, self.value, self.k * x[t])
+
+    def copy(self):
+        return ValueAfter(self.after, self.value, self.error, self.k, self.dt)

@@ -11,7 +11,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from rig_test_models import ALL_MODELS, RaisesAfter, model_or_skip
+from rig_test_models import ALL_MODELS, RaisesAfter, ValueAfter, model_or_skip
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 from bushenv import excitation
@@ -328,6 +328,56 @@ def test_memory_stays_flat_over_a_million_steps():
     tracemalloc.stop()
     grown = sum(s.size_diff for s in after.compare_to(before, "filename"))
     assert grown < 64 * 1024
+
+
+# ----- bad input -------------------------------------------------------------------------------
+def test_a_refused_action_leaves_the_episode_where_it_was():
+    good = np.array([0.5], np.float32)
+    env, twin = make(), make()
+    env.reset(seed=0)
+    twin.reset(seed=0)
+    env.step(good)
+    with pytest.raises(RigError, match=r"^BushRig-v0: action .* shape \(1,\)$"):
+        env.step(np.array([0.1, 0.2], np.float32))
+    twin.step(good)
+    assert env.step(good)[4] == twin.step(good)[4]  # as if the bad call never happened
+
+
+@pytest.mark.parametrize(
+    "error",
+    [ZeroDivisionError("k / 0"), FloatingPointError("overflow"), OverflowError("range")],
+    ids=lambda e: type(e).__name__,
+)
+def test_model_raising_an_arithmetic_error_terminates_with_its_name(error):
+    env = make(model=ValueAfter(after=3, error=error))
+    out = run(env, np.full((20, 1), 0.1, np.float32))
+    assert len(out) == 5  # reset + 3 good samples + the one that raised
+    obs, r, term, trunc, info = out[-1]
+    assert term and not trunc and info["diverged"] and not info["model_force_finite"]
+    assert info["divergence_reason"] == f"model raised {type(error).__name__}: {error}"
+    assert r == 10.0 and env.observation_space.contains(obs)
+
+
+def test_history_beyond_ten_thousand_samples_is_refused_before_allocating():
+    with pytest.raises(RigError, match=r"history must be at most 10000 samples, got 1000000000"):
+        make(history=10**9)
+    with pytest.raises(RigError, match=r"history must be at most 10000"):
+        make(history=10_001)
+    assert make(history=10_000).observation_space.shape == (30_000,)
+
+
+@pytest.mark.parametrize("options", [5, "excitation", [0.0, 0.001], np.zeros(3)], ids=repr)
+def test_reset_options_that_are_not_a_dict_are_refused_naming_them(options):
+    with pytest.raises(RigError, match=r"^BushRig-v0: reset options must be a dict"):
+        make().reset(options=options)
+
+
+@pytest.mark.parametrize(
+    "profile", ["abc", ["0.001", "0.002"], [0.0, None], [[0.0], [0.0, 0.001]]], ids=repr
+)
+def test_excitation_that_is_not_numbers_is_refused(profile):
+    with pytest.raises(RigError, match=r"^excitation must be numbers"):
+        make().reset(options={"excitation": profile})
 
 
 # ----- rendering -------------------------------------------------------------------------------

@@ -11,7 +11,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from rig_test_models import ALL_MODELS, DiffKV, NanAfter, RaisesAfter, model_or_skip
+from rig_test_models import ALL_MODELS, DiffKV, NanAfter, RaisesAfter, ValueAfter, model_or_skip
 from scipy import signal
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
@@ -345,6 +345,81 @@ def test_model_car_beyond_its_bounds_terminates_while_the_twin_is_fine():
             break
     assert term and info["diverged"] and "deflection" in info["model_out_of_bounds"]
     assert info["reference_out_of_bounds"] == ""
+
+
+def reference_keys(info):
+    return [k for k in info if k.startswith("reference_") or k.endswith("_reference_n")]
+
+
+@pytest.mark.parametrize("value", [1e300, -3e4], ids=["1e300", "-30kN"])
+def test_model_force_beyond_the_limit_is_judged_before_it_is_applied(value):
+    """The verdict names the force and the limit; the force never reaches the model car (its
+    state stays finite) nor the twin, which moves exactly as beside a linear model car."""
+    acts = [np.array([a], np.float32) for a in (0.01, -0.01, 0.01, -0.01) + (0.005,) * 40]
+    beside = make(model="linear")
+    beside.reset(seed=0)
+    expected = [beside.step(a)[4] for a in acts]
+    env = make(model={"radial": ValueAfter(after=3, value=value), "axial": "linear"})
+    env.reset(seed=0)
+    for k, a in enumerate(acts):
+        obs, r, term, trunc, info = env.step(a)
+        assert term == (k >= 3) and not trunc and info["diverged"] == (k >= 3)
+        for key in reference_keys(info):
+            assert info[key] == expected[k][key], key
+        assert all(math.isfinite(info[key]) for key in ("chassis_y_m", "wheel_y_m"))
+        assert env.observation_space.contains(obs)
+    assert (
+        info["divergence_reason"] == f"|radial bushing force| = {abs(value):.6g} N exceeds 25000 N"
+    )
+    assert info["reference_out_of_bounds"] == "" and not info["physical_limit"]
+
+
+def test_model_cars_blow_up_cannot_reach_the_twin():
+    """With the force limit off, a 1e300 N model force is applied: the model car's state turns
+    non-finite, and the twin (in its own pymunk space) still moves exactly as beside a linear
+    model car."""
+    acts = [np.array([a], np.float32) for a in (0.01, -0.01, 0.01, -0.01, 0.005, 0.005)]
+    beside = make(model="linear", force_limit_n=1e301)
+    beside.reset(seed=0)
+    expected = [beside.step(a)[4] for a in acts]
+    env = make(
+        model={"radial": ValueAfter(after=3, value=1e300), "axial": "linear"}, force_limit_n=1e301
+    )
+    env.reset(seed=0)
+    for k, a in enumerate(acts):
+        *_, term, trunc, info = env.step(a)
+        for key in reference_keys(info):
+            assert info[key] == expected[k][key], key
+    assert term and not trunc and info["diverged"]
+    assert not math.isfinite(info["chassis_y_m"] + info["wheel_y_m"])
+
+
+@pytest.mark.parametrize(
+    "error", [ZeroDivisionError("k / 0"), FloatingPointError("overflow"), OverflowError("range")]
+)
+def test_model_raising_an_arithmetic_error_terminates_with_its_name(error):
+    env = make(model={"radial": ValueAfter(after=3, error=error), "axial": "linear"})
+    env.reset(seed=0)
+    outs = [env.step(np.array([0.01], np.float32)) for _ in range(4)]
+    assert not any(o[2] for o in outs[:3])
+    _, _, term, trunc, info = outs[3]
+    assert term and not trunc and info["diverged"]
+    assert info["divergence_reason"] == f"model raised {type(error).__name__}: {error}"
+
+
+def test_bad_actions_options_and_roads_are_refused_naming_them():
+    env = make().unwrapped  # Gymnasium's checker wrapper trips over a first call that raised
+    with pytest.raises(RigError, match=r"^QuarterCar-v0: reset options must be a dict"):
+        env.reset(options=5)
+    with pytest.raises(RigError, match=r"^road excitation must be numbers"):
+        env.reset(options={"excitation": "abc"})
+    env.reset(seed=0)
+    env.step(np.array([0.1], np.float32))
+    with pytest.raises(RigError, match=r"^QuarterCar-v0: action .* shape \(1,\)"):
+        env.step(np.array([0.1, 0.2], np.float32))
+    with pytest.raises(RigError, match=r"^QuarterCar-v0: action <str 'up'>"):
+        env.step("up")
+    assert env.step(np.array([0.1], np.float32))[4]["step"] == 2
 
 
 def test_a_road_too_harsh_for_the_reference_car_truncates_without_a_verdict():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
-from rig_test_models import NanAfter
+from rig_test_models import NanAfter, ValueAfter
 
 from bushenv import excitation
 from bushenv.models import get_model
@@ -64,6 +64,23 @@ def test_batch_flags_the_car_whose_model_returns_nan():
     out = QuarterCarBatch(2, model=model, reference="linear").simulate(road)
     assert out["diverged"].all() and (out["divergence_step"] == 10).all()
     assert not out["physical_limit"].any()
+
+
+def test_batch_judges_a_force_beyond_the_limit_without_applying_it():
+    model = {"radial": ValueAfter(after=10, value=1e300), "axial": get_model("linear", "axial")}
+    road = roads()["bump"]
+    out = QuarterCarBatch(2, model=model, reference="linear").simulate(road)
+    ref = QuarterCarBatch(2, model="linear", reference="linear").simulate(road)
+    assert out["diverged"].all() and (out["divergence_step"] == 10).all()
+    assert np.isfinite(out["chassis_y_m"]).all() and np.isfinite(out["wheel_y_m"]).all()
+    np.testing.assert_array_equal(out["reference_chassis_y_m"], ref["reference_chassis_y_m"])
+
+
+@pytest.mark.parametrize("error", [ZeroDivisionError("k / 0"), FloatingPointError("overflow")])
+def test_batch_flags_the_cars_whose_model_raises_an_arithmetic_error(error):
+    model = {"radial": ValueAfter(after=10, error=error), "axial": get_model("linear", "axial")}
+    out = QuarterCarBatch(2, model=model, reference="linear").simulate(roads()["bump"])
+    assert out["diverged"].all() and (out["divergence_step"] == 10).all()
 
 
 def test_batch_refuses_a_road_beyond_the_limits():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
-from rig_test_models import ALL_MODELS, NanAfter, model_or_skip
+from rig_test_models import ALL_MODELS, NanAfter, ValueAfter, model_or_skip
 
 from bushenv.rigs.common import RigError, resolve_reference
 from bushenv.rigs.vector import BushRigVectorEnv
@@ -113,6 +113,48 @@ def test_vector_marks_only_the_nan_column_as_diverged():
     _, r, term, _, info = env.step(a)
     assert term.all() and info["diverged"].all() and (r == 10.0).all()
     assert info["divergence_reason"][0] == "model force is not finite"
+
+
+@pytest.mark.parametrize(
+    "actions",
+    [np.zeros((2, 1), np.float32), np.zeros((3, 2), np.float32), None, "abc", [[0.1], ["x"], [0]]],
+    ids=lambda a: type(a).__name__ + str(getattr(a, "shape", "")),
+)
+def test_vector_refuses_actions_of_another_shape_naming_n1_and_keeps_its_state(actions):
+    env, twin = make_vec(3), make_vec(3)
+    env.reset(seed=0)
+    twin.reset(seed=0)
+    with pytest.raises(RigError, match=r"^BushRig-v0: actions .* shape \(3, 1\)$"):
+        env.step(actions)
+    a = np.full((3, 1), 0.5, np.float32)
+    got, want = env.step(a), twin.step(a)
+    np.testing.assert_array_equal(got[0], want[0])
+    np.testing.assert_array_equal(got[4]["step"], [1, 1, 1])
+
+
+def test_vector_takes_actions_of_shape_n_like_n1():
+    a = np.array([0.5, -0.25, 2.0], np.float32)
+    env, twin = make_vec(3), make_vec(3)
+    env.reset(seed=0)
+    twin.reset(seed=0)
+    np.testing.assert_array_equal(env.step(a)[0], twin.step(a.reshape(3, 1))[0])
+
+
+@pytest.mark.parametrize("error", [ZeroDivisionError("k / 0"), OverflowError("range")], ids=repr)
+def test_vector_model_raising_an_arithmetic_error_terminates_every_column(error):
+    env = BushRigVectorEnv(num_envs=2, model=ValueAfter(after=3, error=error))
+    env.reset(seed=0)
+    a = np.full((2, 1), 0.5, np.float32)
+    for _ in range(3):
+        assert not env.step(a)[2].any()
+    _, r, term, _, info = env.step(a)
+    assert term.all() and info["diverged"].all() and (r == 10.0).all()
+    assert list(info["divergence_reason"]) == [f"model raised {type(error).__name__}: {error}"] * 2
+
+
+def test_vector_reset_options_that_are_not_a_dict_are_refused():
+    with pytest.raises(RigError, match=r"^BushRig-v0: reset options must be a dict"):
+        make_vec(2).reset(options=[1, 2])
 
 
 def test_vector_render_gives_a_frame_of_rig_zero():
