@@ -20,6 +20,8 @@ Targets (name: input generated -> what bushenv must answer):
 - seed_lists: text for ``--seeds`` -> seeds >= 0 or a MatrixError
 - bushrig_actions: sequences of any numeric action (NaN, inf, 1e38, ints; float16/32/64,
   Python float, list) -> no exception, obs in the Box, x exactly the documented clip
+- bushrig_any_action: any Python object (None, text, complex, dicts, lists, arrays of any
+  shape) -> a step with obs in the Box, or a RigError naming the action space
 - bushrig_nan_model: random actions, a model turning NaN at a random step -> the episode ends
   at that step with diverged=True and the reason
 - vector_actions: (4, 1) action arrays with NaN/inf/huge entries -> each column as one env
@@ -550,6 +552,36 @@ def check_quartercar_actions(case) -> None:
             break
 
 
+ANY_ACTION = st.one_of(
+    st.none(),
+    st.text(max_size=6),
+    st.complex_numbers(),
+    st.booleans(),
+    st.dictionaries(st.text(max_size=3), st.floats(), max_size=2),
+    st.lists(st.one_of(st.floats(), st.none(), st.text(max_size=2)), max_size=4),
+    st.tuples(st.integers(0, 3), st.integers(0, 3), st.floats(-2, 2)).map(
+        lambda t: np.full((t[0], t[1]), t[2], dtype=np.float32)
+    ),
+    st.sampled_from([np.float64(0.3), np.float32(np.nan), np.array(0.5), np.array([[0.5]])]),
+)
+
+
+def check_bushrig_any_action(action) -> None:
+    """Any Python object as an action: a step in the Box, or a RigError naming the space."""
+    from bushenv.rigs.common import RigError
+
+    env = cached_env("BushRig-v0")
+    env.reset(seed=0)
+    try:
+        with np.errstate(all="ignore"):
+            obs, reward, term, trunc, info = env.step(action)
+    except RigError as exc:
+        assert "action" in str(exc) and "\n" not in str(exc).strip(), str(exc)
+        return
+    assert env.observation_space.contains(obs)
+    assert math.isfinite(reward)
+
+
 ACTION_SEQUENCES = st.tuples(st.lists(ACTION_VALUES, min_size=1, max_size=25), ACTION_FORMS)
 NAN_MODEL_CASES = st.tuples(st.integers(1, 20), st.lists(ACTION_VALUES, min_size=20, max_size=20))
 VECTOR_ROWS = st.lists(ACTION_VALUES, min_size=4, max_size=4)
@@ -563,6 +595,7 @@ TARGETS = {
     "matrix_results": (results_file(), check_matrix_results),
     "seed_lists": (SEED_TEXT, check_seed_list),
     "bushrig_actions": (ACTION_SEQUENCES, check_bushrig_actions),
+    "bushrig_any_action": (ANY_ACTION, check_bushrig_any_action),
     "bushrig_nan_model": (NAN_MODEL_CASES, check_bushrig_nan_model),
     "vector_actions": (VECTOR_ROWS, check_vector_actions),
     "quartercar_actions": (ACTION_SEQUENCES, check_quartercar_actions),
@@ -627,6 +660,12 @@ def test_fuzz_seed_lists_parse_to_non_negative_seeds_or_a_matrix_error(text):
 @given(ACTION_SEQUENCES)
 def test_fuzz_bushrig_any_numeric_action_is_cleaned_never_raises(case):
     check_bushrig_actions(case)
+
+
+@FAST
+@given(ANY_ACTION)
+def test_fuzz_bushrig_any_object_as_action_steps_or_gives_a_rig_error(action):
+    check_bushrig_any_action(action)
 
 
 @settings(FAST, max_examples=100)
