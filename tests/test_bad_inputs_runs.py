@@ -74,7 +74,15 @@ def start_and_signal(cmd: list[str], results: Path, sig: int, min_lines: int = 1
     """Start ``cmd``, wait until ``results`` holds ``min_lines`` lines, send ``sig`` to the
     main process only; returns (exit code, stderr, seconds from signal to exit)."""
     proc = subprocess.Popen(
-        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True
+        cmd,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        # A job started in the background by a non-interactive shell (as CI may run us)
+        # inherits SIGINT ignored, and Python then never raises KeyboardInterrupt: restore the
+        # default so the child sees Ctrl-C as a user's terminal would send it.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     try:
         deadline = time.monotonic() + 240
