@@ -114,7 +114,12 @@ class LocalBackend:
             if proc.is_alive():
                 proc.terminate()
         for proc in workers:
-            proc.join(timeout=5)
+            proc.join(timeout=2)
+            if proc.is_alive():
+                # A worker that cannot run Python (e.g. stuck on a lock inherited through fork)
+                # never acts on SIGTERM; SIGKILL needs no cooperation.
+                proc.kill()
+                proc.join(timeout=5)
 
     def __enter__(self) -> LocalBackend:
         return self
