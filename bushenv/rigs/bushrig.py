@@ -19,9 +19,9 @@ from bushenv.rigs.common import (
     call_reset,
     check_hook,
     check_options,
+    check_profile,
     force_observation,
     model_label,
-    numeric_profile,
     per_axis,
     plot_traces,
     positive,
@@ -43,30 +43,16 @@ MAX_HISTORY = 10_000  # samples per channel in the observation (3 x 10 000 float
 def check_excitation(profile: Any, max_displacement_m: float, max_step_m: float) -> np.ndarray:
     """A replayable displacement profile: finite (T,) or (T, N), within the stroke, and each
     sample (the rig starting at rest at 0) at most ``max_step_m`` from the previous one."""
-    x = numeric_profile("excitation", profile)
-    if x.ndim not in (1, 2) or x.shape[0] < 1:
-        raise RigError(f"excitation must have shape (T,) or (T, N) with T >= 1, got {x.shape}")
-    bad = ~np.isfinite(x)
-    if bad.any():
-        i = np.argwhere(bad)[0]
-        raise RigError(f"excitation sample {int(i[0])} is {x[tuple(i)]!r}, not finite")
-    tol = 1 + 1e-9
-    over = np.abs(x) > max_displacement_m * tol
-    if over.any():
-        i = tuple(np.argwhere(over)[0])
-        raise RigError(
-            f"excitation sample {i[0]}: |x| = {abs(x[i]):.6g} m exceeds the stroke limit "
-            f"{max_displacement_m:.6g} m"
-        )
-    steps = np.abs(np.diff(x, axis=0, prepend=np.zeros((1,) + x.shape[1:])))
-    fast = steps > max_step_m * tol
-    if fast.any():
-        i = tuple(np.argwhere(fast)[0])
-        raise RigError(
-            f"excitation sample {i[0]}: a step of {steps[i]:.6g} m exceeds the velocity limit "
-            f"({max_step_m:.6g} m per step; the rig starts at rest at x = 0)"
-        )
-    return x
+    return check_profile(
+        "excitation",
+        profile,
+        "excitation",
+        max_displacement_m,
+        "|x| = {value:.6g} m exceeds the stroke limit " + f"{max_displacement_m:.6g} m",
+        max_step_m,
+        "a step of {value:.6g} m exceeds the velocity limit "
+        + f"({max_step_m:.6g} m per step; the rig starts at rest at x = 0)",
+    )
 
 
 class RigParameters:

@@ -338,6 +338,38 @@ def numeric_profile(name: str, profile: Any) -> np.ndarray:
     return np.array(arr, dtype=np.float64)
 
 
+def check_profile(
+    name: str,
+    profile: Any,
+    sample: str,
+    max_abs: float,
+    abs_text: str,
+    max_step: float,
+    step_text: str,
+) -> np.ndarray:
+    """A replayable profile for both rigs: finite (T,) or (T, N), |value| <= ``max_abs`` and each
+    sample (starting from 0) at most ``max_step`` from the previous one. ``sample`` names a
+    sample in messages ("excitation", "road"); ``abs_text``/``step_text`` format the limits."""
+    a = numeric_profile(name, profile)
+    if a.ndim not in (1, 2) or a.shape[0] < 1:
+        raise RigError(f"excitation must have shape (T,) or (T, N) with T >= 1, got {a.shape}")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        i = np.argwhere(bad)[0]
+        raise RigError(f"{sample} sample {int(i[0])} is {a[tuple(i)]!r}, not finite")
+    tol = 1 + 1e-9
+    over = np.abs(a) > max_abs * tol
+    if over.any():
+        i = tuple(np.argwhere(over)[0])
+        raise RigError(f"{sample} sample {i[0]}: " + abs_text.format(value=abs(a[i])))
+    steps = np.abs(np.diff(a, axis=0, prepend=np.zeros((1,) + a.shape[1:])))
+    fast = steps > max_step * tol
+    if fast.any():
+        i = tuple(np.argwhere(fast)[0])
+        raise RigError(f"{sample} sample {i[0]}: " + step_text.format(value=steps[i]))
+    return a
+
+
 # ----- reward ---------------------------------------------------------------------------------
 class ForceDeviationReward:
     """The adversarial objective: how far the model's force is from the reference's.

@@ -24,10 +24,10 @@ from bushenv.rigs.common import (
     call_reset,
     check_hook,
     check_options,
+    check_profile,
     implicit_euler_damping,
     inverse_mass_along,
     model_label,
-    numeric_profile,
     plot_traces,
     positive,
     positive_int,
@@ -69,30 +69,16 @@ def axis_label(models: dict[str, BushingModel], spec: Any) -> str:
 def check_road(profile: Any, max_height_m: float, max_step_m: float) -> np.ndarray:
     """A replayable road: finite (T,) or (T, N), |h| <= max_height_m and each sample (the road
     starting at 0) at most ``max_step_m`` from the previous one."""
-    h = numeric_profile("road excitation", profile)
-    if h.ndim not in (1, 2) or h.shape[0] < 1:
-        raise RigError(f"excitation must have shape (T,) or (T, N) with T >= 1, got {h.shape}")
-    bad = ~np.isfinite(h)
-    if bad.any():
-        i = np.argwhere(bad)[0]
-        raise RigError(f"road sample {int(i[0])} is {h[tuple(i)]!r}, not finite")
-    tol = 1 + 1e-9
-    over = np.abs(h) > max_height_m * tol
-    if over.any():
-        i = tuple(np.argwhere(over)[0])
-        raise RigError(
-            f"road sample {i[0]}: |h| = {abs(h[i]):.6g} m exceeds max_road_height_m "
-            f"{max_height_m:.6g} m"
-        )
-    steps = np.abs(np.diff(h, axis=0, prepend=np.zeros((1,) + h.shape[1:])))
-    fast = steps > max_step_m * tol
-    if fast.any():
-        i = tuple(np.argwhere(fast)[0])
-        raise RigError(
-            f"road sample {i[0]}: a change of {steps[i]:.6g} m exceeds max_road_step_m "
-            f"{max_step_m:.6g} m (the road starts at 0)"
-        )
-    return h
+    return check_profile(
+        "road excitation",
+        profile,
+        "road",
+        max_height_m,
+        "|h| = {value:.6g} m exceeds max_road_height_m " + f"{max_height_m:.6g} m",
+        max_step_m,
+        "a change of {value:.6g} m exceeds max_road_step_m "
+        + f"{max_step_m:.6g} m (the road starts at 0)",
+    )
 
 
 class CarParameters:
