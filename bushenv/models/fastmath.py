@@ -13,9 +13,16 @@ model guards every division against zero, and that branch stops vectorisation.
 
 from __future__ import annotations
 
+import math
+
 import numba as nb
 
 TANH_SATURATION = 19.0  # tanh(19) = 1 - 6.5e-17: saturated in float64
+TANH_REDUCTION = 1.0 / 32.0  # e^(2a) = (e^(a/32))^(2^TANH_SQUARINGS)
+TANH_SQUARINGS = 6
+# Horner coefficients of e^r, highest degree first: 1/15!, 1/14!, ..., 1/1!, 1/0!. ``tanh``
+# below spells them out; code generators (narx_kernels.py) inline the same operations from here.
+TANH_TAYLOR = tuple(1.0 / math.factorial(n) for n in range(15, -1, -1))
 
 
 @nb.njit(cache=True, inline="always", error_model="numpy")

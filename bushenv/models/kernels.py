@@ -337,5 +337,8 @@ def warm_up() -> None:
             0.0,
             np.empty_like(z),
         )
+    from bushenv.models import narx_kernels  # generated per network shape, see there
+
+    narx_kernels.warm_up()
     p = np.ones((len(BW_ORDER), 1))
     boucwen_kernel(z, z, np.zeros((BW_N_STATE, 1)), p, 1e-3, BW_MAX_SUBSTEPS, np.empty_like(z))

@@ -19,6 +19,9 @@ ones; the velocity argument is ignored (the papers' network sees displacement on
 
 The state holds a step counter and two ring buffers (past scaled displacements, past scaled
 outputs), see ``kernels.narx_kernel``. At rest every past displacement and force is zero.
+``_advance`` runs kernels generated for the network's shape (``narx_kernels.py``: straight-line
+code per profile, vectorised over profiles; a register-only variant for one profile), which give
+the same bits as ``kernels.narx_kernel``.
 
 Whatever the input, tanh units lie in [-1, 1], so |F| <= ``nn_bound()`` (see hybrid.py): even
 this pure network cannot blow up to infinity; what it can do on unfamiliar input is wander or
@@ -32,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
-from bushenv.models.kernels import narx_kernel
+from bushenv.models.narx_kernels import COLS_MAX_BATCH, NarxKernels, NarxShape, narx_kernels
 
 N_PAST_X = 5  # seed 000 §4.2
 N_PAST_F = 5
@@ -117,6 +120,7 @@ class NarxBushing(BushingModel):
         self.b2 = _array("b2", b2, (h2,))
         self.w_out = _array("w_out", w_out, (h2 if h2 else h1,))
         self.b_out = _scalar("b_out", b_out)
+        self._kernels: NarxKernels | None = None  # compiled for this shape on first use
         super().__init__(dt)
 
     # ----- structure -----------------------------------------------------------------------
@@ -194,14 +198,25 @@ class NarxBushing(BushingModel):
     def _backbone(self) -> tuple[float, float]:
         return 0.0, 0.0
 
+    def __getstate__(self) -> dict[str, Any]:
+        # Pickles and deep copies carry parameters and state, not compiled code (the kernels'
+        # module exists only in processes that generated or imported it).
+        return {**self.__dict__, "_kernels": None}
+
     def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        kern = self._kernels
+        if kern is None:
+            kern = self._kernels = narx_kernels(
+                NarxShape(self.n_past_x, self.n_past_f, self.w1.shape[0], self.w2.shape[0])
+            )
         k, c = self._backbone()
-        narx_kernel(
+        # One profile: its ring buffers live in registers (no ring indexing per sample); more:
+        # the loop over profiles is vectorised. Same operations per profile, same bits.
+        run = kern.run_cols if x.shape[1] <= COLS_MAX_BATCH else kern.run_rows
+        run(
             x,
             v,
             self.state,
-            self.n_past_x,
-            self.n_past_f,
             self.x_offset_m,
             self.x_scale_m,
             self.f_offset_n,

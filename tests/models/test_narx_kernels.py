@@ -1,0 +1,147 @@
+"""Generated NARX kernels (narx_kernels.py) against the generic reference kernel (kernels.py)."""
+
+import copy
+import pickle
+
+import numpy as np
+import pytest
+
+from bushenv.models import get_model
+from bushenv.models.kernels import narx_kernel
+from bushenv.models.narx import NarxBushing
+from bushenv.models.narx_kernels import (
+    CACHE_ENV,
+    NarxShape,
+    _write_module,
+    cache_dir,
+    generate_source,
+    narx_kernels,
+)
+
+SHAPES = [
+    NarxShape(5, 5, 9, 0),
+    NarxShape(5, 5, 10, 9),
+    NarxShape(2, 3, 4, 3),
+    NarxShape(1, 1, 1, 0),
+]
+
+
+def network(shape, seed):
+    rng = np.random.default_rng(seed)
+    n_in = 1 + shape.n_past_x + shape.n_past_f
+    h_last = shape.h2 or shape.h1
+    return dict(
+        w1=rng.normal(size=(shape.h1, n_in)) * 1.5,
+        b1=rng.normal(size=shape.h1) * 0.3,
+        w2=rng.normal(size=(shape.h2, shape.h1)),
+        b2=rng.normal(size=shape.h2) * 0.3,
+        w_out=rng.normal(size=h_last),
+        b_out=0.1,
+    )
+
+
+def run(kernel, shape, net, x, v, state, k, c):
+    out = np.empty_like(x)
+    lags = (shape.n_past_x, shape.n_past_f) if kernel is narx_kernel else ()
+    kernel(x, v, state, *lags, 1e-4, 2e-3, 5.0, 300.0, net["w1"], net["b1"], net["w2"],
+           net["b2"], net["w_out"], net["b_out"], k, c, out)  # fmt: skip
+    return out
+
+
+@pytest.mark.parametrize("shape", SHAPES, ids=str)
+@pytest.mark.parametrize("batch", [1, 3, 8, 37])
+def test_generated_kernels_give_the_reference_kernels_bits(shape, batch):
+    rng = np.random.default_rng(batch)
+    net = network(shape, seed=batch)
+    T = 97
+    x = np.cumsum(rng.normal(size=(T, batch)), axis=0) * 1e-3
+    x[5, 0] = 40.0  # deep in tanh saturation
+    v = rng.normal(size=(T, batch))
+    n_state = 1 + shape.n_past_x + shape.n_past_f
+    start = rng.normal(size=(n_state, batch))
+    start[0] = 7.0  # mid-period ring counter
+    ref_state = start.copy()
+    ref = run(narx_kernel, shape, net, x, v, ref_state, 3e5, 900.0)
+    kern = narx_kernels(shape)
+    for variant in (kern.run_rows, kern.run_cols):
+        state = start.copy()
+        got = run(variant, shape, net, x, v, state, 3e5, 900.0)
+        assert np.array_equal(got, ref)
+        assert np.array_equal(state, ref_state)
+
+
+def test_generated_kernels_resume_mid_run_like_one_long_run():
+    shape = SHAPES[2]
+    net = network(shape, seed=1)
+    rng = np.random.default_rng(2)
+    x = rng.normal(size=(60, 9)) * 1e-3
+    kern = narx_kernels(shape)
+    state = np.zeros((1 + shape.n_past_x + shape.n_past_f, 9))
+    whole = run(kern.run_rows, shape, net, x, x, state.copy(), 0.0, 0.0)
+    parts = []
+    for lo, hi, variant in (
+        (0, 13, kern.run_cols),
+        (13, 14, kern.run_rows),
+        (14, 60, kern.run_cols),
+    ):
+        parts.append(run(variant, shape, net, x[lo:hi].copy(), x[lo:hi].copy(), state, 0.0, 0.0))
+    assert np.array_equal(np.concatenate(parts), whole)
+
+
+def test_nan_input_gives_nan_in_every_variant():
+    shape = SHAPES[0]
+    net = network(shape, seed=0)
+    x = np.full((4, 2), 1e-3)
+    x[1, 1] = np.nan
+    kern = narx_kernels(shape)
+    n_state = 1 + shape.n_past_x + shape.n_past_f
+    for kernel in (narx_kernel, kern.run_rows, kern.run_cols):
+        out = run(kernel, shape, net, x, x, np.zeros((n_state, 2)), 0.0, 0.0)
+        assert np.all(np.isfinite(out[:, 0]))
+        assert np.all(np.isnan(out[1:, 1]))
+
+
+@pytest.mark.parametrize("name", ["nn", "hybrid"])
+def test_one_profile_path_equals_its_column_in_a_wide_batch(name):
+    m = get_model(name, axis="radial")
+    rng = np.random.default_rng(5)
+    x = np.cumsum(rng.normal(size=(500, 70)), axis=0) * 1e-4
+    batched = m.simulate(x)
+    for b in (0, 33, 69):
+        assert np.array_equal(m.simulate(x[:, b]), batched[:, b])
+    v = np.gradient(x[:, 69], m.dt)  # what simulate uses
+    m.reset(1)
+    stepped = [m.step(x[t, 69], v[t]) for t in range(500)]
+    assert np.array_equal(stepped, batched[:, 69])
+
+
+def test_pickled_and_deep_copied_models_give_the_same_forces():
+    m = NarxBushing.initialised((-0.002, 0.002), (-900.0, 1100.0), seed=3)
+    x = np.linspace(0.0, 0.002, 80)
+    before = m.simulate(x)
+    assert np.array_equal(pickle.loads(pickle.dumps(m)).simulate(x), before)
+    assert np.array_equal(copy.deepcopy(m).simulate(x), before)
+
+
+def test_generated_source_names_its_shape_and_is_deterministic():
+    a = generate_source(NarxShape(2, 3, 4, 3))
+    assert a == generate_source((2, 3, 4, 3))
+    assert "(2, 3, 4, 3)" in a.splitlines()[0]
+    assert a != generate_source(NarxShape(2, 3, 4, 0))
+
+
+def test_module_file_is_rewritten_only_when_its_source_changes(tmp_path):
+    path = _write_module(tmp_path / "k", "mod_a", "X = 1\n")
+    stamp = path.stat().st_mtime_ns
+    assert _write_module(tmp_path / "k", "mod_a", "X = 1\n").stat().st_mtime_ns == stamp
+    _write_module(tmp_path / "k", "mod_a", "X = 2\n")
+    assert path.read_text() == "X = 2\n"
+    assert [p.name for p in (tmp_path / "k").iterdir()] == ["mod_a.py"]  # no temp files left
+
+
+def test_cache_folder_follows_the_environment(monkeypatch, tmp_path):
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "kc"))
+    assert cache_dir() == tmp_path / "kc"
+    monkeypatch.delenv(CACHE_ENV)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert cache_dir() == tmp_path / "xdg" / "bushenv" / "kernels"
