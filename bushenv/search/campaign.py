@@ -54,7 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--model", default="nn", help="model under attack: name or .npz (default nn)")
     p.add_argument("--budget", type=int, default=256, help="model evaluations per search")
     p.add_argument(
-        "--rl-budget", type=int, default=64, help="cap on episodes for ppo/sac (default 64)"
+        "--rl-budget", type=int, default=256, help="cap on episodes for ppo/sac (default 256)"
     )
     p.add_argument("--axis", default="axial", choices=("axial", "radial"))
     p.add_argument("--env", default="rig", choices=("rig", "quartercar"))

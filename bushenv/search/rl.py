@@ -1,31 +1,44 @@
 """Reinforcement-learning searchers: stable-baselines3 PPO and SAC acting in BushRig-v0.
 
-The agent drives the rig sample by sample (action: the displacement change this step as a
-fraction of the machine's velocity limit, see ``BushRigEnv``), so it is free to invent any
-drivable motion, not only the families' shapes. It runs ``N_ENVS`` (32) rigs at once through the
-rig's vector env (``gym.make_vec(..., vectorization_mode="vector_entry_point")``: the models'
-batched kernels, ~40 us per rig-step instead of ~600 us for a wrapped single env), adapted to
-SB3's ``VecEnv`` by ``RigVecEnv`` below.
+The agents act sample by sample in BushRig-v0, ``N_ENVS`` (32) rigs at once through the rig's
+vector env (``gym.make_vec(..., vectorization_mode="vector_entry_point")``: the models' batched
+kernels, ~40 us per rig-step instead of ~600 us for a wrapped single env), adapted to SB3's
+``VecEnv`` by ``RigVecEnv`` and steered through ``OscillatorActions``: each step the agent
+nudges the log-frequency, log-amplitude and offset of a sine, and the rig is sent the velocity
+action that follows it (within the machine's stroke and velocity limit; at the lowest amplitude
+the rig holds). Why not the rig's raw action (the displacement change per step): a Gaussian
+policy on it draws white-noise random walks, and measured on the shipped NN, 64 such walks per
+noise level (std 0.1-1) and rate-limited random positions (+-1 to +-12.5 mm) never diverged --
+the NN's failures need many coherent cycles above its 20 Hz training band, which an agent on
+raw increments must first learn to phase-lock (PPO did not, in 64-256 episodes). Episodes
+start from a frequency and amplitude drawn log-uniformly over the band (exploring starts).
 
 Reward (``DivergenceReward``, the env's ``reward_fn`` hook):
 
-- every step, a dense shaping term: ``min(|F_model - F_ref| / scale_so_far, 5) / steps``,
+- every step, a dense deviation term: ``min(|F_model - F_ref| / scale_so_far, 5) / steps``,
   scale_so_far the reference's running peak |F| (floored at ``FORCE_FLOOR_N``), the same
   normalisation as ``divergence.py``;
+- every step, energy shaping: the change of the potential "work the model gave back beyond the
+  reference's, at the last return to the start deflection" (see the class);
 - at the end of every episode, the episode's whole displacement profile is evaluated ONCE by
   the ``BatchEvaluator`` (the prescribed-motion path and ``divergence.judge``, the single
   definition of divergence) and the agent gets ``-clip(robustness, -10, 10)``: the STL
-  robustness is the objective; the shaping only helps early exploration.
+  robustness is the objective. Robustness alone is flat (the minimum over the criteria sits at
+  the hold/deviation margins until a profile actually fails), so without the shaping the agents
+  settled on slow large strokes, where the NN is merely inaccurate.
+
+The same reward and actions are used for every model (target, hybrid, control).
 
 An episode is one model evaluation: the budget is the number of episodes, and the evaluator's
 verdicts on those profiles are what the result records (so a "failure" found by an agent
 means exactly what it means for random search). The rig itself ends an episode early only
 for non-finite or > 25 kN model forces; the profile up to there is judged the same way.
 
-Seeded: SB3's ``seed``, ``torch.set_num_threads(1)`` and a deterministic CPU run give the same
-episodes for the same seed. The vector env auto-resets on the step after an episode ends
-("next-step" mode); SB3 sees that step as one extra no-op transition from the rest state
-(observation zeros, reward 0), which is harmless: the rig truly is at rest then.
+Seeded: SB3's ``seed``, the exploring starts' generator, ``torch.set_num_threads(1)`` and a
+deterministic CPU run give the same episodes for the same seed. The vector env auto-resets on
+the step after an episode ends ("next-step" mode); SB3 sees that step as one extra no-op
+transition from the rest state (observation zeros, reward 0), which is harmless: the rig truly
+is at rest then.
 
 For road searches (``env="quartercar"``) the agents drive QuarterCar-v0's car through
 ``QuarterCarBatch``, its array integrator (the pymunk env itself costs milliseconds per step;
@@ -38,7 +51,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bushenv.search.divergence import FORCE_FLOOR_N
+from bushenv.search.divergence import CLOSURE_FRACTION, FORCE_FLOOR_N
 from bushenv.search.searchers import Searcher, SearchError
 
 # Road agents: QuarterCar-v0's full action (50 mm per 4.9 ms step, 10 m/s) on a random policy
@@ -48,16 +61,40 @@ from bushenv.search.searchers import Searcher, SearchError
 ROAD_ACTION_SCALE = 0.2
 ROAD_DEAD_ZONE = 0.1
 N_ENVS = 32  # one policy call serves 32 rigs: SB3's per-call cost dominates below that
-EPISODE_S = 10.0  # the rig's default episode: the papers' 10 s records (seed 001)
+EPISODE_S = 2.0  # 100-160 cycles of the NN's failing band; short episodes = more policy updates
 DENSE_CAP = 5.0
 ROBUSTNESS_CLIP = 10.0
+# Rig agents steer an oscillator (``OscillatorActions``): log-frequency, log-amplitude and
+# offset, each moved at most this much per step. Band: the machine's 0.1-80 Hz, from 0.5 Hz (a
+# 2 s episode holds a whole cycle); amplitude 0.1 mm (resolution of the papers' data) to the
+# stroke; at its lowest the amplitude is 0: the rig holds (where the free response is judged).
+OSC_F_HZ = (0.5, 80.0)
+OSC_A_M = (1e-4, 0.0125)
+OSC_LOG_RATE = 0.05  # ln-units per step at |a| = 1: x e in 20 steps (0.1 s)
+OSC_OFFSET_RATE = 0.05  # offset change per step at |a| = 1, as a fraction of the stroke
+VELOCITY_MARGIN = 0.98  # amplitude capped so the sine stays 2 % inside the velocity limit
+# Energy shaping (``DivergenceReward``): weight of the potential "work deficit at the last return
+# to the start deflection", the energy criterion's quantity, telescoped into per-step rewards.
+ENERGY_SHAPING = 5.0
 
 
 class DivergenceReward:
-    """``reward_fn`` hook: dense deviation shaping + terminal -robustness from the evaluator.
+    """``reward_fn`` hook: dense shaping + terminal -robustness from the evaluator.
 
     Keeps each rig's episode (x, F_model, F_ref so far) and, when episodes end, evaluates
-    their profiles in one batch and hands the result to ``on_episodes(batch)``.
+    their profiles in one batch and hands the result to ``on_episodes(batch)``. ``x_now`` is
+    each rig's current displacement (what ``OscillatorActions`` steers from).
+
+    Shaping, both terms normalised like ``divergence.py``:
+
+    - deviation: ``min(|F_model - F_ref| / scale_so_far, 5) / steps``;
+    - energy: ``ENERGY_SHAPING * (phi_t - phi_t-1)`` with the potential
+      ``phi = (W_ref - W_model) / (sum |dW_ref| + 200 N x travel)`` taken at the last return to
+      the start deflection (within 2 % of the span so far, as the energy criterion), held in
+      between: the work a model gives back beyond the reference's, only where a cycle closes,
+      so stored elastic energy in mid-cycle is not rewarded. It telescopes to the potential at
+      the episode's last closure: a model whose loss factor falls below the rubber's scores
+      higher, one that returns net work (the criterion) highest.
     """
 
     def __init__(self, n_envs, episode_steps, evaluator, on_episodes) -> None:
@@ -72,12 +109,38 @@ class DivergenceReward:
         self.peak = np.full(self.n, FORCE_FLOOR_N)
         # judged already; the env's next-step autoreset calls us once more before resetting
         self.finished = np.zeros(self.n, dtype=bool)
+        # x, F_model, F_ref at the last step; W_model, W_ref, normaliser, span, phi
+        self.acc = np.zeros((8, self.n))
+
+    @property
+    def x_now(self) -> np.ndarray:
+        return self.acc[0]
 
     def reset_columns(self, mask) -> None:
         for i in np.flatnonzero(mask):
             self.xs[i] = []
             self.peak[i] = FORCE_FLOOR_N
             self.finished[i] = False
+        self.acc[:, np.asarray(mask, dtype=bool)] = 0.0
+
+    def _energy_shaping(self, x, fm, fr) -> np.ndarray:
+        x_prev, fm_prev, fr_prev, w_m, w_r, norm, span, phi = self.acc
+        fm = np.where(np.isfinite(fm), fm, 0.0)
+        dx = x - x_prev
+        w_m += 0.5 * (fm + fm_prev) * dx
+        w_r += 0.5 * (fr + fr_prev) * dx
+        norm += np.abs(0.5 * (fr + fr_prev) * dx) + FORCE_FLOOR_N * np.abs(dx)
+        np.maximum(span, np.abs(x), out=span)  # the start deflection is 0 (rig at rest)
+        closed = (np.abs(x) <= CLOSURE_FRACTION * span) & (span > 0) & (norm > 0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            new = np.where(closed, (w_r - w_m) / norm, phi)
+        new = np.where(np.isfinite(new), new, phi)
+        gain = new - phi
+        phi[:] = new
+        x_prev[:] = x
+        fm_prev[:] = fm
+        fr_prev[:] = fr
+        return ENERGY_SHAPING * gain
 
     def __call__(self, info) -> np.ndarray:
         x = np.asarray(info["displacement_m"], dtype=np.float64)
@@ -89,7 +152,8 @@ class DivergenceReward:
         with np.errstate(invalid="ignore"):
             dense = np.abs(fm - fr) / self.peak
         dense = np.where(np.isfinite(dense), np.minimum(dense, DENSE_CAP), DENSE_CAP)
-        reward = dense / self.episode_steps
+        reward = dense / self.episode_steps + self._energy_shaping(x, fm, fr)
+        reward[self.finished] = 0.0
         ended = (
             np.asarray(info["diverged"], dtype=bool)
             | np.asarray(info["machine_limit"], dtype=bool)
@@ -104,6 +168,88 @@ class DivergenceReward:
             reward[idx] += -rob
             self.on_episodes(batch)
         return reward
+
+
+def _oscillator_env(venv, reward, params, seed):
+    """Wrap an SB3 rig ``VecEnv`` so the agent steers a sine oscillator (``OscillatorActions``)."""
+    from gymnasium import spaces
+    from stable_baselines3.common.vec_env import VecEnvWrapper
+
+    lo_f, hi_f = np.log(OSC_F_HZ[0]), np.log(OSC_F_HZ[1])
+    lo_a, hi_a = np.log(OSC_A_M[0]), np.log(OSC_A_M[1])
+    max_x, max_step, dt = params.max_x, params.max_step, params.dt
+    a_cap_factor = VELOCITY_MARGIN * params.max_v / (2.0 * np.pi)
+
+    class OscillatorActions(VecEnvWrapper):
+        """Action (3,) in [-1, 1]: d ln f, d ln A (``OSC_LOG_RATE`` per step), d offset
+        (``OSC_OFFSET_RATE`` x stroke per step). The rig is sent the velocity action that moves
+        it toward ``offset + A sin(phase)``; A is capped so the sine is drivable, and is 0 at its
+        lowest (a hold). Each episode starts from a log-uniform frequency and amplitude drawn
+        from the search's seed (exploring starts: the first batch already spans the band) at
+        offset 0. Observation: the rig's 12 values + sin, cos of the phase, and ln f, ln A
+        scaled to [-1, 1]."""
+
+        def __init__(self) -> None:
+            n_obs = venv.observation_space.shape[0] + 4
+            obs = spaces.Box(-np.inf, np.inf, shape=(n_obs,), dtype=np.float32)
+            act = spaces.Box(-1.0, 1.0, shape=(3,), dtype=np.float32)
+            super().__init__(venv, observation_space=obs, action_space=act)
+            n = venv.num_envs
+            self.rng = np.random.default_rng(seed)
+            self.phase = np.zeros(n)
+            self.log_f = np.zeros(n)
+            self.log_a = np.zeros(n)
+            self.offset = np.zeros(n)
+            self._start(np.ones(n, dtype=bool))
+
+        def _start(self, mask) -> None:
+            k = int(np.count_nonzero(mask))
+            if k:
+                self.phase[mask] = 0.0
+                self.offset[mask] = 0.0
+                self.log_f[mask] = self.rng.uniform(lo_f, hi_f, k)
+                self.log_a[mask] = self.rng.uniform(lo_a, hi_a, k)
+
+        def _extra(self) -> np.ndarray:
+            return np.stack(
+                [
+                    np.sin(self.phase),
+                    np.cos(self.phase),
+                    2.0 * (self.log_f - lo_f) / (hi_f - lo_f) - 1.0,
+                    2.0 * (self.log_a - lo_a) / (hi_a - lo_a) - 1.0,
+                ],
+                axis=1,
+            )
+
+        def reset(self):
+            self._start(np.ones(self.num_envs, dtype=bool))
+            return np.hstack([self.venv.reset(), self._extra()]).astype(np.float32)
+
+        def step_async(self, actions) -> None:
+            a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, 3)
+            a = np.clip(np.nan_to_num(a, nan=0.0), -1.0, 1.0)
+            self.log_f = np.clip(self.log_f + OSC_LOG_RATE * a[:, 0], lo_f, hi_f)
+            self.log_a = np.clip(self.log_a + OSC_LOG_RATE * a[:, 1], lo_a, hi_a)
+            self.offset = np.clip(self.offset + OSC_OFFSET_RATE * max_x * a[:, 2], -max_x, max_x)
+            f = np.exp(self.log_f)
+            amp = np.minimum(np.exp(self.log_a), a_cap_factor / f)
+            amp[self.log_a <= lo_a] = 0.0
+            self.phase = np.mod(self.phase + 2.0 * np.pi * f * dt, 2.0 * np.pi)
+            target = np.clip(self.offset + amp * np.sin(self.phase), -max_x, max_x)
+            u = np.clip((target - reward.x_now) / max_step, -1.0, 1.0)
+            self.venv.step_async(u[:, None])
+
+        def step_wait(self):
+            obs, rew, done, infos = self.venv.step_wait()
+            extra = self._extra()
+            for i in np.flatnonzero(done):
+                term = infos[i]["terminal_observation"]
+                infos[i]["terminal_observation"] = np.r_[term, extra[i]].astype(np.float32)
+            self._start(done)
+            obs = np.hstack([obs, self._extra()]).astype(np.float32)
+            return obs, rew, done, infos
+
+    return OscillatorActions()
 
 
 def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward):
@@ -332,7 +478,7 @@ class RLSearch(Searcher):
                 episode_steps,
                 reward,
             )
-            env = _sb3_vec_env(venv)
+            env = _oscillator_env(_sb3_vec_env(venv), reward, venv.params, seed)
         else:
             env = _road_vec_env(evaluator, n_envs, episode_steps, on_episodes)
 
@@ -345,11 +491,11 @@ class RLSearch(Searcher):
             agent = PPO(
                 "MlpPolicy",
                 env,
-                n_steps=128,
-                batch_size=min(1024, 128 * n_envs),
+                n_steps=64,
+                batch_size=min(1024, 64 * n_envs),
                 n_epochs=4,
                 learning_rate=3e-4,
-                gamma=0.995,
+                gamma=0.99,
                 seed=int(seed),
                 device="cpu",
                 policy_kwargs=policy_kwargs,
@@ -360,11 +506,11 @@ class RLSearch(Searcher):
                 "MlpPolicy",
                 env,
                 buffer_size=200_000,
-                learning_starts=256 * n_envs,
+                learning_starts=32 * n_envs,
                 batch_size=256,
-                train_freq=16,
+                train_freq=8,
                 gradient_steps=4,
-                gamma=0.995,
+                gamma=0.99,
                 seed=int(seed),
                 device="cpu",
                 policy_kwargs=policy_kwargs,

@@ -46,3 +46,108 @@ def test_rl_drives_the_quarter_car_and_judges_its_roads(linear_axial, reference_
     assert res.evaluations == 8 and not res.diverged  # the linear control stays clean
     assert res.worst.family == "agent-ppo" and res.worst.profile.size == 102
     assert np.array_equal(res.worst.profile, runs[1].worst.profile)
+
+
+# ----- the oscillator the rig agents steer, and the energy shaping ---------------------------
+
+
+class _Collect:
+    """Stand-in evaluator/on_episodes pair for driving ``DivergenceReward`` by hand."""
+
+    def __init__(self, evaluator):
+        self.evaluator = evaluator
+        self.batches = []
+
+
+def _oscillator_rig(model, reference, n_envs=4, steps=200, seed=0):
+    from bushenv.search.rl import DivergenceReward, _oscillator_env, _rig_vec_env, _sb3_vec_env
+
+    ev = BatchEvaluator(model, reference)
+    got = _Collect(ev)
+    reward = DivergenceReward(n_envs, steps, ev, got.batches.append)
+    venv = _rig_vec_env(model.copy(), reference.copy(), "axial", n_envs, steps, reward)
+    env = _oscillator_env(_sb3_vec_env(venv), reward, venv.params, seed)
+    return env, reward, venv.params, got
+
+
+def _drive(env, reward, actions):
+    env.reset()
+    xs, rewards = [], []
+    for a in actions:
+        env.step_async(np.asarray(a, dtype=np.float32))
+        _, r, _, _ = env.step_wait()
+        xs.append(reward.x_now.copy())
+        rewards.append(r)
+    return np.array(xs), np.array(rewards)
+
+
+def test_oscillator_motion_stays_within_the_machine_and_starts_spread_over_the_band(
+    linear_axial, reference_axial
+):
+    from bushenv.search.rl import OSC_F_HZ
+
+    env, reward, p, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=8, seed=5)
+    rng = np.random.default_rng(0)
+    xs, _ = _drive(env, reward, rng.uniform(-1, 1, (150, 8, 3)))
+    assert np.all(np.abs(xs) <= p.max_x + 1e-12)
+    assert np.all(np.abs(np.diff(np.vstack([np.zeros(8), xs]), axis=0)) <= p.max_step * 1.0001)
+    a, _, _, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=8, seed=5)
+    b, _, _, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=8, seed=5)
+    a.reset(), b.reset()
+    assert np.array_equal(a.log_f, b.log_f)  # exploring starts are seeded
+    f = np.exp(env.log_f)
+    assert np.all((f >= OSC_F_HZ[0]) & (f <= OSC_F_HZ[1])) and np.ptp(np.log(f)) > 1.0
+
+
+def test_oscillator_at_its_lowest_amplitude_holds_the_rig(linear_axial, reference_axial):
+    env, reward, _, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=2)
+    # shrink the amplitude for 150 steps (ln range ~4.8 at 0.05 per step), keep f and offset
+    xs, _ = _drive(env, reward, [np.tile([0.0, -1.0, 0.0], (2, 1))] * 150)
+    assert np.all(np.abs(xs[-30:] - xs[-1]) < 1e-15)  # a hold: the rig does not move
+
+
+def test_energy_shaping_pays_for_returned_work_only_where_a_cycle_closes(reference_axial):
+    from bushenv.search.rl import ENERGY_SHAPING, DivergenceReward
+
+    dt = reference_axial.dt
+    t = np.arange(1, 206) * dt
+    x = 1e-3 * np.sin(2 * np.pi * 10.0 * t)  # 2 cycles + a bit: starts at 0, closes often
+    k, c = 379.68e3, 4.4e3
+    v = np.gradient(np.r_[0.0, x], dt)[1:]
+    f_ref = k * x + c * v
+    payouts = {}
+    for name, c_model in (("passive", c), ("active", -c)):
+        r = DivergenceReward(1, 10_000, None, None)
+        total = 0.0
+        phis = []
+        for i in range(len(x)):
+            info = {
+                "displacement_m": x[i : i + 1],
+                "force_model_n": np.array([k * x[i] + c_model * v[i]]),
+                "force_reference_n": f_ref[i : i + 1],
+                "diverged": np.zeros(1, bool),
+                "machine_limit": np.zeros(1, bool),
+                "step": np.array([i + 1]),
+            }
+            total += float(r(info)[0]) - abs(info["force_model_n"][0] - f_ref[i]) / r.peak[0] / 1e4
+            phis.append(r.acc[7, 0])
+        payouts[name] = total
+        # the potential only moves at returns to 0 (within 2 % of the span)
+        moved = np.flatnonzero(np.diff(np.r_[0.0, phis]) != 0)
+        assert np.all(np.abs(x[moved]) <= 0.02 * np.maximum.accumulate(np.abs(x))[moved] + 1e-18)
+    assert abs(payouts["passive"]) < 1e-9 * ENERGY_SHAPING  # same work as the reference: 0
+    assert payouts["active"] > 0.5 * ENERGY_SHAPING  # negative damping returns work: paid
+
+
+@pytest.mark.parametrize("algo", ["ppo", "sac"])
+def test_rl_agents_find_the_shipped_nn_energy_divergence_and_spare_the_linear_model(
+    algo, reference_axial, linear_axial
+):
+    from bushenv.models import get_model
+
+    nn = get_model("nn", "axial")
+    res = RLSearch(algo).run(BatchEvaluator(nn, reference_axial), budget=96, seed=0)
+    assert res.diverged, res.summary()
+    assert res.first_failure.verdict["first_criterion"] == "energy"
+    ctl = RLSearch(algo).run(BatchEvaluator(linear_axial, reference_axial), budget=32, seed=0)
+    assert not ctl.diverged
