@@ -1,0 +1,66 @@
+"""``scripts/bench.py --quick``: the CI version of the benchmark produces every figure.
+
+Only that each figure is produced (finite, with its unit, and ``met`` wherever a target is
+set) is checked: speed targets belong to the benchmark's full run, never to a unit test.
+"""
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+EXPECTED = [
+    *(
+        f"free_run.{m}.B{b}"
+        for m in ("linear", "nn", "hybrid", "boucwen", "rubber")
+        for b in (1, 64, 1024)
+    ),
+    "free_run.nn.B1024.threads2",
+    "free_run.boucwen.B1024.threads2",
+    *(f"step_latency.{m}" for m in ("linear", "nn", "hybrid", "boucwen", "rubber")),
+    "env.CartPole-v1.single",
+    "env.CartPole-v1.vector1024",
+    "env.BushRig-v0.nn.single_us_over_cartpole_us",
+    "env.BushRig-v0.nn.vector1024_speedup_vs_cartpole_single",
+    "env.QuarterCar-v0.nn.single",
+    "verification_6.44s.nn",
+    "verification_6.44s.boucwen",
+    "identification.nn",
+    "identification.boucwen",
+    "campaign.random.threads2.evaluations_per_s",
+    "campaign.nn.random.seconds_to_first_divergence",
+    "memory.batch_B1024_T512.peak",
+]
+
+
+def test_quick_benchmark_produces_every_figure_with_units_and_targets(tmp_path):
+    out = tmp_path / "bench.json"
+    md = tmp_path / "bench.md"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "scripts" / "bench.py"),
+            "--quick",
+            "--json",
+            str(out),
+            "--markdown",
+            str(md),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    rows = {r["name"]: r for r in json.loads(out.read_text())["figures"]}
+    missing = [n for n in EXPECTED if n not in rows]
+    assert not missing, f"figures not produced: {missing}"
+    for name, r in rows.items():
+        assert r["unit"], name
+        assert math.isfinite(r["value"]), f"{name} = {r['value']}"
+        if "target" in r:
+            assert isinstance(r["met"], bool), name
+    assert rows["free_run.nn.B1024.threads2"]["target"] == 50e6
+    assert "| verification_6.44s.nn |" in md.read_text()
