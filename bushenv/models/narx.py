@@ -203,12 +203,45 @@ class NarxBushing(BushingModel):
         # module exists only in processes that generated or imported it).
         return {**self.__dict__, "_kernels": None}
 
-    def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def _compiled(self) -> NarxKernels:
         kern = self._kernels
         if kern is None:
             kern = self._kernels = narx_kernels(
                 NarxShape(self.n_past_x, self.n_past_f, self.w1.shape[0], self.w2.shape[0])
             )
+        return kern
+
+    def step(self, x: float | np.ndarray, v: float | np.ndarray) -> float | np.ndarray:
+        # Fast path for the common call, floats on an unbatched model (the gym environments):
+        # the same arithmetic as ``_advance`` on (1, 1) arrays, without filling and reading them.
+        tx, tv = type(x), type(v)
+        if (
+            self.batch_size == 1
+            and (tx is float or tx is np.float64)
+            and (tv is float or tv is np.float64)
+        ):
+            k, c = self._backbone()
+            return (self._kernels or self._compiled()).step_one(
+                float(x),  # a np.float64 costs numba's dispatcher more than a float
+                float(v),
+                self.state,
+                self.x_offset_m,
+                self.x_scale_m,
+                self.f_offset_n,
+                self.f_scale_n,
+                self.w1,
+                self.b1,
+                self.w2,
+                self.b2,
+                self.w_out,
+                self.b_out,
+                k,
+                c,
+            )
+        return super().step(x, v)
+
+    def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        kern = self._kernels or self._compiled()
         k, c = self._backbone()
         # One profile: its ring buffers live in registers (no ring indexing per sample); more:
         # the loop over profiles is vectorised. Same operations per profile, same bits.

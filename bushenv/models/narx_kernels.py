@@ -8,8 +8,10 @@ unit is its own local variable and each profile's step is straight-line code, so
 * ``run_rows`` (time outer, profiles inner) lets LLVM vectorise the loop over profiles with all
   hidden accumulators in registers and the weights broadcast (AVX-512 / AVX2 lanes = profiles);
 * ``run_cols`` (profiles outer, time inner) keeps each profile's two ring buffers in registers
-  as shift registers: for one profile (verification, ``step``) it has no ring-index arithmetic
-  and no state traffic inside the time loop.
+  as shift registers: for one profile (verification) it has no ring-index arithmetic and no
+  state traffic inside the time loop;
+* ``step_one`` advances one profile by one sample from scalars and returns the force (``step``
+  of an unbatched model, as in the gym environments).
 
 Both compute each output with exactly the operations, in exactly the order, of
 ``kernels.narx_kernel`` (``h = b1[h]; h += w1[h, i] * inp[i]`` for i = 0, 1, ...; tanh from
@@ -52,6 +54,7 @@ class NarxShape(NamedTuple):
 class NarxKernels(NamedTuple):
     run_rows: object  # numba dispatchers, same signature as kernels.narx_kernel minus the lags
     run_cols: object
+    step_one: object  # (x_t, v_t) floats instead of (x, v), no ``out``: returns the force
     path: Path
 
 
@@ -94,10 +97,18 @@ def _tanh_lines(pre: list[str], post: list[str], ind: str) -> list[str]:
     return lines
 
 
-def _network_body(s: NarxShape, xin: list[str], fin: list[str], ind: str) -> list[str]:
-    """Lines computing ``i0`` (scaled x), the hidden units and ``y`` for one profile."""
+def _network_body(
+    s: NarxShape,
+    xin: list[str],
+    fin: list[str],
+    ind: str,
+    x_at: str = "x[t, b]",
+    v_at: str = "v[t, b]",
+    out_at: str = "out[t, b]",
+) -> list[str]:
+    """Lines computing ``i0`` (scaled x), the hidden units, ``y`` and the force of a profile."""
     inputs = ["i0"] + xin + fin
-    lines = [f"{ind}i0 = (x[t, b] - x_offset) / x_scale"]
+    lines = [f"{ind}i0 = ({x_at} - x_offset) / x_scale"]
     for h in range(s.h1):
         terms = "".join(f" + w1_{h}_{i} * {name}" for i, name in enumerate(inputs))
         lines.append(f"{ind}s{h} = b1_{h}{terms}")
@@ -111,7 +122,7 @@ def _network_body(s: NarxShape, xin: list[str], fin: list[str], ind: str) -> lis
         lines += _tanh_lines([f"q{h}" for h in range(s.h2)], last, ind)
     terms = "".join(f" + wo_{h} * {name}" for h, name in enumerate(last))
     lines.append(f"{ind}y = b_out{terms}")
-    lines.append(f"{ind}out[t, b] = k * x[t, b] + c * v[t, b] + (f_offset + f_scale * y)")
+    lines.append(f"{ind}{out_at} = k * {x_at} + c * {v_at} + (f_offset + f_scale * y)")
     return lines
 
 
@@ -167,6 +178,16 @@ def generate_source(shape: NarxShape) -> str:
         f"{i8}state[{1 + nx} + (cnt_end + {nf - j}) % {nf}, b] = fl{j}" for j in range(1, nf + 1)
     ]
     src += [f"{i8}state[0, b] = float(cnt_end)", ""]
+
+    # One sample of one profile from scalars (``step``): no (1, 1) arrays to fill and read.
+    sig = _SIG.replace("x, v, state", "x_t, v_t, state").replace(", out", "")
+    src += ["@nb.njit(**JIT)", f"def step_one({sig}):  # pragma: no cover - compiled"]
+    src += _weight_locals(s, i4) + [f"{i4}cnt = int(state[0, 0])", f"{i4}b = 0"]
+    src += [f"{i4}xl{j} = state[1 + (cnt + {nx - j}) % {nx}, b]" for j in range(1, nx + 1)]
+    src += [f"{i4}fl{j} = state[{1 + nx} + (cnt + {nf - j}) % {nf}, b]" for j in range(1, nf + 1)]
+    src += _network_body(s, xin, fin, i4, x_at="x_t", v_at="v_t", out_at="force")
+    src += [f"{i4}state[1 + cnt % {nx}, b] = i0", f"{i4}state[{1 + nx} + cnt % {nf}, b] = y"]
+    src += [f"{i4}state[0, b] = float((cnt + 1) % {period})", f"{i4}return force", ""]
     return "\n".join(src)
 
 
@@ -223,7 +244,7 @@ def narx_kernels(shape: NarxShape | tuple[int, int, int, int]) -> NarxKernels:
             folder = Path(tempfile.gettempdir()) / f"bushenv-kernels-{os.getuid()}"
             path = _write_module(folder, name, source)
         module = _import(path, name)
-        found = NarxKernels(module.run_rows, module.run_cols, path)
+        found = NarxKernels(module.run_rows, module.run_cols, module.step_one, path)
         _LOADED[shape] = found
         return found
 
@@ -245,3 +266,4 @@ def warm_up() -> None:
         w_out = np.zeros(shape.h2 or shape.h1)
         for run in (kern.run_rows, kern.run_cols):
             run(x, x, state, 0.0, 1.0, 0.0, 1.0, w1, b1, w2, b2, w_out, 0.0, 0.0, 0.0, x.copy())
+        kern.step_one(0.0, 0.0, state, 0.0, 1.0, 0.0, 1.0, w1, b1, w2, b2, w_out, 0.0, 0.0, 0.0)

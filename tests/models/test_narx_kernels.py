@@ -6,7 +6,7 @@ import pickle
 import numpy as np
 import pytest
 
-from bushenv.models import get_model
+from bushenv.models import ModelError, get_model
 from bushenv.models.kernels import narx_kernel
 from bushenv.models.narx import NarxBushing
 from bushenv.models.narx_kernels import (
@@ -67,6 +67,15 @@ def test_generated_kernels_give_the_reference_kernels_bits(shape, batch):
         state = start.copy()
         got = run(variant, shape, net, x, v, state, 3e5, 900.0)
         assert np.array_equal(got, ref)
+        assert np.array_equal(state, ref_state)
+    if batch == 1:
+        state = start.copy()
+        got = [
+            kern.step_one(x[t, 0], v[t, 0], state, 1e-4, 2e-3, 5.0, 300.0, net["w1"], net["b1"],
+                          net["w2"], net["b2"], net["w_out"], net["b_out"], 3e5, 900.0)
+            for t in range(T)
+        ]  # fmt: skip
+        assert np.array_equal(got, ref[:, 0])
         assert np.array_equal(state, ref_state)
 
 
@@ -145,3 +154,26 @@ def test_cache_folder_follows_the_environment(monkeypatch, tmp_path):
     monkeypatch.delenv(CACHE_ENV)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     assert cache_dir() == tmp_path / "xdg" / "bushenv" / "kernels"
+
+
+@pytest.mark.parametrize("name", ["nn", "hybrid"])
+def test_step_gives_simulate_bits_for_floats_numpy_scalars_and_arrays(name):
+    m = get_model(name, axis="axial")
+    rng = np.random.default_rng(8)
+    x = np.cumsum(rng.normal(size=120)) * 1e-4
+    v = np.gradient(x, m.dt)
+    ref = m.simulate(x, v)
+    for convert in (float, np.float64, lambda a: np.array([a])):
+        m.reset(1)
+        got = np.array([m.step(convert(x[t]), convert(v[t])) for t in range(120)]).ravel()
+        assert np.array_equal(got, ref)
+    m.reset(1)
+    assert isinstance(m.step(0.001, 0.0), float)
+    assert isinstance(m.step(0, 1), float)  # ints take the generic path
+
+
+def test_scalar_step_on_a_batch_is_refused():
+    m = get_model("nn", axis="axial")
+    m.reset(3)
+    with pytest.raises(ModelError, match="scalar step on a batch of 3"):
+        m.step(0.001, 0.0)
