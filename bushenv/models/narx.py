@@ -35,7 +35,14 @@ from typing import Any
 import numpy as np
 
 from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
-from bushenv.models.narx_kernels import COLS_MAX_BATCH, NarxKernels, NarxShape, narx_kernels
+from bushenv.models.narx_kernels import (
+    COLS_MAX_BATCH,
+    NarxKernels,
+    NarxShape,
+    column_split,
+    narx_kernels,
+    thread_pool,
+)
 
 N_PAST_X = 5  # seed 000 §4.2
 N_PAST_F = 5
@@ -121,6 +128,7 @@ class NarxBushing(BushingModel):
         self.w_out = _array("w_out", w_out, (h2 if h2 else h1,))
         self.b_out = _scalar("b_out", b_out)
         self._kernels: NarxKernels | None = None  # compiled for this shape on first use
+        self._threads = 1  # set by simulate(threads=...) for the duration of one call
         super().__init__(dt)
 
     # ----- structure -----------------------------------------------------------------------
@@ -240,13 +248,22 @@ class NarxBushing(BushingModel):
             )
         return super().step(x, v)
 
+    def simulate(self, x: np.ndarray, v: np.ndarray | None = None, threads: int = 1) -> np.ndarray:
+        """``BushingModel.simulate``; ``threads`` > 1 splits the profiles of a (T, B) run over
+        that many threads (opt-in: callers that already run models in parallel threads should
+        not). Every profile is computed as with one thread: the same bits."""
+        if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 1:
+            raise ModelError(f"{self.name}: threads must be a positive integer, got {threads!r}")
+        self._threads = int(threads)
+        try:
+            return super().simulate(x, v)
+        finally:
+            self._threads = 1
+
     def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         kern = self._kernels or self._compiled()
         k, c = self._backbone()
-        # One profile: its ring buffers live in registers (no ring indexing per sample); more:
-        # the loop over profiles is vectorised. Same operations per profile, same bits.
-        run = kern.run_cols if x.shape[1] <= COLS_MAX_BATCH else kern.run_rows
-        run(
+        args = (
             x,
             v,
             self.state,
@@ -264,6 +281,21 @@ class NarxBushing(BushingModel):
             c,
             out,
         )
+        B = x.shape[1]
+        if B <= COLS_MAX_BATCH:
+            # One profile: its ring buffers live in registers (no ring indexing per sample).
+            kern.run_cols(*args)
+        elif self._threads > 1 and B > 8:
+            # Disjoint column ranges of the same arrays; the kernels release the GIL.
+            pool = thread_pool()
+            jobs = [
+                pool.submit(kern.run_rows, *args, lo, hi)
+                for lo, hi in column_split(B, self._threads)
+            ]
+            for job in jobs:
+                job.result()
+        else:
+            kern.run_rows(*args, 0, B)  # the loop over profiles is vectorised
 
     def nn_bound(self) -> float:
         """Largest |network force| any input can produce, N.

@@ -14,6 +14,7 @@ from bushenv.models.narx_kernels import (
     NarxShape,
     _write_module,
     cache_dir,
+    column_split,
     generate_source,
     narx_kernels,
 )
@@ -43,8 +44,9 @@ def network(shape, seed):
 def run(kernel, shape, net, x, v, state, k, c):
     out = np.empty_like(x)
     lags = (shape.n_past_x, shape.n_past_f) if kernel is narx_kernel else ()
+    cols = (0, x.shape[1]) if kernel is narx_kernels(shape).run_rows else ()
     kernel(x, v, state, *lags, 1e-4, 2e-3, 5.0, 300.0, net["w1"], net["b1"], net["w2"],
-           net["b2"], net["w_out"], net["b_out"], k, c, out)  # fmt: skip
+           net["b2"], net["w_out"], net["b_out"], k, c, out, *cols)  # fmt: skip
     return out
 
 
@@ -177,3 +179,53 @@ def test_scalar_step_on_a_batch_is_refused():
     m.reset(3)
     with pytest.raises(ModelError, match="scalar step on a batch of 3"):
         m.step(0.001, 0.0)
+
+
+def test_run_rows_on_a_column_range_advances_only_those_columns():
+    shape = SHAPES[0]
+    net = network(shape, seed=4)
+    rng = np.random.default_rng(4)
+    x = rng.normal(size=(30, 40)) * 1e-3
+    kern = narx_kernels(shape)
+    start = np.zeros((1 + shape.n_past_x + shape.n_past_f, 40))
+    whole_state = start.copy()
+    whole = run(kern.run_rows, shape, net, x, x, whole_state, 0.0, 0.0)
+    state, out = start.copy(), np.full_like(x, -1.0)
+    for lo, hi in ((16, 40), (0, 16), (40, 40)):
+        kern.run_rows(x, x, state, 1e-4, 2e-3, 5.0, 300.0, net["w1"], net["b1"], net["w2"],
+                      net["b2"], net["w_out"], net["b_out"], 0.0, 0.0, out, lo, hi)  # fmt: skip
+        if lo == 16:
+            assert np.all(out[:, :16] == -1.0) and np.all(state[:, :16] == 0.0)
+    assert np.array_equal(out, whole)
+    assert np.array_equal(state, whole_state)
+
+
+@pytest.mark.parametrize("batch", [9, 37, 1000])
+@pytest.mark.parametrize("threads", [2, 3])
+def test_threaded_simulate_gives_the_single_thread_bits(batch, threads):
+    m = get_model("hybrid", axis="radial")
+    rng = np.random.default_rng(batch)
+    x = np.cumsum(rng.normal(size=(200, batch)), axis=0) * 1e-4
+    one = m.simulate(x)
+    state = m.state.copy()
+    assert np.array_equal(m.simulate(x, threads=threads), one)
+    assert np.array_equal(m.state, state)
+    assert m._threads == 1  # the setting lasts one call
+
+
+@pytest.mark.parametrize("bad", [0, -2, 1.5, True, "2"])
+def test_threads_must_be_a_positive_integer(bad):
+    m = get_model("nn", axis="axial")
+    with pytest.raises(ModelError, match="threads must be a positive integer"):
+        m.simulate(np.zeros((5, 16)), threads=bad)
+
+
+def test_column_split_uses_whole_vectors_and_covers_every_column_once():
+    for batch in (1, 7, 8, 9, 100, 1000, 1024, 1025):
+        for parts in (1, 2, 3, 4):
+            ranges = column_split(batch, parts)
+            assert ranges[0][0] == 0 and ranges[-1][1] == batch
+            assert all(a[1] == b[0] for a, b in zip(ranges[:-1], ranges[1:], strict=True))
+            assert all(lo % 8 == 0 and hi > lo for lo, hi in ranges)
+            assert len(ranges) <= parts
+    assert column_split(1024, 2) == [(0, 512), (512, 1024)]
