@@ -88,17 +88,15 @@ def log_pos(a):  # pragma: no cover - compiled
     f = m - 1.0
     s = f / (2.0 + f)
     s2 = s * s
-    q = 1.0 / 23.0
-    q = q * s2 + 1.0 / 21.0
-    q = q * s2 + 1.0 / 19.0
-    q = q * s2 + 1.0 / 17.0
-    q = q * s2 + 1.0 / 15.0
-    q = q * s2 + 1.0 / 13.0
-    q = q * s2 + 1.0 / 11.0
-    q = q * s2 + 1.0 / 9.0
-    q = q * s2 + 1.0 / 7.0
-    q = q * s2 + 1.0 / 5.0
-    q = q * s2 + 1.0 / 3.0
+    # q = sum_k s2^k / (2k + 3), k = 0..10, by Estrin's scheme (short dependency chains)
+    s4 = s2 * s2
+    s8 = s4 * s4
+    q01 = 1.0 / 3.0 + s2 * (1.0 / 5.0)
+    q23 = 1.0 / 7.0 + s2 * (1.0 / 9.0)
+    q45 = 1.0 / 11.0 + s2 * (1.0 / 13.0)
+    q67 = 1.0 / 15.0 + s2 * (1.0 / 17.0)
+    q89 = 1.0 / 19.0 + s2 * (1.0 / 21.0)
+    q = (q01 + s4 * q23) + s8 * ((q45 + s4 * q67) + s8 * (q89 + s4 * (1.0 / 23.0)))
     # 2 atanh(s) = 2 s + 2 s^3 q; f - f s = 2 s exactly-ish: write 2 s = f - s f to keep the
     # leading term's rounding small
     log_m = (f - s * f) + 2.0 * s * s2 * q
@@ -114,20 +112,18 @@ def exp_(y):  # pragma: no cover - compiled
     kf = kf + 0.5 if kf >= 0.0 else kf - 0.5
     k = int(kf)  # round half away from zero; |k| <= 1097
     r = (y - float(k) * LN2_HI) - float(k) * LN2_LO
-    p = 1.0 / 6227020800.0
-    p = p * r + 1.0 / 479001600.0
-    p = p * r + 1.0 / 39916800.0
-    p = p * r + 1.0 / 3628800.0
-    p = p * r + 1.0 / 362880.0
-    p = p * r + 1.0 / 40320.0
-    p = p * r + 1.0 / 5040.0
-    p = p * r + 1.0 / 720.0
-    p = p * r + 1.0 / 120.0
-    p = p * r + 1.0 / 24.0
-    p = p * r + 1.0 / 6.0
-    p = p * r + 0.5
-    p = p * r + 1.0
-    p = p * r + 1.0
+    # degree-13 Taylor polynomial: 1 + r + r^2 Q(r), Q by Estrin's scheme (short chains)
+    r2 = r * r
+    r4 = r2 * r2
+    r8 = r4 * r4
+    e23 = 0.5 + r * (1.0 / 6.0)
+    e45 = 1.0 / 24.0 + r * (1.0 / 120.0)
+    e67 = 1.0 / 720.0 + r * (1.0 / 5040.0)
+    e89 = 1.0 / 40320.0 + r * (1.0 / 362880.0)
+    eab = 1.0 / 3628800.0 + r * (1.0 / 39916800.0)
+    ecd = 1.0 / 479001600.0 + r * (1.0 / 6227020800.0)
+    q = (e23 + r2 * e45) + r4 * (e67 + r2 * e89) + r8 * (eab + r2 * ecd)
+    p = 1.0 + (r + r2 * q)
     k1 = k >> 1
     k2 = k - k1
     s1 = _bits_f64((k1 + 1023) << 52)
