@@ -29,6 +29,8 @@ def linear_kernel(x, v, k, c, out):  # pragma: no cover - compiled
 
 
 # ----- NARX network (nn, hybrid) -----------------------------------------------------------
+# The models run the kernels generated per network shape in narx_kernels.py; this generic one
+# is their reference (they give its bits: tests/models/test_narx_kernels.py).
 # State rows: 0 = step counter (modulo n_past_x * n_past_f; equal in every column),
 # 1 .. n_past_x = ring of past SCALED displacements, then n_past_f rows = ring of past SCALED
 # network outputs. Lag j of a ring of length n sits in slot (counter - j) mod n.

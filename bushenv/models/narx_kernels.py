@@ -7,16 +7,20 @@ unit is its own local variable and each profile's step is straight-line code, so
 
 * ``run_rows`` (time outer, profiles inner) lets LLVM vectorise the loop over profiles with all
   hidden accumulators in registers and the weights broadcast (AVX-512 / AVX2 lanes = profiles);
+  it advances columns lo .. hi-1 of the batch, so threads can share one batch
+  (``NarxBushing.simulate(..., threads=n)``, ``column_split``, ``thread_pool``);
 * ``run_cols`` (profiles outer, time inner) keeps each profile's two ring buffers in registers
   as shift registers: for one profile (verification) it has no ring-index arithmetic and no
   state traffic inside the time loop;
 * ``step_one`` advances one profile by one sample from scalars and returns the force (``step``
   of an unbatched model, as in the gym environments).
 
-Both compute each output with exactly the operations, in exactly the order, of
-``kernels.narx_kernel`` (``h = b1[h]; h += w1[h, i] * inp[i]`` for i = 0, 1, ...; tanh from
-``fastmath``; ``y = b_out; y += w_out[h] * h_h``), so all three agree bit for bit, whatever the
-batch size (``tests/models/test_narx_kernels.py``).
+All three compute each output with exactly the operations, in exactly the order, of
+``kernels.narx_kernel`` (``h = b1[h]; h += w1[h, i] * inp[i]`` for i = 0, 1, ...; then
+``fastmath.tanh``, inlined stage by stage across the units; ``y = b_out; y += w_out[h] * h_h``),
+so all four agree bit for bit, whatever the batch size, column range or thread count
+(``tests/models/test_narx_kernels.py``). No fused multiply-add: it would be ~10 % faster here
+but would change the last bits of every force the shipped models give.
 
 The source goes to a real file in a cache folder (``BUSHENV_KERNEL_CACHE``, else
 ``$XDG_CACHE_HOME/bushenv/kernels``, else ``~/.cache/bushenv/kernels``, falling back to the
@@ -225,6 +229,14 @@ def _write_module(folder: Path, name: str, source: str) -> Path:
     return path
 
 
+def _place_module(name: str, source: str) -> Path:
+    try:
+        return _write_module(cache_dir(), name, source)
+    except OSError:  # read-only home: a per-user temp folder still caches across runs
+        user = getattr(os, "getuid", lambda: "user")()
+        return _write_module(Path(tempfile.gettempdir()) / f"bushenv-kernels-{user}", name, source)
+
+
 def _import(path: Path, name: str) -> ModuleType:
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
@@ -246,11 +258,7 @@ def narx_kernels(shape: NarxShape | tuple[int, int, int, int]) -> NarxKernels:
         source = generate_source(shape)
         digest = hashlib.sha256(f"{GENERATOR_VERSION}\n{source}".encode()).hexdigest()[:16]
         name = "bushenv_narx_x{}_f{}_h{}_{}_{}".format(*shape, digest)
-        try:
-            path = _write_module(cache_dir(), name, source)
-        except OSError:  # read-only home: a per-user temp folder still caches across runs
-            folder = Path(tempfile.gettempdir()) / f"bushenv-kernels-{os.getuid()}"
-            path = _write_module(folder, name, source)
+        path = _place_module(name, source)
         module = _import(path, name)
         found = NarxKernels(module.run_rows, module.run_cols, module.step_one, path)
         _LOADED[shape] = found

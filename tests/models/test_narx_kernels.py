@@ -12,6 +12,7 @@ from bushenv.models.narx import NarxBushing
 from bushenv.models.narx_kernels import (
     CACHE_ENV,
     NarxShape,
+    _place_module,
     _write_module,
     cache_dir,
     column_split,
@@ -229,3 +230,14 @@ def test_column_split_uses_whole_vectors_and_covers_every_column_once():
             assert all(lo % 8 == 0 and hi > lo for lo, hi in ranges)
             assert len(ranges) <= parts
     assert column_split(1024, 2) == [(0, 512), (512, 1024)]
+
+
+def test_unwritable_cache_folder_falls_back_to_a_temp_folder(monkeypatch, tmp_path):
+    blocker = tmp_path / "not_a_folder"
+    blocker.write_text("")
+    monkeypatch.setenv(CACHE_ENV, str(blocker / "kernels"))
+    monkeypatch.setattr("tempfile.tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    path = _place_module("mod_b", "X = 3\n")
+    assert path.parent.parent == tmp_path / "tmp"
+    assert path.read_text() == "X = 3\n"
