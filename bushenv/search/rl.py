@@ -3,15 +3,15 @@
 The agents act sample by sample in BushRig-v0, ``N_ENVS`` (32) rigs at once through the rig's
 vector env (``gym.make_vec(..., vectorization_mode="vector_entry_point")``: the models' batched
 kernels, ~40 us per rig-step instead of ~600 us for a wrapped single env), adapted to SB3's
-``VecEnv`` by ``RigVecEnv`` and steered through ``OscillatorActions``: each step the agent
-nudges the log-frequency, log-amplitude and offset of a sine, and the rig is sent the velocity
-action that follows it (within the machine's stroke and velocity limit; at the lowest amplitude
-the rig holds). Why not the rig's raw action (the displacement change per step): a Gaussian
-policy on it draws white-noise random walks, and measured on the shipped NN, 64 such walks per
-noise level (std 0.1-1) and rate-limited random positions (+-1 to +-12.5 mm) never diverged --
-the NN's failures need many coherent cycles above its 20 Hz training band, which an agent on
-raw increments must first learn to phase-lock (PPO did not, in 64-256 episodes). Episodes
-start from a frequency and amplitude drawn log-uniformly over the band (exploring starts).
+``VecEnv`` by ``RigVecEnv`` and steered through ``OscillatorActions``: the episode's first action
+sets the frequency and amplitude of a sine, later ones move them ("rate") or set targets they
+follow ("follow"), and the rig is sent the velocity action that tracks the sine (within the
+machine's stroke and velocity limit; at the lowest amplitude the rig holds). Why not the rig's
+raw action (the displacement change per step): a Gaussian policy on it draws white-noise random
+walks, and measured on the shipped NN, 64 such walks per noise level (std 0.1-1) and
+rate-limited random positions (+-1 to +-12.5 mm) never diverged -- the NN's failures need many
+coherent cycles at 45-70 Hz, which an agent on raw increments must first learn to phase-lock
+(PPO and SAC did not, in 64 episodes of 10 s or 256 of 0.25-1 s).
 
 Reward (``DivergenceReward``, the env's ``reward_fn`` hook):
 
@@ -22,10 +22,11 @@ Reward (``DivergenceReward``, the env's ``reward_fn`` hook):
   reference's, at the last return to the start deflection" (see the class);
 - at the end of every episode, the episode's whole displacement profile is evaluated ONCE by
   the ``BatchEvaluator`` (the prescribed-motion path and ``divergence.judge``, the single
-  definition of divergence) and the agent gets ``-clip(robustness, -10, 10)``: the STL
-  robustness is the objective. Robustness alone is flat (the minimum over the criteria sits at
-  the hold/deviation margins until a profile actually fails), so without the shaping the agents
-  settled on slow large strokes, where the NN is merely inaccurate.
+  definition of divergence) and the agent gets ``-min(clip(robustness, -10, 10), 0.25)``: the
+  STL robustness, graded only below 0.25 -- every profile ending in a hold has robustness
+  <= 0.25 (the hold term's margin), so uncapped, PPO learned to hold still. Robustness alone is
+  flat until a profile fails, so without the shaping the agents settled on slow large strokes,
+  where the NN is merely inaccurate.
 
 The same reward and actions are used for every model (target, hybrid, control).
 
@@ -34,8 +35,8 @@ verdicts on those profiles are what the result records (so a "failure" found by 
 means exactly what it means for random search). The rig itself ends an episode early only
 for non-finite or > 25 kN model forces; the profile up to there is judged the same way.
 
-Seeded: SB3's ``seed``, the exploring starts' generator, ``torch.set_num_threads(1)`` and a
-deterministic CPU run give the same episodes for the same seed. The vector env auto-resets on
+Seeded: SB3's ``seed``, ``torch.set_num_threads(1)`` and a deterministic CPU run give the same
+episodes for the same seed. The vector env auto-resets on
 the step after an episode ends ("next-step" mode); SB3 sees that step as one extra no-op
 transition from the rest state (observation zeros, reward 0), which is harmless: the rig truly
 is at rest then.
@@ -51,7 +52,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bushenv.search.divergence import CLOSURE_FRACTION, FORCE_FLOOR_N
+from bushenv.search.divergence import CLOSURE_FRACTION, FORCE_FLOOR_N, SETTLE_FRACTION
 from bushenv.search.searchers import Searcher, SearchError
 
 # Road agents: QuarterCar-v0's full action (50 mm per 4.9 ms step, 10 m/s) on a random policy
@@ -64,15 +65,22 @@ N_ENVS = 32  # one policy call serves 32 rigs: SB3's per-call cost dominates bel
 EPISODE_S = 2.0  # 100-160 cycles of the NN's failing band; short episodes = more policy updates
 DENSE_CAP = 5.0
 ROBUSTNESS_CLIP = 10.0
-# Rig agents steer an oscillator (``OscillatorActions``): log-frequency, log-amplitude and
-# offset, each moved at most this much per step. Band: the machine's 0.1-80 Hz, from 0.5 Hz (a
-# 2 s episode holds a whole cycle); amplitude 0.1 mm (resolution of the papers' data) to the
-# stroke; at its lowest the amplitude is 0: the rig holds (where the free response is judged).
+# Rig agents steer an oscillator (``OscillatorActions``): its log-frequency and log-amplitude.
+# Band: the machine's 0.1-80 Hz, from 0.5 Hz (a 2 s episode holds a whole cycle); amplitude
+# 0.1 mm (resolution of the papers' data) to the stroke; at its lowest the amplitude is 0: the
+# rig holds at rest. The episode's first action sets both directly; later actions either move
+# them at most OSC_LOG_RATE per step ("rate") or set a target they follow with a first-order lag
+# of OSC_FOLLOW per step ("follow"): see ``ACTIONS_BY_ALGO``.
 OSC_F_HZ = (0.5, 80.0)
 OSC_A_M = (1e-4, 0.0125)
 OSC_LOG_RATE = 0.05  # ln-units per step at |a| = 1: x e in 20 steps (0.1 s)
-OSC_OFFSET_RATE = 0.05  # offset change per step at |a| = 1, as a fraction of the stroke
+OSC_FOLLOW = 0.05  # lag: 20 steps (0.1 s) time constant
 VELOCITY_MARGIN = 0.98  # amplitude capped so the sine stays 2 % inside the velocity limit
+# Measured (docs/search.md): PPO learns to fail with "follow" (a Gaussian policy's mean is the
+# frequency; per-step noise is averaged out) and not with "rate"; SAC finds failures with "rate"
+# (its broad first actions explore the band) and none with "follow" (its near-uniform per-step
+# actions average to mid-band).
+ACTIONS_BY_ALGO = {"ppo": "follow", "sac": "rate"}
 # Energy shaping (``DivergenceReward``): weight of the potential "work deficit at the last return
 # to the start deflection", the energy criterion's quantity, telescoped into per-step rewards.
 ENERGY_SHAPING = 5.0
@@ -165,50 +173,43 @@ class DivergenceReward:
             profiles = [np.r_[0.0, self.xs[i]] for i in idx]  # the rig starts at rest at 0
             batch = self.evaluator.evaluate(profiles)
             rob = np.clip(batch.verdict.robustness, -ROBUSTNESS_CLIP, ROBUSTNESS_CLIP)
-            reward[idx] += -rob
+            # Every profile ending in a hold has robustness <= SETTLE_FRACTION (the hold term's
+            # margin at zero drift): uncapped, holding still "scores" better than any
+            # non-failing motion, and PPO learned to hold. Only failures are graded.
+            reward[idx] += -np.minimum(rob, SETTLE_FRACTION)
             self.on_episodes(batch)
         return reward
 
 
-def _oscillator_env(venv, reward, params, seed):
+def _oscillator_env(venv, reward, params, mode):
     """Wrap an SB3 rig ``VecEnv`` so the agent steers a sine oscillator (``OscillatorActions``)."""
     from gymnasium import spaces
     from stable_baselines3.common.vec_env import VecEnvWrapper
 
+    if mode not in ("rate", "follow"):
+        raise SearchError(f"oscillator actions must be 'rate' or 'follow', got {mode!r}")
     lo_f, hi_f = np.log(OSC_F_HZ[0]), np.log(OSC_F_HZ[1])
     lo_a, hi_a = np.log(OSC_A_M[0]), np.log(OSC_A_M[1])
     max_x, max_step, dt = params.max_x, params.max_step, params.dt
     a_cap_factor = VELOCITY_MARGIN * params.max_v / (2.0 * np.pi)
 
     class OscillatorActions(VecEnvWrapper):
-        """Action (3,) in [-1, 1]: d ln f, d ln A (``OSC_LOG_RATE`` per step), d offset
-        (``OSC_OFFSET_RATE`` x stroke per step). The rig is sent the velocity action that moves
-        it toward ``offset + A sin(phase)``; A is capped so the sine is drivable, and is 0 at its
-        lowest (a hold). Each episode starts from a log-uniform frequency and amplitude drawn
-        from the search's seed (exploring starts: the first batch already spans the band) at
-        offset 0. Observation: the rig's 12 values + sin, cos of the phase, and ln f, ln A
-        scaled to [-1, 1]."""
+        """Action (2,) in [-1, 1] for ln f and ln A over their ranges. The episode's first action
+        sets them; later ones move them (``mode``). The rig is sent the velocity action that
+        moves it toward ``A sin(phase)``; A is capped so the sine is drivable, and is 0 at its
+        lowest (the rig holds). Observation: the rig's 12 values + sin, cos of the phase, ln f and
+        ln A scaled to [-1, 1], and 1 on an episode's first step (else 0)."""
 
         def __init__(self) -> None:
-            n_obs = venv.observation_space.shape[0] + 4
+            n_obs = venv.observation_space.shape[0] + 5
             obs = spaces.Box(-np.inf, np.inf, shape=(n_obs,), dtype=np.float32)
-            act = spaces.Box(-1.0, 1.0, shape=(3,), dtype=np.float32)
+            act = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
             super().__init__(venv, observation_space=obs, action_space=act)
             n = venv.num_envs
-            self.rng = np.random.default_rng(seed)
             self.phase = np.zeros(n)
-            self.log_f = np.zeros(n)
-            self.log_a = np.zeros(n)
-            self.offset = np.zeros(n)
-            self._start(np.ones(n, dtype=bool))
-
-        def _start(self, mask) -> None:
-            k = int(np.count_nonzero(mask))
-            if k:
-                self.phase[mask] = 0.0
-                self.offset[mask] = 0.0
-                self.log_f[mask] = self.rng.uniform(lo_f, hi_f, k)
-                self.log_a[mask] = self.rng.uniform(lo_a, hi_a, k)
+            self.log_f = np.full(n, lo_f)
+            self.log_a = np.full(n, lo_a)
+            self.first = np.ones(n, dtype=bool)
 
         def _extra(self) -> np.ndarray:
             return np.stack(
@@ -217,25 +218,35 @@ def _oscillator_env(venv, reward, params, seed):
                     np.cos(self.phase),
                     2.0 * (self.log_f - lo_f) / (hi_f - lo_f) - 1.0,
                     2.0 * (self.log_a - lo_a) / (hi_a - lo_a) - 1.0,
+                    self.first.astype(np.float64),
                 ],
                 axis=1,
             )
 
         def reset(self):
-            self._start(np.ones(self.num_envs, dtype=bool))
+            self.phase[:] = 0.0
+            self.first[:] = True
             return np.hstack([self.venv.reset(), self._extra()]).astype(np.float32)
 
         def step_async(self, actions) -> None:
-            a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, 3)
+            a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, 2)
             a = np.clip(np.nan_to_num(a, nan=0.0), -1.0, 1.0)
-            self.log_f = np.clip(self.log_f + OSC_LOG_RATE * a[:, 0], lo_f, hi_f)
-            self.log_a = np.clip(self.log_a + OSC_LOG_RATE * a[:, 1], lo_a, hi_a)
-            self.offset = np.clip(self.offset + OSC_OFFSET_RATE * max_x * a[:, 2], -max_x, max_x)
+            target_f = lo_f + 0.5 * (a[:, 0] + 1.0) * (hi_f - lo_f)
+            target_a = lo_a + 0.5 * (a[:, 1] + 1.0) * (hi_a - lo_a)
+            if mode == "follow":
+                log_f = self.log_f + OSC_FOLLOW * (target_f - self.log_f)
+                log_a = self.log_a + OSC_FOLLOW * (target_a - self.log_a)
+            else:
+                log_f = np.clip(self.log_f + OSC_LOG_RATE * a[:, 0], lo_f, hi_f)
+                log_a = np.clip(self.log_a + OSC_LOG_RATE * a[:, 1], lo_a, hi_a)
+            self.log_f = np.where(self.first, target_f, log_f)
+            self.log_a = np.where(self.first, target_a, log_a)
+            self.first[:] = False
             f = np.exp(self.log_f)
             amp = np.minimum(np.exp(self.log_a), a_cap_factor / f)
             amp[self.log_a <= lo_a] = 0.0
             self.phase = np.mod(self.phase + 2.0 * np.pi * f * dt, 2.0 * np.pi)
-            target = np.clip(self.offset + amp * np.sin(self.phase), -max_x, max_x)
+            target = np.clip(amp * np.sin(self.phase), -max_x, max_x)
             u = np.clip((target - reward.x_now) / max_step, -1.0, 1.0)
             self.venv.step_async(u[:, None])
 
@@ -245,7 +256,8 @@ def _oscillator_env(venv, reward, params, seed):
             for i in np.flatnonzero(done):
                 term = infos[i]["terminal_observation"]
                 infos[i]["terminal_observation"] = np.r_[term, extra[i]].astype(np.float32)
-            self._start(done)
+            self.phase[done] = 0.0
+            self.first[done] = True
             obs = np.hstack([obs, self._extra()]).astype(np.float32)
             return obs, rew, done, infos
 
@@ -439,9 +451,18 @@ def _road_vec_env(evaluator, n_envs, episode_steps, on_episodes):
 class RLSearch(Searcher):
     """PPO or SAC in BushRig-v0 (or the QuarterCar-v0 car); the budget counts episodes."""
 
-    def __init__(self, algo: str, n_envs: int = N_ENVS, episode_s: float = EPISODE_S) -> None:
+    def __init__(
+        self,
+        algo: str,
+        n_envs: int = N_ENVS,
+        episode_s: float = EPISODE_S,
+        actions: str | None = None,
+    ) -> None:
         if algo not in ("ppo", "sac"):
             raise SearchError(f"RL searcher must be 'ppo' or 'sac', got {algo!r}")
+        self.actions = actions or ACTIONS_BY_ALGO[algo]
+        if self.actions not in ("rate", "follow"):
+            raise SearchError(f"RL actions must be 'rate' or 'follow', got {self.actions!r}")
         self.name = algo
         self.n_envs = int(n_envs)
         self.episode_s = float(episode_s)
@@ -478,7 +499,7 @@ class RLSearch(Searcher):
                 episode_steps,
                 reward,
             )
-            env = _oscillator_env(_sb3_vec_env(venv), reward, venv.params, seed)
+            env = _oscillator_env(_sb3_vec_env(venv), reward, venv.params, self.actions)
         else:
             env = _road_vec_env(evaluator, n_envs, episode_steps, on_episodes)
 

@@ -59,14 +59,14 @@ class _Collect:
         self.batches = []
 
 
-def _oscillator_rig(model, reference, n_envs=4, steps=200, seed=0):
+def _oscillator_rig(model, reference, n_envs=4, steps=200, mode="rate"):
     from bushenv.search.rl import DivergenceReward, _oscillator_env, _rig_vec_env, _sb3_vec_env
 
     ev = BatchEvaluator(model, reference)
     got = _Collect(ev)
     reward = DivergenceReward(n_envs, steps, ev, got.batches.append)
     venv = _rig_vec_env(model.copy(), reference.copy(), "axial", n_envs, steps, reward)
-    env = _oscillator_env(_sb3_vec_env(venv), reward, venv.params, seed)
+    env = _oscillator_env(_sb3_vec_env(venv), reward, venv.params, mode)
     return env, reward, venv.params, got
 
 
@@ -81,29 +81,47 @@ def _drive(env, reward, actions):
     return np.array(xs), np.array(rewards)
 
 
-def test_oscillator_motion_stays_within_the_machine_and_starts_spread_over_the_band(
-    linear_axial, reference_axial
-):
-    from bushenv.search.rl import OSC_F_HZ
-
-    env, reward, p, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=8, seed=5)
+@pytest.mark.parametrize("mode", ["rate", "follow"])
+def test_oscillator_motion_stays_within_the_machine_limits(mode, linear_axial, reference_axial):
+    env, reward, p, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=8, mode=mode)
     rng = np.random.default_rng(0)
-    xs, _ = _drive(env, reward, rng.uniform(-1, 1, (150, 8, 3)))
+    xs, _ = _drive(env, reward, rng.uniform(-1, 1, (150, 8, 2)))
     assert np.all(np.abs(xs) <= p.max_x + 1e-12)
     assert np.all(np.abs(np.diff(np.vstack([np.zeros(8), xs]), axis=0)) <= p.max_step * 1.0001)
-    a, _, _, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=8, seed=5)
-    b, _, _, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=8, seed=5)
-    a.reset(), b.reset()
-    assert np.array_equal(a.log_f, b.log_f)  # exploring starts are seeded
-    f = np.exp(env.log_f)
-    assert np.all((f >= OSC_F_HZ[0]) & (f <= OSC_F_HZ[1])) and np.ptp(np.log(f)) > 1.0
+    assert np.ptp(xs) > 1e-3  # it does move
+
+
+def test_oscillator_first_action_sets_the_sine_then_rate_or_follow_moves_it(
+    linear_axial, reference_axial
+):
+    from bushenv.search.rl import OSC_F_HZ, OSC_FOLLOW, OSC_LOG_RATE
+
+    lo, hi = np.log(OSC_F_HZ[0]), np.log(OSC_F_HZ[1])
+    for mode in ("rate", "follow"):
+        env, _, _, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=2, mode=mode)
+        env.reset()
+        env.step_async(np.array([[-1.0, 0.0], [1.0, 0.0]], np.float32))
+        env.step_wait()
+        assert np.allclose(env.log_f, [lo, hi])  # the first action sets f directly
+        env.step_async(np.array([[1.0, 0.0], [-1.0, 0.0]], np.float32))
+        env.step_wait()
+        if mode == "rate":
+            assert np.allclose(env.log_f, [lo + OSC_LOG_RATE, hi - OSC_LOG_RATE])
+        else:
+            assert np.allclose(
+                env.log_f, [lo + OSC_FOLLOW * (hi - lo), hi - OSC_FOLLOW * (hi - lo)]
+            )
 
 
 def test_oscillator_at_its_lowest_amplitude_holds_the_rig(linear_axial, reference_axial):
     env, reward, _, _ = _oscillator_rig(linear_axial, reference_axial, n_envs=2)
-    # shrink the amplitude for 150 steps (ln range ~4.8 at 0.05 per step), keep f and offset
-    xs, _ = _drive(env, reward, [np.tile([0.0, -1.0, 0.0], (2, 1))] * 150)
-    assert np.all(np.abs(xs[-30:] - xs[-1]) < 1e-15)  # a hold: the rig does not move
+    xs, _ = _drive(env, reward, [np.tile([0.0, -1.0], (2, 1))] * 50)
+    assert np.all(xs == 0.0)  # amplitude 0 from the first step: the rig stays at rest
+
+
+def test_rl_refuses_unknown_action_modes():
+    with pytest.raises(SearchError, match="'rate' or 'follow'"):
+        RLSearch("ppo", actions="jerk")
 
 
 def test_energy_shaping_pays_for_returned_work_only_where_a_cycle_closes(reference_axial):
@@ -146,7 +164,9 @@ def test_rl_agents_find_the_shipped_nn_energy_divergence_and_spare_the_linear_mo
     from bushenv.models import get_model
 
     nn = get_model("nn", "axial")
-    res = RLSearch(algo).run(BatchEvaluator(nn, reference_axial), budget=96, seed=0)
+    # PPO learns to fail (first failure after ~130-190 episodes over seeds 0-4); SAC explores
+    budget = {"ppo": 256, "sac": 64}[algo]
+    res = RLSearch(algo).run(BatchEvaluator(nn, reference_axial), budget=budget, seed=0)
     assert res.diverged, res.summary()
     assert res.first_failure.verdict["first_criterion"] == "energy"
     ctl = RLSearch(algo).run(BatchEvaluator(linear_axial, reference_axial), budget=32, seed=0)
