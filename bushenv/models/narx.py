@@ -233,16 +233,7 @@ class NarxBushing(BushingModel):
                 float(x),  # a np.float64 costs numba's dispatcher more than a float
                 float(v),
                 self.state,
-                self.x_offset_m,
-                self.x_scale_m,
-                self.f_offset_n,
-                self.f_scale_n,
-                self.w1,
-                self.b1,
-                self.w2,
-                self.b2,
-                self.w_out,
-                self.b_out,
+                *self._weights(),
                 k,
                 c,
             )
@@ -260,13 +251,9 @@ class NarxBushing(BushingModel):
         finally:
             self._threads = 1
 
-    def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        kern = self._kernels or self._compiled()
-        k, c = self._backbone()
-        args = (
-            x,
-            v,
-            self.state,
+    def _weights(self) -> tuple:
+        """Scaling and network arrays in the order every NARX kernel takes them."""
+        return (
             self.x_offset_m,
             self.x_scale_m,
             self.f_offset_n,
@@ -277,6 +264,16 @@ class NarxBushing(BushingModel):
             self.b2,
             self.w_out,
             self.b_out,
+        )
+
+    def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        kern = self._kernels or self._compiled()
+        k, c = self._backbone()
+        args = (
+            x,
+            v,
+            self.state,
+            *self._weights(),
             k,
             c,
             out,
