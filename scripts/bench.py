@@ -214,10 +214,41 @@ QUICK_FIT_OPTIONS = {
 }
 
 
+# The records of the identification figures (radial reference, as seed 002 Table 4). Every
+# record has its own drive seed and its own sensor-noise seed (two measurements never share a
+# noise sequence). Two verdicts on one fit:
+# - same amplitude (the papers' protocol, seed 000 §4.2: "random test data are split into
+#   training and prediction data sets; the prediction set should remain unseen"): an unseen
+#   n = 1 record of 20 s (the machine's verification length). Over drive/noise seeds 2-11 a
+#   fixed NN fit's RMS ratio has a std of 0.23 points on 20 s records, 0.50 on 10 s and 0.62
+#   on the papers' 6.44 s (Bouc-Wen: 0.15 / 0.24 / 0.22); 40 s is no steadier (0.30).
+# - n = 1.5 (seed 001 §4 verifies at n = 1.5; seed 002's 6.44 s verification record): 50 %
+#   beyond the training amplitude, so an extrapolation. Same target; reported as it is.
+PAPER_RECORDS = {
+    "train": dict(n_index=1.0, duration_s=40.0, seed=0),
+    "unseen_same_amplitude": dict(n_index=1.0, duration_s=20.0, seed=2),
+    "unseen_n1.5": dict(n_index=1.5, duration_s=6.44, seed=1),
+}
+QUICK_RECORD_S = 5.0  # --quick: every record this long
+
+
+def paper_record(which: str, quick: bool):
+    """One of PAPER_RECORDS measured on the radial reference (noise seed = drive seed), and
+    the force the reference gives on it without its sensor noise."""
+    from bushenv.machine import random_test
+    from bushenv.reference.rubber import RubberBushing
+
+    spec = dict(PAPER_RECORDS[which])
+    if quick:
+        spec["duration_s"] = QUICK_RECORD_S
+    ref = RubberBushing.preset("radial", seed=spec["seed"])
+    rec = random_test(ref, **spec)
+    return rec, ref.without_effects(("noise",)).simulate(rec.displacement)
+
+
 def bench_paper_tasks(fig: Figures, quick: bool) -> None:
     from bushenv.excitation import random_rpc
     from bushenv.identify import fit_model
-    from bushenv.machine import random_test
     from bushenv.metrics import rms_ratio
     from bushenv.models import get_model
 
@@ -235,9 +266,23 @@ def bench_paper_tasks(fig: Figures, quick: bool) -> None:
             note=f"theirs {theirs:g} s; speedup {theirs / sec:.3g}x",
         )
     if quick:
-        print("  (quick: identification timed on a 5 s record with a small budget)")
-    ref = get_model("rubber", axis="radial")
-    rec = random_test(ref, n_index=1.0, duration_s=5.0 if quick else 40.0, seed=0)
+        print(f"  (quick: identification on {QUICK_RECORD_S:g} s records with a small budget)")
+    rec = paper_record("train", quick)[0]
+    judged = {k: paper_record(k, quick) for k in ("unseen_same_amplitude", "unseen_n1.5")}
+    what = {
+        "unseen_same_amplitude": "an unseen n = 1 record (the papers' protocol, seed 000 §4.2)",
+        "unseen_n1.5": "an n = 1.5 record, 50 % beyond the training amplitude (extrapolation)",
+    }
+    # The floor no model can beat: the reference's own noise-free force against its measured
+    # one (the sensor noise; every other effect of the reference is deterministic).
+    for key, (unseen, clean) in judged.items():
+        fig.add(
+            f"identification.noise_floor.rms_ratio_{key}",
+            100.0 * rms_ratio(unseen.force, clean),
+            "%",
+            better="lower",
+            note="the reference without its sensor noise, on " + what[key],
+        )
     for name, target in (("nn", 60.0), ("boucwen", 120.0)):
         opts = QUICK_FIT_OPTIONS[name] if quick else {}
         t0 = time.perf_counter()
@@ -252,20 +297,21 @@ def bench_paper_tasks(fig: Figures, quick: bool) -> None:
             better="lower",
             note="theirs 263 min" if name == "nn" else "theirs 725 min",
         )
-        # Accuracy of that fit, judged on a record it never saw (the papers' radial 6.44 s
-        # verification at n = 1.5): RMS ratio, seed 002 Table 4 (NN 4.5 %, Bouc-Wen 3.7 %).
+        # Accuracy of that fit in free run from rest on records it never saw: RMS ratio
+        # against seed 002 Table 4 (radial: NN 4.5 %, Bouc-Wen 3.7 %), on both verdicts.
         paper = {"nn": 4.5, "boucwen": 3.7}[name]
-        unseen = random_test(ref, n_index=1.5, duration_s=6.44, seed=1)
-        fitted.reset(1)
-        pred = fitted.simulate(unseen.displacement)
-        fig.add(
-            f"identification.{name}.rms_ratio_unseen",
-            100.0 * rms_ratio(unseen.force, pred),
-            "%",
-            None if quick else paper,
-            better="lower",
-            note=f"theirs {paper} % (seed 002 Table 4); fit on 40 s at n = 1, judged at n = 1.5",
-        )
+        for key, (unseen, _) in judged.items():
+            fitted.reset(1)
+            pred = fitted.simulate(unseen.displacement)
+            fig.add(
+                f"identification.{name}.rms_ratio_{key}",
+                100.0 * rms_ratio(unseen.force, pred),
+                "%",
+                None if quick else paper,
+                better="lower",
+                note=f"theirs {paper} % (seed 002 Table 4); fit on 40 s at n = 1, judged on "
+                + what[key],
+            )
 
 
 def bench_campaign(fig: Figures, quick: bool) -> None:

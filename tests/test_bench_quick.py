@@ -30,6 +30,11 @@ EXPECTED = [
     "verification_6.44s.boucwen",
     "identification.nn",
     "identification.boucwen",
+    *(
+        f"identification.{m}.rms_ratio_{k}"
+        for m in ("noise_floor", "nn", "boucwen")
+        for k in ("unseen_same_amplitude", "unseen_n1.5")
+    ),
     "campaign.random.threads2.evaluations_per_s",
     "campaign.nn.random.seconds_to_first_divergence",
     "memory.batch_B1024_T512.peak",

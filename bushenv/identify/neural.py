@@ -31,6 +31,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+import numba as nb
 import numpy as np
 import torch
 
@@ -39,6 +40,10 @@ from bushenv.metrics import rms_ratio
 from bushenv.models.base import PAPER_DT
 from bushenv.models.hybrid import HybridBushing
 from bushenv.models.narx import HIDDEN, N_PAST_F, N_PAST_X, NarxBushing, scaling_of
+
+INPUT_BASES = ("lags", "differences")
+EARLY_STOPS = ("training", "stage")
+ENGINES = ("numba", "torch")
 
 
 @dataclass
@@ -53,10 +58,14 @@ class NarxTrainingOptions:
     iters_per_length: tuple[int, ...] = (150, 150, 150)
     batch_windows: int = 16
     free_run_lr: float = 3e-3
+    free_run_lr_final: float = 1.0  # cosine decay to free_run_lr * this over all iterations
+    input_basis: str = "lags"  # "lags" or "differences": the basis the first layer trains in
+    engine: str = "torch"  # the free-run unroll in training: "numba" (fast) or "torch"
     grad_clip: float = 1.0
     weight_decay: float = 0.0
     eval_every: int = 25
     patience: int = 8
+    early_stop: str = "training"  # patience ends: "training" (all of it) or "stage" (one window)
     threads: int = 1
     time_budget_s: float = 120.0
     progress_every_s: float = 3.0
@@ -70,15 +79,158 @@ class NarxTrainingOptions:
             )
         if not 0.0 < self.val_fraction < 0.9:
             raise IdentificationError(f"val_fraction must be in (0, 0.9), got {self.val_fraction}")
+        if self.early_stop not in EARLY_STOPS:
+            raise IdentificationError(
+                f"early_stop must be one of {EARLY_STOPS}, got {self.early_stop!r}"
+            )
+        if self.engine not in ENGINES:
+            raise IdentificationError(f"engine must be one of {ENGINES}, got {self.engine!r}")
+        if self.input_basis not in INPUT_BASES:
+            raise IdentificationError(
+                f"input_basis must be one of {INPUT_BASES}, got {self.input_basis!r}"
+            )
         if min(self.window_lengths, default=1) < 1:
             raise IdentificationError(f"window_lengths must be >= 1, got {self.window_lengths}")
 
 
-class TorchNarx(torch.nn.Module):
-    """The NARX net with the numpy model's parameter layout (float64)."""
+# ----- the free-run unroll with a hand-written backward pass (numba) ------------------------
+# Training time is the unroll: L sequential steps of a 9-unit net, where torch spends ~10
+# microseconds of dispatch per operation and autograd node. These two kernels do the same
+# forward pass and its exact backward pass (backpropagation through time) in compiled loops;
+# ``TorchNarx.unroll(..., engine="torch")`` stays the reference they are tested against.
 
-    def __init__(self, n_in: int, hidden: tuple[int, ...]) -> None:
+
+@nb.njit(cache=True, nogil=True)
+def _unroll_forward(zx, yh0, wy, w2, b2, w_out, b_out, h1s, h2s, ys):
+    n_win, length, h1n = zx.shape
+    nf = yh0.shape[1]
+    h2n = w2.shape[0]
+    yh = np.empty(nf)
+    for w in range(n_win):
+        for k in range(nf):
+            yh[k] = yh0[w, k]
+        for j in range(length):
+            for u in range(h1n):
+                acc = zx[w, j, u]
+                for k in range(nf):
+                    acc += wy[u, k] * yh[k]
+                h1s[w, j, u] = np.tanh(acc)
+            y = b_out
+            if h2n > 0:
+                for u2 in range(h2n):
+                    acc = b2[u2]
+                    for u in range(h1n):
+                        acc += w2[u2, u] * h1s[w, j, u]
+                    t = np.tanh(acc)
+                    h2s[w, j, u2] = t
+                    y += w_out[u2] * t
+            else:
+                for u in range(h1n):
+                    y += w_out[u] * h1s[w, j, u]
+            ys[w, j] = y
+            for k in range(nf - 1, 0, -1):
+                yh[k] = yh[k - 1]
+            yh[0] = y
+
+
+@nb.njit(cache=True, nogil=True)
+def _unroll_backward(gys, yh0, wy, w2, w_out, h1s, h2s, ys, g_zx, g_wy, g_w2, g_b2, g_wout):
+    """Gradients of sum(gys * ys) (ys from ``_unroll_forward``); accumulates into the g_*
+    arrays (zeroed by the caller), returns the gradient of b_out."""
+    n_win, length, h1n = h1s.shape
+    nf = wy.shape[1]
+    h2n = w2.shape[0]
+    pending = np.empty(length)  # d loss / d y_j through the later steps that feed on y_j
+    dh1 = np.empty(h1n)
+    g_bout = 0.0
+    for w in range(n_win):
+        pending[:] = 0.0
+        for j in range(length - 1, -1, -1):
+            gy = gys[w, j] + pending[j]
+            g_bout += gy
+            if h2n > 0:
+                dh1[:] = 0.0
+                for u2 in range(h2n):
+                    t = h2s[w, j, u2]
+                    g_wout[u2] += gy * t
+                    d = gy * w_out[u2] * (1.0 - t * t)
+                    g_b2[u2] += d
+                    for u in range(h1n):
+                        g_w2[u2, u] += d * h1s[w, j, u]
+                        dh1[u] += w2[u2, u] * d
+            else:
+                for u in range(h1n):
+                    g_wout[u] += gy * h1s[w, j, u]
+                    dh1[u] = gy * w_out[u]
+            for u in range(h1n):
+                t = h1s[w, j, u]
+                dz = dh1[u] * (1.0 - t * t)
+                g_zx[w, j, u] = dz
+                for k in range(nf):
+                    src = j - 1 - k  # the input y_{j-1-k}: an output of this window or history
+                    if src >= 0:
+                        g_wy[u, k] += dz * ys[w, src]
+                        pending[src] += wy[u, k] * dz
+                    else:
+                        g_wy[u, k] += dz * yh0[w, k - j]
+    return g_bout
+
+
+def _np(t: torch.Tensor) -> np.ndarray:
+    return np.ascontiguousarray(t.detach().cpu().numpy(), dtype=np.float64)
+
+
+class _NumbaUnroll(torch.autograd.Function):
+    """ys = unroll(zx, yh0; wy, w2, b2, w_out, b_out), forward and backward in numba."""
+
+    @staticmethod
+    def forward(ctx, zx, yh0, wy, w2, b2, w_out, b_out):
+        zx_, yh0_, wy_, w2_, wout_ = _np(zx), _np(yh0), _np(wy), _np(w2), _np(w_out)
+        n_win, length, h1n = zx_.shape
+        h1s = np.empty((n_win, length, h1n))
+        h2s = np.empty((n_win, length, w2_.shape[0]))
+        ys = np.empty((n_win, length))
+        _unroll_forward(zx_, yh0_, wy_, w2_, _np(b2), wout_, float(b_out), h1s, h2s, ys)
+        ctx.saved = (yh0_, wy_, w2_, wout_, h1s, h2s, ys)
+        return torch.from_numpy(ys)
+
+    @staticmethod
+    def backward(ctx, gys):
+        yh0_, wy_, w2_, wout_, h1s, h2s, ys = ctx.saved
+        g_zx = np.empty_like(h1s)
+        g_wy = np.zeros_like(wy_)
+        g_w2 = np.zeros_like(w2_)
+        g_b2 = np.zeros(w2_.shape[0])
+        g_wout = np.zeros_like(wout_)
+        g_bout = _unroll_backward(
+            _np(gys), yh0_, wy_, w2_, wout_, h1s, h2s, ys, g_zx, g_wy, g_w2, g_b2, g_wout
+        )
+        t = torch.from_numpy
+        return (
+            t(g_zx),
+            None,
+            t(g_wy),
+            t(g_w2),
+            t(g_b2),
+            t(g_wout),
+            torch.tensor(g_bout, dtype=torch.float64),
+        )
+
+
+class TorchNarx(torch.nn.Module):
+    """The NARX net with the numpy model's parameter layout (float64).
+
+    ``basis`` (n_in, n_in), identity by default: the first layer's trained weights act on
+    ``basis @ u`` for the lagged input u, so the model's weights are ``w1 @ basis``
+    (``w1_eff``, what ``arrays`` exports). A change of variables for the optimiser only.
+    """
+
+    def __init__(self, n_in: int, hidden: tuple[int, ...], basis: np.ndarray | None = None):
         super().__init__()
+        b = np.eye(n_in) if basis is None else np.asarray(basis, dtype=np.float64)
+        if b.shape != (n_in, n_in):
+            raise IdentificationError(f"basis must be ({n_in}, {n_in}), got {b.shape}")
+        self.register_buffer("basis", torch.from_numpy(b.copy()))
         h1 = hidden[0]
         h2 = hidden[1] if len(hidden) == 2 else 0
         lin1 = torch.nn.Linear(n_in, h1).double()
@@ -103,15 +255,29 @@ class TorchNarx(torch.nn.Module):
             h = torch.tanh(h @ self.w2.T + self.b2)
         return h @ self.w_out + self.b_out
 
-    def forward(self, inp: torch.Tensor) -> torch.Tensor:
-        return self.head(inp @ self.w1.T + self.b1)
+    def w1_eff(self) -> torch.Tensor:
+        """The first layer's weights on the lagged inputs (the model's w1)."""
+        return self.w1 @ self.basis
 
-    def unroll(self, x_in: torch.Tensor, y_hist: torch.Tensor, n_past_x: int) -> torch.Tensor:
+    def forward(self, inp: torch.Tensor) -> torch.Tensor:
+        return self.head(inp @ self.w1_eff().T + self.b1)
+
+    def unroll(
+        self, x_in: torch.Tensor, y_hist: torch.Tensor, n_past_x: int, engine: str = "torch"
+    ) -> torch.Tensor:
         """Free run: x_in (W, L, 1 + n_past_x) = [x_t, x_{t-1}, ...]; y_hist (W, n_past_f) =
-        [y_{t-1}, y_{t-2}, ...] at the first step. Returns (W, L) scaled outputs."""
+        [y_{t-1}, y_{t-2}, ...] at the first step. Returns (W, L) scaled outputs.
+
+        ``engine="numba"``: the same values (to rounding) and gradients from the compiled
+        kernels above; ``"torch"``: step by step in torch (the reference)."""
         nx1 = 1 + n_past_x
-        zx = x_in @ self.w1[:, :nx1].T + self.b1  # the x part of layer 1 for every step at once
-        wy = self.w1[:, nx1:]
+        w1 = self.w1_eff()
+        zx = x_in @ w1[:, :nx1].T + self.b1  # the x part of layer 1 for every step at once
+        wy = w1[:, nx1:]
+        if engine == "numba":
+            return _NumbaUnroll.apply(zx, y_hist, wy, self.w2, self.b2, self.w_out, self.b_out)
+        if engine != "torch":
+            raise IdentificationError(f"unroll engine must be one of {ENGINES}, got {engine!r}")
         outs = []
         for j in range(x_in.shape[1]):
             y = self.head(zx[:, j] + y_hist @ wy.T)
@@ -121,13 +287,35 @@ class TorchNarx(torch.nn.Module):
 
     def load_from(self, model: NarxBushing) -> TorchNarx:
         with torch.no_grad():
+            self.basis.copy_(torch.eye(self.basis.shape[0], dtype=torch.float64))
             for name in ("w1", "b1", "w2", "b2", "w_out"):
                 getattr(self, name).copy_(torch.from_numpy(np.asarray(getattr(model, name))))
             self.b_out.fill_(float(model.b_out))
         return self
 
     def arrays(self) -> dict[str, np.ndarray]:
-        return {k: v.detach().cpu().numpy().copy() for k, v in self.named_parameters()}
+        out = {k: v.detach().cpu().numpy().copy() for k, v in self.named_parameters()}
+        out["w1"] = self.w1_eff().detach().cpu().numpy().copy()
+        return out
+
+
+def difference_basis(n_past_x: int, n_past_f: int, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """Basis of [x_t, gx dx_t, ..., gx dx_{t-nx+1}, y_{t-1}, gy dy_{t-1}, ...] over the lagged
+    input [x_t, ..., x_{t-nx}, y_{t-1}, ..., y_{t-nf}] (dx_t = x_t - x_{t-1}); gx, gy scale
+    the differences to the spread of the signal itself on the training part (xs, ys scaled)."""
+
+    def gain(s: np.ndarray) -> float:
+        d = np.std(np.diff(s))
+        return float(np.std(s) / d) if d > 0 else 1.0
+
+    n = 1 + n_past_x + n_past_f
+    b = np.zeros((n, n))
+    for first, count, g in ((0, 1 + n_past_x, gain(xs)), (1 + n_past_x, n_past_f, gain(ys))):
+        b[first, first] = 1.0
+        for j in range(1, count):
+            b[first + j, first + j - 1] = g
+            b[first + j, first + j] = -g
+    return b
 
 
 def _x_windows(xs_p: np.ndarray, starts: np.ndarray, length: int, n_past_x: int) -> np.ndarray:
@@ -221,7 +409,10 @@ def fit_narx(
             last_print[0] = now
 
     try:
-        net = TorchNarx(1 + nx + nf, opt.hidden)
+        basis = None
+        if opt.input_basis == "differences":
+            basis = difference_basis(nx, nf, xs_p[pad : pad + t_train], ys_p[pad : pad + t_train])
+        net = TorchNarx(1 + nx + nf, opt.hidden, basis)
 
         # --- validation: free run over the held-out part from the measured history -------
         v_start = np.array([t_train + pad])
@@ -232,7 +423,7 @@ def fit_narx(
 
         def validate() -> float:
             with torch.no_grad():
-                ys = net.unroll(v_x_in, v_y_hist, nx)[0].numpy()
+                ys = net.unroll(v_x_in, v_y_hist, nx, opt.engine)[0].numpy()
             pred = backbone_val + f_off + f_sc * ys
             if not np.all(np.isfinite(pred)):
                 return float("inf")
@@ -241,7 +432,7 @@ def fit_narx(
         def penalty() -> torch.Tensor:
             # L2 on the hidden-layer weights keeps units near tanh's linear part, so the net
             # extrapolates to larger amplitudes like a linear filter rather than saturating
-            return opt.weight_decay * (torch.sum(net.w1**2) + torch.sum(net.w2**2))
+            return opt.weight_decay * (torch.sum(net.w1_eff() ** 2) + torch.sum(net.w2**2))
 
         # --- stage 1: one step ahead on measured past outputs ------------------------------
         starts = np.arange(pad, t_train + pad)
@@ -274,10 +465,16 @@ def fit_narx(
         history = [(0, val_after_teacher)]
         free_losses = []
         adam = torch.optim.Adam(net.parameters(), lr=opt.free_run_lr)
+        sched = torch.optim.lr_scheduler.CosineAnnealingLR(
+            adam, max(1, sum(opt.iters_per_length)), eta_min=opt.free_run_lr * opt.free_run_lr_final
+        )
         it = 0
         stale = 0
         stopped = "iterations done"
+        stage_stops = []
         for length, n_iter in zip(opt.window_lengths, opt.iters_per_length, strict=True):
+            if opt.early_stop == "stage":
+                stale = 0
             for _ in range(n_iter):
                 it += 1
                 s = rng.integers(pad, t_train + pad - length + 1, size=opt.batch_windows)
@@ -285,10 +482,11 @@ def fit_narx(
                 y_hist = torch.from_numpy(_y_history(ys_p, s, nf))
                 tgt = torch.from_numpy(ys_p[s[:, None] + np.arange(length)[None, :]])
                 adam.zero_grad()
-                loss = torch.mean((net.unroll(x_in, y_hist, nx) - tgt) ** 2)
+                loss = torch.mean((net.unroll(x_in, y_hist, nx, opt.engine) - tgt) ** 2)
                 (loss + penalty()).backward()
                 torch.nn.utils.clip_grad_norm_(net.parameters(), opt.grad_clip)
                 adam.step()
+                sched.step()
                 free_losses.append(loss.item())
                 if it % opt.eval_every == 0:
                     val = validate()
@@ -303,6 +501,10 @@ def fit_narx(
                         f"free-run iter {it} (window {length}): loss {loss.item():.3e}, "
                         f"validation RMS ratio {val:.4f} (best {best_val:.4f})"
                     )
+                    if stale >= opt.patience and opt.early_stop == "stage":
+                        stage_stops.append((length, it))
+                        say(f"window {length}: patience {opt.patience} ran out at {it}", True)
+                        break
                     if stale >= opt.patience:
                         stopped = f"early stop at iteration {it} (patience {opt.patience})"
                         break
@@ -311,7 +513,8 @@ def fit_narx(
                     break
             else:
                 continue
-            break
+            if stopped != "iterations done":
+                break
         net.load_state_dict(best_state)
         elapsed = time.perf_counter() - t0
         say(
@@ -350,6 +553,7 @@ def fit_narx(
         "best_validation_rms_ratio": best_val,
         "validation_after_teacher": val_after_teacher,
         "stopped": stopped,
+        "stage_stops": stage_stops,
         "seconds": elapsed,
     }
     return model

@@ -2,10 +2,11 @@
 
 import numpy as np
 import pytest
+import torch
 from standin import DT, standin_drive, standin_force
 
 from bushenv.identify import fit_model
-from bushenv.identify.neural import torch_free_run
+from bushenv.identify.neural import TorchNarx, difference_basis, torch_free_run
 from bushenv.metrics import rms_ratio
 from bushenv.models.hybrid import HybridBushing
 from bushenv.models.narx import NarxBushing
@@ -67,6 +68,73 @@ def test_unknown_training_option_is_refused(record):
     x, f = record
     with pytest.raises(ValueError, match="unknown options"):
         fit_model("nn", x, f, DT, progress=False, epochs=3)
+
+
+@pytest.mark.parametrize("hidden", [(9,), (10, 9)])
+@pytest.mark.parametrize("basis", ["lags", "differences"])
+def test_numba_unroll_gives_the_torch_unrolls_values_and_gradients(hidden, basis):
+    rng = np.random.default_rng(3)
+    b = None
+    if basis == "differences":
+        b = difference_basis(5, 5, rng.normal(size=400).cumsum(), rng.normal(size=400).cumsum())
+    torch.manual_seed(3)
+    net = TorchNarx(11, hidden, b)
+    x_in = torch.from_numpy(rng.uniform(-1, 1, (4, 37, 6)))
+    y_hist = torch.from_numpy(rng.uniform(-1, 1, (4, 5)))
+    target = torch.from_numpy(rng.uniform(-1, 1, (4, 37)))
+    out, grads = {}, {}
+    for engine in ("torch", "numba"):
+        net.zero_grad()
+        ys = net.unroll(x_in, y_hist, 5, engine)
+        torch.mean((ys - target) ** 2).backward()
+        out[engine] = ys.detach().numpy()
+        grads[engine] = {
+            k: p.grad.numpy().copy() for k, p in net.named_parameters() if p.grad is not None
+        }
+    assert np.max(np.abs(out["numba"] - out["torch"])) < 1e-12
+    assert set(grads["torch"]) <= set(grads["numba"])
+    for name, g in grads["torch"].items():
+        assert np.max(np.abs(grads["numba"][name] - g)) <= 1e-10 * np.max(np.abs(g)), name
+
+
+def test_difference_basis_changes_the_training_variables_not_the_network():
+    rng = np.random.default_rng(4)
+    b = difference_basis(5, 5, rng.normal(size=300).cumsum(), rng.normal(size=300).cumsum())
+    assert abs(np.linalg.det(b)) > 0
+    torch.manual_seed(0)
+    net = TorchNarx(11, (9,), b)
+    u = torch.from_numpy(rng.uniform(-1, 1, (20, 11)))
+    plain = TorchNarx(11, (9,))
+    with torch.no_grad():
+        for name, p in plain.named_parameters():
+            p.copy_(torch.from_numpy(net.arrays()[name]))
+        assert torch.allclose(net(u), plain(u), rtol=0, atol=1e-12)
+    # the trained variables act on [x_t, gain * (x_t - x_{t-1}), ...]
+    v = u.numpy() @ b.T
+    assert np.array_equal(v[:, 0], u.numpy()[:, 0])
+    assert np.allclose(v[:, 1], b[1, 0] * (u.numpy()[:, 0] - u.numpy()[:, 1]), rtol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "bad", [{"engine": "jax"}, {"input_basis": "wavelets"}, {"early_stop": "never"}]
+)
+def test_unknown_choice_of_training_option_is_refused(bad, record):
+    x, f = record
+    with pytest.raises(ValueError, match=next(iter(bad))):
+        fit_model("nn", x, f, DT, progress=False, **QUICK, **bad)
+
+
+def test_stage_early_stopping_moves_on_to_the_next_window_instead_of_ending(record):
+    x, f = record
+    opts = dict(QUICK, iters_per_length=(60, 60), eval_every=5, patience=1, free_run_lr=0.05)
+    whole = fit_model("nn", x, f, DT, seed=0, progress=False, early_stop="training", **opts)
+    staged = fit_model("nn", x, f, DT, seed=0, progress=False, early_stop="stage", **opts)
+    assert whole.training["stopped"].startswith("early stop at iteration")
+    assert whole.training["validation_rms_ratio"][-1][0] <= 60  # inside the first window
+    assert staged.training["stopped"] == "iterations done"
+    window, at = staged.training["stage_stops"][0]
+    assert window == 10
+    assert staged.training["validation_rms_ratio"][-1][0] > at  # the 30-sample stage ran
 
 
 @pytest.mark.slow
