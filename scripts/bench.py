@@ -7,9 +7,11 @@
 Figures: batched free-run throughput of each model at B = 1, 64, 1024; single-step latency;
 env steps/s of BushRig-v0 and QuarterCar-v0 (single and vectorised) beside CartPole-v1 (single
 and its numpy-vectorised form); the papers' verification task (6.44 s at 204.8 Hz) and
-identification times; a campaign's evaluations/s and time to the first NN divergence; peak
-memory of a 10^6-step rollout and of a B = 1024 batch. This machine is shared and noisy:
-compare ratios measured in the same run, not absolute figures across runs.
+identification times, with the identified models' accuracy on an unseen n = 1 record (the
+papers' protocol) and on an n = 1.5 record (extrapolation), beside the sensor-noise floor;
+a campaign's evaluations/s and time to the first NN divergence; peak memory of a 10^6-step
+rollout and of a B = 1024 batch. This machine is shared and noisy: compare ratios measured in
+the same run, not absolute figures across runs.
 """
 
 from __future__ import annotations
