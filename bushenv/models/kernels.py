@@ -139,11 +139,9 @@ from bushenv.models.boucwen_kernels import (  # noqa: E402, F401
     BW_MAX_SUBSTEPS,
     BW_N_STATE,
     BW_ORDER,
-    RK4_STABLE_FRACTION,
-    _bw_rate,
-    _bw_rhs,
+    BW_RTOL,
+    boucwen_fixed_step,
     boucwen_kernel,
-    boucwen_kernel_reference,
 )
 
 
@@ -176,4 +174,6 @@ def warm_up() -> None:
 
     narx_kernels.warm_up()
     p = np.ones((len(BW_ORDER), 1))
-    boucwen_kernel(z, z, np.zeros((BW_N_STATE, 1)), p, 1e-3, BW_MAX_SUBSTEPS, np.empty_like(z))
+    boucwen_kernel(
+        z, z, np.zeros((BW_N_STATE, 1)), p, 1e-3, BW_MAX_SUBSTEPS, BW_RTOL, np.empty_like(z)
+    )

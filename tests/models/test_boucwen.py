@@ -99,17 +99,21 @@ def reference_solution(m, x, v, dt):
     return out
 
 
-def test_rk4_substeps_match_a_tight_implicit_solver():
+def test_free_run_matches_a_tight_implicit_solver_and_converges_to_it():
     x = random_2mm(seed=1, duration_s=20.0)[:40]
     v = np.gradient(x, DT)
-    m = BoucWenBushing.preset()
-    f = m.simulate(x, v)
-    ref = reference_solution(m, x, v, DT)
-    assert np.max(np.abs(f - ref)) < 1e-4 * np.max(np.abs(ref))
+    ref = None
+    for rtol, bound in ((3e-5, 2e-3), (1e-9, 1e-6)):  # measured 2.3e-4 and 2.2e-8
+        m = BoucWenBushing(rtol=rtol, **BoucWenBushing.preset().params)
+        f = m.simulate(x, v)
+        if ref is None:
+            ref = reference_solution(m, x, v, DT)
+        assert np.max(np.abs(f - ref)) < bound * np.max(np.abs(ref))
 
 
 def test_unintegrable_parameters_raise_instead_of_clamping():
     p = BoucWenBushing.preset().params
-    m = BoucWenBushing(**{**p, "c1": 1e-30})
-    with pytest.raises(BoucWenError, match="sub-steps"):
+    # c1 -> 0: eq. 3 is algebraic to 1e-8 of a sample; its form here would lose its digits
+    m = BoucWenBushing(**{**p, "c1": 1e-9})
+    with pytest.raises(BoucWenError, match="could not be integrated"):
         m.simulate(random_2mm(duration_s=1.0))
