@@ -121,11 +121,15 @@ RGS4 = RG + RG41 + RG42 + RG43
 # The tile scratch L is flat: row r of lane j is L[r * BW_TILE + j]. Offsets known at compile
 # time let LLVM tell the rows apart and vectorise over lanes (a 2-D array's runtime row stride
 # made it give up: "too many memory checks"). The names below are those offsets.
-_ROWS = ("LAM KX CU AA A BE GA N WY WZ TOL FL PRE Y Z H X0 U0 DX DU TAU NST ACT FAIL DONE").split()
+# F0-F4: this block's share of eq. 5, kept here so that finishing a sample does not read p
+# (16, B) at five cache lines.
+_ROWS = (
+    "LAM KX CU AA A BE GA N WY WZ TOL FL PRE Y Z H X0 U0 DX DU TAU NST ACT FAIL DONE F0 F1 F2 F3 F4"
+).split()
 _N_ROWS = len(_ROWS)
 (
     _LAM, _KX, _CU, _AA, _A, _BE, _GA, _N, _WY, _WZ, _TOL, _FL, _PRE,
-    _Y, _Z, _H, _X0, _U0, _DX, _DU, _TAU, _NST, _ACT, _FAIL, _DONE,
+    _Y, _Z, _H, _X0, _U0, _DX, _DU, _TAU, _NST, _ACT, _FAIL, _DONE, _F0, _F1, _F2, _F3, _F4,
 ) = (r * BW_TILE for r in range(_N_ROWS))  # fmt: skip
 
 
@@ -316,6 +320,7 @@ def boucwen_kernel(x, v, state, p, dt, max_substeps, rtol, out):  # pragma: no c
                     L[_AA + j] = aa
                     L[_WY + j] = abs(k0)
                     L[_WZ + j] = abs(k0) * abs(aa) / max(abs(lam), inv_dt)
+                    L[_F0 + j] = k0
                 else:
                     mu = c0 + c2
                     lam = k2 / mu
@@ -326,6 +331,11 @@ def boucwen_kernel(x, v, state, p, dt, max_substeps, rtol, out):  # pragma: no c
                     L[_AA + j] = aa
                     L[_WY + j] = abs(c0) * abs(lam)
                     L[_WZ + j] = abs(c0) * abs(aa)
+                    L[_F0 + j] = c0
+                    L[_F1 + j] = c2
+                    L[_F2 + j] = k2
+                    L[_F3 + j] = p[15, b]
+                    L[_F4 + j] = mu
                 A = p[6 + blk, b]
                 n = p[12 + blk, b]
                 L[_A + j] = A
@@ -374,12 +384,13 @@ def boucwen_kernel(x, v, state, p, dt, max_substeps, rtol, out):  # pragma: no c
                         u1 = v[t, b]
                         yy = L[_Y + j]
                         if blk == 0:
-                            out[t, b] = p[1, b] * yy
-                        else:
-                            c0 = p[0, b]
-                            c2 = p[4, b]
-                            dw = (c2 * u1 + p[5, b] * (x1 - yy) + p[15, b] * L[_Z + j]) / (c0 + c2)
-                            out[t, b] = out[t, b] + c0 * dw
+                            out[t, b] = L[_F0 + j] * yy  # k0 y
+                        else:  # c0 w', eq. 4
+                            zz = L[_Z + j]
+                            dw = (L[_F1 + j] * u1 + L[_F2 + j] * (x1 - yy) + L[_F3 + j] * zz) / L[
+                                _F4 + j
+                            ]
+                            out[t, b] = out[t, b] + L[_F0 + j] * dw
                         if t == T - 1 or not failed:
                             break
                         t += 1  # a failed lane: NaN for every remaining sample
