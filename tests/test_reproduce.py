@@ -35,6 +35,9 @@ def test_report_json_holds_every_table_figure(quick_report):
         for key in ("rms_ratio", "esr", "max_error", "peak_error", "identification_s"):
             assert isinstance(row[key], float), (name, key)
         assert 0.0 < row["rms_ratio"] < 1.0
+        # judged on an unseen record of the training amplitude too (the papers' protocol)
+        assert 0.0 < row["same_amplitude"]["rms_ratio"] < 1.0
+        assert row["same_amplitude"]["rms_ratio"] != row["rms_ratio"]
         assert row["verification_s"] > 0.0
         step = report["step"]["radial"][name]
         assert isinstance(step["bounded"], bool)

@@ -27,7 +27,7 @@ beta1 + gamma1 = delta1 > 0 (gamma1 = (1 - rho1) delta1); beta2 - gamma2 = delta
 Procedure: ``scipy.optimize.differential_evolution`` (seeded, ``vectorized=True``, workers=1,
 ``maxiter`` generations) on the first ``fit_seconds`` of the record, then a bounded Powell
 polish on the whole record. Members that cannot be integrated (more than ``search_max_substeps``
-RK4 sub-steps in a sample) score ``inf``.
+trial steps in a sample, or a solution that blows up) score ``inf``.
 """
 
 from __future__ import annotations

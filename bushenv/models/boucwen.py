@@ -87,7 +87,7 @@ def n_mm_to_si(p: dict[str, float]) -> dict[str, float]:
 
 
 class BoucWenError(ModelError):
-    """The Bouc-Wen equations could not be integrated (stiffness beyond the sub-step limit)."""
+    """The Bouc-Wen equations could not be integrated (step limit, blow-up, or c -> 0)."""
 
 
 @register
