@@ -129,29 +129,21 @@ def bench_models(fig: Figures, quick: bool) -> None:
 def bench_boucwen_accuracy(fig: Figures, model, T: int) -> None:
     """What the Bouc-Wen throughput buys: error against a converged run, steps per sample."""
     from bushenv.excitation import random_rpc
-    from bushenv.models.boucwen_kernels import boucwen_fixed_step
+    from bushenv.models.boucwen_accuracy import error_against_converged
 
-    x = random_rpc(1.0, T * model.dt, model.dt, seed=0)[:, None]
-    v = np.gradient(x, model.dt, axis=0)
-    ref = np.empty_like(x)
-    boucwen_fixed_step(x, v, model.vector()[:, None].copy(), model.dt, 512, ref)
-    f = model.simulate(x, v)
+    x = random_rpc(1.0, T * model.dt, model.dt, seed=0)
+    err_of_peak, _, steps = error_against_converged(model.vector(), x, model.rtol, model.dt)
     fig.add(
         "free_run.boucwen.error_vs_converged",
-        float(np.max(np.abs(f - ref)) / np.max(np.abs(ref))),
+        err_of_peak,
         "of peak",
         2e-3,  # the accuracy the model states (bushenv/models/boucwen.py)
         better="lower",
         note=f"rtol {model.rtol:g}; vs RK4 with 512 sub-steps/sample (docs/boucwen-integration.md)",
     )
-    model.reset(1)
-    steps = 0.0
-    for t in range(x.shape[0]):  # one sample per call: state row 6 counts that sample's steps
-        model.step(float(x[t, 0]), float(v[t, 0]))
-        steps += float(model.max_substeps_last_sample()[0])
     fig.add(
         "free_run.boucwen.trial_steps_per_sample",
-        steps / x.shape[0],
+        steps,
         "steps",
         better="lower",
         note="both blocks, rejected steps included; 4 right-hand sides each",

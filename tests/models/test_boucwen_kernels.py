@@ -8,13 +8,18 @@ import pytest
 from bushenv import excitation as ex
 from bushenv.models import PAPER_DT, get_model
 from bushenv.models.boucwen import BoucWenBushing, BoucWenError, simulate_population
+from bushenv.models.boucwen_accuracy import (
+    INPUTS,
+    converged,
+    force_scale,
+    parameter_sets,
+)
 from bushenv.models.boucwen_kernels import (
     BW_MAX_SUBSTEPS,
     BW_N_STATE,
     BW_ORDER,
     BW_RTOL,
     BW_TILE,
-    boucwen_fixed_step,
     boucwen_kernel,
 )
 
@@ -33,46 +38,10 @@ def run(p, x, v, max_substeps=BW_MAX_SUBSTEPS, rtol=BW_RTOL):
     return out, state, n_bad
 
 
-def converged(p, x, v, n_sub=256):
-    out = np.empty_like(x)
-    boucwen_fixed_step(
-        np.ascontiguousarray(x), np.ascontiguousarray(v), np.ascontiguousarray(p), DT, n_sub, out
-    )
-    return out
-
-
-def soft_block1_sharp_block2():
-    """Table 3 with block 1 made slow and non-hysteretic: only block 2's knee sets the step.
-
-    The previous kernel chose its sub-steps from a stability estimate at the start of each
-    sample, where d = 0 before a step: one sub-step, z2 overshot its saturation fourfold and the
-    force was 7 % of the peak off on a 4 mm step.
-    """
-    p = BoucWenBushing.preset().vector()
-    p[BW_ORDER.index("c1")] *= 100.0
-    p[BW_ORDER.index("a1")] = 0.0
-    return p
-
-
-PARAMETER_SETS = {
-    "shipped axial": lambda: get_model("boucwen", axis="axial").vector(),
-    "shipped radial": lambda: get_model("boucwen", axis="radial").vector(),
-    "table 3": lambda: BoucWenBushing.preset().vector(),
-    "soft block 1, sharp block 2": soft_block1_sharp_block2,
-}
-INPUTS = {
-    "random n = 1.5": lambda: ex.random_rpc(1.5, 3.0, DT, seed=1),
-    "4 mm step held": lambda: ex.step_hold(4e-3, 1.5, DT),
-    "80 Hz at the velocity limit": lambda: ex.sine(80.0, 1.2 / (2 * np.pi * 80.0), 1.0, DT),
-    "out-of-band random": lambda: ex.random_ood(2.0, DT, seed=0),
-    "1 mm zig-zag": lambda: np.tile([0.0, 1e-3, 0.0, -1e-3], 150),
-}
-
-
 @pytest.mark.parametrize("input_name", list(INPUTS))
-@pytest.mark.parametrize("set_name", list(PARAMETER_SETS))
+@pytest.mark.parametrize("set_name", list(parameter_sets()))
 def test_free_run_agrees_with_a_converged_solution_within_the_stated_accuracy(set_name, input_name):
-    p = PARAMETER_SETS[set_name]()[:, None]
+    p = parameter_sets()[set_name]()[:, None]
     x = INPUTS[input_name]()[:, None]
     v = np.gradient(x, DT, axis=0)
     f, _, n_bad = run(p, x, v)
@@ -82,7 +51,7 @@ def test_free_run_agrees_with_a_converged_solution_within_the_stated_accuracy(se
 
 
 def test_the_fixed_step_reference_is_converged():
-    p = np.stack([PARAMETER_SETS[s]() for s in PARAMETER_SETS], axis=1)
+    p = np.stack([make() for make in parameter_sets().values()], axis=1)
     x1 = ex.random_rpc(1.5, 1.0, DT, seed=4)
     x = np.repeat(x1[:, None], p.shape[1], axis=1)
     v = np.gradient(x, DT, axis=0)
@@ -176,7 +145,6 @@ def test_the_step_limit_fails_histories_and_the_model_raises():
 
 def test_identification_candidates_are_accurate_or_flagged():
     from bushenv.identify.global_search import SEARCH_BOUNDS, search_to_parameters
-    from bushenv.models.boucwen_kernels import V_REF_M_PER_S, X_REF_M
 
     rng = np.random.default_rng(7)
     lo, hi = np.array(SEARCH_BOUNDS).T
@@ -196,9 +164,7 @@ def test_identification_candidates_are_accurate_or_flagged():
     assert judged.sum() >= 0.8 * len(vectors)
     assert not np.any(bad[judged])
     # the tolerance is relative to F_REF, so a candidate far softer than F_REF is held to it
-    k = np.abs(vectors[:, [1, 3, 5]]).sum(axis=1)
-    c = np.abs(vectors[:, [0, 2, 4]]).sum(axis=1)
-    f_ref = np.maximum(k * X_REF_M, c * V_REF_M_PER_S)
+    f_ref = force_scale(vectors)
     err = np.max(np.abs(out - ref), axis=0)
     assert np.all(err[judged] <= ACCURACY * np.maximum(peak, f_ref)[judged])
 
