@@ -26,7 +26,7 @@ beta1 + gamma1 = delta1 > 0 (gamma1 = (1 - rho1) delta1); beta2 - gamma2 = delta
 
 Procedure: ``scipy.optimize.differential_evolution`` (seeded, ``vectorized=True``, workers=1,
 ``maxiter`` generations) on the first ``fit_seconds`` of the record, then a bounded Powell
-polish on the whole record. Why 400 generations (about 30 s alone on this machine): with 40 the
+polish on the whole record. Why 400 generations (about 50 s alone on this machine): with 40 the
 search stopped short and the fit was a draw, 3.2-4.6 % RMS ratio on an unseen n = 1 record over
 seeds 0-11, the papers' 3.7 % met by 2 seeds of 12 (the bench's seed 0 was one); 250 gave
 2.5-3.1 % (seeds 1-8) and 400 gave 2.5-2.7 % (seeds 1-4). ``docs/fit-seed-spread.md``.
