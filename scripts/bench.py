@@ -425,6 +425,9 @@ def write_markdown(fig: Figures, path: Path, quick: bool) -> None:
         f"{os.cpu_count()} cores ({time.strftime('%Y-%m-%d')}). Noisy shared machine: "
         "compare ratios within this table.",
         "",
+        "The identification figures are one fit per model (seed 0); how they vary with the "
+        "training seed: `python scripts/fit_seed_spread.py` (docs/fit-seed-spread.md).",
+        "",
         "| figure | value | unit | target | met | note |",
         "|---|---:|---|---:|---|---|",
     ]
