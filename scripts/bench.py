@@ -124,6 +124,26 @@ def bench_models(fig: Figures, quick: bool) -> None:
         fig.add(f"step_latency.{name}", 1e6 * sec / n, "us/step", better="lower")
         if name == "boucwen":
             bench_boucwen_accuracy(fig, model, T)
+        if name in ("nn", "hybrid"):
+            bench_float32_error(fig, model, T)
+
+
+def bench_float32_error(fig: Figures, model, T: int) -> None:
+    """What float32 would cost the NARX models' accuracy (the kernels compute in float64)."""
+    from bushenv.excitation import random_rpc
+    from bushenv.models.precision import float32_error
+
+    x = np.stack(
+        [random_rpc(n, T * model.dt, model.dt, seed=b) for n in (1.0, 1.5) for b in range(32)], 1
+    )
+    fig.add(
+        f"free_run.{model.name}.float32_error",
+        float32_error(model, x, np.gradient(x, model.dt, axis=0)),
+        "of peak",
+        better="lower",
+        note="max |F32 - F64| / max |F64|, numpy free run of the same network, 32 profiles "
+        "each at n = 1 and n = 1.5 (bushenv/models/precision.py)",
+    )
 
 
 def bench_boucwen_accuracy(fig: Figures, model, T: int) -> None:

@@ -22,6 +22,8 @@ EXPECTED = [
     "free_run.boucwen.B1024.threads2",
     "free_run.boucwen.error_vs_converged",
     "free_run.boucwen.trial_steps_per_sample",
+    "free_run.nn.float32_error",
+    "free_run.hybrid.float32_error",
     *(f"step_latency.{m}" for m in ("linear", "nn", "hybrid", "boucwen", "rubber")),
     "env.CartPole-v1.single",
     "env.CartPole-v1.vector1024",
