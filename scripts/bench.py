@@ -75,13 +75,13 @@ def _split_in_two(model, x, v):
     ]
 
 
-def _two_threads(parts):
+def _two_threads(parts, **kw):
     from concurrent.futures import ThreadPoolExecutor
 
     global _POOL
     if _POOL is None:
         _POOL = ThreadPoolExecutor(2)
-    futures = [_POOL.submit(m.simulate, a, b) for m, a, b in parts]
+    futures = [_POOL.submit(m.simulate, a, b, **kw) for m, a, b in parts]
     return [f.result() for f in futures]
 
 
@@ -110,6 +110,8 @@ def bench_models(fig: Figures, quick: bool) -> None:
                 parts = _split_in_two(model, x, v)
                 sec2 = _time_per_call(lambda: _two_threads(parts), min_time)  # noqa: B023
                 fig.add(f"free_run.{name}.B{B}.threads2", T * B / sec2, "steps/s", target)
+                if name in ("nn", "hybrid"):
+                    bench_float32(fig, name, model, x, v, min_time, T * B)
         model.reset(1)
         xs = random_rpc(1.0, 2.0, model.dt, seed=0)
         vs = np.gradient(xs, model.dt)
@@ -128,21 +130,42 @@ def bench_models(fig: Figures, quick: bool) -> None:
             bench_float32_error(fig, model, T)
 
 
+def bench_float32(fig: Figures, name: str, model, x, v, min_time: float, steps: int) -> None:
+    """The NARX models' float32 free run (``simulate(..., dtype="float32")``), B = 1024."""
+    x32, v32 = x.astype(np.float32), v.astype(np.float32)
+    sec = _time_per_call(lambda: model.simulate(x32, v32, dtype="float32"), min_time)
+    fig.add(f"free_run.{name}.B1024.float32", steps / sec, "steps/s")
+    parts = _split_in_two(model, x32, v32)
+    sec2 = _time_per_call(lambda: _two_threads(parts, dtype="float32"), min_time)
+    fig.add(f"free_run.{name}.B1024.threads2.float32", steps / sec2, "steps/s")
+
+
 def bench_float32_error(fig: Figures, model, T: int) -> None:
-    """What float32 would cost the NARX models' accuracy (the kernels compute in float64)."""
+    """What float32 costs the NARX models' accuracy: the compiled float32 run, and an ideal one
+    (numpy, libm tanh) that shows how much of it is the kernel's float32 tanh."""
     from bushenv.excitation import random_rpc
     from bushenv.models.precision import float32_error
 
     x = np.stack(
         [random_rpc(n, T * model.dt, model.dt, seed=b) for n in (1.0, 1.5) for b in range(32)], 1
     )
+    v = np.gradient(x, model.dt, axis=0)
+    f64 = model.simulate(x, v)
+    f32 = model.simulate(x.astype(np.float32), v.astype(np.float32), dtype="float32")
+    what = "32 profiles each at n = 1 and n = 1.5"
     fig.add(
         f"free_run.{model.name}.float32_error",
-        float32_error(model, x, np.gradient(x, model.dt, axis=0)),
+        float(np.max(np.abs(f32 - f64)) / np.max(np.abs(f64))),
         "of peak",
         better="lower",
-        note="max |F32 - F64| / max |F64|, numpy free run of the same network, 32 profiles "
-        "each at n = 1 and n = 1.5 (bushenv/models/precision.py)",
+        note=f"max |F32 - F64| / max |F64| of simulate(dtype='float32'), {what}",
+    )
+    fig.add(
+        f"free_run.{model.name}.float32_error_numpy",
+        float32_error(model, x, v),
+        "of peak",
+        better="lower",
+        note=f"the same in numpy with libm tanh (bushenv/models/precision.py), {what}",
     )
 
 
@@ -393,6 +416,37 @@ def bench_campaign(fig: Figures, quick: bool) -> None:
     )
 
 
+def bench_float32_verdicts(fig: Figures, quick: bool) -> None:
+    """Does float32 change what a search concludes? Divergence verdicts on random profiles of
+    the search's "any" family, NN in float32 and in float64 against the same reference."""
+    from bushenv.models import get_model
+    from bushenv.search.corpus import truth_reference
+    from bushenv.search.divergence import judge
+    from bushenv.search.families import get_family, pad_batch
+
+    rng = np.random.default_rng(0)
+    fam = get_family("any")
+    n = 128 if quick else 2048
+    flips = diverged = 0
+    for axis in ("axial", "radial"):
+        ref = truth_reference(axis)
+        model = get_model("nn", axis=axis, dt=ref.dt)
+        x, lengths = pad_batch([fam.profile(rng.random(fam.dim), ref.dt) for _ in range(n)])
+        fr = ref.simulate(x)
+        d64 = np.asarray(judge(x, model.simulate(x), fr, ref.dt, lengths=lengths).diverged)
+        f32 = model.simulate(x, dtype="float32").astype(np.float64)
+        d32 = np.asarray(judge(x, f32, fr, ref.dt, lengths=lengths).diverged)
+        flips += int(np.sum(d64 != d32))
+        diverged += int(np.sum(d64))
+    fig.add(
+        "campaign.nn.float32_verdict_changes",
+        flips,
+        "profiles",
+        better="lower",
+        note=f"of {2 * n} random 'any' profiles (axial + radial; {diverged} diverge in float64)",
+    )
+
+
 def bench_memory(fig: Figures, quick: bool) -> None:
     import gymnasium as gym
 
@@ -433,6 +487,7 @@ SECTIONS = {
     "envs": bench_envs,
     "paper": bench_paper_tasks,
     "campaign": bench_campaign,
+    "float32": bench_float32_verdicts,
     "memory": bench_memory,
 }
 

@@ -22,8 +22,16 @@ EXPECTED = [
     "free_run.boucwen.B1024.threads2",
     "free_run.boucwen.error_vs_converged",
     "free_run.boucwen.trial_steps_per_sample",
-    "free_run.nn.float32_error",
-    "free_run.hybrid.float32_error",
+    *(
+        f"free_run.{m}.{f}"
+        for m in ("nn", "hybrid")
+        for f in (
+            "float32_error",
+            "float32_error_numpy",
+            "B1024.float32",
+            "B1024.threads2.float32",
+        )
+    ),
     *(f"step_latency.{m}" for m in ("linear", "nn", "hybrid", "boucwen", "rubber")),
     "env.CartPole-v1.single",
     "env.CartPole-v1.vector1024",
@@ -41,6 +49,7 @@ EXPECTED = [
     ),
     "campaign.random.threads2.evaluations_per_s",
     "campaign.nn.random.seconds_to_first_divergence",
+    "campaign.nn.float32_verdict_changes",
     "memory.batch_B1024_T512.peak",
 ]
 

@@ -122,7 +122,23 @@ class BushingModel:
         ``v`` defaults to the central-difference velocity of ``x`` (``np.gradient``). The model
         is reset to ``B`` histories first and keeps its final state afterwards.
         """
-        x = np.asarray(x, dtype=np.float64)
+        x2, v2, one_d = self._profiles(x, v)
+        self.reset(x2.shape[1])
+        out = np.empty_like(x2)
+        self._advance(x2, v2, out)
+        return out[:, 0] if one_d else out
+
+    def _profiles(self, x, v, dtype=np.float64) -> tuple[np.ndarray, np.ndarray, bool]:
+        """``simulate``'s inputs as C-contiguous (T, B) arrays of ``dtype``, and whether x was
+        1-D. ``v`` defaults to the central-difference velocity of x."""
+
+        def as_array(a):
+            # float32 in, float32 wanted: no round trip through float64 (two passes over memory)
+            if isinstance(a, np.ndarray) and a.dtype == dtype == np.float32:
+                return a
+            return np.asarray(a, dtype=np.float64)
+
+        x = as_array(x)
         one_d = x.ndim == 1
         x2 = x[:, None] if one_d else x
         if x2.ndim != 2 or x2.shape[0] < 1:
@@ -130,16 +146,11 @@ class BushingModel:
         if v is None:
             v2 = velocity_of(x2, self.dt)
         else:
-            v2 = np.asarray(v, dtype=np.float64)
+            v2 = as_array(v)
             v2 = v2[:, None] if v2.ndim == 1 else v2
             if v2.shape != x2.shape:
                 raise ModelError(f"{self.name}: v shape {v2.shape} differs from x {x2.shape}")
-        x2 = np.ascontiguousarray(x2)
-        v2 = np.ascontiguousarray(v2)
-        self.reset(x2.shape[1])
-        out = np.empty_like(x2)
-        self._advance(x2, v2, out)
-        return out[:, 0] if one_d else out
+        return np.ascontiguousarray(x2, dtype), np.ascontiguousarray(v2, dtype), one_d
 
     # ----- files -------------------------------------------------------------------------
     def save(self, path: str | os.PathLike) -> Path:

@@ -37,6 +37,7 @@ import numpy as np
 from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
 from bushenv.models.narx_kernels import (
     COLS_MAX_BATCH,
+    DTYPES,
     NarxKernels,
     NarxShape,
     column_split,
@@ -214,9 +215,7 @@ class NarxBushing(BushingModel):
     def _compiled(self) -> NarxKernels:
         kern = self._kernels
         if kern is None:
-            kern = self._kernels = narx_kernels(
-                NarxShape(self.n_past_x, self.n_past_f, self.w1.shape[0], self.w2.shape[0])
-            )
+            kern = self._kernels = narx_kernels(self._shape())
         return kern
 
     def step(self, x: float | np.ndarray, v: float | np.ndarray) -> float | np.ndarray:
@@ -239,17 +238,43 @@ class NarxBushing(BushingModel):
             )
         return super().step(x, v)
 
-    def simulate(self, x: np.ndarray, v: np.ndarray | None = None, threads: int = 1) -> np.ndarray:
+    def simulate(
+        self,
+        x: np.ndarray,
+        v: np.ndarray | None = None,
+        threads: int = 1,
+        dtype: str = "float64",
+    ) -> np.ndarray:
         """``BushingModel.simulate``; ``threads`` > 1 splits the profiles of a (T, B) run over
         that many threads (opt-in: callers that already run models in parallel threads should
-        not). Every profile is computed as with one thread: the same bits."""
+        not). Every profile is computed as with one thread: the same bits.
+
+        ``dtype="float32"`` runs the network in single precision (twice the vector lanes, about
+        twice the steps/s) and returns float32 forces: within 3.5e-6 of the peak force of the
+        float64 run on the shipped models' random records (``free_run.*.float32_error`` in
+        docs/benchmarks.md). For batched free runs (searches); ``step`` stays float64, and the
+        state kept afterwards is the float32 state in float64.
+        """
         if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 1:
             raise ModelError(f"{self.name}: threads must be a positive integer, got {threads!r}")
+        if dtype not in DTYPES:
+            raise ModelError(f"{self.name}: dtype must be one of {DTYPES}, got {dtype!r}")
         self._threads = int(threads)
         try:
-            return super().simulate(x, v)
+            if dtype == "float64":
+                return super().simulate(x, v)
+            x2, v2, one_d = self._profiles(x, v, np.float32)
+            self.reset(x2.shape[1])
+            state = self.state.astype(np.float32)
+            out = np.empty_like(x2)
+            self._run(narx_kernels(self._shape(), dtype), x2, v2, state, np.float32, out)
+            self.state[...] = state
+            return out[:, 0] if one_d else out
         finally:
             self._threads = 1
+
+    def _shape(self) -> NarxShape:
+        return NarxShape(self.n_past_x, self.n_past_f, self.w1.shape[0], self.w2.shape[0])
 
     def _weights(self) -> tuple:
         """Scaling and network arrays in the order every NARX kernel takes them."""
@@ -267,17 +292,16 @@ class NarxBushing(BushingModel):
         )
 
     def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        kern = self._kernels or self._compiled()
+        self._run(self._kernels or self._compiled(), x, v, self.state, float, out)
+
+    def _run(self, kern: NarxKernels, x, v, state, scalar, out) -> None:
+        """Advance ``state`` over x, v into ``out`` with ``kern``; ``scalar`` casts the scaling
+        and backbone numbers to the kernel's precision (its arrays must match)."""
         k, c = self._backbone()
-        args = (
-            x,
-            v,
-            self.state,
-            *self._weights(),
-            k,
-            c,
-            out,
-        )
+        w = self._weights()
+        if scalar is not float:
+            w = tuple(scalar(a) if isinstance(a, float) else a.astype(scalar) for a in w)
+        args = (x, v, state, *w, scalar(k), scalar(c), out)
         B = x.shape[1]
         if B <= COLS_MAX_BATCH:
             # One profile: its ring buffers live in registers (no ring indexing per sample).

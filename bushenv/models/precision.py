@@ -1,12 +1,12 @@
-"""What single precision would cost a NARX free run: the same network in numpy, in any dtype.
+"""A reference for single precision: the NARX recurrence in numpy, in any dtype.
 
-The compiled kernels compute in float64 (issue 6 asks for float32 "where accuracy allows, state
-the error"). This module states it: ``narx_free_run_numpy`` is the kernels' recurrence written
-in numpy with every array and constant in ``dtype`` (np.tanh instead of the kernels' arithmetic
-tanh), and ``float32_error`` is the largest |F32 - F64| over the largest |F64| of a batch. In
-float64 it agrees with ``NarxBushing.simulate`` to rounding (tests/models/test_precision.py), so
-the float32 difference is precision, not a different model. Slow (a numpy call per step):
-for measuring, not for running.
+``NarxBushing.simulate(..., dtype="float32")`` runs the compiled kernels in float32 with their
+own float32 tanh. This module is the yardstick for it: ``narx_free_run_numpy`` is the kernels'
+recurrence written in numpy with every array and constant in ``dtype`` and libm's np.tanh, and
+``float32_error`` is the largest |F32 - F64| over the largest |F64| of a batch. In float64 it
+agrees with the compiled model to rounding (tests/models/test_precision.py), so its float32
+error is what precision alone costs; the kernels' float32 error beyond it is their tanh's.
+Slow (a numpy call per step): for measuring, not for running.
 """
 
 from __future__ import annotations

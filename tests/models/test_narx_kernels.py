@@ -2,6 +2,7 @@
 
 import copy
 import pickle
+import re
 
 import numpy as np
 import pytest
@@ -241,3 +242,86 @@ def test_unwritable_cache_folder_falls_back_to_a_temp_folder(monkeypatch, tmp_pa
     path = _place_module("mod_b", "X = 3\n")
     assert path.parent.parent == tmp_path / "tmp"
     assert path.read_text() == "X = 3\n"
+
+
+# ----- float32 (simulate(..., dtype="float32")) ---------------------------------------------
+def shaped_model(shape, seed=0):
+    # Weights scaled down so the recurrence forgets (contracts) like a trained model's: a
+    # random net at full scale is chaotic, and there float32 and float64 runs part ways, as
+    # any two runs with different rounding would.
+    net = network(shape, seed)
+    net["w1"] *= 0.2
+    net["w_out"] *= 0.5
+    return NarxBushing(
+        x_offset_m=1e-4, x_scale_m=2e-3, f_offset_n=5.0, f_scale_n=300.0,
+        n_past_x=shape.n_past_x, n_past_f=shape.n_past_f, **net,
+    )  # fmt: skip
+
+
+def random_drive(T, batch, seed):
+    rng = np.random.default_rng(seed)
+    x = np.cumsum(rng.normal(size=(T, batch)), axis=0) * 2e-4
+    return x, np.gradient(x, 1 / 204.8, axis=0)
+
+
+@pytest.mark.parametrize("shape", SHAPES, ids=str)
+def test_float32_source_has_no_float64_constant_and_float64_source_is_unchanged(shape):
+    src32 = generate_source(shape, "float32")
+    body = src32.split("import numpy as np", 1)[1]
+    # every float constant is wrapped in np.float32(...), but the 0.0 of the sign test (a
+    # comparison, which promotes nothing)
+    bare = re.findall(r"(?<!np\.float32\()(?<![\w.])(\d+\.\d*(?:e-?\d+)?)", body)
+    assert set(bare) <= {"0.0"}, set(bare)
+    assert "np.float32(" in body
+    assert "float32" not in generate_source(shape)
+    with pytest.raises(ValueError, match="dtype must be one of"):
+        generate_source(shape, "float16")
+
+
+@pytest.mark.parametrize("shape", SHAPES, ids=str)
+def test_float32_run_is_single_precision_and_close_to_float64(shape):
+    model = shaped_model(shape, seed=1)
+    x, v = random_drive(400, 16, seed=2)
+    f64 = model.simulate(x, v)
+    f32 = model.simulate(x.astype(np.float32), v.astype(np.float32), dtype="float32")
+    assert f32.dtype == np.float32 and f32.shape == f64.shape
+    err = np.max(np.abs(f32 - f64)) / np.max(np.abs(f64))
+    assert 0 < err < 1e-4, err  # the shipped models: ~3e-6 (docs/benchmarks.md)
+
+
+@pytest.mark.parametrize("name", ["nn", "hybrid"])
+def test_float32_shipped_models_stay_within_the_stated_error(name):
+    model = get_model(name, axis="radial")
+    x, v = random_drive(2048, 24, seed=3)
+    f64 = model.simulate(x, v)
+    f32 = model.simulate(x, v, dtype="float32")  # float64 in: cast on the way
+    assert np.max(np.abs(f32 - f64)) < 1e-5 * np.max(np.abs(f64))
+
+
+@pytest.mark.parametrize("batch", [37, 64])
+def test_float32_columns_threads_and_one_profile_give_the_same_bits(batch):
+    model = get_model("nn", axis="axial")
+    x, v = random_drive(300, batch, seed=4)
+    x, v = x.astype(np.float32), v.astype(np.float32)
+    wide = model.simulate(x, v, dtype="float32")
+    assert np.array_equal(model.simulate(x, v, dtype="float32", threads=2), wide)
+    for b in (0, batch // 2, batch - 1):  # alone: the one-profile (register) kernel
+        assert np.array_equal(model.simulate(x[:, b], v[:, b], dtype="float32"), wide[:, b])
+
+
+def test_float32_run_leaves_its_final_state_and_float64_runs_are_untouched():
+    model = get_model("nn", axis="axial")
+    x, v = random_drive(200, 3, seed=5)
+    before = model.simulate(x, v)
+    model.simulate(x, v, dtype="float32")
+    assert model.state.dtype == np.float64 and model.state.shape[1] == 3
+    ring = model.state[1 + model.n_past_x :, :]
+    assert np.array_equal(ring, ring.astype(np.float32))  # the float32 run's own history
+    assert np.array_equal(model.simulate(x, v), before)
+
+
+@pytest.mark.parametrize("bad", ["float16", np.float32, "f4", None])
+def test_unknown_dtype_is_refused_naming_the_choices(bad):
+    model = get_model("nn", axis="axial")
+    with pytest.raises(ModelError, match=r"dtype must be one of \('float64', 'float32'\)"):
+        model.simulate(np.zeros(10), dtype=bad)
