@@ -89,16 +89,22 @@ JIT = dict(cache=True, fastmath=False, nogil=True, error_model="numpy")
 _SIG = "x, v, state, x_offset, x_scale, f_offset, f_scale, w1, b1, w2, b2, w_out, b_out, k, c, out"
 
 
-def _tanh_lines(pre: list[str], post: list[str], ind: str, lit=repr, spec=None) -> list[str]:
+def _lit(value: float, dtype: str) -> str:
+    """A float constant in generated source: plain in float64, np.float32(...) in float32 (a
+    bare literal is float64 and would promote every operation it touches)."""
+    return repr(float(value)) if dtype == "float64" else f"np.float32({float(value)!r})"
+
+
+def _tanh_lines(pre: list[str], post: list[str], ind: str, dtype: str = "float64") -> list[str]:
     """``post[u] = fastmath.tanh(pre[u])`` for every unit u, inlined stage by stage.
 
     The same IEEE operations in the same order as ``fastmath.tanh`` (so the same bits), but
     written across units one stage at a time: the units' independent Horner chains sit side
     by side, so the out-of-order core overlaps them instead of waiting on one chain's latency.
     """
-    saturation, reduction, squarings, taylor = spec or TANH_SPEC["float64"]
-    c = [lit(float(k)) for k in taylor]
-    sat, red, one = lit(saturation), lit(reduction), lit(1.0)
+    saturation, reduction, squarings, taylor = TANH_SPEC[dtype]
+    c = [_lit(k, dtype) for k in taylor]
+    sat, red, one = (_lit(k, dtype) for k in (saturation, reduction, 1.0))
     lines = [f"{ind}{q}_a = min(abs({s}), {sat})" for s, q in zip(pre, post, strict=True)]
     lines += [f"{ind}{q}_r = {q}_a * {red}" for q in post]
     lines += [f"{ind}{q}_p = {c[0]} * {q}_r + {c[1]}" for q in post]
@@ -123,8 +129,7 @@ def _network_body(
     x_at: str = "x[t, b]",
     v_at: str = "v[t, b]",
     out_at: str = "out[t, b]",
-    lit=repr,
-    spec=None,
+    dtype: str = "float64",
 ) -> list[str]:
     """Lines computing ``i0`` (scaled x), the hidden units, ``y`` and the force of a profile."""
     inputs = ["i0"] + xin + fin
@@ -133,13 +138,13 @@ def _network_body(
         terms = "".join(f" + w1_{h}_{i} * {name}" for i, name in enumerate(inputs))
         lines.append(f"{ind}s{h} = b1_{h}{terms}")
     last = [f"a{h}" for h in range(s.h1)]
-    lines += _tanh_lines([f"s{h}" for h in range(s.h1)], last, ind, lit, spec)
+    lines += _tanh_lines([f"s{h}" for h in range(s.h1)], last, ind, dtype)
     if s.h2:
         for h in range(s.h2):
             terms = "".join(f" + w2_{h}_{i} * a{i}" for i in range(s.h1))
             lines.append(f"{ind}q{h} = b2_{h}{terms}")
         last = [f"z{h}" for h in range(s.h2)]
-        lines += _tanh_lines([f"q{h}" for h in range(s.h2)], last, ind, lit, spec)
+        lines += _tanh_lines([f"q{h}" for h in range(s.h2)], last, ind, dtype)
     terms = "".join(f" + wo_{h} * {name}" for h, name in enumerate(last))
     lines.append(f"{ind}y = b_out{terms}")
     lines.append(f"{ind}{out_at} = k * {x_at} + c * {v_at} + (f_offset + f_scale * y)")
@@ -168,8 +173,6 @@ def generate_source(shape: NarxShape, dtype: str = "float64") -> str:
     if dtype not in DTYPES:
         raise ValueError(f"dtype must be one of {DTYPES}, got {dtype!r}")
     s = NarxShape(*(int(n) for n in shape))
-    lit = repr if dtype == "float64" else (lambda value: f"np.float32({value!r})")
-    spec = TANH_SPEC[dtype]
     nx, nf = s.n_past_x, s.n_past_f
     period = nx * nf
     xin = [f"xl{j}" for j in range(1, nx + 1)]  # lag j of the scaled displacement
@@ -194,7 +197,7 @@ def generate_source(shape: NarxShape, dtype: str = "float64") -> str:
     src += [f"{i8}for b in range(nb.uint64(lo), nb.uint64(hi)):"]
     src += [f"{i12}xl{j} = state[rx{j}, b]" for j in range(1, nx + 1)]
     src += [f"{i12}fl{j} = state[rf{j}, b]" for j in range(1, nf + 1)]
-    src += _network_body(s, xin, fin, i12, lit=lit, spec=spec)
+    src += _network_body(s, xin, fin, i12, dtype=dtype)
     src += [f"{i12}state[row_x, b] = i0", f"{i12}state[row_f, b] = y", f"{i12}state[0, b] = nxt"]
     src += [""]
 
@@ -205,7 +208,7 @@ def generate_source(shape: NarxShape, dtype: str = "float64") -> str:
     src += [f"{i8}xl{j} = state[1 + (cnt0 + {nx - j}) % {nx}, b]" for j in range(1, nx + 1)]
     src += [f"{i8}fl{j} = state[{1 + nx} + (cnt0 + {nf - j}) % {nf}, b]" for j in range(1, nf + 1)]
     src += [f"{i8}for t in range(T):"]
-    src += _network_body(s, xin, fin, i12, lit=lit, spec=spec)
+    src += _network_body(s, xin, fin, i12, dtype=dtype)
     src += [f"{i12}xl{j} = xl{j - 1}" for j in range(nx, 1, -1)] + [f"{i12}xl1 = i0"]
     src += [f"{i12}fl{j} = fl{j - 1}" for j in range(nf, 1, -1)] + [f"{i12}fl1 = y"]
     src += [f"{i8}state[1 + (cnt_end + {nx - j}) % {nx}, b] = xl{j}" for j in range(1, nx + 1)]
@@ -220,9 +223,7 @@ def generate_source(shape: NarxShape, dtype: str = "float64") -> str:
     src += _weight_locals(s, i4) + [f"{i4}cnt = int(state[0, 0])", f"{i4}b = 0"]
     src += [f"{i4}xl{j} = state[1 + (cnt + {nx - j}) % {nx}, b]" for j in range(1, nx + 1)]
     src += [f"{i4}fl{j} = state[{1 + nx} + (cnt + {nf - j}) % {nf}, b]" for j in range(1, nf + 1)]
-    src += _network_body(
-        s, xin, fin, i4, x_at="x_t", v_at="v_t", out_at="force", lit=lit, spec=spec
-    )
+    src += _network_body(s, xin, fin, i4, x_at="x_t", v_at="v_t", out_at="force", dtype=dtype)
     src += [f"{i4}state[1 + cnt % {nx}, b] = i0", f"{i4}state[{1 + nx} + cnt % {nf}, b] = y"]
     src += [f"{i4}state[0, b] = float((cnt + 1) % {period})", f"{i4}return force", ""]
     return "\n".join(src)
@@ -286,9 +287,8 @@ def narx_kernels(
             return found
         source = generate_source(shape, dtype)
         digest = hashlib.sha256(f"{GENERATOR_VERSION}\n{source}".encode()).hexdigest()[:16]
-        name = "bushenv_narx_x{}_f{}_h{}_{}_{}".format(*shape, digest)
-        if dtype != "float64":
-            name = name.replace("bushenv_narx_", f"bushenv_narx_{dtype}_")
+        prefix = "bushenv_narx_" if dtype == "float64" else f"bushenv_narx_{dtype}_"
+        name = prefix + "x{}_f{}_h{}_{}_{}".format(*shape, digest)
         path = _place_module(name, source)
         module = _import(path, name)
         found = NarxKernels(module.run_rows, module.run_cols, module.step_one, path)
