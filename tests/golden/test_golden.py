@@ -27,9 +27,8 @@ def differences(want, got, where="$"):
     if isinstance(want, list) and isinstance(got, list):
         if len(want) != len(got):
             return [f"{where}: {len(want)} items in golden, {len(got)} now"]
-        return [
-            d for i, (a, b) in enumerate(zip(want, got)) for d in differences(a, b, f"{where}[{i}]")
-        ]
+        pairs = enumerate(zip(want, got, strict=True))
+        return [d for i, (a, b) in pairs for d in differences(a, b, f"{where}[{i}]")]
     if isinstance(want, float) and isinstance(got, float | int) and not isinstance(got, bool):
         if math.isclose(want, got, rel_tol=FLOAT_RTOL, abs_tol=1e-12):
             return []
