@@ -22,17 +22,19 @@ paper's own constraint (eq. 6, beta1 + gamma1 > 0): z1 then hardens instead of s
 We keep the printed values (see ``tests/models/test_boucwen.py`` for the size of the forces
 they give on a 2 mm record).
 
-Integration (``boucwen_kernels.boucwen_kernel``; why and how it was chosen there): eqs. 1 + 3
-and eqs. 2 + 4 are two independent 2 x 2 systems, each integrated by an error-controlled
-Rosenbrock-W method (ROS34PW2: order 3, L-stable, a 2 x 2 solve per stage) with x and x'
-interpolated linearly inside each sample. ``rtol`` (default ``BW_RTOL`` = 3e-5) bounds each
-step's error in the force relative to F_REF = max(sum |k| x 1 mm, sum |c| x 10 mm/s); at the
-default the free run agrees with a converged fixed-step RK4 to 2e-3 of max(peak force, F_REF)
-on random, step, 80 Hz, out-of-band and zig-zag inputs -- 2e-3 of the peak for the Table 3
-preset and the shipped sets (``tests/models/test_boucwen_kernels.py``). Nothing is clamped: a
-history whose solution blows up (e.g. a < 0 with hardening), that needs more than
-``BW_MAX_SUBSTEPS`` trial steps in one sample, or whose eq. 3 or 4 is algebraic to working
-precision (c1 -> 0) gives NaN and ``simulate`` raises.
+Integration (``boucwen_kernels.boucwen_kernel``; docs/boucwen-integration.md): z is advanced
+along the relative travel by an exact map tabulated once per parameter set
+(``boucwen_tables``), which leaves one stiff scalar ODE per block (eqs. 3 and 4), integrated by
+error-controlled exponential collocation with x and x' linear within each sample; reversals of
+the relative velocity are located on the step's dense output. ``rtol`` (default ``BW_RTOL``)
+bounds each step's error in the force relative to F_REF = max(sum |k| x 1 mm, sum |c| x 10
+mm/s); at the default the free run agrees with a converged fixed-step RK4 to 2e-3 of the peak
+on random, step, 80 Hz, out-of-band and zig-zag inputs for the shipped sets and the Table 3
+preset (``tests/models/test_boucwen_kernels.py``). Nothing is clamped: a parameter set outside
+what the map covers (A <= 0, n <= 0, an unloading branch that runs away, a block that relaxes
+faster than 1e-8 of a sample) is refused when the model is built; a history whose hardening z
+runs away (its force beyond 1e3 F_REF), that needs more than ``BW_MAX_SUBSTEPS`` trial steps in
+one sample, or whose state is no longer finite gives NaN and ``simulate`` raises.
 """
 
 from __future__ import annotations
@@ -42,13 +44,8 @@ from typing import Any
 import numpy as np
 
 from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
-from bushenv.models.kernels import (
-    BW_MAX_SUBSTEPS,
-    BW_N_STATE,
-    BW_ORDER,
-    BW_RTOL,
-    boucwen_kernel,
-)
+from bushenv.models.boucwen_kernels import BW_MAX_SUBSTEPS, BW_N_STATE, boucwen_kernel
+from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare
 
 MM_PER_M = 1000.0
 
@@ -87,18 +84,21 @@ def n_mm_to_si(p: dict[str, float]) -> dict[str, float]:
 
 
 class BoucWenError(ModelError):
-    """The Bouc-Wen equations could not be integrated (step limit, blow-up, or c -> 0)."""
+    """The Bouc-Wen equations cannot be integrated (refused set, step limit, or a runaway)."""
 
 
 @register
 class BoucWenBushing(BushingModel):
-    """seed 002 eqs. 1-5, 16 parameters in SI; error-controlled Rosenbrock-W integration.
+    """seed 002 eqs. 1-5, 16 parameters in SI; z along the travel, exponential collocation.
 
     ``rtol``: error tolerance on the force (see the module docstring); saved with the model.
     """
 
     name = "boucwen"
     param_names = BW_ORDER
+    # every state row is its history's own (the rigs' probe could take the direction of travel
+    # or the carried step size, equal by chance in two histories, for a shared row)
+    shared_state_rows: tuple[int, ...] = ()
 
     def __init__(self, dt: float = PAPER_DT, rtol: float = BW_RTOL, **params: float) -> None:
         try:
@@ -124,7 +124,10 @@ class BoucWenBushing(BushingModel):
         if self.c0 + self.c2 == 0.0:
             raise ModelError("boucwen: c0 + c2 = 0 (eq. 4 divides by c0 + c2)")
         self._p = np.array([[getattr(self, k)] for k in BW_ORDER])
-        self._p_batch = self._p
+        self._tabs, self._bc, why = prepare(self._p.T, float(dt), rtol)
+        if why[0]:
+            raise BoucWenError(f"boucwen: cannot integrate these parameters: {why[0]}")
+        self._tab_index = np.array([[0], [1]], dtype=np.int64)
         super().__init__(dt)
 
     @classmethod
@@ -156,17 +159,18 @@ class BoucWenBushing(BushingModel):
 
     def reset(self, batch_size: int = 1) -> None:
         super().reset(batch_size)
-        self._p_batch = np.ascontiguousarray(np.repeat(self._p, self.batch_size, axis=1))
+        if self._tab_index.shape[1] != self.batch_size:
+            self._tab_index = np.repeat(np.array([[0], [1]], dtype=np.int64), self.batch_size, 1)
 
     def _advance(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         n_bad = boucwen_kernel(
-            x, v, self.state, self._p_batch, self.dt, BW_MAX_SUBSTEPS, self.rtol, out
+            x, v, self.state, self._tabs, self._bc, self._tab_index, self.dt, BW_MAX_SUBSTEPS, out
         )
         if n_bad:
             raise BoucWenError(
                 f"boucwen: {n_bad} of {x.shape[1]} histories could not be integrated: more "
-                f"than {BW_MAX_SUBSTEPS} sub-steps in one sample, or the solution blew up; "
-                f"parameters {self.params}"
+                f"than {BW_MAX_SUBSTEPS} trial steps in one sample, or the solution ran away "
+                f"(z beyond its table, or not finite); parameters {self.params}"
             )
 
     def max_substeps_last_sample(self) -> np.ndarray:
@@ -197,17 +201,18 @@ def simulate_population(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Free-run P parameter sets (P, 16) on one record (T,) at once: forces (T, P), bad (P,).
 
-    Columns whose integration failed (more than ``max_substeps`` trial steps in a sample, or a
-    solution that blew up) hold NaN and are flagged in ``bad``; no error is raised: the
-    identification treats them as infeasible.
+    Columns whose set is refused (outside what the kernel covers) or whose integration failed
+    (more than ``max_substeps`` trial steps in a sample, or a runaway) hold NaN and are flagged
+    in ``bad``; no error is raised: the identification treats them as infeasible.
     """
-    vectors = np.asarray(vectors, dtype=np.float64)
+    vectors = np.atleast_2d(np.asarray(vectors, dtype=np.float64))
     P = vectors.shape[0]
-    p = np.ascontiguousarray(vectors.T)
+    tabs, bc, _ = prepare(vectors, float(dt), float(rtol))
+    index = np.ascontiguousarray(np.stack([2 * np.arange(P), 2 * np.arange(P) + 1]))
     xx = np.ascontiguousarray(np.repeat(np.asarray(x, dtype=np.float64)[:, None], P, axis=1))
     vv = np.ascontiguousarray(np.repeat(np.asarray(v, dtype=np.float64)[:, None], P, axis=1))
     state = np.zeros((BW_N_STATE, P))
     out = np.empty_like(xx)
-    boucwen_kernel(xx, vv, state, p, dt, int(max_substeps), float(rtol), out)
+    boucwen_kernel(xx, vv, state, tabs, bc, index, float(dt), int(max_substeps), out)
     bad = ~np.all(np.isfinite(out), axis=0)
     return out, bad

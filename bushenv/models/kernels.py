@@ -138,11 +138,10 @@ def narx_kernel(  # pragma: no cover - compiled
 from bushenv.models.boucwen_kernels import (  # noqa: E402, F401
     BW_MAX_SUBSTEPS,
     BW_N_STATE,
-    BW_ORDER,
-    BW_RTOL,
     boucwen_fixed_step,
     boucwen_kernel,
 )
+from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare  # noqa: E402, F401
 
 
 def warm_up() -> None:
@@ -173,7 +172,9 @@ def warm_up() -> None:
     from bushenv.models import narx_kernels  # generated per network shape, see there
 
     narx_kernels.warm_up()
-    p = np.ones((len(BW_ORDER), 1))
+    p = np.ones((1, len(BW_ORDER)))
+    tabs, bc, _ = prepare(p, 1e-3, BW_RTOL)
+    index = np.array([[0], [1]], dtype=np.int64)
     boucwen_kernel(
-        z, z, np.zeros((BW_N_STATE, 1)), p, 1e-3, BW_MAX_SUBSTEPS, BW_RTOL, np.empty_like(z)
+        z, z, np.zeros((BW_N_STATE, 1)), tabs, bc, index, 1e-3, BW_MAX_SUBSTEPS, np.empty_like(z)
     )

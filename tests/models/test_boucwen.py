@@ -103,7 +103,7 @@ def test_free_run_matches_a_tight_implicit_solver_and_converges_to_it():
     x = random_2mm(seed=1, duration_s=20.0)[:40]
     v = np.gradient(x, DT)
     ref = None
-    for rtol, bound in ((3e-5, 2e-3), (1e-9, 1e-6)):  # measured 2.3e-4 and 2.2e-8
+    for rtol, bound in ((7e-4, 2e-3), (1e-9, 1e-6)):
         m = BoucWenBushing(rtol=rtol, **BoucWenBushing.preset().params)
         f = m.simulate(x, v)
         if ref is None:
@@ -111,9 +111,25 @@ def test_free_run_matches_a_tight_implicit_solver_and_converges_to_it():
         assert np.max(np.abs(f - ref)) < bound * np.max(np.abs(ref))
 
 
-def test_unintegrable_parameters_raise_instead_of_clamping():
+@pytest.mark.parametrize(
+    "change, why",
+    [
+        # c1 -> 0: eq. 3 is algebraic to 1e-8 of a sample; its form here would lose its digits
+        ({"c1": 1e-9}, "below 1e-8 of a sample"),
+        ({"A1": 0.0}, "A = 0 must be > 0"),
+        ({"n2": -0.5}, "n = -0.5 must be > 0"),
+        ({"beta1": -500.0, "gamma1": 0.0}, "runs away on unloading"),
+    ],
+)
+def test_parameters_the_kernel_cannot_integrate_are_refused_with_the_reason(change, why):
     p = BoucWenBushing.preset().params
-    # c1 -> 0: eq. 3 is algebraic to 1e-8 of a sample; its form here would lose its digits
-    m = BoucWenBushing(**{**p, "c1": 1e-9})
+    with pytest.raises(BoucWenError, match=why):
+        BoucWenBushing(**{**p, **change})
+
+
+def test_a_runaway_history_raises_instead_of_clamping():
+    # hardening with n > 1 (beta1 + gamma1 < 0): z1 reaches infinity at finite travel
+    p = {**BoucWenBushing.preset().params, "beta1": 0.0, "gamma1": -1e6, "n1": 1.5, "A1": 1.0}
+    m = BoucWenBushing(**p)
     with pytest.raises(BoucWenError, match="could not be integrated"):
         m.simulate(random_2mm(duration_s=1.0))

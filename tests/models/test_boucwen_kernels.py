@@ -17,11 +17,10 @@ from bushenv.models.boucwen_accuracy import (
 from bushenv.models.boucwen_kernels import (
     BW_MAX_SUBSTEPS,
     BW_N_STATE,
-    BW_ORDER,
-    BW_RTOL,
     BW_TILE,
     boucwen_kernel,
 )
+from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare
 
 DT = PAPER_DT
 ACCURACY = 2e-3  # of max(peak force, F_REF), at the default rtol (module docstring)
@@ -31,10 +30,12 @@ def run(p, x, v, max_substeps=BW_MAX_SUBSTEPS, rtol=BW_RTOL):
     """p (16, B), x and v (T, B): forces, final state, n_bad."""
     x = np.ascontiguousarray(x)
     v = np.ascontiguousarray(v)
-    p = np.ascontiguousarray(p)
-    state = np.zeros((BW_N_STATE, x.shape[1]))
+    B = x.shape[1]
+    tabs, bc, _ = prepare(np.asarray(p).T, DT, rtol)
+    index = np.ascontiguousarray(np.stack([2 * np.arange(B), 2 * np.arange(B) + 1]))
+    state = np.zeros((BW_N_STATE, B))
     out = np.empty_like(x)
-    n_bad = boucwen_kernel(x, v, state, p, DT, max_substeps, rtol, out)
+    n_bad = boucwen_kernel(x, v, state, tabs, bc, index, DT, max_substeps, out)
     return out, state, n_bad
 
 
@@ -61,25 +62,26 @@ def test_the_fixed_step_reference_is_converged():
     assert np.all(np.max(np.abs(a - b), axis=0) <= 1e-6 * np.max(np.abs(b), axis=0))
 
 
-def test_error_shrinks_as_the_tolerance_is_tightened():
-    p = get_model("boucwen", axis="radial").vector()[:, None]
+@pytest.mark.parametrize("axis", ["radial", "axial"])
+def test_error_shrinks_as_the_tolerance_is_tightened(axis):
+    p = get_model("boucwen", axis=axis).vector()[:, None]
     x = ex.random_rpc(1.5, 2.0, DT, seed=2)[:, None]
     v = np.gradient(x, DT, axis=0)
     ref = converged(p, x, v, 512)
     errs = []
-    for rtol in (3e-5, 3e-7, 3e-9):
+    for rtol in (7e-4, 7e-6, 7e-8):  # measured 7.8e-4, 8.1e-7, 9.2e-9 (radial)
         f, _, _ = run(p, x, v, rtol=rtol)
         errs.append(np.max(np.abs(f - ref)) / np.max(np.abs(ref)))
     assert errs[0] > 10 * errs[1] > 100 * errs[2]
-    assert errs[2] < 1e-6
+    assert errs[2] < 1e-7
 
 
-def test_a_held_step_costs_one_or_two_steps_per_sample():
-    # L-stable: the stiff relaxation after a step does not force small steps
+def test_a_held_step_costs_one_step_per_sample_and_block():
+    # the exponential step is exact for the linear relaxation after the step
     m = get_model("boucwen", axis="radial")
     x = ex.step_hold(4e-3, 2.0, DT)
     m.simulate(x)
-    assert m.max_substeps_last_sample()[0] <= 2
+    assert m.max_substeps_last_sample()[0] == 2
 
 
 def test_each_column_gives_the_same_bits_alone_in_a_full_tile_and_in_a_partial_tile():
@@ -109,15 +111,32 @@ def test_looped_step_equals_simulate_bit_for_bit_on_a_batch():
     assert np.array_equal(looped, f)
 
 
+def test_a_call_split_anywhere_continues_bit_for_bit():
+    m = get_model("boucwen", axis="radial")
+    x = np.ascontiguousarray(ex.random_rpc(1.5, 1.0, DT, seed=3)[:, None])
+    v = np.ascontiguousarray(np.gradient(x, DT, axis=0))
+    index = np.array([[0], [1]])
+    whole = m.simulate(x, v)
+    state = np.zeros((BW_N_STATE, 1))
+    parts = []
+    for a, b in ((0, 77), (77, 78), (78, len(x))):
+        out = np.empty((b - a, 1))
+        boucwen_kernel(
+            x[a:b].copy(), v[a:b].copy(), state, m._tabs, m._bc, index, DT, BW_MAX_SUBSTEPS, out
+        )
+        parts.append(out)
+    assert np.array_equal(np.concatenate(parts), whole)
+
+
 @pytest.mark.parametrize("B", [1, BW_TILE])
-def test_blowing_up_and_nan_columns_are_counted_and_nan_without_hanging(B):
+def test_runaway_refused_and_nan_columns_are_counted_and_nan_without_hanging(B):
     good = BoucWenBushing.preset().vector()
     p = np.repeat(good[:, None], B, axis=1)
     i = BW_ORDER.index
     # a1 < 0 with hardening (beta1 + gamma1 < 0, n1 > 1): z1 reaches infinity at finite travel
     p[[i("A1"), i("beta1"), i("gamma1"), i("n1"), i("a1")], 0] = (1.0, 0.0, -1e6, 1.5, -612.5)
     if B > 1:
-        p[i("n2"), 1] = np.nan
+        p[i("n2"), 1] = np.nan  # refused when the tables are built
         p[i("c1"), 2] = 1e-9  # eq. 3 algebraic to 1e-8 of a sample: refused, not mis-solved
     x = ex.random_rpc(1.0, 0.5, DT, seed=0)
     x = np.repeat(x[:, None], B, axis=1)
@@ -137,10 +156,10 @@ def test_the_step_limit_fails_histories_and_the_model_raises():
     m = get_model("boucwen", axis="radial")
     x = ex.random_rpc(1.5, 2.0, DT, seed=0)[:, None]
     p = m.vector()[:, None]
-    _, _, n_bad = run(p, x, np.gradient(x, DT, axis=0), max_substeps=2)
+    _, _, n_bad = run(p, x, np.gradient(x, DT, axis=0), max_substeps=1)
     assert n_bad == 1
-    with pytest.raises(BoucWenError, match="could not be integrated"):
-        BoucWenBushing(**{**m.params, "c1": 1e-9}).simulate(x[:, 0])
+    with pytest.raises(BoucWenError, match="cannot integrate"):
+        BoucWenBushing(**{**m.params, "c1": 1e-9})
 
 
 def test_identification_candidates_are_accurate_or_flagged():
