@@ -22,6 +22,19 @@ EXPECTED = [
     "free_run.boucwen.B1024.threads2",
     "free_run.boucwen.error_vs_converged",
     "free_run.boucwen.trial_steps_per_sample",
+    "compare.boucwen.bushenv_B1",
+    "compare.boucwen.bushenv_B1.error_vs_converged",
+    *(
+        f"compare.boucwen.{f}_{m}"
+        for f in ("scipy", "bushenv_B1_over_scipy")
+        for m in ("LSODA", "Radau")
+    ),
+    "compare.nn.torch_agreement",
+    *(
+        f"compare.nn.{f}.threads{t}"
+        for f in ("torch", "bushenv", "bushenv_over_torch")
+        for t in (1, 2)
+    ),
     *(
         f"free_run.{m}.{f}"
         for m in ("nn", "hybrid")
@@ -81,4 +94,9 @@ def test_quick_benchmark_produces_every_figure_with_units_and_targets(tmp_path):
         if "target" in r:
             assert isinstance(r["met"], bool), name
     assert rows["free_run.nn.B1024.threads2"]["target"] == 50e6
+    assert rows["free_run.boucwen.B1024.threads2"]["target"] == 10e6  # issue 18
+    # the comparisons are of the same computation: same network, same accuracy
+    assert rows["compare.nn.torch_agreement"]["value"] < 1e-9
+    for m in ("LSODA", "Radau"):
+        assert rows[f"compare.boucwen.scipy_{m}"]["note"].startswith("rtol")
     assert "| verification_6.44s.nn |" in md.read_text()

@@ -76,12 +76,12 @@ BC_ROWS = tuple(
 )
 SAT_EPS = 1e-9  # a saturating side counts as saturated where 1 - xi^n is below this
 MAX_NODES = 1 << 16  # per side of xi = 0 (the default tolerance needs a few hundred)
-RK4_SUBSTEPS = 1  # per node interval, away from xi = 0
 # the first node intervals next to xi = 0 (the |xi|^n cusp), with this many RK4 sub-steps each
 CUSP_SUBSTEPS = (16, 4, 2)
+TAYLOR_FROM = 8.0  # nodes where xi >= this many spacings use the Taylor step
 DLAMBDA_DEFAULT = 1.0 / 16.0  # node spacing (natural units) at the default tolerance
 CUSP_XI = 0.1  # for n < 1 the curvature is judged at xi = CUSP_XI (it is infinite at 0)
-RATE_MAX = 64.0  # finest spacing dl / RATE_MAX; a blowing-up side ends where it needs finer
+RATE_MAX = 1024.0  # finest spacing dl / RATE_MAX; a blowing-up side ends where it needs finer
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -95,6 +95,24 @@ def _rk4(xi, step, n_sub, kappa, n):  # pragma: no cover - compiled
         d = 1.0 - kappa * abs(xi + hs * c) ** n
         xi += hs / 6.0 * (a + 2.0 * b + 2.0 * c + d)
     return xi
+
+
+@nb.njit(cache=True, error_model="numpy")
+def _taylor4(xi, p, step, kappa, n):  # pragma: no cover - compiled
+    """One step of the degree-4 Taylor series of dxi/dlambda = 1 - kappa xi^n from xi > 0 with
+    p = xi^n: one power per step (RK4 needs four); the series converges for step << xi."""
+    q = p / xi  # xi^(n-1)
+    r = q / xi  # xi^(n-2)
+    w = r / xi  # xi^(n-3)
+    d1 = 1.0 - kappa * p
+    d2 = -kappa * n * q * d1
+    d3 = -kappa * n * ((n - 1.0) * r * d1 * d1 + q * d2)
+    d4 = (
+        -kappa
+        * n
+        * ((n - 1.0) * (n - 2.0) * w * d1 * d1 * d1 + 3.0 * (n - 1.0) * r * d1 * d2 + q * d3)
+    )
+    return xi + step * (d1 + step * (0.5 * d2 + step * (d3 / 6.0 + step * d4 / 24.0)))
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -123,21 +141,32 @@ def _side(kappa, n, reach, dl):  # pragma: no cover - compiled
     )
     rate = n * a ** (n - 1.0)
     spacing = dl / min(RATE_MAX, max(1.0, rate))
-    out = np.empty(MAX_NODES)
+    out = np.empty(256)
     out[0] = 0.0
     xi = 0.0
+    pw = 0.0
+    n_cusp = len(CUSP_SUBSTEPS)
     for i in range(1, MAX_NODES):
-        n_sub = CUSP_SUBSTEPS[i - 1] if i <= len(CUSP_SUBSTEPS) else RK4_SUBSTEPS
-        xn = _rk4(xi, spacing, n_sub, kappa, n)
+        if i <= n_cusp:  # next to the cusp at 0: RK4, finely
+            xn = _rk4(xi, spacing, CUSP_SUBSTEPS[i - 1], kappa, n)
+        elif xi < TAYLOR_FROM * spacing:
+            xn = _rk4(xi, spacing, 1, kappa, n)
+        else:  # further out: one power per node
+            xn = _taylor4(xi, pw, spacing, kappa, n)
         if not (xn < 1e300):
             return out[:i].copy(), spacing, False
         xi = xn
+        pw = xi**n
+        if i >= out.shape[0]:
+            grown = np.empty(2 * out.shape[0])
+            grown[:i] = out[:i]
+            out = grown
         out[i] = xi
-        if kappa > 0.0 and 1.0 - xi**n < SAT_EPS:
+        if kappa > 0.0 and 1.0 - pw < SAT_EPS:
             return out[: i + 1].copy(), spacing, True
         if xi >= reach:
             return out[: i + 1].copy(), spacing, False
-    return out, spacing, False
+    return out[:MAX_NODES].copy(), spacing, False
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -177,29 +206,28 @@ def build_table(c_load, c_unload, A, n, dl, xi_cap):  # pragma: no cover - compi
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _solve_in(nodes, i0, i1, l0, dl, target):  # pragma: no cover - compiled
+def _solve_in(nodes, i0, i1, l0, dl, target, hint):  # pragma: no cover - compiled
     """lambda with xi(lambda) = target within nodes i0..i1 (increasing) of one segment, whose
-    node i0 sits at lambda = l0 (spacing dl): bisection-safeguarded Newton on the interval's
-    Hermite cubic. Returns (lambda, dxi/dlambda there); clamps to the segment's ends."""
+    node i0 sits at lambda = l0 (spacing dl): the interval is found by walking down from node
+    ``hint`` (the targets of ``reflection`` decrease), then bisection-safeguarded Newton on its
+    Hermite cubic. Returns (lambda, dxi/dlambda there, the interval for the next hint); the
+    segment's ends clamp."""
     if target <= nodes[i0, 0]:  # at the end itself (xi = 0) the slope is the node's
-        return l0, nodes[i0, 1] / dl if target == nodes[i0, 0] else 0.0
+        return l0, nodes[i0, 1] / dl if target == nodes[i0, 0] else 0.0, i0
     if target >= nodes[i1, 0]:
-        return l0 + (i1 - i0) * dl, nodes[i1, 1] / dl if target == nodes[i1, 0] else 0.0
-    lo = i0
-    hi = i1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if nodes[mid, 0] <= target:
-            lo = mid
-        else:
-            hi = mid
+        return l0 + (i1 - i0) * dl, nodes[i1, 1] / dl if target == nodes[i1, 0] else 0.0, i1
+    lo = min(max(hint, i0), i1 - 1)
+    while lo < i1 - 1 and nodes[lo + 1, 0] <= target:
+        lo += 1
+    while lo > i0 and nodes[lo, 0] > target:
+        lo -= 1
     p0, m0 = nodes[lo, 0], nodes[lo, 1]
     p1, m1 = nodes[lo + 1, 0], nodes[lo + 1, 1]
     c2 = 3.0 * (p1 - p0) - 2.0 * m0 - m1
     c3 = 2.0 * (p0 - p1) + m0 + m1
     t = (target - p0) / (p1 - p0) if p1 > p0 else 0.0
     a, b = 0.0, 1.0
-    for _ in range(30):
+    for _ in range(8):
         f = p0 + t * (m0 + t * (c2 + t * c3)) - target
         if f > 0.0:
             b = t
@@ -212,26 +240,29 @@ def _solve_in(nodes, i0, i1, l0, dl, target):  # pragma: no cover - compiled
             t = tn
             break
         t = tn
-    return l0 + (lo - i0 + t) * dl, (m0 + t * (2.0 * c2 + 3.0 * t * c3)) / dl
+    return l0 + (lo - i0 + t) * dl, (m0 + t * (2.0 * c2 + 3.0 * t * c3)) / dl, lo
 
 
 @nb.njit(cache=True, error_model="numpy")
 def reflection(nodes, n_down, dl_down, dl_up):  # pragma: no cover - compiled
-    """The reflection lambda_r(lambda) at every node (same layout as ``nodes``): a reversal at
-    lambda continues from lambda_r, where xi(lambda_r) = -xi(lambda); its slope is
-    -xi'(lambda) / xi'(lambda_r) (0 where -xi is beyond the other segment: clamped)."""
+    """The reflection lambda_r(lambda) at every node above lambda = 0 (same layout as
+    ``nodes``; zero below, where the kernel solves for it): a reversal at lambda continues
+    from lambda_r, where xi(lambda_r) = -xi(lambda); its slope is -xi'(lambda) /
+    xi'(lambda_r) (0 where -xi is beyond the other segment: clamped)."""
     N = nodes.shape[0]
-    out = np.empty((N, 2))
+    out = np.zeros((N, 2))
     l0_down = -(n_down - 1) * dl_down
-    for i in range(N):
+    hint_down = n_down - 1  # the targets -xi fall as xi rises: walk each segment downwards
+    hint_up = N - 1
+    for i in range(n_down, N):
         xi = nodes[i, 0]
         up = i >= n_down
         dl = dl_up if up else dl_down
         slope = nodes[i, 1] / dl
         if up:  # -xi <= 0: in the segment below
-            lam, s_r = _solve_in(nodes, 0, n_down - 1, l0_down, dl_down, -xi)
+            lam, s_r, hint_down = _solve_in(nodes, 0, n_down - 1, l0_down, dl_down, -xi, hint_down)
         else:
-            lam, s_r = _solve_in(nodes, n_down, N - 1, 0.0, dl_up, -xi)
+            lam, s_r, hint_up = _solve_in(nodes, n_down, N - 1, 0.0, dl_up, -xi, hint_up)
         out[i, 0] = lam
         out[i, 1] = dl * (-slope / s_r if s_r > 0.0 else 0.0)
     return out
@@ -254,8 +285,10 @@ def domain_error(A: float, beta: float, gamma: float, n: float) -> str:
         )
     for c in (c_load, c_unload):
         if c != 0.0:
-            with np.errstate(all="ignore"):
-                W = float(np.float64(A / abs(c)) ** (1.0 / n))
+            try:
+                W = (A / abs(c)) ** (1.0 / n)
+            except OverflowError:
+                W = math.inf
             if not (math.isfinite(W) and W > 0.0):
                 return f"z scale (A / |gamma +- beta|)^(1/n) = {W!r} is out of range"
     return ""

@@ -138,9 +138,9 @@ def narx_kernel(  # pragma: no cover - compiled
 from bushenv.models.boucwen_kernels import (  # noqa: E402, F401
     BW_MAX_SUBSTEPS,
     BW_N_STATE,
-    boucwen_fixed_step,
     boucwen_kernel,
 )
+from bushenv.models.boucwen_reference import boucwen_fixed_step  # noqa: E402, F401
 from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare  # noqa: E402, F401
 
 

@@ -128,8 +128,10 @@ def test_parameters_the_kernel_cannot_integrate_are_refused_with_the_reason(chan
 
 
 def test_a_runaway_history_raises_instead_of_clamping():
-    # hardening with n > 1 (beta1 + gamma1 < 0): z1 reaches infinity at finite travel
+    # hardening with n > 1 (beta1 + gamma1 < 0) fed back with a1 < 0: z1 reaches infinity at
+    # finite travel, and the travel keeps growing
     p = {**BoucWenBushing.preset().params, "beta1": 0.0, "gamma1": -1e6, "n1": 1.5, "A1": 1.0}
+    p["a1"] = -612.5
     m = BoucWenBushing(**p)
     with pytest.raises(BoucWenError, match="could not be integrated"):
         m.simulate(random_2mm(duration_s=1.0))
