@@ -45,9 +45,6 @@ from __future__ import annotations
 
 import numba as nb
 import numpy as np
-from llvmlite import ir
-from numba.core import cgutils, types
-from numba.extending import intrinsic
 
 from bushenv.models.boucwen_pass import (  # noqa: F401  (row offsets: the scratch layout)
     _AAW,
@@ -88,6 +85,7 @@ from bushenv.models.boucwen_pass import (  # noqa: F401  (row offsets: the scrat
     _OFFU,
     _OK,
     _OUTV,
+    _RTOL,
     _S,
     _SHIFT,
     _TAU,
@@ -104,7 +102,13 @@ from bushenv.models.boucwen_pass import (  # noqa: F401  (row offsets: the scrat
     JIT,
     _pass,
 )
-from bushenv.models.boucwen_step import hermite, inverse, locate, locate_zero_crossing
+from bushenv.models.boucwen_step import (
+    hermite,
+    inverse,
+    locate,
+    locate_tolerance,
+    locate_zero_crossing,
+)
 from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, V_REF_M_PER_S, X_REF_M
 
 # State rows: y, w, z1, z2 (z: written for inspection, not read), x_prev, v_prev, trial steps in
@@ -113,32 +117,6 @@ from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, V_REF_M_PER_S, X_RE
 BW_N_STATE = 13
 BW_MAX_SUBSTEPS = 20_000  # trial steps per sample and block; beyond: not integrable here
 __all__ = ["BW_ORDER", "BW_RTOL", "X_REF_M", "V_REF_M_PER_S", "BW_N_STATE", "BW_TILE"]
-
-PREFETCH_SAMPLES = 8  # a lane taking sample t asks the caches for sample t + this
-
-
-@intrinsic
-def _prefetch(typingctx, arr, i, j):
-    """Hint the caches to fetch arr[i, j] (2-D float64; never faults). The lanes of a tile walk
-    x, v and out (T, B) each at its own pace: without it every new sample waits for memory."""
-    if not (isinstance(arr, types.Array) and arr.ndim == 2):
-        return None
-
-    def codegen(context, builder, signature, args):
-        a, ii, jj = args
-        ary = context.make_array(signature.args[0])(context, builder, a)
-        ptr = cgutils.get_item_pointer(
-            context, builder, signature.args[0], ary, [ii, jj], wraparound=False
-        )
-        i8p = ir.IntType(8).as_pointer()
-        i32 = ir.IntType(32)
-        fnty = ir.FunctionType(ir.VoidType(), [i8p, i32, i32, i32])
-        fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.prefetch.p0i8")
-        # read, high locality, data cache
-        builder.call(fn, [builder.bitcast(ptr, i8p), i32(0), i32(3), i32(1)])
-        return context.get_dummy_value()
-
-    return types.void(arr, i, j), codegen
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -178,7 +156,7 @@ def _cut_at_reversal(L, tabs, j, dt, inv_dt, first):  # pragma: no cover - compi
     ua = L[_UA + j]
     th, y = locate(
         ya, L[_LR + j], hh, L[_N0 + j], L[_D1 + j], L[_D2 + j], s,
-        L[_G0 + j], L[_G1 + j], L[_G2 + j], first, ua, du_dt,
+        L[_G0 + j], L[_G1 + j], L[_G2 + j], first, ua, du_dt, locate_tolerance(L[_RTOL + j]),
     )  # fmt: skip
     tau = L[_TAU + j]
     dt_r = th * hh
@@ -224,9 +202,9 @@ def _f_at_end(L, tabs, j):  # pragma: no cover - compiled
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _load_lane(L, j, b, blk, x, v, state, bc, k, dt):  # pragma: no cover - compiled
+def _load_lane(L, j, b, blk, xs, vs, state, bc, k, dt):  # pragma: no cover - compiled
     """Lane j takes block ``blk`` of profile b (constants: row k of bc) at the call's first
-    sample."""
+    sample; xs, vs: the tile's staged columns."""
     for r in range(_N_BC):
         L[r * BW_TILE + j] = bc[k, r]
     L[_Y + j] = state[blk, b]
@@ -236,7 +214,7 @@ def _load_lane(L, j, b, blk, x, v, state, bc, k, dt):  # pragma: no cover - comp
     L[_H + j] = h0 if h0 > 0.0 else dt
     L[_TAU + j] = 0.0
     L[_NST + j] = 0.0
-    _take_sample(L, j, state[4, b], state[5, b], x[0, b], v[0, b])
+    _take_sample(L, j, state[4, b], state[5, b], xs[0, j], vs[0, j])
     L[_ACT + j] = 1.0
     L[_CODE + j] = 0.0
     L[_EVT + j] = 0.0
@@ -261,12 +239,12 @@ def _take_sample(L, j, x0, u0, x1, u1):  # pragma: no cover - compiled
 
 
 @nb.njit(cache=True, error_model="numpy")
-def _event(L, tabs, out, state, tidx, bad_col, b, j, dt, inv_dt):  # pragma: no cover - compiled
-    """Lane j failed (returns True) or holds a reversal to act on."""
+def _event(L, tabs, fs, state, tidx, bad_col, b, j, dt, inv_dt):  # pragma: no cover - compiled
+    """Lane j (profile b) failed (returns True) or holds a reversal to act on."""
     if L[_FAIL + j] != 0.0:
         bad_col[b] = True
-        for t in range(tidx[j], out.shape[0]):
-            out[t, b] = np.nan
+        for t in range(tidx[j], fs.shape[0]):
+            fs[t, j] = np.nan
         state[6, b] += L[_NST + j]
         L[_Y + j] = np.nan
         L[_LB + j] = np.nan
@@ -294,12 +272,12 @@ def _event(L, tabs, out, state, tidx, bad_col, b, j, dt, inv_dt):  # pragma: no 
 
 @nb.njit(**JIT)
 def _hand_over(
-    L, tabs, x, v, out, state, tidx, bad_col, lo, n, blk, dt, inv_dt
+    L, tabs, xs, vs, fs, state, tidx, bad_col, lo, n, blk, dt, inv_dt
 ):  # pragma: no cover
     """After a pass, per lane (scalar): fail, reverse, or on finishing a sample write its share
-    of eq. 5 and take the next sample. Returns how many lanes finished the call's last sample
-    or failed."""
-    T = x.shape[0]
+    of eq. 5 and take the next sample (xs, vs, fs: the tile's staged columns of x, v, out).
+    Returns how many lanes finished the call's last sample or failed."""
+    T = xs.shape[0]
     n_out = 0
     for j in range(n):
         code = L[_CODE + j]
@@ -307,15 +285,15 @@ def _hand_over(
             continue
         b = lo + j
         if code == 2.0:
-            if _event(L, tabs, out, state, tidx, bad_col, b, j, dt, inv_dt):
+            if _event(L, tabs, fs, state, tidx, bad_col, b, j, dt, inv_dt):
                 n_out += 1
             if L[_CODE + j] != 1.0:
                 continue
         t = tidx[j]
         if blk == 0:
-            out[t, b] = L[_OUTV + j]
+            fs[t, j] = L[_OUTV + j]
         else:
-            out[t, b] = out[t, b] + L[_OUTV + j]
+            fs[t, j] = fs[t, j] + L[_OUTV + j]
         if t == T - 1:
             state[6, b] += L[_NST + j]
             L[_ACT + j] = 0.0
@@ -324,11 +302,7 @@ def _hand_over(
             continue
         t += 1
         tidx[j] = t
-        tp = min(t + PREFETCH_SAMPLES, T - 1)
-        _prefetch(x, tp, b)
-        _prefetch(v, tp, b)
-        _prefetch(out, tp, b)
-        _take_sample(L, j, L[_X1 + j], L[_U1 + j], x[t, b], v[t, b])
+        _take_sample(L, j, L[_X1 + j], L[_U1 + j], xs[t, j], vs[t, j])
     return n_out
 
 
@@ -352,17 +326,26 @@ def boucwen_kernel(x, v, state, tabs, bc, tab_index, dt, max_substeps, out):  # 
         state[6, b] = 0.0
     if T == 0:
         return 0
-    for blk in range(2):
-        for lo in range(0, B, W):
-            n_lanes = min(W, B - lo)
+    # A tile's columns of x, v and out are staged in contiguous (T, BW_TILE) buffers: the lanes
+    # walk them at their own paces, and in (T, B) every sample of every lane was another page.
+    xs = np.empty((T, W))
+    vs = np.empty((T, W))
+    fs = np.empty((T, W))
+    for lo in range(0, B, W):
+        n_lanes = min(W, B - lo)
+        for t in range(T):
             for j in range(n_lanes):
-                _load_lane(L, j, lo + j, blk, x, v, state, bc, tab_index[blk, lo + j], dt)
+                xs[t, j] = x[t, lo + j]
+                vs[t, j] = v[t, lo + j]
+        for blk in range(2):
+            for j in range(n_lanes):
+                _load_lane(L, j, lo + j, blk, xs, vs, state, bc, tab_index[blk, lo + j], dt)
                 tidx[j] = 0
             n_live = n_lanes
             while n_live > 0:
                 _pass(L, tabs, n_lanes, dt, inv_dt, maxs)
                 n_live -= _hand_over(
-                    L, tabs, x, v, out, state, tidx, bad_col, lo, n_lanes, blk, dt, inv_dt
+                    L, tabs, xs, vs, fs, state, tidx, bad_col, lo, n_lanes, blk, dt, inv_dt
                 )
             for j in range(n_lanes):
                 b = lo + j
@@ -375,6 +358,9 @@ def boucwen_kernel(x, v, state, tabs, bc, tab_index, dt, max_substeps, out):  # 
                     L[_OFFU + j], L[_IDLU + j], L[_IMU + j],
                 )  # fmt: skip
                 state[2 + blk, b] = L[_S + j] * L[_ZW + j] * xi
+        for t in range(T):
+            for j in range(n_lanes):
+                out[t, lo + j] = fs[t, j]
     n_bad = 0
     for b in range(B):
         state[4, b] = x[T - 1, b]

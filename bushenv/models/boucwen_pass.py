@@ -26,8 +26,8 @@ from bushenv.models.boucwen_tables import BC_ROWS
 JIT = dict(cache=True, fastmath=False, nogil=True, error_model="numpy")
 
 MIN_STEP_FRACTION = 1e-14  # of dt
-LAST_FRACTION = 0.8  # a step reaching this far into the rest of the sample takes all of it
-LAST_REJECT = 0.75  # a rejected step is retried with at most this much of the rest
+LAST_FRACTION = 0.6  # a step reaching this far into the rest of the sample takes all of it
+LAST_REJECT = 0.55  # a rejected step is retried with at most this much of the rest
 DIP = 1e-3  # a reversal and its return within one step, this shallow, are ignored
 TOUCH_STEP = 1.0 / 64.0  # of dt: the step taken through a touch of d = 0 (see _finish)
 BW_TILE = 16  # lanes per tile: two 8-double AVX-512 vectors
@@ -51,7 +51,7 @@ _N_ROWS = len(_ROWS)
 _N_BC = len(BC_ROWS)
 (
     _LAM, _KX, _CU, _AAW, _AAA, _AW, _TOL, _WGT, _WJ, _FOUT,
-    _OFFD, _L0D, _IDLD, _IMD, _OFFU, _IDLU, _IMU, _LTOP, _FTOP, _OK, _ZW, _SHIFT, _CUSP,
+    _OFFD, _L0D, _IDLD, _IMD, _OFFU, _IDLU, _IMU, _LTOP, _FTOP, _OK, _ZW, _SHIFT, _CUSP, _RTOL,
     _Y, _LB, _S, _H, _TAU, _NST, _X0, _DX, _U0, _DU, _X1, _U1,
     _ACT, _CODE, _FAIL, _EVT, _OUTV, _FLIPT,
     _YA, _HH, _LR, _N0, _D1, _D2, _G0, _G1, _G2, _FAC, _F2, _UA, _L2,

@@ -26,11 +26,20 @@ from bushenv.models.fastpow import exp_
 SMALL_Z = 0.5  # |z| below which the phi functions are summed as series (cancellation)
 N_SERIES = 14  # series terms: truncation below 1e-17 at |z| = SMALL_Z
 INV_FACT = tuple(1.0 / math.factorial(i) for i in range(N_SERIES + 4))
-# Newton steps from the parabola's root, to LOCATE_TOL: with one step only, the error stopped
-# shrinking with rtol at ~6e-5 of the peak (shipped radial set, rtol <= 7e-6)
-LOCATE_ITERATIONS = 8
+LOCATE_ITERATIONS = 8  # Newton steps from the parabola's root, at most
 ZERO_ITERATIONS = 8  # a z = 0 crossing is converged: lambda is then set to 0 exactly
 LOCATE_TOL = 1e-7  # in fractions of the step: r at the reversal is off by O(tol^2)
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def locate_tolerance(rtol):  # pragma: no cover - compiled
+    """How closely a reversal is located, in fractions of the step: rtol itself within [1e-7,
+    1e-3]. At the default rtol one Newton step mostly suffices (one exponential); a converged
+    location changes no error of the accuracy table, and the error keeps shrinking with rtol
+    (with one step always, it stopped at ~6e-5 of the peak for rtol <= 7e-6)."""
+    return min(1e-3, max(LOCATE_TOL, rtol))
+
+
 INVERSE_ITERATIONS = 6
 
 
@@ -157,10 +166,11 @@ def dense(theta, ya, lr, hh, n0, d1, d2):  # pragma: no cover - compiled
 
 
 @nb.njit(cache=True, error_model="numpy")
-def locate(ya, lr, hh, n0, d1, d2, s, g0, g1, g2, first, ua, du_dt):  # pragma: no cover
+def locate(ya, lr, hh, n0, d1, d2, s, g0, g1, g2, first, ua, du_dt, tol):  # pragma: no cover
     """Where in the step (fraction theta) the relative velocity d = u - y' changes sign, and y
     there. s d was g0, g1, g2 at theta = 0, 1/2, 1, turning negative in the ``first`` half or
-    the second; ``ua``, ``du_dt``: u at the step's start and its slope in time.
+    the second; ``ua``, ``du_dt``: u at the step's start and its slope in time; ``tol``: in
+    fractions of the step (``locate_tolerance``).
 
     Start: the root of the parabola through the three values; then Newton on s d(theta) of
     the dense output, kept inside the bracket by bisection.
@@ -191,7 +201,7 @@ def locate(ya, lr, hh, n0, d1, d2, s, g0, g1, g2, first, ua, du_dt):  # pragma: 
         tn = th - g / dg if dg != 0.0 else 0.5 * (lo + hi)
         if not (lo < tn < hi):
             tn = 0.5 * (lo + hi)
-        if abs(tn - th) <= LOCATE_TOL or hi - lo <= LOCATE_TOL:
+        if abs(tn - th) <= tol or hi - lo <= tol:
             return tn, y + dy * hh * (tn - th)
         th = tn
     y, _, _ = dense(th, ya, lr, hh, n0, d1, d2)  # the stiff transient: y' changes fast

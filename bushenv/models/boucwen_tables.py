@@ -68,11 +68,11 @@ LAM_DT_MAX = 1e8
 # |df/dy| if WJ = 1), the force factor FOUT (k0 y or c0 y'), the table segments below (OFFD,
 # L0D, IDLD, IMD) and above zero (OFFU, IDLU, IMU), LTOP (lambda of the top node) and FTOP (1:
 # beyond it the history fails), OK (0: the set was refused), W (the z scale, m), SHIFT (the
-# reflection table's offset from the nodes', ``boucwen_step``) and CUSP (1 if n < 1: steps
-# are cut where z passes 0, where the slope of |z|^n is infinite).
+# reflection table's offset from the nodes', ``boucwen_step``), CUSP (1 if n < 1: steps are
+# cut where z passes 0, where the slope of |z|^n is infinite) and RTOL (the tolerance).
 BC_ROWS = tuple(
     "LAM KX CU AAW AAA AW TOL WGT WJ FOUT OFFD L0D IDLD IMD OFFU IDLU IMU LTOP FTOP OK ZW "
-    "SHIFT CUSP".split()
+    "SHIFT CUSP RTOL".split()
 )
 SAT_EPS = 1e-9  # a saturating side counts as saturated where 1 - xi^n is below this
 MAX_NODES = 1 << 16  # per side of xi = 0 (the default tolerance needs a few hundred)
@@ -380,7 +380,7 @@ def prepare(vectors: np.ndarray, dt: float, rtol: float) -> tuple[np.ndarray, np
                 OFFD=size, L0D=-(n_down - 1) * dl_d, IDLD=1.0 / dl_d, IMD=n_down - 1,
                 OFFU=size + 2 * n_down, IDLU=1.0 / dl_u, IMU=n_up - 1, LTOP=(n_up - 1) * dl_u,
                 FTOP=0.0 if (sat or co["a"] == 0.0) else 1.0, OK=1.0, ZW=W, SHIFT=nodes.size,
-                CUSP=1.0 if co["n"] < 1.0 else 0.0,
+                CUSP=1.0 if co["n"] < 1.0 else 0.0, RTOL=rtol,
             )  # fmt: skip
             for k, v in vals.items():
                 row[col[k]] = v
