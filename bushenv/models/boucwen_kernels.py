@@ -1,4 +1,4 @@
-"""Compiled Bouc-Wen free run (seed 002 eqs. 1-5): the production kernel and a plain reference.
+"""Compiled Bouc-Wen free run (seed 002 eqs. 1-5): the driver, its lanes and the reversals.
 
 Eqs. 1-4 are two independent 2 x 2 systems driven by the same x(t): (y, z1) by eqs. 1 and 3,
 (w, z2) by eqs. 2 and 4. Each is one *block* of the same form,
@@ -25,20 +25,20 @@ integrates it with exponential collocation (docs/boucwen-integration.md):
   max(sum |k| x 1 mm, sum |c| x 10 mm/s); step sizes are carried from sample to sample;
 * reversals: when d changes sign inside an accepted step, the step is cut where the dense
   output's d = 0 (Newton on the exact exponential form) and z continues on the other branch
-  (lambda reflected: xi(lambda_new) = -xi(lambda)).
+  (lambda reflected: xi(lambda_new) = -xi(lambda)); for n < 1 a step is also cut where z passes
+  0, the cusp of |z|^n.
 
-Lanes: a tile holds BW_TILE lanes (one block of BW_TILE profiles); each pass makes one trial
-step in every lane (vectorised, branch-free) and a lane that finishes its sample is handed its
-next one at once. A lane reads and writes only its own entries, with no fused multiply-add,
-so a profile gives the same bits alone, in any tile, in one call or one sample per call.
+Lanes: a tile holds BW_TILE lanes (one block of BW_TILE profiles, their columns of x, v and out
+staged in contiguous buffers); each pass (``boucwen_pass``) makes one trial step in every lane
+(vectorised, branch-free) and the hand-over loop here acts on its outcome: a reversal to
+locate, a failure, or a finished sample, whose lane takes its next one at once. A lane reads and
+writes only its own entries, with no fused multiply-add, so a profile gives the same bits alone,
+in any tile, in one call or one sample per call.
 
 A lane fails (NaN from then on, counted) when a sample needs more than ``max_substeps`` trial
 steps, the step falls below 1e-14 dt, the state is no longer finite, z leaves a hardening
-table (its hysteretic force beyond 1e3 F_REF: the solution runs away), or the parameter set
-was refused when the tables were built (``boucwen_tables.prepare``).
-
-``boucwen_fixed_step`` is the reference: classical RK4 with a fixed number of equal sub-steps
-per sample on eqs. 1-4 as printed (libm pow), obviously right and slow.
+table (the solution runs away), or the parameter set was refused when the tables were built
+(``boucwen_tables.prepare``). The plain reference is ``boucwen_reference``.
 """
 
 from __future__ import annotations

@@ -1,11 +1,11 @@
 """Pieces of the Bouc-Wen step: table look-ups, phi functions, the dense output at a reversal.
 
-Inlined into the lane pass of ``boucwen_kernels``; the method is in docs/boucwen-integration.md.
-``segment_index``, ``hermite_values`` and ``phis`` are branch-free arithmetic (selects, no calls)
-so the loops over lanes vectorise; the table reads between them are gathers, which LLVM does not
-vectorise on this machine's CPU (AMD), so the kernel does them in short scalar loops of their
-own. ``locate`` and ``inverse`` run per lane in the scalar hand-over loop (a reversal is about
-one trial step in eight).
+Inlined into the lane pass (``boucwen_pass``); the method is in docs/boucwen-integration.md.
+``segment_index``, ``hermite_values`` and ``phis_half_and_full`` are branch-free arithmetic
+(selects, no calls) so the loops over lanes vectorise; the table reads between them are
+gathers, which LLVM does not vectorise on this machine's CPU (AMD), so the pass does them in
+short scalar loops of their own. ``locate``, ``locate_zero_crossing`` and ``inverse`` run per
+lane in the scalar hand-over loop (a reversal is about one trial step in eight).
 
 Table layout (``tabs``, flat float64): a segment of nodes i = 0..imax at lambda = l0 + i / idl
 holds xi_i at ``off + 2 i`` and the slope dxi/dlambda times the node spacing at
@@ -112,12 +112,6 @@ def _phis_from(z, e):  # pragma: no cover - compiled
     q1, q2, q3 = _closed(z if big else 1.0, e)
     s1, s2, s3 = _series(0.0 if big else z)
     return (q1 if big else s1), (q2 if big else s2), (q3 if big else s3)
-
-
-@nb.njit(cache=True, inline="always", error_model="numpy")
-def phis(z):  # pragma: no cover - compiled
-    """phi_1, phi_2, phi_3 of z (phi_k(z) = sum_j z^j / (j + k)!), for any finite z."""
-    return _phis_from(z, exp_(z))
 
 
 @nb.njit(cache=True, inline="always", error_model="numpy")
