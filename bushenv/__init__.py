@@ -7,7 +7,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-from bushenv.models import get_model, load_model, model_names  # noqa: E402
+from bushenv.models import get_model, get_reference, load_model, model_names  # noqa: E402
 
 
 def _register_envs() -> None:
@@ -20,4 +20,4 @@ def _register_envs() -> None:
 
 _register_envs()
 
-__all__ = ["__version__", "get_model", "load_model", "model_names"]
+__all__ = ["__version__", "get_model", "get_reference", "load_model", "model_names"]

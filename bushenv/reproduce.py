@@ -12,7 +12,7 @@
    Table 2/3 of seed 000 (linear, NN, hybrid), Table 4 of seed 002 (NN vs Bouc-Wen, radial),
    Table 5 (identification and verification times; the verification record is 6.44 s long).
 4. The 4 mm step held 10 s: each model beside the reference; bounded or not, and when the NN
-   departs (seed 000 saw 7.3 s), decided by ``bushenv.search.divergence`` (defined once there).
+   departs (seed 000 saw 7.3 s), decided by ``bushenv.divergence`` (defined once there).
 
 ``DIR/report.json`` layout (every number of the printed tables)::
 
@@ -133,8 +133,8 @@ def _verification_time(model, dt: float) -> float:
 
 
 def _step_verdicts(axis: str, models: dict[str, Any], dt: float) -> dict[str, Any]:
+    from bushenv.divergence import judge
     from bushenv.excitation import step_hold
-    from bushenv.search.divergence import judge
 
     x = step_hold(4e-3, 10.0, dt, pre_s=1.0)
     from bushenv.reference.rubber import RubberBushing

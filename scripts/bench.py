@@ -419,9 +419,9 @@ def bench_campaign(fig: Figures, quick: bool) -> None:
 def bench_float32_verdicts(fig: Figures, quick: bool) -> None:
     """Does float32 change what a search concludes? Divergence verdicts on random profiles of
     the search's "any" family, NN in float32 and in float64 against the same reference."""
+    from bushenv.divergence import judge
     from bushenv.models import get_model
     from bushenv.search.corpus import truth_reference
-    from bushenv.search.divergence import judge
     from bushenv.search.families import get_family, pad_batch
 
     rng = np.random.default_rng(0)

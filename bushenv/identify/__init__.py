@@ -1,6 +1,7 @@
 """Identification: a model from one measured record (displacement x, force f, sample time dt).
 
-``fit_model(name, x, f, dt, seed=0, progress=True, **options)`` dispatches on the registry name:
+``fit_model(name, x, f, dt, seed=0, progress=True, **options)`` calls the identification the
+model's registry entry names (``bushenv.models.registry.MODELS``):
 
 | name      | method                                              | module             |
 |-----------|-----------------------------------------------------|--------------------|
@@ -19,8 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.identify.linear import IdentificationError, fit_linear
+from bushenv.identify.linear import IdentificationError
 from bushenv.models.base import BushingModel
+from bushenv.models.registry import MODELS
 
 
 def fit_model(
@@ -32,20 +34,16 @@ def fit_model(
     progress: bool = True,
     **options: Any,
 ) -> BushingModel:
-    """Identify model ``name`` from the record (x m, f N) sampled every ``dt`` s."""
-    if name == "linear":
-        return fit_linear(x, f, dt, seed=seed, progress=progress, **options)
-    if name in ("nn", "hybrid"):
-        from bushenv.identify.neural import fit_narx  # torch only when needed
+    """Identify model ``name`` from the record (x m, f N) sampled every ``dt`` s.
 
-        return fit_narx(name, x, f, dt, seed=seed, progress=progress, **options)
-    if name == "boucwen":
-        from bushenv.identify.global_search import fit_boucwen
-
-        return fit_boucwen(x, f, dt, seed=seed, progress=progress, **options)
-    raise IdentificationError(
-        f"fit_model: no identification for model {name!r}; known: linear, nn, hybrid, boucwen"
-    )
+    The method is the registry entry's ``fit`` (``bushenv.models.registry.MODELS``)."""
+    fit = MODELS[name].fit_function() if name in MODELS else None
+    if fit is None:
+        known = [n for n, e in MODELS.items() if e.fit is not None]
+        raise IdentificationError(
+            f"fit_model: no identification for model {name!r}; known: {', '.join(known)}"
+        )
+    return fit(x, f, dt, seed=seed, progress=progress, **options)
 
 
 __all__ = ["IdentificationError", "fit_model"]

@@ -370,6 +370,16 @@ def torch_free_run(model: NarxBushing, x, v=None) -> np.ndarray:
     return k * x + c * v + (model.f_offset_n + model.f_scale_n * ys[0].numpy())
 
 
+def fit_nn(x, f, dt: float = PAPER_DT, **kwargs: Any) -> NarxBushing:
+    """Identify the pure NARX network (``fit_narx`` with kind "nn")."""
+    return fit_narx("nn", x, f, dt, **kwargs)
+
+
+def fit_hybrid(x, f, dt: float = PAPER_DT, **kwargs: Any) -> HybridBushing:
+    """Identify the hybrid: least-squares backbone + NARX residual (``fit_narx``)."""
+    return fit_narx("hybrid", x, f, dt, **kwargs)
+
+
 def fit_narx(
     kind: str,
     x,

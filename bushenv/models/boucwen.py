@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
+from bushenv.models.base import PAPER_DT, BushingModel, ModelError
 from bushenv.models.kernels import (
     BW_MAX_SUBSTEPS,
     BW_N_STATE,
@@ -90,7 +90,6 @@ class BoucWenError(ModelError):
     """The Bouc-Wen equations could not be integrated (step limit, blow-up, or c -> 0)."""
 
 
-@register
 class BoucWenBushing(BushingModel):
     """seed 002 eqs. 1-5, 16 parameters in SI; error-controlled Rosenbrock-W integration.
 

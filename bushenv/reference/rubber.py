@@ -99,7 +99,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
+from bushenv.models.base import PAPER_DT, BushingModel, ModelError
 from bushenv.reference import kernel
 from bushenv.reference.kernel import FRICTION_LAWS, HARDENING_LAWS, friction_rows, rubber_kernel
 
@@ -181,7 +181,6 @@ def _check_names(names: Any, what: str) -> tuple[str, ...]:
     return names
 
 
-@register
 class RubberBushing(BushingModel):
     """Reference rubber bushing; see the module docstring for the force law and parameters."""
 

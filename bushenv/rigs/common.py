@@ -28,7 +28,6 @@ Fixed-rate coupling (seed 001 §2: the network ran at 204.8 Hz beside ADAMS)
 
 from __future__ import annotations
 
-import inspect
 import math
 import numbers
 import os
@@ -41,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models import MODEL_REGISTRY, BushingModel, get_model, model_names
+from bushenv.models import MODELS, BushingModel, get_model, get_reference
 
 SPEC_PACKAGE = "bushenv.envs"
 SOURCE_SPEC_DIR = Path(__file__).resolve().parents[2] / "envs"
@@ -138,36 +137,23 @@ def per_axis(name: str, value: Any, axis: str) -> float:
 def resolve_model(spec: Any, axis: str, dt: float) -> BushingModel:
     """The model under test: a registered name, a ``.npz`` path or a model object (copied, so
     two environments never share one model's state)."""
-    if isinstance(spec, BushingModel):
-        model = get_model(spec, axis=axis, dt=dt).copy()
-    else:
-        model = get_model(spec, axis=axis, dt=dt)
+    model = get_model(spec, axis=axis, dt=dt)
     model.reset(1)
     return model
 
 
 def resolve_reference(spec: Any, axis: str, dt: float) -> BushingModel:
-    """The reference bushing. ``"rubber"`` is the calibrated specimen without the load cell's
-    measurement effects (no delay, fixture inertia or noise): the bushing alone. If the rubber
-    reference is not available in this install, the linear Table-1 bushing stands in."""
-    if isinstance(spec, str) and spec == "rubber":
-        model_names()  # fills the registry
-        cls = MODEL_REGISTRY.get("rubber")
-        if cls is None:
-            model = MODEL_REGISTRY["linear"].preset(axis=axis, dt=dt)
-        elif "measurement" in inspect.signature(cls.preset).parameters:
-            model = cls.preset(axis=axis, dt=dt, measurement=False)
-        else:
-            model = cls.preset(axis=axis, dt=dt)
-        model.reset(1)
-        return model
-    return resolve_model(spec, axis, dt)
+    """The reference bushing (``bushenv.models.get_reference``; ``"rubber"``: the calibrated
+    specimen without the load cell's delay, fixture inertia and noise)."""
+    model = get_reference(spec, axis=axis, dt=dt)
+    model.reset(1)
+    return model
 
 
 def model_label(model: BushingModel, spec: Any) -> str:
     if isinstance(spec, str | os.PathLike) and not isinstance(spec, BushingModel):
         text = os.fspath(spec)
-        return text if text in MODEL_REGISTRY else Path(text).name
+        return text if text in MODELS else Path(text).name
     return model.name
 
 

@@ -143,14 +143,12 @@ def load_profiles(path: Path) -> tuple[list[np.ndarray], list[dict]]:
 
 
 def _model_identity(spec: str, model, axis: str) -> dict[str, Any]:
-    from bushenv.models import TRAINED, default_model_path, file_hash
+    from bushenv.models import file_hash, model_file
     from bushenv.search.corpus import params_sha
 
-    path = None
-    if spec in TRAINED:
-        path = default_model_path(spec, axis)
-    elif Path(spec).is_file():
-        path = Path(spec)
+    path = model_file(spec, axis)
+    if path is not None and not path.is_file():
+        path = None
     return {
         "spec": spec,
         "class": type(model).__name__,

@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models import TRAINED, BushingModel, default_model_path, file_hash, get_model
+from bushenv.models import BushingModel, file_hash, get_model, get_reference, model_file
 from bushenv.models.base import PAPER_DT
 
 CASE_FORMAT = "bushenv-divergence-case"
@@ -86,11 +86,9 @@ def profile_sha(x: np.ndarray) -> str:
 
 # ----- model and reference identity -------------------------------------------------------------
 def model_sha(name: str, axis: str) -> str | None:
-    """sha256 of the shipped file behind a registered trained name (None for presets)."""
-    if name in TRAINED:
-        path = default_model_path(name, axis)
-        return file_hash(path) if path.is_file() else None
-    return None
+    """sha256 of the file behind a model name (a shipped default or a path; None for presets)."""
+    path = model_file(name, axis)
+    return file_hash(path) if path is not None and path.is_file() else None
 
 
 def params_sha(model: BushingModel) -> str:
@@ -106,9 +104,7 @@ def params_sha(model: BushingModel) -> str:
 
 def truth_reference(axis: str, dt: float = PAPER_DT) -> BushingModel:
     """The "real" bushing every verdict is measured against: the rubber specimen alone."""
-    from bushenv.reference.rubber import RubberBushing
-
-    return RubberBushing.preset(axis, dt=dt, measurement=False)
+    return get_reference("rubber", axis=axis, dt=dt)
 
 
 # ----- cases -------------------------------------------------------------------------------------

@@ -35,9 +35,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bushenv.divergence import Verdict, judge
 from bushenv.models.base import BushingModel
 from bushenv.models.narx import NarxBushing
-from bushenv.search.divergence import Verdict, judge
 from bushenv.search.families import pad_batch
 
 REFERENCE_CACHE_SIZE = 4096

@@ -52,7 +52,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bushenv.search.divergence import CLOSURE_FRACTION, FORCE_FLOOR_N, SETTLE_FRACTION
+from bushenv.divergence import CLOSURE_FRACTION, FORCE_FLOOR_N, SETTLE_FRACTION
 from bushenv.search.searchers import Searcher, SearchError
 
 # Road agents: QuarterCar-v0's full action (50 mm per 4.9 ms step, 10 m/s) on a random policy

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from bushenv.divergence import judge
 from bushenv.models.base import BushingModel
-from bushenv.search.divergence import judge
 
 AXES = ("radial", "axial")
 

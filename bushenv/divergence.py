@@ -71,7 +71,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bushenv.search import stl
+from bushenv import stl
 
 FORCE_FLOOR_N = 200.0
 FORCE_PEAK_FACTOR = 5.0
@@ -145,6 +145,20 @@ def _prepare(x, f_model, f_ref, lengths):
     if not np.all(np.isfinite(fr[valid])) or not np.all(np.isfinite(x[valid])):
         raise DivergenceInputError("the reference force or the displacement holds NaN or inf")
     return x, fm, fr, lengths, valid
+
+
+def force_termination(f_model, f_ref, limit_n):
+    """Whether a rig's episode ends at these samples: the instantaneous criteria, decided once.
+
+    Works on floats or arrays of any shape (the scalar env, the vector env and ``judge`` call
+    it). Returns ``(non_finite, model_over, reference_over)``: the model force is NaN or inf
+    (terminate); ``|f_model| > limit_n`` while the reference is within it (terminate: a
+    divergence); the reference itself beyond the limit (truncate: the profile cannot judge).
+    """
+    finite = np.isfinite(f_model)
+    reference_over = ~(np.abs(f_ref) <= limit_n)
+    model_over = finite & (np.abs(np.where(finite, f_model, 0.0)) > limit_n) & ~reference_over
+    return ~finite, model_over, reference_over
 
 
 def force_scale(f_ref: np.ndarray, valid: np.ndarray) -> np.ndarray:
@@ -292,9 +306,10 @@ def judge(
     sig, scale, dev = _signals(x, fm, fr, dt, valid, *extra)
     width = max(1, int(round(DEVIATION_MIN_S / dt)))
 
+    non_finite, model_over, _ = force_termination(fm, fr, force_bound(scale))
     first: dict[str, np.ndarray] = {}
-    first["non_finite"] = _first_index(~sig["finite"])
-    first["force_bound"] = _first_index(sig["force_bound"] < 0)
+    first["non_finite"] = _first_index(non_finite & valid)
+    first["force_bound"] = _first_index(model_over & valid)
     # deviation: first sample that completes a run of `width` consecutive violations
     above = (sig["deviation"] < 0).astype(np.int64)
     run = np.zeros_like(above)

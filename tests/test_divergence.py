@@ -3,12 +3,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from bushenv import divergence as dv
 from bushenv import excitation as ex
+from bushenv.divergence import DivergenceInputError, judge
 from bushenv.models.base import PAPER_DT as DT
 from bushenv.models.linear import LinearBushing
 from bushenv.reference.rubber import RubberBushing
-from bushenv.search import divergence as dv
-from bushenv.search.divergence import DivergenceInputError, judge
 from bushenv.search.families import FAMILIES, RIG_FAMILIES, pad_batch
 
 
