@@ -82,6 +82,9 @@ class Registry(Generic[T]):
     def items(self):
         return self._entries.items()
 
+    def values(self):
+        return self._entries.values()
+
     def __contains__(self, name: object) -> bool:
         return name in self._entries
 

@@ -395,7 +395,7 @@ def bench_campaign(fig: Figures, quick: bool) -> None:
     ref = truth_reference("axial")
     model = get_model("nn", axis="axial", dt=ref.dt)
     for threads in (1, 2):
-        with BatchEvaluator(model, ref, env="rig", threads=threads, axis="axial") as ev:
+        with BatchEvaluator(model, ref, target="rig", threads=threads, axis="axial") as ev:
             res = get_searcher("random").run(ev, 64 if quick else 512, seed=0)
         s = res.summary()
         fig.add(

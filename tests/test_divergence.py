@@ -9,7 +9,10 @@ from bushenv.divergence import DivergenceInputError, judge
 from bushenv.models.base import PAPER_DT as DT
 from bushenv.models.linear import LinearBushing
 from bushenv.reference.rubber import RubberBushing
-from bushenv.search.families import FAMILIES, RIG_FAMILIES, pad_batch
+from bushenv.search.families import FAMILIES, pad_batch
+from bushenv.search.targets import TARGETS
+
+RIG_FAMILIES = TARGETS["rig"].family_names()
 
 
 def _step_case(size=4e-3, hold_s=6.0):

@@ -311,7 +311,7 @@ class Campaign:
         return BatchEvaluator(
             self.models[key],
             self.reference,
-            env=self.args.env,
+            target=self.args.env,
             threads=threads,
             axis=self.args.axis,
         )

@@ -162,7 +162,7 @@ def judge_profile(
 
     out = {}
     for name, model in models.items():
-        ev = BatchEvaluator(model, reference, env=env, axis=axis)
+        ev = BatchEvaluator(model, reference, target=env, axis=axis)
         out[name] = ev.evaluate([profile]).verdict.row(0)
     return out
 

@@ -5,7 +5,7 @@ within the test machine's limits (``bushenv.excitation``: |x| <= 12.5 mm, |dx/dt
 0.1-80 Hz) and builds the signal with the generators of ``bushenv.excitation``. Every rig
 profile starts at rest (x[0] = 0), ends in a hold (x constant, so the free response after the
 input stops is judged, seed 000 §5.2) and lasts at most ``max_s`` seconds. Road families
-(``env == "quartercar"``) give road height under the wheel instead.
+(target ``quartercar``) give road height under the wheel instead.
 
 | family      | d | parameters (physical range)                                                 |
 |-------------|---|-----------------------------------------------------------------------------|
@@ -43,6 +43,7 @@ import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.models.base import PAPER_DT
+from bushenv.registry import Registry
 
 MAX_PROFILE_S = 12.0  # the papers' step is held 10 s; 12 s covers their 7.3 s departure
 MIN_HOLD_S = 0.5
@@ -281,8 +282,10 @@ class Family:
 
     name: str
     dim: int
-    env: str  # "rig": bushing displacement, m; "quartercar": road height, m
+    target: str  # the TARGETS name: "rig" (bushing displacement, m), "quartercar" (road, m)
     build: Callable[[np.ndarray, float, float], tuple[np.ndarray, dict]]
+    random: bool = True  # drawn by random search (not so the meta-family "any")
+    finish: Callable[[np.ndarray, float, float], np.ndarray] | None = None
 
     def _check(self, u) -> np.ndarray:
         u = np.asarray(u, dtype=np.float64).reshape(-1)
@@ -295,8 +298,8 @@ class Family:
     def profile(self, u, dt: float = PAPER_DT, max_s: float = MAX_PROFILE_S) -> np.ndarray:
         """The (T,) profile for parameters ``u`` (clipped to [0, 1])."""
         x, _ = self.build(self._check(u), dt, max_s)
-        if self.env == "rig":
-            return _finish(x, dt, max_s)
+        if self.finish is not None:
+            return self.finish(x, dt, max_s)
         return np.asarray(x, dtype=np.float64)[: _n(max_s, dt)]
 
     def describe(self, u, dt: float = PAPER_DT, max_s: float = MAX_PROFILE_S) -> dict:
@@ -315,20 +318,18 @@ def _plain(v):
     return v
 
 
-FAMILIES: dict[str, Family] = {
-    **{name: Family(name, d, "rig", b) for name, (d, b) in _RIG_BUILDERS.items()},
-    "sequence": Family("sequence", SEQUENCE_SLOTS * _SLOT_DIM, "rig", _sequence),
-    "any": Family("any", _SLOT_DIM, "rig", _any),
-    "bump": Family("bump", 4, "quartercar", _bump),
-    "pothole": Family("pothole", 5, "quartercar", _pothole),
-}
-RIG_FAMILIES = tuple(n for n, f in FAMILIES.items() if f.env == "rig")
-ROAD_FAMILIES = tuple(n for n, f in FAMILIES.items() if f.env == "quartercar")
+FAMILIES: Registry[Family] = Registry("excitation family", FamilyError)
+for _name, (_d, _b) in _RIG_BUILDERS.items():
+    FAMILIES.add(_name, Family(_name, _d, "rig", _b, finish=_finish))
+FAMILIES.add(
+    "sequence", Family("sequence", SEQUENCE_SLOTS * _SLOT_DIM, "rig", _sequence, finish=_finish)
+)
+FAMILIES.add("any", Family("any", _SLOT_DIM, "rig", _any, random=False, finish=_finish))
+FAMILIES.add("bump", Family("bump", 4, "quartercar", _bump))
+FAMILIES.add("pothole", Family("pothole", 5, "quartercar", _pothole))
 
 
 def get_family(name: str) -> Family:
-    if name not in FAMILIES:
-        raise FamilyError(f"unknown excitation family {name!r}; known: {sorted(FAMILIES)}")
     return FAMILIES[name]
 
 

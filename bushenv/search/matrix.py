@@ -103,7 +103,7 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     reference = truth_reference(cell["axis"])
     model = get_model(cell["model"], axis=cell["axis"], dt=reference.dt)
     t0 = time.perf_counter()
-    with BatchEvaluator(model, reference, env=cell["env"], threads=1, axis=cell["axis"]) as ev:
+    with BatchEvaluator(model, reference, target=cell["env"], threads=1, axis=cell["axis"]) as ev:
         result = get_searcher(cell["searcher"]).run(ev, cell["budget"], seed=cell["seed"])
     out = {**cell, **result.summary()}
     out["wall_s"] = time.perf_counter() - t0

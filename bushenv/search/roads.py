@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv.divergence import judge
+from bushenv.models import get_reference
 from bushenv.models.base import BushingModel
 
 AXES = ("radial", "axial")
@@ -80,6 +81,4 @@ def make_cars(model, reference, n: int, dt: float, axis: str, episode_steps: int
 
 
 def _reference_for(axis: str, dt: float) -> BushingModel:
-    from bushenv.search.corpus import truth_reference
-
-    return truth_reference(axis, dt)
+    return get_reference("rubber", axis=axis, dt=dt)

@@ -35,7 +35,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bushenv import excitation as ex
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.families import VMAX
 
@@ -90,7 +89,7 @@ def _join(a: float, b: float, dt: float) -> np.ndarray:
     return a + (b - a) * 0.5 * (1.0 - np.cos(np.pi * s))
 
 
-def _candidates(x: np.ndarray, dt: float, rig: bool) -> list[np.ndarray]:
+def _candidates(x: np.ndarray, dt: float, finish) -> list[np.ndarray]:
     T = x.size
     out: list[np.ndarray] = []
     for k in range(1, 8):  # collapse the start: one move straight to where the profile is at a
@@ -120,9 +119,7 @@ def _candidates(x: np.ndarray, dt: float, rig: bool) -> list[np.ndarray]:
             continue
         c = c.copy()
         c[0] = 0.0
-        if rig:
-            c = ex.clip_to_limits(c, dt)
-        fixed.append(c)
+        fixed.append(finish(c, dt))
     return fixed
 
 
@@ -140,7 +137,7 @@ def shrink(
     last bit of rounding (e.g. the corpus's float32 storage). The input must fail; otherwise
     ValueError.
     """
-    rig = evaluator.env == "rig"
+    finish = evaluator.target.finish
     dt = evaluator.dt
     x = np.asarray(profile, dtype=np.float64).copy()
     start_evals = evaluator.n_evaluations
@@ -172,7 +169,7 @@ def shrink(
         row = first.verdict.row(0)
     rounds = 0
     while evaluator.n_evaluations - start_evals < budget - 1:  # one kept for the final check
-        cands = _candidates(x, dt, rig)
+        cands = _candidates(x, dt, finish)
         room = budget - 1 - (evaluator.n_evaluations - start_evals)
         cands = [c for c in cands if complexity(c) < complexity(x)][:room]
         if not cands:

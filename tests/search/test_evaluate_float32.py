@@ -42,7 +42,7 @@ def test_float32_is_refused_where_there_is_no_float32_path(
 ):
     _, ref = profiles_and_reference
     with pytest.raises(ValueError, match=message):
-        BatchEvaluator(get_model(model, axis="radial", dt=ref.dt), ref, env=env, dtype="float32")
+        BatchEvaluator(get_model(model, axis="radial", dt=ref.dt), ref, target=env, dtype="float32")
 
 
 def test_unknown_dtype_is_refused(profiles_and_reference):

@@ -40,7 +40,7 @@ def test_rl_refuses_unknown_algorithms():
 def test_rl_drives_the_quarter_car_and_judges_its_roads(linear_axial, reference_axial):
     runs = []
     for _ in range(2):
-        ev = BatchEvaluator(linear_axial, reference_axial, env="quartercar")
+        ev = BatchEvaluator(linear_axial, reference_axial, target="quartercar")
         runs.append(RLSearch("ppo", n_envs=4, episode_s=0.5).run(ev, budget=8, seed=1))
     res = runs[0]
     assert res.evaluations == 8 and not res.diverged  # the linear control stays clean
@@ -60,7 +60,7 @@ class _Collect:
 
 
 def _oscillator_rig(model, reference, n_envs=4, steps=200, mode="rate"):
-    from bushenv.search.rl import DivergenceReward, _oscillator_env, _rig_vec_env, _sb3_vec_env
+    from bushenv.search.rl_rig import DivergenceReward, _oscillator_env, _rig_vec_env, _sb3_vec_env
 
     ev = BatchEvaluator(model, reference)
     got = _Collect(ev)
@@ -125,7 +125,8 @@ def test_rl_refuses_unknown_action_modes():
 
 
 def test_energy_shaping_pays_for_returned_work_only_where_a_cycle_closes(reference_axial):
-    from bushenv.search.rl import ENERGY_SHAPING, DivergenceReward
+    from bushenv.search.rl import ENERGY_SHAPING
+    from bushenv.search.rl_rig import DivergenceReward
 
     dt = reference_axial.dt
     t = np.arange(1, 206) * dt
