@@ -18,7 +18,7 @@ import threading
 COMMANDS = {
     # name: (module, one-line help)
     "reproduce": ("bushenv.reproduce", "identify every model and reproduce the papers' tables"),
-    "attack": ("bushenv.search.campaign", "adversarial campaign: excitations that break a model"),
+    "attack": ("bushenv.search.attack", "adversarial campaign: excitations that break a model"),
     "campaign": ("bushenv.search.matrix", "campaign matrix: models x axes x searchers x seeds"),
     "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
@@ -28,6 +28,10 @@ COMMANDS = {
 
 class CliError(Exception):
     """A user-facing problem: printed as one line, exit code 2."""
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    """Descriptions as written, and every option's default in ``--help``."""
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
@@ -52,7 +56,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             name,
             help=help_text,
             description=help_text,
-            formatter_class=argparse.RawDescriptionHelpFormatter,
+            formatter_class=HelpFormatter,
             allow_abbrev=False,
         )
         mod = _command_module(name)

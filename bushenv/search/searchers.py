@@ -109,6 +109,7 @@ class SearcherEntry:
     factory: Callable[..., Searcher] | str  # or "module:attribute"
     summary: str
     episodes: bool = False  # RL agents: the budget counts episodes, capped by --rl-budget
+    cost: float = 1.0  # wall time per evaluation relative to a batched search (progress only)
 
     def make(self, **kwargs) -> Searcher:
         f = self.factory
@@ -119,10 +120,12 @@ SEARCHERS: Registry[SearcherEntry] = Registry("searcher", SearchError)
 SEARCHERS.add("random", SearcherEntry(RandomSearch, "uniform random families and parameters"))
 SEARCHERS.add("cma", SearcherEntry(CMASearch, "CMA-ES over the target's search family"))
 SEARCHERS.add(
-    "ppo", SearcherEntry("bushenv.search.rl:PPOSearch", "PPO agent (SB3) steering", episodes=True)
+    "ppo",
+    SearcherEntry("bushenv.search.rl:PPOSearch", "PPO agent (SB3)", episodes=True, cost=8.0),
 )
 SEARCHERS.add(
-    "sac", SearcherEntry("bushenv.search.rl:SACSearch", "SAC agent (SB3) steering", episodes=True)
+    "sac",
+    SearcherEntry("bushenv.search.rl:SACSearch", "SAC agent (SB3)", episodes=True, cost=8.0),
 )
 
 
