@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Callable
 from typing import TextIO
 
 
@@ -34,6 +35,8 @@ class Progress:
         Print nothing (``--quiet``).
     every_s : float
         Least time between two ``update`` lines.
+    sink : callable, optional
+        Receives each line instead of ``stream`` (tests, or a caller's own log).
     """
 
     def __init__(
@@ -42,11 +45,13 @@ class Progress:
         quiet: bool = False,
         every_s: float = 2.0,
         stream: TextIO | None = None,
+        sink: Callable[[str], None] | None = None,
     ) -> None:
         self.total = total
         self.quiet = quiet
         self.every_s = every_s
         self.stream = stream
+        self.sink = sink
         self.t0 = time.perf_counter()
         self.done = 0.0
         self._last = -float("inf")
@@ -63,9 +68,13 @@ class Progress:
 
     def say(self, msg: str) -> None:
         """One line now (unless quiet), prefixed with the time elapsed."""
-        if not self.quiet:
-            print(f"[{format_seconds(self.elapsed_s()):>10}] {msg}", file=self.stream or sys.stderr)
-            (self.stream or sys.stderr).flush()
+        if self.quiet:
+            return
+        if self.sink is not None:
+            self.sink(msg)
+            return
+        stream = self.stream or sys.stderr
+        print(f"[{format_seconds(self.elapsed_s()):>10}] {msg}", file=stream, flush=True)
 
     def update(self, done: float, msg: str = "", force: bool = False) -> None:
         """Work done so far is ``done`` units; a line with the time left, throttled."""

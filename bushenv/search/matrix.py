@@ -22,11 +22,21 @@ import argparse
 import json
 import os
 import time
+from dataclasses import dataclass
 from itertools import product
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from bushenv.execution import get_backend
+from bushenv.models import AXES, MODELS, ModelError, check_axis, get_model
+from bushenv.persist import json_default, write_json, write_text
+from bushenv.progress import Progress
+from bushenv.search.corpus import truth_reference
+from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.searchers import SEARCHERS, get_searcher
+from bushenv.search.targets import TARGETS
 
 EXAMPLE = (
     "bushenv campaign --models nn,hybrid --axes axial --searchers random,cma "
@@ -95,11 +105,6 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     import torch
 
     torch.set_num_threads(1)
-    from bushenv.models import get_model
-    from bushenv.search.corpus import truth_reference
-    from bushenv.search.evaluate import BatchEvaluator
-    from bushenv.search.searchers import get_searcher
-
     reference = truth_reference(cell["axis"])
     model = get_model(cell["model"], axis=cell["axis"], dt=reference.dt)
     t0 = time.perf_counter()
@@ -175,22 +180,14 @@ def _result_row(line: str, require_results: bool) -> dict[str, Any] | None:
 def _truncate_last_line(path: Path) -> None:
     text = path.read_text()
     keep = text[: text.rstrip("\n").rfind("\n") + 1] if "\n" in text.rstrip("\n") else ""
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(keep)
-    os.replace(tmp, path)
+    write_text(path, keep)
 
 
 def _append(path: Path, row: dict[str, Any]) -> None:
     with path.open("a") as fh:
-        fh.write(json.dumps(row, sort_keys=True, default=_plain) + "\n")
+        fh.write(json.dumps(row, sort_keys=True, default=json_default) + "\n")
         fh.flush()
         os.fsync(fh.fileno())
-
-
-def _plain(o: Any) -> Any:
-    if isinstance(o, np.generic):
-        return o.item()
-    raise TypeError(type(o))
 
 
 def run_matrix(
@@ -198,7 +195,7 @@ def run_matrix(
     out: Path,
     backend,
     resume: bool = False,
-    progress=print,
+    progress: Progress | None = None,
 ) -> list[dict[str, Any]]:
     """Run every cell not yet in ``out/cells.jsonl``; returns all rows in cell order."""
     out.mkdir(parents=True, exist_ok=True)
@@ -207,19 +204,22 @@ def run_matrix(
     if not resume and results_path.exists():
         raise MatrixError(f"{results_path} exists; pass --resume to continue or --out elsewhere")
     todo = [c for c in cells if cell_key(c) not in done]
-    progress(
+    progress = progress or Progress(quiet=True)
+    progress.total = len(todo)
+    progress.say(
         f"matrix: {len(cells)} cells, {len(cells) - len(todo)} already done, "
         f"{len(todo)} to run on {backend.name} ({backend.workers} workers)"
     )
-    t0 = time.perf_counter()
     for n, (i, row) in enumerate(backend.imap_unordered(run_cell, todo), start=1):
         row["worker_backend"] = backend.name
         _append(results_path, row)
         done[cell_key(todo[i])] = row
-        progress(
-            f"  [{n}/{len(todo)}] {row['model']:8s} {row['axis']:6s} {row['searcher']:6s} "
+        progress.update(
+            n,
+            f"[{n}/{len(todo)}] {row['model']:8s} {row['axis']:6s} {row['searcher']:6s} "
             f"seed {row['seed']}: {'DIVERGED' if row['diverged'] else 'bounded'} "
-            f"({row['evaluations']} evals, {time.perf_counter() - t0:.0f} s)"
+            f"({row['evaluations']} evals)",
+            force=True,
         )
     return [done[cell_key(c)] for c in cells]
 
@@ -244,9 +244,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def write_summary(out: Path, summary: dict[str, Any]) -> None:
-    tmp = out / "summary.json.tmp"
-    tmp.write_text(json.dumps(summary, indent=2))
-    os.replace(tmp, out / "summary.json")
+    write_json(out / "summary.json", summary, indent=2)
     searchers = sorted({s for per in summary.values() for s in per})
     lines = [
         "| model | " + " | ".join(searchers) + " |",
@@ -265,13 +263,12 @@ def write_summary(out: Path, summary: dict[str, Any]) -> None:
                 + (f", median {med:.0f} evals" if med is not None else "")
             )
         lines.append(f"| {model} | " + " | ".join(cells) + " |")
-    tmp = out / "summary.md.tmp"
-    tmp.write_text(
+    write_text(
+        out / "summary.md",
         "Divergence rate and median evaluations to failure, per model and searcher\n\n"
         + "\n".join(lines)
-        + "\n"
+        + "\n",
     )
-    os.replace(tmp, out / "summary.md")
     import matplotlib
 
     matplotlib.use("Agg")
@@ -305,76 +302,110 @@ def write_summary(out: Path, summary: dict[str, Any]) -> None:
     plt.close(fig)
 
 
+@dataclass
+class MatrixConfig:
+    """A campaign matrix; ``bushenv campaign`` translates its arguments into this."""
+
+    models: tuple[str, ...] = ("nn", "hybrid")
+    axes: tuple[str, ...] = ("axial",)
+    searchers: tuple[str, ...] = ("random", "cma")
+    seeds: tuple[int, ...] = (0, 1, 2, 3)
+    budget: int = 128
+    target: str = "rig"
+    out: Path = Path("runs/matrix")
+    resume: bool = False
+
+    def checked(self) -> MatrixConfig:
+        """Every name known, every model resolvable now (a missing default file must stop the
+        matrix before it starts, not fail in a worker); raises ``MatrixError``."""
+        if self.budget <= 0:
+            raise MatrixError(
+                f"--budget must be a positive number of evaluations, got {self.budget}"
+            )
+        for what, names, registry in (
+            ("--models", self.models, MODELS),
+            ("--searchers", self.searchers, SEARCHERS),
+            ("--env", (self.target,), TARGETS),
+        ):
+            if not names:
+                raise MatrixError(f"{what} names nothing")
+            for n in names:
+                if n not in registry:
+                    raise MatrixError(registry.unknown_message(n))
+        if not self.axes:
+            raise MatrixError("--axes names nothing")
+        for m, a in product(self.models, self.axes):
+            check_axis(a)
+            try:
+                get_model(m, axis=a)
+            except ModelError as exc:
+                raise MatrixError(f"model {m!r} ({a}): {exc}") from None
+        self.out = Path(self.out)
+        if self.out.exists() and not self.out.is_dir():
+            raise MatrixError(f"--out {self.out}: exists and is not a folder")
+        return self
+
+    def cells(self) -> list[dict[str, Any]]:
+        return make_cells(
+            list(self.models),
+            list(self.axes),
+            list(self.searchers),
+            list(self.seeds),
+            self.budget,
+            self.target,
+        )
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--models", default="nn,hybrid", help="comma list of model names")
-    p.add_argument("--axes", default="axial", help="comma list: axial, radial")
-    p.add_argument("--searchers", default="random,cma", help="comma list: random, cma, ppo, sac")
+    d = MatrixConfig()
+    p.add_argument("--models", default=",".join(d.models), help="comma list of model names")
+    p.add_argument("--axes", default=",".join(d.axes), help=f"comma list: {', '.join(AXES)}")
+    p.add_argument(
+        "--searchers",
+        default=",".join(d.searchers),
+        help=f"comma list: {', '.join(SEARCHERS.names())}",
+    )
     p.add_argument("--seeds", default="0-3", help="e.g. 0-9 or 1,4,7")
-    p.add_argument("--budget", type=int, default=128, help="model evaluations per cell (> 0)")
-    p.add_argument("--env", choices=("rig", "quartercar"), default="rig")
+    p.add_argument("--budget", type=int, default=d.budget, help="model evaluations per cell (> 0)")
+    p.add_argument("--env", choices=TARGETS.names(), default=d.target)
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--resume", action="store_true", help="continue an interrupted matrix")
     p.add_argument("--workers", type=int, default=None, help="local worker processes")
     p.add_argument("--ray", action="store_true", help="run on Ray (a local instance)")
     p.add_argument("--ray-address", default=None, help="run on an existing Ray cluster")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+
+
+def _names(flag: str, text: str) -> tuple[str, ...]:
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    if not names:
+        raise MatrixError(f"{flag} {text!r} names nothing")
+    return names
 
 
 def run(args: argparse.Namespace) -> int:
-    from bushenv.cli import CliError
-    from bushenv.execution import BackendError, get_backend
-    from bushenv.models import AXES, model_names
-    from bushenv.search.searchers import SEARCHERS
-
-    if args.budget <= 0:
-        raise CliError(f"--budget must be a positive number of evaluations, got {args.budget}")
-    models = [m for m in args.models.split(",") if m]
-    known = set(model_names())
-    for m in models:
-        if m not in known:
-            raise CliError(f"unknown model {m!r}; known: {sorted(known)}")
-    axes = [a for a in args.axes.split(",") if a]
-    for a in axes:
-        if a not in AXES:
-            raise CliError(f"unknown axis {a!r}; known: {list(AXES)}")
-    searchers = [s for s in args.searchers.split(",") if s]
-    for s in searchers:
-        if s not in (*SEARCHERS, "ppo", "sac"):
-            raise CliError(f"unknown searcher {s!r}; known: {sorted(SEARCHERS) + ['ppo', 'sac']}")
-    for what, names in (("--models", models), ("--axes", axes), ("--searchers", searchers)):
-        if not names:
-            raise CliError(f"{what} {getattr(args, what[2:])!r} names nothing")
-    try:
-        seeds = parse_seeds(args.seeds)
-    except MatrixError as exc:
-        raise CliError(str(exc)) from None
-    # Resolve every model now: a missing default file must stop the matrix before it starts,
-    # not fail in a worker after the output folder exists.
-    from bushenv.models import ModelError, get_model
-
-    for m, a in product(models, axes):
-        try:
-            get_model(m, axis=a)
-        except ModelError as exc:
-            raise CliError(f"model {m!r} ({a}): {exc}") from None
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise CliError(f"--out {out}: exists and is not a folder")
-    cells = make_cells(models, axes, searchers, seeds, args.budget, args.env)
-    try:
-        backend = get_backend(
-            "ray" if (args.ray or args.ray_address) else "local",
-            workers=args.workers,
-            address=args.ray_address,
-        )
-    except BackendError as exc:
-        raise CliError(str(exc)) from None
+    config = MatrixConfig(
+        models=_names("--models", args.models),
+        axes=_names("--axes", args.axes),
+        searchers=_names("--searchers", args.searchers),
+        seeds=tuple(parse_seeds(args.seeds)),
+        budget=args.budget,
+        target=args.env,
+        out=Path(args.out),
+        resume=args.resume,
+    ).checked()
+    backend = get_backend(
+        "ray" if (args.ray or args.ray_address) else "local",
+        workers=args.workers,
+        address=args.ray_address,
+    )
+    progress = Progress(quiet=args.quiet)
     with backend:
-        try:
-            rows = run_matrix(cells, out, backend, resume=args.resume)
-        except MatrixError as exc:
-            raise CliError(str(exc)) from None
+        rows = run_matrix(
+            config.cells(), config.out, backend, resume=config.resume, progress=progress
+        )
     summary = summarise(rows)
-    write_summary(out, summary)
-    print((out / "summary.md").read_text())
-    print(f"wrote {out}/cells.jsonl, summary.json, summary.md, summary.png")
+    write_summary(config.out, summary)
+    print((config.out / "summary.md").read_text())
+    print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md, summary.png")
     return 0
