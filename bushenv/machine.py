@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -320,12 +319,9 @@ def programme_items(args: argparse.Namespace, dt: float) -> list[ProgrammeItem]:
 
 def cli_run(args: argparse.Namespace) -> int:
     from bushenv.models import get_model
+    from bushenv.progress import Progress
 
-    start = time.monotonic()
-
-    def progress(msg: str) -> None:
-        if not args.quiet:
-            print(f"[{time.monotonic() - start:6.1f} s] {msg}", file=sys.stderr, flush=True)
+    progress = Progress(quiet=args.quiet)
 
     if not (np.isfinite(args.rate) and args.rate > 0):
         raise MachineError(f"--rate must be a positive number of Hz, got {args.rate!r}")

@@ -32,7 +32,6 @@ import base64
 import hashlib
 import json
 import os
-import tempfile
 import zlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -43,6 +42,9 @@ import numpy as np
 
 from bushenv.models import BushingModel, file_hash, get_model, get_reference, model_file
 from bushenv.models.base import PAPER_DT
+from bushenv.persist import write_json
+from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.targets import TARGETS
 
 CASE_FORMAT = "bushenv-divergence-case"
 CASE_VERSION = 1
@@ -158,8 +160,6 @@ def judge_profile(
     reference: BushingModel,
 ) -> dict[str, dict[str, Any]]:
     """Verdict row of ``profile`` for each model (prescribed-motion or quarter-car path)."""
-    from bushenv.search.evaluate import BatchEvaluator
-
     out = {}
     for name, model in models.items():
         ev = BatchEvaluator(model, reference, target=env, axis=axis)
@@ -219,21 +219,10 @@ def _slug(text: str) -> str:
 
 def save_case(case: Case, directory: str | os.PathLike, force: bool = False) -> Path | None:
     """Write ``case`` atomically as ``directory/<name>.json``; None if it exists (unless force)."""
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / f"{case.name}.json"
+    path = Path(directory) / f"{case.name}.json"
     if path.exists() and not force:
         return None
-    text = json.dumps(case.to_json(), indent=1, sort_keys=False) + "\n"
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=path.name, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp makes 0600; these are ordinary shared files
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_json(path, case.to_json())
     case.path = path
     return path
 
@@ -251,8 +240,8 @@ def load_case(path: str | os.PathLike) -> Case:
     for key in ("name", "env", "axis", "dt", "profile", "expect", "found_by"):
         if key not in d:
             raise CorpusError(f"{path}: case lacks {key!r}")
-    if d["env"] not in ("rig", "quartercar"):
-        raise CorpusError(f"{path}: env must be 'rig' or 'quartercar', got {d['env']!r}")
+    if d["env"] not in TARGETS:
+        raise CorpusError(f"{path}: env {d['env']!r}: {TARGETS.unknown_message(d['env'])}")
     if not isinstance(d["expect"], dict) or not d["expect"]:
         raise CorpusError(f"{path}: 'expect' must name at least one model")
     for name, e in d["expect"].items():

@@ -18,10 +18,9 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv.divergence import judge
-from bushenv.models import get_reference
+from bushenv.models import AXES, get_reference
 from bushenv.models.base import BushingModel
 
-AXES = ("radial", "axial")
 
 
 def quarter_car_responses(
