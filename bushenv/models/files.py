@@ -54,6 +54,26 @@ def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel
     wrongly shaped parameters, and (when ``dt`` is given) a sample time other than ``dt``.
     """
     path = Path(path)
+    files = _archive(path)
+    meta = _header(path, files)
+    name = meta["model"]
+    cls = MODELS[name].model_class()
+    file_dt = _sample_time(path, meta, dt)
+    shapes, extra = meta.get("shapes", {}), meta.get("extra", {})
+    if not isinstance(shapes, dict) or not isinstance(extra, dict):
+        raise ModelError(f"{path}: corrupt __meta__ entry ('shapes' and 'extra' must be objects)")
+    for key in cls.param_names:
+        _check_parameter(path, name, key, files, shapes.get(key))
+    try:
+        return cls.from_params(files, file_dt, extra)
+    except ModelError as exc:
+        raise ModelError(f"{path}: {exc}") from None
+    except (TypeError, ValueError, KeyError) as exc:
+        raise ModelError(f"{path}: parameters do not fit a {name} model: {exc}") from None
+
+
+def _archive(path: Path) -> dict[str, np.ndarray]:
+    """Every array of the ``.npz`` at ``path``, read without unpickling anything."""
     if not path.exists():
         raise ModelError(f"{path}: no such model file")
     if not path.is_file():
@@ -67,7 +87,7 @@ def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel
         )
     try:
         with np.load(path, allow_pickle=False) as z:
-            files = {k: z[k] for k in z.files}
+            return {k: z[k] for k in z.files}
     except ValueError as exc:
         if "allow_pickle" in str(exc) or "pickled" in str(exc):
             raise ModelError(
@@ -82,6 +102,10 @@ def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel
         ) from None
     except Exception as exc:  # zlib.error and the like from a damaged member
         raise ModelError(f"{path}: damaged .npz archive ({type(exc).__name__}: {exc})") from None
+
+
+def _header(path: Path, files: dict[str, np.ndarray]) -> dict:
+    """The ``__meta__`` JSON (removed from ``files``), checked: format, version, model name."""
     if "__meta__" not in files:
         raise ModelError(f"{path}: not a bushenv model file (no __meta__ entry)")
     raw = files.pop("__meta__")
@@ -104,7 +128,10 @@ def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel
     name = meta.get("model")
     if not isinstance(name, str) or name not in MODELS:
         raise ModelError(f"{path}: {MODELS.unknown_message(name)}")
-    cls = MODELS[name].model_class()
+    return meta
+
+
+def _sample_time(path: Path, meta: dict, dt: float | None) -> float:
     file_dt = meta.get("dt")
     if isinstance(file_dt, bool) or not isinstance(file_dt, int | float):
         raise ModelError(f"{path}: invalid dt {file_dt!r} in the header, expected seconds")
@@ -116,39 +143,29 @@ def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel
             f"{path}: model sampled at {1 / file_dt:.6g} Hz (dt={file_dt:.6g} s), "
             f"expected {1 / dt:.6g} Hz (dt={dt:.6g} s)"
         )
-    shapes = meta.get("shapes", {})
-    extra = meta.get("extra", {})
-    if not isinstance(shapes, dict) or not isinstance(extra, dict):
-        raise ModelError(f"{path}: corrupt __meta__ entry ('shapes' and 'extra' must be objects)")
-    for key in cls.param_names:
-        if key not in files:
-            raise ModelError(f"{path}: {name} model file lacks parameter {key!r}")
-        a = files[key]
-        if a.dtype.kind not in "biuf":
-            raise ModelError(
-                f"{path}: parameter {key!r} holds {a.dtype} data, expected real numbers"
-            )
-        want = shapes.get(key)
-        if want is not None and not (
-            isinstance(want, list) and all(type(n) is int and n >= 0 for n in want)
-        ):
-            raise ModelError(
-                f"{path}: corrupt __meta__ entry (shape of {key!r} is {want!r}, "
-                "expected a list of sizes)"
-            )
-        if want is not None and list(a.shape) != list(want):
-            raise ModelError(
-                f"{path}: parameter {key!r} has shape {list(a.shape)}, "
-                f"the file's header says {want}"
-            )
-        if not np.all(np.isfinite(a)):
-            raise ModelError(f"{path}: parameter {key!r} holds NaN or inf")
-    try:
-        return cls.from_params(files, file_dt, extra)
-    except ModelError as exc:
-        raise ModelError(f"{path}: {exc}") from None
-    except (TypeError, ValueError, KeyError) as exc:
-        raise ModelError(f"{path}: parameters do not fit a {name} model: {exc}") from None
+    return file_dt
+
+
+def _check_parameter(path: Path, name: str, key: str, files: dict, want) -> None:
+    """Parameter ``key`` is present, real, finite and of the shape the header states."""
+    if key not in files:
+        raise ModelError(f"{path}: {name} model file lacks parameter {key!r}")
+    a = files[key]
+    if a.dtype.kind not in "biuf":
+        raise ModelError(f"{path}: parameter {key!r} holds {a.dtype} data, expected real numbers")
+    if want is not None and not (
+        isinstance(want, list) and all(type(n) is int and n >= 0 for n in want)
+    ):
+        raise ModelError(
+            f"{path}: corrupt __meta__ entry (shape of {key!r} is {want!r}, "
+            "expected a list of sizes)"
+        )
+    if want is not None and list(a.shape) != list(want):
+        raise ModelError(
+            f"{path}: parameter {key!r} has shape {list(a.shape)}, the file's header says {want}"
+        )
+    if not np.all(np.isfinite(a)):
+        raise ModelError(f"{path}: parameter {key!r} holds NaN or inf")
 
 
 def file_hash(path: str | os.PathLike) -> str:

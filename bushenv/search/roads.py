@@ -22,7 +22,6 @@ from bushenv.models import AXES, get_reference
 from bushenv.models.base import BushingModel
 
 
-
 def quarter_car_responses(
     model: BushingModel,
     reference: BushingModel,
