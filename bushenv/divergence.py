@@ -72,10 +72,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bushenv import stl
+from bushenv.scales import MACHINE, BushingScales
 
-FORCE_FLOOR_N = 200.0
 FORCE_PEAK_FACTOR = 5.0
-RIG_FORCE_LIMIT_N = 25.0e3  # seed 002 Table 1, max dynamic force of the MTS test machine
 RIG_EXCESS_FACTOR = 2.0
 DEVIATION_FRACTION = 1.0
 DEVIATION_MIN_S = 0.5
@@ -84,13 +83,16 @@ HOLD_TOLERANCE_M = 1e-9  # a "hold": consecutive samples differ by less than a n
 SETTLE_FRACTION = 0.25
 ENERGY_TOLERANCE_FRACTION = 0.05
 CLOSURE_FRACTION = 0.02
+STATIC_LOW_FRACTION = 0.5
+STATIC_HIGH_FACTOR = 2.5
 NON_FINITE_ROBUSTNESS = -1.0e3  # robustness of a NaN/inf response (finite, so searchers rank)
 
-CRITERIA = ("non_finite", "force_bound", "deviation", "self_sustained", "energy")
+CRITERIA = ("non_finite", "force_bound", "deviation", "self_sustained", "energy", "static")
+NEEDS_REFERENCE = ("deviation", "static")  # judged only against a reference's force
 
 
 class DivergenceInputError(ValueError):
-    """Arrays of wrong shape or a reference that is itself not finite."""
+    """Arrays of wrong shape or a displacement that is not finite."""
 
 
 @dataclass
@@ -105,10 +107,13 @@ class Verdict:
     robustness: np.ndarray  # STL robustness of "does not diverge"; < 0 iff diverged
     criterion_robustness: dict[str, np.ndarray] = field(default_factory=dict)
     scale_n: np.ndarray | None = None
+    criteria_run: tuple[str, ...] = CRITERIA  # without a reference: not NEEDS_REFERENCE
+    reference_unusable: np.ndarray | None = None  # the reference's own force is not finite
 
     def row(self, b: int) -> dict:
         """Plain-JSON summary of profile ``b``."""
         t = float(self.first_time_s[b])
+        unusable = self.reference_unusable is not None and bool(self.reference_unusable[b])
         return {
             "diverged": bool(self.diverged[b]),
             "criteria": [c for c in CRITERIA if bool(self.flags[c][b])],
@@ -116,6 +121,7 @@ class Verdict:
             "first_time_s": None if np.isnan(t) else t,
             "worst_deviation": _json_float(self.worst_deviation[b]),
             "robustness": _json_float(self.robustness[b]),
+            "reference_unusable": unusable,
         }
 
 
@@ -127,10 +133,11 @@ def _json_float(v: float) -> float | None:
 def _prepare(x, f_model, f_ref, lengths):
     x = np.asarray(x, dtype=np.float64)
     fm = np.asarray(f_model, dtype=np.float64)
-    fr = np.asarray(f_ref, dtype=np.float64)
+    fr = None if f_ref is None else np.asarray(f_ref, dtype=np.float64)
     if x.ndim == 1:
-        x, fm, fr = x[:, None], fm.reshape(-1, 1), fr.reshape(-1, 1)
-    if x.ndim != 2 or fm.shape != x.shape or fr.shape != x.shape:
+        x, fm = x[:, None], fm.reshape(-1, 1)
+        fr = None if fr is None else fr.reshape(-1, 1)
+    if x.ndim != 2 or fm.shape != x.shape or (fr is not None and fr.shape != x.shape):
         raise DivergenceInputError(
             f"x, f_model, f_ref must share a (T,) or (T, B) shape; got {x.shape}, "
             f"{np.shape(f_model)}, {np.shape(f_ref)}"
@@ -142,9 +149,14 @@ def _prepare(x, f_model, f_ref, lengths):
     if lengths.shape != (B,) or np.any(lengths < 1) or np.any(lengths > T):
         raise DivergenceInputError(f"lengths must be (B,)={B} values in [1, {T}], got {lengths}")
     valid = np.arange(T)[:, None] < lengths[None, :]
-    if not np.all(np.isfinite(fr[valid])) or not np.all(np.isfinite(x[valid])):
-        raise DivergenceInputError("the reference force or the displacement holds NaN or inf")
-    return x, fm, fr, lengths, valid
+    if not np.all(np.isfinite(x[valid])):
+        raise DivergenceInputError("the displacement holds NaN or inf")
+    unusable = np.zeros(B, dtype=bool)
+    if fr is not None:
+        unusable = ~np.all(np.isfinite(fr) | ~valid, axis=0)
+        if unusable.any():  # judged as a rest response; the verdict is then "unusable"
+            fr = np.where(unusable[None, :], 0.0, fr)
+    return x, fm, fr, lengths, valid, unusable
 
 
 def force_termination(f_model, f_ref, limit_n):
@@ -161,15 +173,23 @@ def force_termination(f_model, f_ref, limit_n):
     return ~finite, model_over, reference_over
 
 
-def force_scale(f_ref: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """(B,) force scale: the reference's peak |force|, never below ``FORCE_FLOOR_N``."""
-    return np.maximum(np.max(np.where(valid, np.abs(f_ref), 0.0), axis=0), FORCE_FLOOR_N)
+def force_scale(
+    f_ref: np.ndarray | None, valid: np.ndarray, scales: BushingScales = MACHINE
+) -> np.ndarray:
+    """(B,) force scale: the reference's peak |force|, never below the floor; without a
+    reference the bushing's typical peak (``scales.force_scale_n``) or a fifth of the rig's
+    force limit (so the force bound is the limit itself)."""
+    if f_ref is None:
+        typical = scales.force_scale_n or scales.force_limit_n / FORCE_PEAK_FACTOR
+        return np.full(valid.shape[1], max(typical, scales.force_floor_n))
+    return np.maximum(np.max(np.where(valid, np.abs(f_ref), 0.0), axis=0), scales.force_floor_n)
 
 
-def force_bound(scale: np.ndarray) -> np.ndarray:
+def force_bound(scale: np.ndarray, scales: BushingScales = MACHINE) -> np.ndarray:
     """(B,) largest admissible |model force|."""
     return np.minimum(
-        FORCE_PEAK_FACTOR * scale, np.maximum(RIG_FORCE_LIMIT_N, RIG_EXCESS_FACTOR * scale)
+        FORCE_PEAK_FACTOR * scale,
+        np.maximum(scales.force_limit_n, RIG_EXCESS_FACTOR * scale),
     )
 
 
@@ -199,55 +219,107 @@ def cumulative_work(x: np.ndarray, f: np.ndarray) -> np.ndarray:
     return w
 
 
-def _signals(x, fm, fr, dt, valid, x_ref=None, hold_input=None):
+def _absolute_work(x: np.ndarray, f: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """(B,) sum of |work| per sample: the work that went in and out, however it cancelled."""
+    dx = np.zeros_like(x)
+    dx[1:] = np.diff(x, axis=0)
+    return np.sum(np.where(valid, np.abs(0.5 * (f + np.roll(f, 1, axis=0)) * dx), 0), axis=0)
+
+
+def _energy_signal(x, fm_safe, fr, x_ref, valid, floor_n):
+    """Normalised margin of the model's work at returns to the start deflection."""
+    w_m = cumulative_work(x, fm_safe)
+    if fr is None:  # a passive bushing's own work never goes below zero at a return
+        w_floor = np.zeros(x.shape[1])
+        abs_work = _absolute_work(x, fm_safe, valid)
+    else:
+        w_r = np.where(valid, cumulative_work(x_ref, fr), np.inf)
+        w_floor = np.minimum(0.0, np.min(w_r, axis=0))
+        abs_work = _absolute_work(x_ref, fr, valid)
+    dx = np.zeros_like(x)
+    dx[1:] = np.diff(x, axis=0)
+    travel = np.sum(np.where(valid, np.abs(dx), 0.0), axis=0)
+    e_tol = np.maximum(ENERGY_TOLERANCE_FRACTION * abs_work, floor_n * travel)
+    e_tol = np.where(e_tol > 0, e_tol, 1.0)
+    w_thr = w_floor - e_tol
+    xv = np.where(valid, x, x[:1])
+    span = np.max(xv, axis=0) - np.min(xv, axis=0)
+    closure = (np.abs(x - x[:1]) <= CLOSURE_FRACTION * span) & (span > 0)
+    return np.where(closure, (w_m - w_thr) / e_tol, np.inf)
+
+
+def _static_signal(fm_safe, fr, f_static, late, scale, floor_n):
+    """Normalised margin of a settled hold's force against the reference's static curve.
+
+    ``f_static`` is the force the reference holds at the same displacement with no history
+    (``static_curve``); ``|fr - f_static|`` is how far the reference's own memory (friction,
+    relaxation, heating) moved it on this profile. The model must hold the static force's
+    sign and at least ``STATIC_LOW_FRACTION``, at most ``STATIC_HIGH_FACTOR`` of its size,
+    each widened by the floor and by the reference's own memory.
+    """
+    memory = np.abs(fr - f_static)
+    s = np.where(f_static != 0, np.sign(f_static), np.sign(fm_safe))
+    along = s * fm_safe
+    lower = STATIC_LOW_FRACTION * np.abs(f_static) - floor_n - memory
+    upper = STATIC_HIGH_FACTOR * np.abs(f_static) + floor_n + memory
+    return np.where(late, np.minimum(along - lower, upper - along) / scale, np.inf)
+
+
+def static_curve(reference, stroke_m: float, points: int = 101) -> tuple[np.ndarray, np.ndarray]:
+    """The reference's static force curve: (x [m], F [N]) on ``points`` displacements over
+    +-``stroke_m``, each reached from rest by a 0.2 s half-cosine and held ``HOLD_SETTLE_S``
+    (the moment the ``static`` criterion starts judging a hold)."""
+    dt = reference.dt
+    xs = np.linspace(-stroke_m, stroke_m, points)
+    n_rise, n_hold = max(2, int(round(0.2 / dt))), max(1, int(round(HOLD_SETTLE_S / dt)))
+    rise = 0.5 * (1.0 - np.cos(np.pi * np.arange(1, n_rise + 1) / n_rise))
+    shape = np.concatenate([[0.0], rise, np.ones(n_hold)])
+    f = reference.simulate(np.ascontiguousarray(shape[:, None] * xs[None, :]))
+    return xs, np.asarray(f[-1], dtype=np.float64)
+
+
+def _signals(x, fm, fr, dt, valid, x_ref=None, hold_input=None, scales=MACHINE, f_static=None):
     """The normalised pointwise robustness signals every criterion and the STL formula share."""
-    T, B = x.shape
     x_ref = x if x_ref is None else x_ref
     hold_input = x if hold_input is None else hold_input
-    scale = force_scale(fr, valid)
+    floor_n = scales.force_floor_n
+    scale = force_scale(fr, valid, scales)
     finite = np.isfinite(fm) | ~valid
+    no_ref = np.full(x.shape, np.inf)
     with np.errstate(invalid="ignore", over="ignore"):
         fm_safe = np.where(finite, fm, 0.0)
         abs_fm = np.where(finite, np.abs(fm), np.inf)
-        dev = np.where(finite, np.abs(fm - fr), np.inf) / scale
-        r_force = (force_bound(scale) - abs_fm) / scale
-        r_dev = DEVIATION_FRACTION - dev
+        r_force = (force_bound(scale, scales) - abs_fm) / scale
         late, anchor = hold_windows(hold_input, dt)
         drift_m = np.abs(fm_safe - np.take_along_axis(fm_safe, anchor, axis=0))
-        drift_r = np.abs(fr - np.take_along_axis(fr, anchor, axis=0))
-        r_hold = SETTLE_FRACTION - (drift_m - drift_r) / scale
-        r_hold = np.where(late, r_hold, np.inf)
-        w_m = cumulative_work(x, fm_safe)
-        w_r = cumulative_work(x_ref, fr)
-        w_r_valid = np.where(valid, w_r, np.inf)
-        dx_r = np.zeros_like(x)
-        dx_r[1:] = np.diff(x_ref, axis=0)
-        abs_work = np.sum(
-            np.where(valid, np.abs(0.5 * (fr + np.roll(fr, 1, axis=0)) * dx_r), 0), axis=0
-        )
-        dx = np.zeros_like(x)
-        dx[1:] = np.diff(x, axis=0)
-        travel = np.sum(np.where(valid, np.abs(dx), 0.0), axis=0)
-        e_tol = np.maximum(ENERGY_TOLERANCE_FRACTION * abs_work, FORCE_FLOOR_N * travel)
-        e_tol = np.where(e_tol > 0, e_tol, 1.0)
-        w_thr = np.minimum(0.0, np.min(w_r_valid, axis=0)) - e_tol
-        xv = np.where(valid, x, x[:1])
-        span = np.max(xv, axis=0) - np.min(xv, axis=0)
-        closure = np.abs(x - x[:1]) <= CLOSURE_FRACTION * span
-        closure &= span > 0
-        r_energy = np.where(closure, (w_m - w_thr) / e_tol, np.inf)
+        r_static = no_ref
+        if fr is None:
+            dev, r_dev = no_ref, no_ref
+            drift_r = 0.0
+        else:
+            dev = np.where(finite, np.abs(fm - fr), np.inf) / scale
+            r_dev = DEVIATION_FRACTION - dev
+            drift_r = np.abs(fr - np.take_along_axis(fr, anchor, axis=0))
+            if f_static is not None:
+                # not a hold's last sample: a central-difference velocity already sees the move
+                still = late.copy()
+                still[:-1] &= np.abs(np.diff(hold_input, axis=0)) < HOLD_TOLERANCE_M
+                r_static = _static_signal(fm_safe, fr, f_static, still, scale, floor_n)
+        r_hold = np.where(late, SETTLE_FRACTION - (drift_m - drift_r) / scale, np.inf)
+        r_energy = _energy_signal(x, fm_safe, fr, x_ref, valid, floor_n)
     sig = {
         "finite": finite,
         "force_bound": r_force,
         "deviation": r_dev,
         "self_sustained": r_hold,
         "energy": r_energy,
+        "static": r_static,
     }
-    for k in ("force_bound", "deviation", "self_sustained", "energy"):
-        s = sig[k]
-        s[~valid] = np.inf
-        s[np.isnan(s)] = -np.inf
-    return sig, scale, dev
+    for k in ("force_bound", "deviation", "self_sustained", "energy", "static"):
+        sig[k] = np.array(sig[k], dtype=np.float64)
+        sig[k][~valid] = np.inf
+        sig[k][np.isnan(sig[k])] = -np.inf
+    return sig, scale, np.where(valid, dev, 0.0) if fr is not None else np.zeros(x.shape)
 
 
 def stl_robustness(sig: dict[str, np.ndarray], dt: float) -> dict[str, np.ndarray]:
@@ -255,6 +327,7 @@ def stl_robustness(sig: dict[str, np.ndarray], dt: float) -> dict[str, np.ndarra
 
         phi = G finite  &  G (bound - |F| >= 0)  &  G F[0, W-1] (1.0 scale - |F - F_ref| >= 0)
               &  G (late_hold -> settle excess <= 0.25 scale)  &  G (closure -> W >= W_thr)
+              &  G (late_hold -> static force within [0.5, 2.5] x the reference's +- floor)
 
     with ``W = DEVIATION_MIN_S / dt`` samples. Each term is normalised (by the force scale or
     the energy tolerance) so the terms are comparable and their minimum is the overall margin.
@@ -269,6 +342,7 @@ def stl_robustness(sig: dict[str, np.ndarray], dt: float) -> dict[str, np.ndarra
         ),
         "self_sustained": stl.at_start(stl.always(sig["self_sustained"])),
         "energy": stl.at_start(stl.always(sig["energy"])),
+        "static": stl.at_start(stl.always(sig["static"])),
     }
 
 
@@ -278,23 +352,53 @@ def _first_index(mask: np.ndarray) -> np.ndarray:
     return np.where(any_, np.argmax(mask, axis=0), -1)
 
 
+def _first_failures(sig, fm, fr, scale, valid, dt, scales) -> dict[str, np.ndarray]:
+    """(B,) first failing sample per criterion, -1 where it never fails."""
+    fr_or_zero = np.zeros_like(fm) if fr is None else fr
+    non_finite, model_over, _ = force_termination(fm, fr_or_zero, force_bound(scale, scales))
+    width = max(1, int(round(DEVIATION_MIN_S / dt)))
+    first = {
+        "non_finite": _first_index(non_finite & valid),
+        "force_bound": _first_index(model_over & valid),
+    }
+    # deviation: first sample that completes a run of `width` consecutive violations
+    above = (sig["deviation"] < 0).astype(np.int64)
+    run = np.zeros_like(above)
+    acc = np.zeros(above.shape[1], dtype=np.int64)
+    for t in range(above.shape[0]):
+        acc = (acc + 1) * above[t]
+        run[t] = acc
+    first["deviation"] = _first_index(run >= width)
+    for c in ("self_sustained", "energy", "static"):
+        first[c] = _first_index(sig[c] < 0)
+    return first
+
+
 def judge(
     x: np.ndarray,
     f_model: np.ndarray,
-    f_ref: np.ndarray,
+    f_ref: np.ndarray | None,
     dt: float,
     lengths: np.ndarray | None = None,
     x_ref: np.ndarray | None = None,
     hold_input: np.ndarray | None = None,
+    scales: BushingScales = MACHINE,
+    f_static: np.ndarray | None = None,
 ) -> Verdict:
     """Decide, per profile, whether the model diverged (see the module docstring).
 
     In a closed loop (the quarter car) the model's and the reference's bushings deflect
     differently: ``x`` is the model's deflection, ``x_ref`` (default ``x``) the reference's
     (for its work), and ``hold_input`` (default ``x``) the prescribed input whose constancy
-    defines a hold (the road height).
+    defines a hold (the road height). A profile on which the reference's own force is not
+    finite gets no verdict (``reference_unusable``; never "diverged", robustness +inf).
+    ``f_ref=None`` judges without a reference: only the
+    criteria that need none run (``Verdict.criteria_run``). ``scales``: the bushing's force
+    floor and the rig's limit (``bushenv.scales``). ``f_static`` (same shape as ``x``): the
+    reference's static force at each sample's displacement (``static_curve``); the ``static``
+    criterion runs only with it.
     """
-    x, fm, fr, lengths, valid = _prepare(x, f_model, f_ref, lengths)
+    x, fm, fr, lengths, valid, unusable = _prepare(x, f_model, f_ref, lengths)
     T, B = x.shape
     extra = []
     for name, a in (("x_ref", x_ref), ("hold_input", hold_input)):
@@ -303,25 +407,11 @@ def judge(
             if not np.all(np.isfinite(a[valid])):
                 raise DivergenceInputError(f"{name} holds NaN or inf")
         extra.append(a)
-    sig, scale, dev = _signals(x, fm, fr, dt, valid, *extra)
-    width = max(1, int(round(DEVIATION_MIN_S / dt)))
-
-    non_finite, model_over, _ = force_termination(fm, fr, force_bound(scale))
-    first: dict[str, np.ndarray] = {}
-    first["non_finite"] = _first_index(non_finite & valid)
-    first["force_bound"] = _first_index(model_over & valid)
-    # deviation: first sample that completes a run of `width` consecutive violations
-    above = (sig["deviation"] < 0).astype(np.int64)
-    run = np.zeros_like(above)
-    acc = np.zeros(B, dtype=np.int64)
-    for t in range(T):
-        acc = (acc + 1) * above[t]
-        run[t] = acc
-    first["deviation"] = _first_index(run >= width)
-    first["self_sustained"] = _first_index(sig["self_sustained"] < 0)
-    first["energy"] = _first_index(sig["energy"] < 0)
-
-    flags = {c: first[c] >= 0 for c in CRITERIA}
+    if f_static is not None:
+        f_static = np.asarray(f_static, dtype=np.float64).reshape(x.shape)
+    sig, scale, dev = _signals(x, fm, fr, dt, valid, *extra, scales=scales, f_static=f_static)
+    first = _first_failures(sig, fm, fr, scale, valid, dt, scales)
+    flags = {c: (first[c] >= 0) & ~unusable for c in CRITERIA}
     diverged = np.zeros(B, dtype=bool)
     for c in CRITERIA:
         diverged |= flags[c]
@@ -330,11 +420,12 @@ def judge(
     which = stack.argmin(axis=0)
     first_time = np.where(diverged, first_idx * dt, np.nan)
     first_crit = [CRITERIA[which[b]] if diverged[b] else None for b in range(B)]
-
-    worst = np.max(np.where(valid, dev, 0.0), axis=0)
+    worst = np.max(dev, axis=0) if fr is not None else np.full(B, np.nan)
     rob_c = stl_robustness(sig, dt)
     rob = np.min(np.stack([rob_c[c] for c in CRITERIA]), axis=0)
-    rob = np.maximum(rob, NON_FINITE_ROBUSTNESS)
+    rob = np.where(unusable, np.inf, np.maximum(rob, NON_FINITE_ROBUSTNESS))
+    skipped = (*NEEDS_REFERENCE,) if fr is None else ("static",) if f_static is None else ()
+    run = tuple(c for c in CRITERIA if c not in skipped)
     return Verdict(
         diverged=diverged,
         flags=flags,
@@ -344,4 +435,6 @@ def judge(
         robustness=rob,
         criterion_robustness=rob_c,
         scale_n=scale,
+        criteria_run=run,
+        reference_unusable=unusable,
     )

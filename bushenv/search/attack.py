@@ -40,8 +40,38 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--seed", type=int, default=d.seed)
     p.add_argument("--out", default=str(d.out), help="output directory")
-    p.add_argument("--hybrid", default=d.hybrid, help="the model rechecked on the failures")
-    p.add_argument("--control", default=d.control, help="the control that must stay clean")
+    p.add_argument(
+        "--reference",
+        default=None,
+        help="the bushing the verdicts compare with: a registered name or a model file "
+        "(default: rubber for a registered --model; none for a model file: then only the "
+        "criteria that need no reference run)",
+    )
+    p.add_argument(
+        "--hybrid",
+        default=None,
+        help="name or file rechecked on the failures and attacked (default: the shipped hybrid "
+        "with the built-in rubber; none for your bushing)",
+    )
+    p.add_argument(
+        "--control",
+        default=None,
+        help="name or file that must stay clean (default: the Table-1 linear model with the "
+        "built-in rubber; for your bushing a linear model fitted to the reference)",
+    )
+    p.add_argument("--stroke-mm", type=float, default=None, help="the bushing's stroke, +-mm")
+    p.add_argument(
+        "--max-velocity", type=float, default=None, help="the bushing's velocity limit, m/s"
+    )
+    p.add_argument(
+        "--force-floor-n", type=float, default=None, help="verdicts' force resolution, N"
+    )
+    p.add_argument(
+        "--force-scale-n",
+        type=float,
+        default=None,
+        help="the bushing's typical peak force, N (scales the verdicts without a reference)",
+    )
     p.add_argument("--max-shrink", type=int, default=d.max_shrink, help="failures to shrink")
     p.add_argument("--shrink-budget", type=int, default=d.shrink_budget, help="evals per shrink")
     p.add_argument("--threads", type=int, default=None, help="evaluation threads (default: cores)")
@@ -72,8 +102,13 @@ def config_from(args: argparse.Namespace) -> CampaignConfig:
         searchers=searchers,
         seed=args.seed,
         out=Path(args.out),
+        reference=args.reference,
         hybrid=args.hybrid,
         control=args.control,
+        stroke_mm=args.stroke_mm,
+        max_velocity_m_per_s=args.max_velocity,
+        force_floor_n=args.force_floor_n,
+        force_scale_n=args.force_scale_n,
         max_shrink=args.max_shrink,
         shrink_budget=args.shrink_budget,
         threads=args.threads,

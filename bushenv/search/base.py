@@ -60,6 +60,7 @@ class SearchResult:
     worst: Candidate | None = None
     failures: list[Candidate] = field(default_factory=list)
     n_failures: int = 0
+    n_reference_unusable: int = 0  # profiles the reference itself could not run
     history: list[tuple[int, float]] = field(default_factory=list)  # (evals, best robustness)
 
     @property
@@ -85,6 +86,7 @@ class SearchResult:
             "worst_family": w.family if w else None,
             "worst_criterion": w.verdict["first_criterion"] if w else None,
             "failing_families": sorted({c.family for c in self.failures}),
+            "reference_unusable": self.n_reference_unusable,
         }
 
 
@@ -109,8 +111,11 @@ class Recorder:
         res = self.result
         now = time.perf_counter() - self.t0
         n = len(families) if limit is None else min(len(families), int(limit))
+        unusable = v.reference_unusable
         for b in range(n):
             res.evaluations += 1
+            if unusable is not None and unusable[b]:
+                res.n_reference_unusable += 1
             rob = float(v.robustness[b])
             div = bool(v.diverged[b])
             worse = res.worst is None or rob < res.worst.robustness

@@ -25,12 +25,22 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.divergence import CRITERIA, NEEDS_REFERENCE
 from bushenv.execution import local_cores
-from bushenv.models import get_model
-from bushenv.persist import load_profiles, save_profiles, write_json
+from bushenv.models import get_model, get_reference
+from bushenv.persist import load_profiles, save_profiles, write_json, write_text
 from bushenv.progress import Progress
-from bushenv.search.campaign_report import fresh_report, resumed_report
-from bushenv.search.corpus import DEFAULT_CORPUS, truth_reference
+from bushenv.scales import stiffness_mismatch
+from bushenv.search.campaign_models import (
+    FITTED_CONTROL,
+    builtin_reference,
+    campaign_scales,
+    fitted_linear,
+    reference_spec,
+    roles,
+)
+from bushenv.search.campaign_report import fresh_report, report_markdown, resumed_report
+from bushenv.search.corpus import DEFAULT_CORPUS
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import SEARCHERS, get_searcher
 from bushenv.search.targets import TARGETS, Target
@@ -54,8 +64,13 @@ class CampaignConfig:
     searchers: tuple[str, ...] | None = None  # default: the target's
     seed: int = 0
     out: Path = Path("runs/attack")
-    hybrid: str = "hybrid"  # rechecked on the failures, and attacked
-    control: str = "linear"  # must stay clean
+    reference: str | None = None  # name or file; None: "rubber" for a registered model, else none
+    hybrid: str | None = None  # rechecked and attacked; None: the shipped one for the rubber
+    control: str | None = None  # must stay clean; None: see ``Campaign.controls``
+    stroke_mm: float | None = None  # the bushing's limits, beyond what the reference gives
+    max_velocity_m_per_s: float | None = None
+    force_floor_n: float | None = None
+    force_scale_n: float | None = None  # typical peak force, for judging without a reference
     max_shrink: int = 3
     shrink_budget: int = 200
     threads: int | None = None  # evaluation threads (default: the cores)
@@ -91,6 +106,7 @@ class CampaignConfig:
             "axis": self.axis,
             "env": self.target,
             "seed": self.seed,
+            "reference": self.reference,
             "hybrid": self.hybrid,
             "control": self.control,
             "max_shrink": self.max_shrink,
@@ -121,18 +137,16 @@ class Campaign:
             raise CampaignError(
                 f"{self.report_path} exists; pass --resume to continue it or --force to start again"
             )
-        self.reference = truth_reference(c.axis)
-        roles = [("target", c.model), ("hybrid", c.hybrid), ("control", c.control)]
-        self.models: dict[str, Any] = {}
-        self.roles: dict[str, str] = {}
-        for role, spec in roles:
-            key = label(spec)
-            if key in self.models:  # e.g. --model hybrid: the hybrid step is the target step
-                continue
-            self.models[key] = get_model(spec, axis=c.axis, dt=self.reference.dt)
-            self.roles[key] = role
-        self.specs = {label(spec): spec for _, spec in roles}
-        self.target_key, self.hybrid_key, self.control_key = (label(s) for _, s in roles)
+        self.reference_spec = reference_spec(c)
+        self.dt = get_model(c.model, axis=c.axis).dt
+        self.reference = (
+            None
+            if self.reference_spec is None
+            else get_reference(self.reference_spec, axis=c.axis, dt=self.dt)
+        )
+        self.scales = campaign_scales(c, self.reference, builtin_reference(c))
+        self.notes: list[str] = []
+        self._models()
         fresh = fresh_report(self)
         if c.resume and self.report_path.exists():
             fresh = resumed_report(self.report_path, fresh)
@@ -140,7 +154,39 @@ class Campaign:
         self.report = fresh
         self.seconds_before = fresh["seconds"]
         self.progress.total = self._work_units()
+        for note in self.notes:
+            self.progress.say(f"note: {note}")
         self.save()
+
+    def _models(self) -> None:
+        """The target, the hybrid and the control, each with its role (see ``roles``)."""
+        c = self.config
+        self.models: dict[str, Any] = {}
+        self.roles: dict[str, str] = {}
+        self.specs: dict[str, str] = {}
+        keys = {}
+        for role, spec in roles(c, self.notes):
+            key = label(spec)
+            keys[role] = key
+            if key in self.models:  # e.g. --model hybrid: the hybrid step is the target step
+                continue
+            self.models[key], spec = self._resolve(spec)
+            self.roles[key], self.specs[key] = role, spec
+            if self.reference is not None:
+                warning = stiffness_mismatch(self.models[key], self.reference)
+                if warning:
+                    self.notes.append(f"{key}: {warning}")
+        self.target_key = keys["target"]
+        self.hybrid_key = keys.get("hybrid")
+        self.control_key = keys.get("control")
+
+    def _resolve(self, spec: str):
+        """The model ``spec`` names, and the spec to record (a fitted control's saved file)."""
+        c = self.config
+        if spec == FITTED_CONTROL:
+            model = fitted_linear(self.reference, self.scales)
+            return model, str(model.save(self.out / "models" / "control-linear.npz"))
+        return get_model(spec, axis=c.axis, dt=self.dt), spec
 
     def save(self) -> None:
         self.report["seconds"] = round(self.seconds_before + time.perf_counter() - self.t0, 3)
@@ -153,6 +199,7 @@ class Campaign:
             target=self.target,
             threads=self.config.threads or local_cores(),
             axis=self.config.axis,
+            scales=self.scales,
         )
 
     # ----- progress accounting -----------------------------------------------------------------
@@ -285,11 +332,27 @@ class Campaign:
             if key != self.target_key:
                 self.search(key)
         shrink_and_save(self)
-        if c.plots:
-            plot_campaign(self)
+        plots = plot_campaign(self) if c.plots else []
         self.report["complete"] = True
         self.save()
+        write_text(self.out / "report.md", report_markdown(self.report, self.target_key, plots))
         return self.report
+
+    def criteria(self) -> dict[str, Any]:
+        """Which criteria the verdicts used, and why some did not run."""
+        if self.reference is None:
+            why = (
+                f"no reference: {self.config.model} is a model file and no --reference was "
+                f"given, so only the criteria that need none ran ({', '.join(NEEDS_REFERENCE)} "
+                "compare with a reference's force); pass --reference NAME|FILE for all"
+            )
+            run = [c for c in CRITERIA if c not in NEEDS_REFERENCE]
+        else:
+            run, why = list(CRITERIA), f"all, against the reference {self.reference_spec!r}"
+        if not self.target.judges_static and "static" in run:
+            run.remove("static")
+            why += f"; static is judged on the rig only (the {self.target.name} has no hold)"
+        return {"run": run, "why": why}
 
     def control_flagged(self) -> bool:
         control = self.report["models"].get(self.control_key, {}).get("searchers", {})

@@ -60,6 +60,7 @@ def _case(campaign, profile, family, params, found_by, **extra) -> Case:
     """``profile`` judged on every model of the campaign, as a corpus case."""
     c = campaign.config
     shas = {k: model_sha(campaign.specs[k], c.axis) for k in campaign.models}
+    c = campaign.config
     return make_case(
         profile,
         env=c.target,
@@ -69,6 +70,8 @@ def _case(campaign, profile, family, params, found_by, **extra) -> Case:
         found_by=found_by,
         models={campaign.specs[k]: m for k, m in campaign.models.items()},
         reference=campaign.reference,
+        reference_spec=campaign.reference_spec,
+        scales=campaign.scales,
         shas={campaign.specs[k]: shas[k] for k in campaign.models},
         **extra,
     )

@@ -23,10 +23,11 @@ def _row(axes, t, profile, x, fm, fr, verdict: dict, key: str, profile_label: st
     ax_p, ax_f, ax_l = axes
     ax_p.plot(t, profile * 1e3, "k", lw=0.8)
     ax_p.set_ylabel(profile_label)
-    ax_f.plot(t, fr, color=REF_COLOUR, lw=0.9, label="reference")
+    if fr is not None:
+        ax_f.plot(t, fr, color=REF_COLOUR, lw=0.9, label="reference")
+        ax_l.plot(x * 1e3, fr, color=REF_COLOUR, lw=0.8, label="reference")
     ax_f.plot(t, fm, color=MODEL_COLOUR, lw=0.8, label=key)
     ax_f.set_ylabel("force [N]")
-    ax_l.plot(x * 1e3, fr, color=REF_COLOUR, lw=0.8, label="reference")
     ax_l.plot(x * 1e3, fm, color=MODEL_COLOUR, lw=0.7, label=key)
     ax_l.set_xlabel("bushing deflection [mm]")
     ax_l.set_ylabel("force [N]")
@@ -37,8 +38,11 @@ def _row(axes, t, profile, x, fm, fr, verdict: dict, key: str, profile_label: st
             a.axvline(t_fail, color=FAIL_COLOUR, ls="--", lw=0.9, label=what)
     if verdict.get("first_criterion") == "energy" or "energy" in verdict.get("criteria", []):
         w_m = float(cumulative_work(x[:, None], np.nan_to_num(fm)[:, None])[-1, 0])
-        w_r = float(cumulative_work(x[:, None], fr[:, None])[-1, 0])
-        ax_l.set_title(f"net work: reference {w_r:+.3g} J, {key} {w_m:+.3g} J", fontsize=8)
+        ref = "" if fr is None else "reference "
+        if fr is not None:
+            w_r = float(cumulative_work(x[:, None], fr[:, None])[-1, 0])
+            ref = f"reference {w_r:+.3g} J, "
+        ax_l.set_title(f"net work over the profile: {ref}{key} {w_m:+.3g} J", fontsize=8)
     ax_f.legend(fontsize=7, loc="upper right")
     ax_l.legend(fontsize=7, loc="upper left")
 
@@ -59,9 +63,10 @@ def _figure(plt, n_rows: int):
     return plt.subplots(n_rows, 3, figsize=(15, 2.8 * n_rows), squeeze=False)
 
 
-def plot_worst(campaign, plt, plot_dir) -> None:
+def plot_worst(campaign, plt, plot_dir) -> list[str]:
     """``plots/worst-<model>.png``: each search's worst profile on that model."""
-    dt, label = campaign.reference.dt, campaign.target.profile_label
+    dt, label = campaign.dt, campaign.target.profile_label
+    names = []
     for key in campaign.models:
         rows = _worst_rows(campaign, key)
         if not rows:
@@ -72,7 +77,8 @@ def plot_worst(campaign, plt, plot_dir) -> None:
         for r, (name, p, m) in enumerate(rows):
             n, v = p.size, m["verdict"]
             t = np.arange(n) * dt
-            args = (batch.x[:n, r], batch.f_model[:n, r], batch.f_ref[:n, r])
+            fr = None if batch.f_ref is None else batch.f_ref[:n, r]
+            args = (batch.x[:n, r], batch.f_model[:n, r], fr)
             _row(axes[r], t, p, *args, v, key, label)
             state = "DIVERGES" if v["diverged"] else "bounded"
             axes[r, 0].set_title(
@@ -82,13 +88,16 @@ def plot_worst(campaign, plt, plot_dir) -> None:
         for a in axes[-1, :2]:
             a.set_xlabel("time [s]")
         fig.tight_layout()
-        fig.savefig(plot_dir / f"worst-{key}.png", dpi=90)
+        names.append(f"worst-{key}.png")
+        fig.savefig(plot_dir / names[-1], dpi=90)
         plt.close(fig)
+    return names
 
 
-def plot_shrunk(campaign, plt, plot_dir) -> None:
+def plot_shrunk(campaign, plt, plot_dir) -> list[str]:
     """``plots/shrunk-<i>.png``: each shrunk failure on every model of the campaign."""
-    dt, label = campaign.reference.dt, campaign.target.profile_label
+    dt, label = campaign.dt, campaign.target.profile_label
+    names = []
     for i, entry in enumerate(campaign.report["shrunk"]):
         case = load_case(campaign.out / entry["case_file"])
         p = case.profile
@@ -98,17 +107,21 @@ def plot_shrunk(campaign, plt, plot_dir) -> None:
             with campaign.evaluator(key) as ev:
                 b = ev.evaluate([p])
             row = b.verdict.row(0)
-            _row(axes[r], t, p, b.x[:, 0], b.f_model[:, 0], b.f_ref[:, 0], row, key, label)
+            fr = None if b.f_ref is None else b.f_ref[:, 0]
+            _row(axes[r], t, p, b.x[:, 0], b.f_model[:, 0], fr, row, key, label)
             state = "DIVERGES" if row["diverged"] else "bounded"
             axes[r, 0].set_title(f"shrunk failure {case.name}: {key} {state}", fontsize=9)
         for a in axes[-1, :2]:
             a.set_xlabel("time [s]")
         fig.tight_layout()
-        fig.savefig(plot_dir / f"shrunk-{i}.png", dpi=90)
+        names.append(f"shrunk-{i}.png")
+        fig.savefig(plot_dir / names[-1], dpi=90)
         plt.close(fig)
+    return names
 
 
-def plot_campaign(campaign) -> None:
+def plot_campaign(campaign) -> list[str]:
+    """Every plot of the campaign in ``DIR/plots``; returns their file names."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -116,5 +129,4 @@ def plot_campaign(campaign) -> None:
 
     plot_dir = campaign.out / "plots"
     plot_dir.mkdir(parents=True, exist_ok=True)
-    plot_worst(campaign, plt, plot_dir)
-    plot_shrunk(campaign, plt, plot_dir)
+    return plot_worst(campaign, plt, plot_dir) + plot_shrunk(campaign, plt, plot_dir)

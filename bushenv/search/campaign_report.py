@@ -3,7 +3,9 @@
 ``report.json`` (docs/search.md describes every field)::
 
     {"format": "bushenv-attack-report", "version": 1, "arguments": {...}, "searchers": [...],
-     "reference": {"name", "measurement", "params_sha256"},
+     "reference": {"spec", "file_sha256", "params_sha256"} (spec null: judged without one),
+     "scales": {"stroke_m", "velocity_m_per_s", "force_floor_n", "force_limit_n", ...},
+     "criteria": {"run": [...], "why": "..."}, "notes": [...],
      "models": {key: {"role", "spec", "class", "file", "sha256", "params_sha256",
                       "searchers": {name: SearchResult.summary() + first_failure, worst,
                                     profiles_file}}},
@@ -18,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from bushenv.models import file_hash, model_file
-from bushenv.search.corpus import params_sha
+from bushenv.search.corpus import params_sha, reference_identity
 
 REPORT_FORMAT = "bushenv-attack-report"
 REPORT_VERSION = 1
@@ -50,11 +52,10 @@ def fresh_report(campaign) -> dict[str, Any]:
         "version": REPORT_VERSION,
         "arguments": c.arguments(),
         "searchers": list(c.searchers),
-        "reference": {
-            "name": "rubber",
-            "measurement": False,
-            "params_sha256": params_sha(campaign.reference),
-        },
+        "reference": reference_identity(campaign.reference_spec, campaign.reference, c.axis),
+        "scales": campaign.scales.to_json(),
+        "criteria": campaign.criteria(),
+        "notes": list(campaign.notes),
         "models": {
             key: {
                 "role": campaign.roles[key],
@@ -125,6 +126,36 @@ def _search_row(key: str, role: str, name: str, s: dict[str, Any]) -> str:
     )
 
 
+COLUMNS = (
+    ("model", "the model's report key (a registered name or a model file's stem)"),
+    (
+        "role",
+        "target (under attack), hybrid (rechecked on its failures, then attacked), "
+        "control (must stay clean: a flagged control means the criteria are at fault)",
+    ),
+    ("searcher", "the search that produced the row (``SEARCHERS``)"),
+    ("evals", "model evaluations spent (profiles simulated; an RL episode is one)"),
+    ("diverged", "whether any profile made the model diverge"),
+    ("evals->fail", "evaluations until the first failing profile"),
+    ("s->fail", "wall-clock seconds until the first failing profile (this machine, this load)"),
+    (
+        "worst dev",
+        "largest |F_model - F_reference| over the worst profile, as a multiple of the "
+        "reference's peak force (dimensionless; 1.0 = an error as large as the whole force)",
+    ),
+    (
+        "robustness",
+        "STL robustness of the worst profile: the margin to the nearest criterion, "
+        "in units of that criterion's scale (negative = diverged)",
+    ),
+    (
+        "failing family (criterion)",
+        "the excitation family of the first failure and the "
+        "divergence criterion that fired (bushenv/divergence.py)",
+    ),
+)
+
+
 def format_table(report: dict[str, Any], target_key: str) -> str:
     """The campaign as a plain-text table, the recheck and the shrunk failures."""
     head = (
@@ -132,7 +163,15 @@ def format_table(report: dict[str, Any], target_key: str) -> str:
         f"{'evals->fail':>11} {'s->fail':>8} {'worst dev':>9} {'robustness':>10} "
         f"{'failing family (criterion)'}"
     )
-    lines = [head, "-" * len(head)]
+    ref = report["reference"].get("spec")
+    lines = [
+        f"reference: {ref if ref is not None else 'none'}; criteria run: "
+        f"{', '.join(report['criteria']['run'])}",
+        *(f"note: {n}" for n in report.get("notes", [])),
+        "",
+        head,
+        "-" * len(head),
+    ]
     for key, entry in report["models"].items():
         for name, s in entry["searchers"].items():
             lines.append(_search_row(key, entry["role"], name, s))
@@ -154,4 +193,23 @@ def format_table(report: dict[str, Any], target_key: str) -> str:
                 f"{fin['samples']} samples, {fin['peak_um'] / 1e3:.2f} mm peak; "
                 f"{_verdicts(e['verdicts'])}"
             )
+    return "\n".join(lines)
+
+
+def report_markdown(report: dict[str, Any], target_key: str, plots: list[str]) -> str:
+    """``report.md``: the table, what each column means with its unit, the scales, the plots."""
+    lines = ["# Adversarial campaign", "", "```", format_table(report, target_key), "```", ""]
+    lines += ["## The columns", "", "| column | meaning |", "|---|---|"]
+    lines += [f"| {name} | {text} |" for name, text in COLUMNS]
+    lines += ["", "## Criteria", "", report["criteria"]["why"], ""]
+    sc = report["scales"]
+    lines += [
+        "## Scales",
+        "",
+        f"stroke {sc['stroke_m'] * 1e3:.4g} mm, velocity {sc['velocity_m_per_s']:.4g} m/s, "
+        f"force floor {sc['force_floor_n']:.4g} N, force limit {sc['force_limit_n']:.4g} N "
+        f"({sc['source']})",
+        "",
+    ]
+    lines += [f"![{p}](plots/{p})\n" for p in plots]
     return "\n".join(lines)

@@ -15,8 +15,12 @@ A case file (``tests/regressions/corpus/<name>.json``) holds:
 | found_by      | searcher, seed, model name and the sha256 of the model file it was found on |
 | expect        | per model name: ``diverged`` (bool), the ``criterion`` it fired (or null),  |
 |               | ``sha256`` of the model file the verdict was recorded with                  |
-| reference     | the reference bushing (``rubber``, measurement effects off) and a sha256 of |
-|               | its parameters                                                              |
+| reference     | ``spec``: the reference the verdicts were judged against (a registered name |
+|               | or a model file; null: judged without one, by the criteria that need none), |
+|               | ``file_sha256`` and ``params_sha256``; replay refuses when it is missing    |
+|               | (cases before this field name the built-in ``rubber``)                     |
+| scales        | the bushing's scales the verdicts used (``bushenv/scales.py``; default the  |
+|               | papers' machine)                                                            |
 | shrink        | what shrinking did (segments / samples / peak before and after)            |
 
 The verdicts in ``expect`` are measured on the DECODED profile when the case is made (float32
@@ -43,6 +47,7 @@ import numpy as np
 from bushenv.models import BushingModel, file_hash, get_model, get_reference, model_file
 from bushenv.models.base import PAPER_DT
 from bushenv.persist import write_json
+from bushenv.scales import MACHINE, BushingScales
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.targets import TARGETS
 
@@ -105,8 +110,36 @@ def params_sha(model: BushingModel) -> str:
 
 
 def truth_reference(axis: str, dt: float = PAPER_DT) -> BushingModel:
-    """The "real" bushing every verdict is measured against: the rubber specimen alone."""
+    """The built-in "real" bushing: the rubber specimen alone (``get_reference("rubber")``)."""
     return get_reference("rubber", axis=axis, dt=dt)
+
+
+def reference_identity(spec: str | None, reference: BushingModel | None, axis: str) -> dict:
+    """What a case or report records of its reference: the spec it was given by (a registered
+    name or a model file; None: judged without one), the file's and the parameters' sha256."""
+    if reference is None:
+        return {"spec": None, "file_sha256": None, "params_sha256": None}
+    return {
+        "spec": spec,
+        "file_sha256": model_sha(spec, axis) if spec is not None else None,
+        "params_sha256": params_sha(reference),
+    }
+
+
+def case_reference(case: Case) -> BushingModel | None:
+    """The reference a case was judged against, resolved today; refuses (``CorpusError``) when
+    it is gone. Cases written before references were explicit name the built-in rubber."""
+    ref = case.reference
+    spec = ref.get("spec", ref.get("name", "rubber")) if ref else "rubber"
+    if spec is None:
+        return None
+    try:
+        return get_reference(spec, axis=case.axis, dt=case.dt)
+    except ValueError as exc:
+        raise CorpusError(
+            f"case {case.name}: its reference {spec!r} cannot be loaded ({exc}); restore the "
+            f"file (sha256 {str(ref.get('file_sha256'))[:12]}) or record the case again"
+        ) from None
 
 
 # ----- cases -------------------------------------------------------------------------------------
@@ -124,6 +157,7 @@ class Case:
     reference: dict[str, Any]
     shrink: dict[str, Any] | None = None
     notes: str = ""
+    scales: BushingScales = MACHINE
     path: Path | None = field(default=None, compare=False)
 
     def to_json(self) -> dict[str, Any]:
@@ -140,6 +174,7 @@ class Case:
             "found_by": self.found_by,
             "expect": self.expect,
             "reference": self.reference,
+            "scales": self.scales.to_json(),
             "shrink": self.shrink,
             "notes": self.notes,
         }
@@ -157,12 +192,13 @@ def judge_profile(
     models: dict[str, BushingModel],
     env: str,
     axis: str,
-    reference: BushingModel,
+    reference: BushingModel | None,
+    scales: BushingScales = MACHINE,
 ) -> dict[str, dict[str, Any]]:
     """Verdict row of ``profile`` for each model (prescribed-motion or quarter-car path)."""
     out = {}
     for name, model in models.items():
-        ev = BatchEvaluator(model, reference, target=env, axis=axis)
+        ev = BatchEvaluator(model, reference, target=env, axis=axis, scales=scales)
         out[name] = ev.evaluate([profile]).verdict.row(0)
     return out
 
@@ -176,14 +212,17 @@ def make_case(
     params: Any,
     found_by: dict[str, Any],
     models: dict[str, BushingModel],
-    reference: BushingModel,
+    reference: BushingModel | None,
+    reference_spec: str | None = "rubber",
+    scales: BushingScales = MACHINE,
     shas: dict[str, str | None] | None = None,
     shrink: dict[str, Any] | None = None,
     notes: str = "",
 ) -> Case:
-    """A case whose ``expect`` holds what each model does on the decoded profile now."""
+    """A case whose ``expect`` holds what each model does on the decoded profile now, against
+    ``reference`` (given by ``reference_spec``; None: judged without one) at ``scales``."""
     x = decode_profile(encode_profile(profile))
-    rows = judge_profile(x, models, env, axis, reference)
+    rows = judge_profile(x, models, env, axis, reference, scales)
     shas = shas or {}
     expect = {
         name: {
@@ -200,15 +239,16 @@ def make_case(
         name=name,
         env=env,
         axis=axis,
-        dt=float(reference.dt),
+        dt=float(next(iter(models.values())).dt),
         profile=x,
         family=family,
         params=params,
         found_by=found_by,
         expect=expect,
-        reference={"name": "rubber", "measurement": False, "params_sha256": params_sha(reference)},
+        reference=reference_identity(reference_spec, reference, axis),
         shrink=shrink,
         notes=notes,
+        scales=scales,
     )
 
 
@@ -258,10 +298,20 @@ def load_case(path: str | os.PathLike) -> Case:
         found_by=d["found_by"],
         expect=d["expect"],
         reference=d.get("reference", {}),
+        scales=_scales(d.get("scales"), path),
         shrink=d.get("shrink"),
         notes=d.get("notes", ""),
         path=path,
     )
+
+
+def _scales(d: Any, path: Path) -> BushingScales:
+    if d is None:
+        return MACHINE
+    try:
+        return BushingScales(**d)
+    except (TypeError, ValueError) as exc:
+        raise CorpusError(f"{path}: 'scales' is not valid: {exc}") from None
 
 
 def case_files(directory: str | os.PathLike = DEFAULT_CORPUS) -> list[Path]:
@@ -294,9 +344,9 @@ def replay(
     """
     resolve = resolve or _default_resolver
     sha_of = sha_of or model_sha
-    reference = truth_reference(case.axis, case.dt)
+    reference = case_reference(case)
     models = {name: resolve(name, case.axis, case.dt) for name in case.expect}
-    rows = judge_profile(case.profile, models, case.env, case.axis, reference)
+    rows = judge_profile(case.profile, models, case.env, case.axis, reference, case.scales)
     return [
         Replay(
             model=name,
@@ -318,7 +368,8 @@ def check(
     """Messages for every changed verdict (empty when the case still holds)."""
     problems = []
     results = replay(case, resolve, sha_of)
-    ref_now = params_sha(truth_reference(case.axis, case.dt))
+    reference = case_reference(case)
+    ref_now = None if reference is None else params_sha(reference)
     ref_changed = case.reference.get("params_sha256") not in (None, ref_now)
     for r in results:
         if r.ok:
@@ -338,6 +389,6 @@ def check(
         elif r.sha_recorded and r.sha_recorded == r.sha_now:
             msg += f"; the {r.model} model file is the one the case was recorded with"
         if ref_changed:
-            msg += "; the reference rubber bushing's parameters changed since then"
+            msg += "; the reference's parameters changed since the case was recorded"
         problems.append(msg)
     return problems

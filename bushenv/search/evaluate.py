@@ -35,12 +35,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bushenv.divergence import Verdict
+from bushenv.divergence import Verdict, static_curve
 from bushenv.models.base import DT_TOLERANCE, BushingModel
 from bushenv.models.narx import NarxBushing
+from bushenv.scales import MACHINE, BushingScales
 from bushenv.search.base import SearchError
 from bushenv.search.families import pad_batch
-from bushenv.search.targets import Responses, Target, get_target
+from bushenv.search.targets import Responses, Target, get_target, simulate_or_nan
 
 REFERENCE_CACHE_SIZE = 4096
 
@@ -52,7 +53,7 @@ class BatchResult:
     x: np.ndarray  # (T, B) bushing deflection the model saw, m
     lengths: np.ndarray  # (B,)
     f_model: np.ndarray  # (T, B) N
-    f_ref: np.ndarray  # (T, B) N
+    f_ref: np.ndarray | None  # (T, B) N; None when judged without a reference
     verdict: Verdict
     profiles: np.ndarray  # (T, B) the profiles as given (displacement or road height)
 
@@ -62,25 +63,48 @@ class BatchResult:
 
 class ReferenceRuns:
     """The reference's forces on (T, B) profiles, cached by each profile's bytes (shared by the
-    evaluator's threads; each thread runs its own copy of the model)."""
+    evaluator's threads; each thread runs its own copy of the model), and its static curve.
+    ``model`` None: no reference (every force is None)."""
 
-    def __init__(self, model: BushingModel, cache: OrderedDict, lock: threading.Lock) -> None:
-        self.model, self._cache, self._lock = model, cache, lock
+    def __init__(
+        self,
+        model: BushingModel | None,
+        cache: OrderedDict,
+        lock: threading.Lock,
+        scales: BushingScales = MACHINE,
+    ) -> None:
+        self.model, self._cache, self._lock, self.scales = model, cache, lock, scales
+        self._curve: tuple[np.ndarray, np.ndarray] | None = None
 
-    def forces(self, x: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    def static_forces(self, x: np.ndarray) -> np.ndarray | None:
+        """The reference's static force at every sample's displacement (``static_curve``)."""
+        if self.model is None:
+            return None
+        with self._lock:
+            if "static curve" not in self._cache:
+                self._cache["static curve"] = static_curve(self.model.copy(), self.scales.stroke_m)
+            xs, fs = self._cache["static curve"]
+        return np.interp(x, xs, fs)
+
+    def forces(self, x: np.ndarray, lengths: np.ndarray) -> np.ndarray | None:
         """Reference force for each column; only the first ``lengths[b]`` samples are real."""
+        if self.model is None:
+            return None
         keys = [hashlib.sha1(x[: lengths[b], b].tobytes()).hexdigest() for b in range(x.shape[1])]
         with self._lock:
             found = {b: self._cache.get(key) for b, key in enumerate(keys)}
         missing = [b for b, got in found.items() if got is None]
         if missing:
-            fr_new = self.model.simulate(np.ascontiguousarray(x[:, missing]))
+            fr_new = simulate_or_nan(self.model, np.ascontiguousarray(x[:, missing]))
             with self._lock:
                 for j, b in enumerate(missing):
                     found[b] = fr_new[: lengths[b], j].copy()
                     self._cache[keys[b]] = found[b]
                 while len(self._cache) > REFERENCE_CACHE_SIZE:
-                    self._cache.popitem(last=False)
+                    oldest = next(iter(self._cache))
+                    curve = self._cache.pop(oldest)
+                    if oldest == "static curve":  # kept: it serves every profile
+                        self._cache["static curve"] = curve
         out = np.empty_like(x)
         for b, cached in found.items():
             out[: lengths[b], b] = cached
@@ -94,19 +118,24 @@ class BatchEvaluator:
     def __init__(
         self,
         model: BushingModel,
-        reference: BushingModel,
+        reference: BushingModel | None,
         target: str | Target = "rig",
         threads: int = 1,
         axis: str = "axial",
         dtype: str = "float64",
+        scales: BushingScales = MACHINE,
     ) -> None:
-        if abs(model.dt - reference.dt) > DT_TOLERANCE * model.dt:
+        self.target = get_target(target)
+        if reference is None and not self.target.reference_free:
+            raise SearchError(
+                f"the {self.target.name} target needs a reference (its twin runs on it)"
+            )
+        if reference is not None and abs(model.dt - reference.dt) > DT_TOLERANCE * model.dt:
             raise SearchError(
                 f"the model runs at {1 / model.dt:.6g} Hz (dt {model.dt:.6g} s), the reference "
                 f"at {1 / reference.dt:.6g} Hz (dt {reference.dt:.6g} s): a verdict needs both "
                 "at one rate"
             )
-        self.target = get_target(target)
         if dtype not in ("float64", "float32"):
             raise SearchError(f"dtype must be 'float64' or 'float32', got {dtype!r}")
         if dtype == "float32" and not (isinstance(model, NarxBushing) and self.target.float32):
@@ -115,6 +144,7 @@ class BatchEvaluator:
                 f"on the {self.target.name}"
             )
         self.dtype = dtype
+        self.scales = scales
         self.model = model
         self.reference = reference
         self.dt = model.dt
@@ -126,13 +156,15 @@ class BatchEvaluator:
         cache: OrderedDict[str, np.ndarray] = OrderedDict()
         lock = threading.Lock()
         self._copies = [
-            (model.copy(), ReferenceRuns(reference.copy(), cache, lock))
+            (model.copy(), ReferenceRuns(reference and reference.copy(), cache, lock, scales))
             for _ in range(self.threads)
         ]
 
     def _run_chunk(self, k: int, x: np.ndarray, lengths: np.ndarray) -> Responses:
         model, ref = self._copies[k]
-        return self.target.responses(model, ref, x, lengths, self.dt, self.axis, self.dtype)
+        return self.target.responses(
+            model, ref, x, lengths, self.dt, self.axis, self.dtype, self.scales
+        )
 
     def evaluate(self, profiles: list[np.ndarray]) -> BatchResult:
         """Judge every profile; counts ``len(profiles)`` model evaluations."""
@@ -153,7 +185,7 @@ class BatchEvaluator:
         verdict = _merge_verdicts([p.verdict for p in parts])
         xs = np.concatenate([p.x for p in parts], axis=1)
         fm = np.concatenate([p.f_model for p in parts], axis=1)
-        fr = np.concatenate([p.f_ref for p in parts], axis=1)
+        fr = None if parts[0].f_ref is None else np.concatenate([p.f_ref for p in parts], axis=1)
         self.n_evaluations += B
         self.seconds += time.perf_counter() - t0
         return BatchResult(xs, lengths, fm, fr, verdict, profiles=x)
@@ -186,4 +218,6 @@ def _merge_verdicts(parts: list[Verdict]) -> Verdict:
             for k in parts[0].criterion_robustness
         },
         scale_n=cat([p.scale_n for p in parts]),
+        criteria_run=parts[0].criteria_run,
+        reference_unusable=cat([p.reference_unusable for p in parts]),
     )

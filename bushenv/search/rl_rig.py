@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from bushenv.divergence import CLOSURE_FRACTION, FORCE_FLOOR_N, SETTLE_FRACTION
+from bushenv.divergence import CLOSURE_FRACTION, SETTLE_FRACTION
+from bushenv.scales import MACHINE
 from bushenv.search.base import SearchError
 from bushenv.search.rl import (
     DENSE_CAP,
@@ -27,13 +28,17 @@ def rig_agent_env(evaluator, n_envs, episode_steps, on_episodes, actions):
     """SB3 ``VecEnv`` of ``n_envs`` rigs driven by an oscillator; episodes judged by
     ``evaluator`` and handed to ``on_episodes(batch)``."""
     reward = DivergenceReward(n_envs, episode_steps, evaluator, on_episodes)
+    # With no reference the rig runs the model beside itself (the dense term is then zero);
+    # the episodes are judged by the evaluator, reference-free.
+    reference = evaluator.reference if evaluator.reference is not None else evaluator.model
     venv = _rig_vec_env(
         evaluator.model.copy(),
-        evaluator.reference.copy(),
+        reference.copy(),
         evaluator.axis,
         n_envs,
         episode_steps,
         reward,
+        evaluator.scales,
     )
     return _oscillator_env(_sb3_vec_env(venv), reward, venv.params, actions)
 
@@ -61,12 +66,13 @@ class DivergenceReward:
         self.n = n_envs
         self.episode_steps = episode_steps
         self.evaluator = evaluator
+        self.floor = (evaluator.scales if evaluator is not None else MACHINE).force_floor_n
         self.on_episodes = on_episodes
         self.reset()
 
     def reset(self) -> None:
         self.xs: list[list[float]] = [[] for _ in range(self.n)]
-        self.peak = np.full(self.n, FORCE_FLOOR_N)
+        self.peak = np.full(self.n, self.floor)
         # judged already; the env's next-step autoreset calls us once more before resetting
         self.finished = np.zeros(self.n, dtype=bool)
         # x, F_model, F_ref at the last step; W_model, W_ref, normaliser, span, phi
@@ -79,7 +85,7 @@ class DivergenceReward:
     def reset_columns(self, mask) -> None:
         for i in np.flatnonzero(mask):
             self.xs[i] = []
-            self.peak[i] = FORCE_FLOOR_N
+            self.peak[i] = self.floor
             self.finished[i] = False
         self.acc[:, np.asarray(mask, dtype=bool)] = 0.0
 
@@ -89,7 +95,7 @@ class DivergenceReward:
         dx = x - x_prev
         w_m += 0.5 * (fm + fm_prev) * dx
         w_r += 0.5 * (fr + fr_prev) * dx
-        norm += np.abs(0.5 * (fr + fr_prev) * dx) + FORCE_FLOOR_N * np.abs(dx)
+        norm += np.abs(0.5 * (fr + fr_prev) * dx) + self.floor * np.abs(dx)
         np.maximum(span, np.abs(x), out=span)  # the start deflection is 0 (rig at rest)
         closed = (np.abs(x) <= CLOSURE_FRACTION * span) & (span > 0) & (norm > 0)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -216,7 +222,7 @@ def _oscillator_env(venv, reward, params, mode):
     return OscillatorActions()
 
 
-def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward):
+def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward, scales=MACHINE):
     import gymnasium as gym
 
     import bushenv  # noqa: F401  (registers BushRig-v0)
@@ -230,7 +236,20 @@ def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward):
         axis=axis,
         episode_steps=episode_steps,
         reward_fn=reward,
+        **_limits_kwargs(scales),
     )
+
+
+def _limits_kwargs(scales) -> dict:
+    """BushRig-v0 keyword arguments for the bushing's limits (none for the machine's own, so
+    the env's spec defaults stand)."""
+    if scales == MACHINE:
+        return {}
+    return {
+        "max_displacement_m": scales.stroke_m,
+        "max_velocity_m_per_s": scales.velocity_m_per_s,
+        "force_limit_n": scales.force_limit_n,
+    }
 
 
 def _sb3_vec_env(venv):

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bushenv.divergence import FORCE_FLOOR_N
+from bushenv.scales import FORCE_FLOOR_N
 from bushenv.search.rl import DENSE_CAP, ROAD_ACTION_SCALE, ROAD_DEAD_ZONE, ROBUSTNESS_CLIP
 
 

@@ -20,6 +20,7 @@ import numpy as np
 from bushenv.divergence import judge
 from bushenv.models import AXES, get_reference
 from bushenv.models.base import BushingModel
+from bushenv.scales import MACHINE
 
 
 def quarter_car_responses(
@@ -29,6 +30,7 @@ def quarter_car_responses(
     lengths: np.ndarray,
     dt: float,
     axis: str,
+    scales=MACHINE,
 ):
     """(Verdict, x_model, f_model, f_ref, None) for (T, B) roads; see the module docstring."""
     from bushenv.rigs.quartercar import check_road
@@ -55,7 +57,7 @@ def quarter_car_responses(
     judged = np.maximum(1, np.minimum(lengths, limit_at))
     x, x_ref = rows[keys[0]], rows[keys[1]]
     fm, fr = rows[keys[2]], rows[keys[3]]
-    verdict = judge(x, fm, fr, dt, lengths=judged, x_ref=x_ref, hold_input=h)
+    verdict = judge(x, fm, fr, dt, lengths=judged, x_ref=x_ref, hold_input=h, scales=scales)
     return verdict, x, fm, fr, None
 
 

@@ -43,7 +43,10 @@ class RandomSearch(Searcher):
             n = min(self.batch_size, budget - done)
             picks = rng.integers(0, len(fams), size=n)
             us = [rng.random(fams[i].dim) for i in picks]
-            profiles = [fams[i].profile(u, evaluator.dt) for i, u in zip(picks, us, strict=True)]
+            lim = evaluator.scales
+            profiles = [
+                fams[i].profile(u, evaluator.dt, limits=lim) for i, u in zip(picks, us, strict=True)
+            ]
             batch = evaluator.evaluate(profiles)
             recorder.record(batch, [fams[i].name for i in picks], [u.tolist() for u in us])
             done += n
@@ -80,7 +83,7 @@ class CMASearch(Searcher):
                 xs = es.ask()
                 n = min(len(xs), budget - done)
                 xs_eval = [np.clip(np.asarray(u), 0.0, 1.0) for u in xs[:n]]
-                profiles = [fam.profile(u, evaluator.dt) for u in xs_eval]
+                profiles = [fam.profile(u, evaluator.dt, limits=evaluator.scales) for u in xs_eval]
                 batch = evaluator.evaluate(profiles)
                 fams = [_family_label(fam, u) for u in xs_eval]
                 recorder.record(batch, fams, [u.tolist() for u in xs_eval])

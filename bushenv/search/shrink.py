@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.families import VMAX
+from bushenv.search.families import SPEED_MARGIN
 
 SCALES = (0.5, 0.7, 0.85, 0.95)
 MIN_CHUNK_S = 0.05
@@ -79,23 +79,23 @@ class ShrinkResult:
         }
 
 
-def _join(a: float, b: float, dt: float) -> np.ndarray:
+def _join(a: float, b: float, dt: float, vmax: float) -> np.ndarray:
     """Half-cosine move from a (excluded) to b (included) at half the velocity limit."""
     dist = abs(b - a)
     if dist < 1e-12:
         return np.zeros(0)
-    n = max(1, math.ceil(dist * math.pi / 2 / (0.5 * VMAX * dt)))
+    n = max(1, math.ceil(dist * math.pi / 2 / (0.5 * vmax * dt)))
     s = np.arange(1, n + 1) / n
     return a + (b - a) * 0.5 * (1.0 - np.cos(np.pi * s))
 
 
-def _candidates(x: np.ndarray, dt: float, finish) -> list[np.ndarray]:
+def _candidates(x: np.ndarray, dt: float, finish, vmax: float) -> list[np.ndarray]:
     T = x.size
     out: list[np.ndarray] = []
     for k in range(1, 8):  # collapse the start: one move straight to where the profile is at a
         a = k * T // 8
         if 1 < a < T - 1:
-            out.append(np.concatenate([[0.0], _join(0.0, x[a], dt), x[a + 1 :]]))
+            out.append(np.concatenate([[0.0], _join(0.0, x[a], dt, vmax), x[a + 1 :]]))
             out.append(np.concatenate([x[:a], np.full(T - a, x[a - 1])]))  # hold from a on
     min_chunk = max(2, int(round(MIN_CHUNK_S / dt)))
     chunk = T // 2
@@ -104,7 +104,7 @@ def _candidates(x: np.ndarray, dt: float, finish) -> list[np.ndarray]:
             b = min(T - 1, a + chunk)
             if b <= a:
                 continue
-            join = _join(x[a - 1], x[b], dt)
+            join = _join(x[a - 1], x[b], dt, vmax)
             out.append(np.concatenate([x[:a], join[:-1], x[b:]]))  # delete [a, b)
             n_join = join.size
             if b - a > n_join:  # flatten [a, b): hold, then move to x[b]
@@ -137,7 +137,12 @@ def shrink(
     last bit of rounding (e.g. the corpus's float32 storage). The input must fail; otherwise
     ValueError.
     """
-    finish = evaluator.target.finish
+    lim = evaluator.scales
+    vmax = lim.velocity_m_per_s * SPEED_MARGIN
+
+    def finish(c: np.ndarray, dt: float) -> np.ndarray:
+        return evaluator.target.finish(c, dt, lim)
+
     dt = evaluator.dt
     x = np.asarray(profile, dtype=np.float64).copy()
     start_evals = evaluator.n_evaluations
@@ -169,7 +174,7 @@ def shrink(
         row = first.verdict.row(0)
     rounds = 0
     while evaluator.n_evaluations - start_evals < budget - 1:  # one kept for the final check
-        cands = _candidates(x, dt, finish)
+        cands = _candidates(x, dt, finish, vmax)
         room = budget - 1 - (evaluator.n_evaluations - start_evals)
         cands = [c for c in cands if complexity(c) < complexity(x)][:room]
         if not cands:

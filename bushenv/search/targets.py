@@ -22,6 +22,7 @@ from bushenv import excitation as ex
 from bushenv.divergence import Verdict, judge
 from bushenv.models.base import BushingModel, velocity_of
 from bushenv.registry import Registry
+from bushenv.scales import MACHINE
 from bushenv.search.base import SearchError
 from bushenv.search.families import FAMILIES, Family
 from bushenv.search.roads import quarter_car_responses
@@ -47,6 +48,8 @@ class Target:
     default_searchers: tuple[str, ...] = ()
     float32 = False  # NARX models may run in float32 on this target
     paper_step = False  # the papers' 4 mm step applies (prescribed displacement)
+    reference_free = False  # can judge a model with no reference (criteria that need none)
+    judges_static = False  # holds are of the bushing itself (the static criterion applies)
 
     def families(self) -> list[Family]:
         return [f for f in FAMILIES.values() if f.target == self.name]
@@ -66,11 +69,13 @@ class Target:
             )
         return fam
 
-    def finish(self, x: np.ndarray, dt: float) -> np.ndarray:
+    def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
         """``x`` kept within the env's limits (a shrinking move may step outside them)."""
         return x
 
-    def responses(self, model, reference, x, lengths, dt, axis, dtype="float64") -> Responses:
+    def responses(
+        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
+    ) -> Responses:
         raise NotImplementedError
 
     def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
@@ -87,18 +92,24 @@ class RigTarget(Target):
     default_searchers = ("random", "cma", "ppo", "sac")
     float32 = True
     paper_step = True
+    reference_free = True
+    judges_static = True
 
-    def finish(self, x: np.ndarray, dt: float) -> np.ndarray:
-        return ex.clip_to_limits(x, dt)
+    def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
+        return ex.clip_to_limits(x, dt, limits.stroke_m, limits.velocity_m_per_s)
 
-    def responses(self, model, reference, x, lengths, dt, axis, dtype="float64") -> Responses:
+    def responses(
+        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
+    ) -> Responses:
         """``reference`` is a ``ReferenceRuns`` (its forces are cached by profile)."""
         if dtype == "float32":
             fm = model.simulate(x, dtype="float32").astype(np.float64)
         else:
             fm = simulate_or_nan(model, x)
         fr = reference.forces(x, lengths)
-        return Responses(judge(x, fm, fr, dt, lengths=lengths), x, fm, fr)
+        fs = reference.static_forces(x)
+        verdict = judge(x, fm, fr, dt, lengths=lengths, scales=scales, f_static=fs)
+        return Responses(verdict, x, fm, fr)
 
     def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
         from bushenv.search.rl_rig import rig_agent_env
@@ -116,8 +127,12 @@ class QuarterCarTarget(Target):
     cma_family = "bump"
     default_searchers = ("random", "cma")
 
-    def responses(self, model, reference, x, lengths, dt, axis, dtype="float64") -> Responses:
-        verdict, xm, fm, fr, _ = quarter_car_responses(model, reference.model, x, lengths, dt, axis)
+    def responses(
+        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
+    ) -> Responses:
+        verdict, xm, fm, fr, _ = quarter_car_responses(
+            model, reference.model, x, lengths, dt, axis, scales
+        )
         return Responses(verdict, xm, fm, fr)
 
     def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):

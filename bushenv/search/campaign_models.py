@@ -1,0 +1,102 @@
+"""Which models a campaign judges, against what, at which scales.
+
+For the built-in rubber (the reference by default when the model under attack is a registered
+name) the hybrid and the control are the shipped hybrid and the papers' Table-1 linear model.
+For a user's bushing they are models *of that bushing*: the hybrid only when given
+(``--hybrid FILE``), the control a linear model fitted by least squares to the reference's
+response on a random record within the bushing's stroke (with no reference: none, unless
+given). Rows of another bushing's models would say nothing about this one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from bushenv import excitation as ex
+from bushenv.identify.linear import least_squares_kc
+from bushenv.models import MODELS
+from bushenv.models.base import velocity_of
+from bushenv.models.linear import LinearBushing
+from bushenv.scales import BushingScales, scales_of_reference
+
+FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
+CONTROL_RECORD_S = 40.0  # the papers' identification record length (seed 000 §4.1)
+
+
+def roles(config, notes: list[str]) -> list[tuple[str, str]]:
+    """(role, spec) for the target, the hybrid (when there is one) and the control."""
+    builtin = builtin_reference(config)
+    out = [("target", config.model)]
+    if config.hybrid is not None:
+        out.append(("hybrid", config.hybrid))
+    elif builtin:
+        out.append(("hybrid", "hybrid"))
+    else:
+        notes.append(
+            "no hybrid row: the shipped hybrid is a model of the built-in rubber, not of this "
+            "bushing (give yours with --hybrid FILE)"
+        )
+    if config.control is not None:
+        out.append(("control", config.control))
+    elif builtin:
+        out.append(("control", "linear"))
+    elif config.reference is not None:
+        notes.append(
+            "control: a linear model fitted by least squares to the reference's response to a "
+            f"{CONTROL_RECORD_S:.0f} s random record within the bushing's stroke"
+        )
+        out.append(("control", FITTED_CONTROL))
+    else:
+        notes.append(
+            "no control row: without a reference there is no bushing to fit a linear control "
+            "to (give --reference, or --control FILE)"
+        )
+    return out
+
+
+def builtin_reference(config) -> bool:
+    """The campaign judges against the built-in rubber: asked for, or by default for a
+    registered model (the shipped models are models of it)."""
+    if config.reference is None:
+        return config.model in MODELS
+    return config.reference == "rubber"
+
+
+def reference_spec(config) -> str | None:
+    """The reference the campaign is judged against: as given; by default the rubber for a
+    registered model; None (judged without one) for a model file."""
+    if config.reference is None:
+        return "rubber" if config.model in MODELS else None
+    return config.reference
+
+
+def campaign_scales(config, reference, builtin: bool) -> BushingScales:
+    """The reference's scales (``bushenv.scales``), with the flags' values on top."""
+    scales = scales_of_reference(reference, builtin)
+    flags = {
+        "stroke_m": None if config.stroke_mm is None else config.stroke_mm * 1e-3,
+        "velocity_m_per_s": config.max_velocity_m_per_s,
+        "force_floor_n": config.force_floor_n,
+        "force_scale_n": config.force_scale_n,
+    }
+    given = {k: v for k, v in flags.items() if v is not None}
+    if not given:
+        return scales
+    return replace(scales, **given, source=scales.source + f"; flags: {sorted(given)}")
+
+
+def fitted_linear(source, scales: BushingScales, seed: int = 0) -> LinearBushing:
+    """Least-squares Kelvin-Voigt fit of ``source``'s response to an n = 1 random record
+    scaled to the bushing's stroke (the papers' n = 1 peak is 2 mm of a 12.5 mm stroke)."""
+    dt = source.dt
+    x = ex.random_rpc(1.0, CONTROL_RECORD_S, dt, seed)
+    x = x * (scales.stroke_m / ex.MAX_DISPLACEMENT_M)
+    speed = np.max(np.abs(np.diff(x))) / dt
+    if speed > scales.velocity_m_per_s:
+        x = x * (scales.velocity_m_per_s / speed)
+    v = velocity_of(x, dt)
+    f = source.copy().simulate(x, v)
+    k, c = least_squares_kc(x, f, v)
+    return LinearBushing(k_n_per_m=k, c_ns_per_m=c, dt=dt)
