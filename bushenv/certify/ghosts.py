@@ -24,7 +24,7 @@ import numpy as np
 
 from bushenv.certify.network import NarxNet, diagonal, lag_gradients
 
-GHOST_CELLS = 1024  # grid on which phi's extrema are located (then refined)
+GHOST_CELLS = 512  # grid on which phi's extrema are located (then refined)
 MIN_PASSAGE_S = 0.05  # ghosts passed faster than this (10 samples at 204.8 Hz) are not kept
 FLOW_POINTS = 2001  # quadrature points of slow_flow_time
 

@@ -40,9 +40,15 @@ ACCELERATION = 3.0  # leaving: the fastest sample after the plateau vs its mean 
 def step_profiles(x_m: np.ndarray, hold_s: float, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """(T, M) step-and-hold profiles (shorter ones padded with their hold) and (M,) indices
     of the first sample at the held value."""
-    cols = [step_item(float(x), hold_s, dt, pre_s=STEP_PRE_S).x for x in np.atleast_1d(x_m)]
-    T = max(c.size for c in cols)
-    prof = np.stack([np.pad(c, (0, T - c.size), mode="edge") for c in cols], axis=1)
+    # the machine's step with a short hold, then the rest of the hold: the same samples as
+    # step_item(x, hold_s, ...) without building a whole profile per hold
+    short = min(0.1, hold_s)
+    heads = [step_item(float(x), short, dt, pre_s=STEP_PRE_S).x for x in np.atleast_1d(x_m)]
+    T = max(h.size for h in heads) + int(round((hold_s - short) / dt))
+    prof = np.empty((T, len(heads)))
+    for i, (h, x) in enumerate(zip(heads, np.atleast_1d(x_m), strict=True)):
+        prof[: h.size, i] = h
+        prof[h.size :, i] = x
     start = np.argmax(prof == prof[-1], axis=0)
     return prof, start
 

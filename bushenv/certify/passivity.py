@@ -51,10 +51,14 @@ def dynamic_stiffness(
     a, b = lag_gradients(net, net.held_preactivation(x_m), y)
     w_t = 2.0 * np.pi * np.asarray(freq_hz, dtype=np.float64) * net.dt_s
     zinv = np.exp(-1j * w_t)
-    pow_b = zinv[:, None] ** np.arange(b.shape[1])  # (F, n_past_x + 1)
-    pow_a = zinv[:, None] ** np.arange(1, a.shape[1] + 1)  # (F, n_past_f)
-    num = b @ pow_b.T
-    den = 1.0 - a @ pow_a.T
+    # B and A term by term (a handful of lags): a (P, lags) @ (lags, F) product goes through
+    # multi-threaded BLAS, which on a loaded machine is 20-50 times slower than this loop
+    num = np.zeros((x_m.size, w_t.size), dtype=complex)
+    for j in range(b.shape[1]):
+        num += b[:, j : j + 1] * zinv**j
+    den = np.ones((x_m.size, w_t.size), dtype=complex)
+    for j in range(a.shape[1]):
+        den -= a[:, j : j + 1] * zinv ** (j + 1)
     if velocity == "central":
         v = (1.0 / zinv - zinv) / (2.0 * net.dt_s)
     else:
@@ -66,20 +70,14 @@ def negative_bands(freq_hz: np.ndarray, values: np.ndarray) -> list[tuple[float,
     """Intervals of ``freq_hz`` (F,) ascending where ``values`` (F,) < 0, edges found by linear
     interpolation of the zero crossings; an interval open at a grid end stops there."""
     f, v = np.asarray(freq_hz, dtype=np.float64), np.asarray(values, dtype=np.float64)
-    neg = v < 0
+    neg = np.concatenate([[False], v < 0, [False]]).astype(np.int8)
+    starts = np.flatnonzero(np.diff(neg) == 1)  # first negative index of each run
+    ends = np.flatnonzero(np.diff(neg) == -1) - 1  # last negative index
     bands = []
-    k = 0
-    while k < f.size:
-        if not neg[k]:
-            k += 1
-            continue
-        j = k
-        while j + 1 < f.size and neg[j + 1]:
-            j += 1
+    for k, j in zip(starts, ends, strict=True):
         lo = f[k] if k == 0 else f[k - 1] + (f[k] - f[k - 1]) * v[k - 1] / (v[k - 1] - v[k])
         hi = f[j] if j == f.size - 1 else f[j] + (f[j + 1] - f[j]) * v[j] / (v[j] - v[j + 1])
         bands.append((float(lo), float(hi)))
-        k = j + 1
     return bands
 
 
@@ -118,11 +116,20 @@ def sine_stiffness(
     skip = int(round(SKIP_S / model.dt))
     t = np.arange(x.shape[0] - k0) * model.dt
     sel = slice(skip, t.size - 1)
-    ts, fs = t[sel], f[k0:][sel]
-    out = np.empty(freq_hz.size, dtype=complex)
-    for i, fr in enumerate(freq_hz):
-        w = 2.0 * np.pi * fr
-        basis = np.stack([np.sin(w * ts), np.cos(w * ts), np.ones_like(ts), ts - ts.mean()], 1)
-        coef, *_ = np.linalg.lstsq(basis, fs[:, i], rcond=None)
-        out[i] = (coef[0] + 1j * coef[1]) / amplitude_m
-    return out
+    ts, fs = t[sel], f[k0:][sel]  # (N,), (N, F)
+    w = 2.0 * np.pi * freq_hz
+    ph = np.outer(ts, w)
+    basis = np.stack(  # (N, F, 4)
+        [
+            np.sin(ph),
+            np.cos(ph),
+            np.ones_like(ph),
+            np.broadcast_to((ts - ts.mean())[:, None], ph.shape),
+        ],
+        axis=-1,
+    )
+    # normal equations per frequency, all at once (well conditioned: near-orthogonal columns)
+    gram = np.einsum("nfi,nfj->fij", basis, basis)
+    rhs = np.einsum("nfi,nf->fi", basis, fs)
+    coef = np.linalg.solve(gram, rhs[..., None])[..., 0]
+    return (coef[:, 0] + 1j * coef[:, 1]) / amplitude_m
