@@ -27,11 +27,15 @@ from bushenv.certify.passivity import (
     negative_bands,
     sine_stiffness,
 )
+from bushenv.search.divergence import FORCE_FLOOR_N
 
 # A sign is meaningful above 10 N: over 3 sigma of the reference rubber's load-cell noise
 # (sigma <= 3 N, radial) and below the force of the smallest hold that matters (0.05 mm x
 # 380 N/mm = 19 N, seed 000 Table 1).
 SIGN_FLOOR_N = 10.0
+# Off in size (issue 15's ``static`` criterion): the static force differs from the reference's
+# by more than half of it plus the judge's force floor (search.divergence.FORCE_FLOOR_N).
+STATIC_FRACTION = 0.5
 K_POINTS = 512  # frequencies of the analytic K, 0 to Nyquist (0.2 Hz apart at 204.8 Hz)
 
 
@@ -40,6 +44,7 @@ class CertifyOptions:
     """Settings of :func:`certify` (SI units)."""
 
     holds: int = 201
+    extra_holds_m: tuple[float, ...] = ()  # held displacements added to the grid
     stroke_m: float = 12.5e-3  # the machine's +-12.5 mm (seed 002 Table 1)
     hold_s: float = HOLD_S
     velocity: str = "central"
@@ -56,6 +61,8 @@ class CertifyOptions:
             raise CertifyError(f"stroke must be a positive length, got {self.stroke_m!r} m")
         if not (np.isfinite(self.hold_s) and self.hold_s >= 2.0):
             raise CertifyError(f"hold must last at least 2 s, got {self.hold_s!r} s")
+        if not np.all(np.isfinite(self.extra_holds_m)):
+            raise CertifyError(f"extra holds must be finite, got {self.extra_holds_m}")
         if not (np.isfinite(self.reference_amplitude_m) and self.reference_amplitude_m > 0):
             raise CertifyError(f"sine amplitude must be positive, got {self.reference_amplitude_m}")
 
@@ -119,6 +126,7 @@ def _hold_entry(net, fp, gh, run, i, ref_n, bands) -> dict:
     static = None if run.reached is None else float(fp.force_n[idx[run.reached]])
     ref = float(ref_n[i])
     wrong = static is not None and static * ref < 0 and min(abs(static), abs(ref)) > SIGN_FLOOR_N
+    off = static is not None and abs(static - ref) > STATIC_FRACTION * abs(ref) + FORCE_FLOOR_N
     g = gh.hold == i
     return {
         "x_m": float(fp.x_m[i]),
@@ -135,11 +143,13 @@ def _hold_entry(net, fp, gh, run, i, ref_n, bands) -> dict:
         "departure_s": run.departure_s,
         "departure_observed": run.observed if run.departs else None,
         "departs_from": run.departs_from,
+        "linger_force_n": run.linger_force_n,
         "oscillates": run.oscillates,
         "static_force_n": static,
         "reference_static_force_n": ref,
         "static_error_n": None if static is None else static - ref,
         "wrong_sign": bool(wrong),
+        "static_off": bool(off),
         "ghosts": [
             {"force_n": float(net.force_n(fp.x_m[i], y)), "passage_s": float(s)}
             for y, s in zip(gh.y[g], gh.passage_s[g], strict=True)
@@ -248,7 +258,7 @@ def certify(
         return time.perf_counter()
 
     t = stage("fixed points")
-    x = np.linspace(-opts.stroke_m, opts.stroke_m, opts.holds)
+    x = np.unique(np.r_[np.linspace(-opts.stroke_m, opts.stroke_m, opts.holds), opts.extra_holds_m])
     fp = fixed_points(net, x)
     gh = ghosts(net, x)
     fo = folds(net, fp)
@@ -312,6 +322,8 @@ def _document(net, opts, holds, fo, pas, scan, timing) -> dict:
         "oscillating_holds": int(sum(h["oscillates"] for h in holds)),
         "wrong_sign_holds": int(wrong.sum()),
         "wrong_sign_ranges_m": _ranges(x, wrong),
+        "static_off_holds": int(sum(h["static_off"] for h in holds)),
+        "static_off_ranges_m": _ranges(x, np.array([h["static_off"] for h in holds])),
         "folds": len(fo),
         "max_reached_spectral_radius": max(rho) if rho else None,
         "unresolved_cells": int(sum(h["unresolved_cells"] for h in holds)),
@@ -336,6 +348,7 @@ def _document(net, opts, holds, fo, pas, scan, timing) -> dict:
             "reference_average_s": AVERAGE_S,
             "velocity": opts.velocity,
             "sign_floor_n": SIGN_FLOOR_N,
+            "static_off": f"|F - F_ref| > {STATIC_FRACTION} |F_ref| + {FORCE_FLOOR_N} N",
             "reference_sine_amplitude_m": opts.reference_amplitude_m,
         },
         "summary": summary,

@@ -66,6 +66,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"holds span -S..+S mm (default: {DEFAULTS.stroke_m * 1e3:g}, the machine's)",
     )
     parser.add_argument(
+        "--at-mm",
+        type=_mm_list,
+        default=(),
+        help="held displacements to certify besides the grid, mm, e.g. 0.53,4 (default: none)",
+    )
+    parser.add_argument(
         "--hold-s",
         type=float,
         default=DEFAULTS.hold_s,
@@ -140,6 +146,7 @@ def run(args: argparse.Namespace) -> int:
     reference = resolve_model(args.reference, args.axis, dt=model.dt)
     opts = CertifyOptions(
         holds=args.holds,
+        extra_holds_m=args.at_mm,
         stroke_m=args.stroke_mm * 1e-3,
         hold_s=args.hold_s,
         velocity=args.velocity,
@@ -155,7 +162,7 @@ def run(args: argparse.Namespace) -> int:
     doc["reference"] = {"source": str(args.reference), "class": type(reference).__name__}
     report("plots", 0.99)
     out.mkdir(parents=True, exist_ok=True)
-    name = f"{args.model} ({args.axis})"
+    name = f"{Path(args.model).name} ({args.axis})"
     paths = [
         static_force_plot(cert, out / "static_force.png", f"{name}: static force in a hold"),
         spectral_radius_plot(cert, out / "spectral_radius.png", f"{name}: hold stability"),
@@ -166,15 +173,24 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _mm_ranges(ranges: list[list[float]]) -> str:
+    return "[" + ", ".join(f"{a * 1e3:+.3g}..{b * 1e3:+.3g} mm" for a, b in ranges) + "]"
+
+
+def _hz_bands(bands: list[list[float]]) -> str:
+    return "[" + ", ".join(f"{a:.1f}-{b:.1f} Hz" for a, b in bands) + "]"
+
+
 def _summary(doc: dict, paths: list[Path]) -> None:
     s = doc["summary"]
     print(
         f"holds: {s['holds']}, settling stably {s['holds_settling_stably']}, departing "
-        f"{s['departing_holds']}, oscillating {s['oscillating_holds']}, wrong sign "
-        f"{s['wrong_sign_holds']} {s['wrong_sign_ranges_m']} m, folds {s['folds']}"
+        f"{s['departing_holds']}, oscillating {s['oscillating_holds']}, folds {s['folds']}; "
+        f"wrong sign {s['wrong_sign_holds']} {_mm_ranges(s['wrong_sign_ranges_m'])}, static "
+        f"force off {s['static_off_holds']} {_mm_ranges(s['static_off_ranges_m'])}"
     )
     print(
-        f"non-passive band at rest: {s['non_passive_bands_hz_at_rest']} Hz; "
+        f"non-passive at rest: {_hz_bands(s['non_passive_bands_hz_at_rest'])}; "
         f"hold certificate {'passes' if s['passes_holds'] else 'FAILS'}, passivity "
         f"{'passes' if s['passes_passivity'] else 'FAILS'}"
     )

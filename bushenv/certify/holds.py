@@ -70,7 +70,8 @@ class HoldRun:
     increasing y) where the run ends, or the one it will reach after a
     predicted departure; None when it oscillates or no fixed point is in its way.
     ``departure_s`` counts from the step; ``observed`` False means predicted.
-    ``departs_from``: "ghost", "unstable fixed point" or None (not explained)."""
+    ``departs_from``: "ghost", "unstable fixed point" or None (not explained).
+    ``linger_force_n``: where a departing run sat before it left (else None), N."""
 
     reached: int | None
     departs: bool
@@ -79,6 +80,7 @@ class HoldRun:
     departs_from: str | None
     oscillates: bool
     final_force_n: float
+    linger_force_n: float | None = None
 
 
 def _windows(y: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
@@ -153,7 +155,8 @@ def hold_run(
             return HoldRun(reached, False, None, True, None, False, final)
         leave, level = dep
         why = _explain(level, ys, stable, ghost_y)
-        return HoldRun(reached, True, leave * dt, True, why, False, final)
+        linger = float(net.force_n(x, level))
+        return HoldRun(reached, True, leave * dt, True, why, False, final, linger)
     if np.ptp(tail[-w:]) >= PLATEAU_RANGE:
         return HoldRun(None, False, None, True, None, True, final)
     # lingering at the end, away from every fixed point: predict when it leaves and where to
@@ -167,7 +170,8 @@ def hold_run(
         reached = int(ahead[0] if direction > 0 else ahead[-1])
     level = float(np.mean(y[-w:]))
     why = _explain(level, ys, stable, ghost_y)
-    return HoldRun(reached, True, (y.size - 1 - step) * dt + remaining, False, why, False, final)
+    departure = (y.size - 1 - step) * dt + remaining
+    return HoldRun(reached, True, departure, False, why, False, final, float(net.force_n(x, level)))
 
 
 def _phi(net: NarxNet, x: float, y: float) -> float:

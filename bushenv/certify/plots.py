@@ -74,15 +74,10 @@ def static_force_plot(cert: Certificate, path: Path, title: str) -> Path:
             lw=0,
             label="wrong sign" if k == 0 else None,
         )
-    dep = [i for i, r in enumerate(cert.runs) if r.departs]
+    dep = [(x_mm[i], r.linger_force_n) for i, r in enumerate(cert.runs) if r.departs]
     if dep:
-        ax.plot(
-            x_mm[dep],
-            [r.final_force_n for r in np.array(cert.runs)[dep]],
-            "x",
-            color="tab:red",
-            label="departs (lingers, then jumps)",
-        )
+        dx, df = np.array(dep).T
+        ax.plot(dx, df, "x", ms=8, color="tab:red", label="departs: lingers here, then jumps")
     _folds(ax, cert)
     ax.axhline(0, color="grey", lw=0.5)
     ax.set_xlabel("held displacement x [mm]")

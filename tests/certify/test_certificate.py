@@ -110,3 +110,18 @@ def test_bad_options_and_mismatched_rates_are_refused():
         certify(fold_nn(), LinearBushing(1e6, 0.0, dt=0.01), CertifyOptions(holds=5))
     with pytest.raises(CertifyError, match="NARX models"):
         certify(LinearBushing(1e6, 0.0), LinearBushing(1e6, 0.0))
+
+
+def test_extra_holds_join_the_grid_and_a_departing_one_says_where_it_lingered():
+    model = fold_nn()
+    hold = fold_u(2.0) * (1 + 1e-4) * X_SCALE_M
+    opts = CertifyOptions(holds=5, stroke_m=1e-3, extra_holds_m=(hold,), **SMALL)
+    doc = certify(model, LinearBushing(1.0e6, 0.0), opts).document
+    x = [h["x_m"] for h in doc["holds"]]
+    assert x == sorted(x) and len(x) == 6 and hold in x
+    h = doc["holds"][x.index(hold)]
+    assert h["departs"] and h["departure_observed"] and h["departs_from"] == "ghost"
+    # it sat near the ghost of the vanished lower pair (y = -sqrt(1/2)), then jumped up
+    ghost_force = model.f_offset_n - np.sqrt(0.5) * model.f_scale_n
+    assert h["linger_force_n"] == pytest.approx(ghost_force, abs=0.05 * model.f_scale_n)
+    assert h["static_force_n"] > 1800
