@@ -157,9 +157,11 @@ def hold_run(
         why = _explain(level, ys, stable, ghost_y)
         linger = float(net.force_n(x, level))
         return HoldRun(reached, True, leave * dt, True, why, False, final, linger)
-    if np.ptp(tail[-w:]) >= PLATEAU_RANGE:
+    last = tail[-w:]
+    reversals = np.count_nonzero(np.diff(np.sign(np.diff(last))) != 0)
+    if np.ptp(last) >= PLATEAU_RANGE and reversals > 2:
         return HoldRun(None, False, None, True, None, True, final)
-    # lingering at the end, away from every fixed point: predict when it leaves and where to
+    # still on its way, away from every fixed point: predict when it leaves and where to
     remaining, moves = slow_flow_time(net, x, float(y[-1]), JUMP)
     if not moves:
         return HoldRun(None, False, None, False, None, False, final)
