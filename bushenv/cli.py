@@ -23,6 +23,7 @@ COMMANDS = {
     "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
     "measure": ("bushenv.machine", "run a test programme on a model and write CSV records"),
+    "certify": ("bushenv.certify.command", "hold-stability and passivity certificates of a NARX"),
 }
 
 

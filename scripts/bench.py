@@ -447,6 +447,49 @@ def bench_float32_verdicts(fig: Figures, quick: bool) -> None:
     )
 
 
+def bench_certify(fig: Figures, quick: bool) -> None:
+    """The certificate of one model over 200 held displacements (issue 17: under 1 s), whole
+    (fixed points, folds, free runs, reference holds, passivity, energy scan; no plots) and
+    its analysis alone (every fixed point, stability, folds, ghosts)."""
+    print("\n== certificates: hold stability and passivity over 200 holds")
+    from bushenv.certify import CertifyOptions, certify, fixed_points, folds, narx_net
+    from bushenv.certify.ghosts import ghosts
+    from bushenv.models import get_model
+
+    holds = 20 if quick else 200
+    min_time = 0.05 if quick else 2.0
+    for axis in ("axial", "radial"):
+        ref = get_model("rubber", axis=axis)
+        for name in ("nn", "hybrid"):
+            model = get_model(name, axis=axis, dt=ref.dt)
+            opts = CertifyOptions(holds=holds)
+            sec = _time_per_call(lambda: certify(model, ref, opts), min_time)  # noqa: B023
+            fig.add(
+                f"certify.{name}.{axis}.holds{holds}",
+                sec,
+                "s",
+                target=1.0,
+                better="lower",
+                note="whole certificate, no plots",
+            )
+            net = narx_net(model)
+            x = np.linspace(-12.5e-3, 12.5e-3, holds)
+
+            def analysis(net=net, x=x):
+                fp = fixed_points(net, x)
+                folds(net, fp)
+                ghosts(net, x)
+
+            sec = _time_per_call(analysis, min_time)
+            fig.add(
+                f"certify.{name}.{axis}.analysis_holds{holds}",
+                sec,
+                "s",
+                better="lower",
+                note="fixed points, stability, folds, ghosts",
+            )
+
+
 def bench_memory(fig: Figures, quick: bool) -> None:
     import gymnasium as gym
 
@@ -489,6 +532,7 @@ SECTIONS = {
     "campaign": bench_campaign,
     "float32": bench_float32_verdicts,
     "memory": bench_memory,
+    "certify": bench_certify,
 }
 
 

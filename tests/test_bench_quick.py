@@ -82,3 +82,28 @@ def test_quick_benchmark_produces_every_figure_with_units_and_targets(tmp_path):
             assert isinstance(r["met"], bool), name
     assert rows["free_run.nn.B1024.threads2"]["target"] == 50e6
     assert "| verification_6.44s.nn |" in md.read_text()
+
+
+def test_quick_certify_benchmark_produces_its_figures(tmp_path):
+    out = tmp_path / "bench.json"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "scripts" / "bench.py"),
+            "--quick",
+            "--only",
+            "certify",
+            "--json",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    rows = {r["name"]: r for r in json.loads(out.read_text())["figures"]}
+    for name in ("nn", "hybrid"):
+        for axis in ("axial", "radial"):
+            r = rows[f"certify.{name}.{axis}.holds20"]
+            assert r["unit"] == "s" and r["target"] == 1.0 and isinstance(r["met"], bool)
+            assert math.isfinite(rows[f"certify.{name}.{axis}.analysis_holds20"]["value"])
