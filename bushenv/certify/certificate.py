@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bushenv.certify import energy as en
+import bushenv.certify.energy as en
 from bushenv.certify.fixed_points import FixedPoints, Fold, fixed_points, folds
 from bushenv.certify.ghosts import Ghosts, ghosts
 from bushenv.certify.holds import AVERAGE_S, HOLD_S, HoldRun, free_runs, reference_static_force
@@ -27,15 +27,14 @@ from bushenv.certify.passivity import (
     negative_bands,
     sine_stiffness,
 )
-from bushenv.search.divergence import FORCE_FLOOR_N
+from bushenv.divergence import static_margin
+from bushenv.scales import FORCE_FLOOR_N
 
 # A sign is meaningful above 10 N: over 3 sigma of the reference rubber's load-cell noise
 # (sigma <= 3 N, radial) and below the force of the smallest hold that matters (0.05 mm x
 # 380 N/mm = 19 N, seed 000 Table 1).
 SIGN_FLOOR_N = 10.0
-# Off in size (issue 15's ``static`` criterion): the static force differs from the reference's
-# by more than half of it plus the judge's force floor (search.divergence.FORCE_FLOOR_N).
-STATIC_FRACTION = 0.5
+# Off in size: outside the divergence criterion ``static``'s band (``static_margin``).
 K_POINTS = 512  # frequencies of the analytic K, 0 to Nyquist (0.2 Hz apart at 204.8 Hz)
 
 
@@ -126,7 +125,7 @@ def _hold_entry(net, fp, gh, run, i, ref_n, bands) -> dict:
     static = None if run.reached is None else float(fp.force_n[idx[run.reached]])
     ref = float(ref_n[i])
     wrong = static is not None and static * ref < 0 and min(abs(static), abs(ref)) > SIGN_FLOOR_N
-    off = static is not None and abs(static - ref) > STATIC_FRACTION * abs(ref) + FORCE_FLOOR_N
+    off = static is not None and float(static_margin(static, ref, FORCE_FLOOR_N)) < 0
     g = gh.hold == i
     return {
         "x_m": float(fp.x_m[i]),
@@ -348,7 +347,8 @@ def _document(net, opts, holds, fo, pas, scan, timing) -> dict:
             "reference_average_s": AVERAGE_S,
             "velocity": opts.velocity,
             "sign_floor_n": SIGN_FLOOR_N,
-            "static_off": f"|F - F_ref| > {STATIC_FRACTION} |F_ref| + {FORCE_FLOOR_N} N",
+            "static_off": "outside the divergence criterion static's band about F_ref "
+            f"(bushenv.divergence.static_margin, floor {FORCE_FLOOR_N} N)",
             "reference_sine_amplitude_m": opts.reference_amplitude_m,
         },
         "summary": summary,

@@ -7,22 +7,21 @@ summary on stdout and progress on stderr.
 from __future__ import annotations
 
 import argparse
-import sys
-import time
 from pathlib import Path
 
 from bushenv.certify.certificate import CertifyOptions, certify
 from bushenv.certify.network import CertifyError, narx_net
 from bushenv.certify.plots import passivity_plot, spectral_radius_plot, static_force_plot
+from bushenv.models import get_model, get_reference
+from bushenv.persist import write_json
+from bushenv.progress import Progress
 
 EXAMPLE = "bushenv certify hybrid --axis radial --reference rubber --out runs/certify-radial"
 DEFAULTS = CertifyOptions()
 
 
 def resolve_model(spec: str, axis: str, dt: float | None = None):
-    """A registered name or a model file -> model (the one place certify resolves names)."""
-    from bushenv.models import get_model
-
+    """A registered name or a model file -> the model to certify."""
     return get_model(spec, axis=axis, dt=dt)
 
 
@@ -111,25 +110,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _progress(quiet: bool):
-    start = time.monotonic()
+    """``report(stage, fraction_done)`` on the shared progress lines (stderr, time left)."""
+    progress = Progress(total=1.0, quiet=quiet, every_s=0.0)
 
     def report(stage: str, fraction: float) -> None:
-        if quiet:
-            return
-        el = time.monotonic() - start
-        left = f", about {el / fraction - el:.0f} s left" if fraction > 0.05 and el > 1.0 else ""
-        print(
-            f"[{el:6.1f} s] {stage} ({100 * fraction:.0f} % done{left})",
-            file=sys.stderr,
-            flush=True,
-        )
+        progress.update(fraction, stage)
 
     return report
 
 
 def run(args: argparse.Namespace) -> int:
-    from bushenv.search.campaign import write_json_atomic
-
     if args.holds < 3:
         raise CertifyError(f"--holds must be >= 3, got {args.holds}")
     out = Path(args.out)
@@ -143,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
         narx_net(model)
     except CertifyError as exc:
         raise CertifyError(f"{args.model}: {exc}") from None
-    reference = resolve_model(args.reference, args.axis, dt=model.dt)
+    reference = get_reference(args.reference, axis=args.axis, dt=model.dt)
     opts = CertifyOptions(
         holds=args.holds,
         extra_holds_m=args.at_mm,
@@ -168,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
         spectral_radius_plot(cert, out / "spectral_radius.png", f"{name}: hold stability"),
         passivity_plot(cert, out / "passivity.png", f"{name}: small-signal Im K"),
     ]
-    write_json_atomic(target, doc)
+    write_json(target, doc)
     _summary(doc, [target, *paths])
     return 0
 

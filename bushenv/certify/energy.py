@@ -3,7 +3,7 @@ linearised non-passive band (``passivity``).
 
 Each profile starts at rest, follows A sin(2 pi f t) for ``DURATION_S`` and then holds its last
 value for ``TAIL_S`` (as the search's sine family ends in a hold); model and reference run the
-same profiles and ``search.divergence.judge`` decides. Amplitudes the machine cannot drive at a
+same profiles and ``bushenv.divergence.judge`` decides. Amplitudes the machine cannot drive at a
 frequency (2 pi f A above ``excitation.MAX_VELOCITY_M_PER_S``) are not run (``None``).
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv import excitation as ex
-from bushenv.search.divergence import judge
+from bushenv.divergence import judge
 
 DURATION_S = 4.0
 TAIL_S = 1.0

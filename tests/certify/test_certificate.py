@@ -12,7 +12,7 @@ from bushenv.certify import (
 )
 from bushenv.certify.certificate import SIGN_FLOOR_N
 from bushenv.models.linear import LinearBushing
-from bushenv.search.campaign import write_json_atomic
+from bushenv.persist import write_json
 
 from .conftest import X_SCALE_M, fold_nn, fold_u, wrong_sign_hybrid
 
@@ -76,7 +76,7 @@ def test_the_fold_model_certificate_lists_its_folds_and_least_stable_holds():
 def test_the_document_is_plain_json_with_the_issues_fields(tmp_path):
     cert = certify(fold_nn(), LinearBushing(1.0e6, 0.0), CertifyOptions(holds=5, **SMALL))
     path = tmp_path / "c.json"
-    write_json_atomic(path, cert.document)
+    write_json(path, cert.document)
     doc = json.loads(path.read_text())
     h = doc["holds"][0]
     for key in (

@@ -7,11 +7,11 @@ from bushenv.certify.fixed_points import fixed_points
 from bushenv.certify.ghosts import ghosts
 from bushenv.certify.holds import JUMP, free_runs, reference_static_force, step_profiles
 from bushenv.certify.network import narx_net
+from bushenv.divergence import judge
 from bushenv.models import get_model
 from bushenv.models.linear import LinearBushing
 from bushenv.models.narx import NarxBushing
 from bushenv.reference.rubber import RubberBushing
-from bushenv.search.divergence import judge
 
 from .conftest import X_SCALE_M, fold_hybrid, fold_nn, fold_u
 

@@ -4,9 +4,9 @@ import pytest
 from bushenv.certify.fixed_points import fixed_points
 from bushenv.certify.network import CertifyError, narx_net
 from bushenv.certify.passivity import dynamic_stiffness, negative_bands, sine_stiffness
+from bushenv.divergence import cumulative_work
 from bushenv.models import get_model
 from bushenv.models.hybrid import HybridBushing
-from bushenv.search.divergence import cumulative_work
 
 from .conftest import fold_hybrid, random_narx
 
