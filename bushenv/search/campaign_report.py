@@ -119,7 +119,7 @@ def _search_row(key: str, role: str, name: str, s: dict[str, Any]) -> str:
     stf = f"{s['seconds_to_failure']:.2f}" if s["diverged"] else "-"
     wds = f"{wd:.3g}" if wd is not None else "-"
     return (
-        f"{key:<10} {role:<8} {name:<8} {s['evaluations']:>6} "
+        f"{key:<10} {role:<8} {name:<11} {s['evaluations']:>6} "
         f"{'YES' if s['diverged'] else 'no':>8} "
         f"{s['evaluations_to_failure'] or '-':>11} "
         f"{stf:>8} {wds:>9} {s['worst_robustness']:>10.3g} {fam}"
@@ -159,7 +159,7 @@ COLUMNS = (
 def format_table(report: dict[str, Any], target_key: str) -> str:
     """The campaign as a plain-text table, the recheck and the shrunk failures."""
     head = (
-        f"{'model':<10} {'role':<8} {'searcher':<8} {'evals':>6} {'diverged':>8} "
+        f"{'model':<10} {'role':<8} {'searcher':<11} {'evals':>6} {'diverged':>8} "
         f"{'evals->fail':>11} {'s->fail':>8} {'worst dev':>9} {'robustness':>10} "
         f"{'failing family (criterion)'}"
     )

@@ -8,6 +8,8 @@
 |          | cube, by default the target's (the rig's ``any``, whose first coordinate picks    |
 |          | the family); a generation is one batch; restarts from a new random mean when it   |
 |          | stalls                                                                            |
+| certificate | steps to the holds and sines in the bands the model's certificates find     |
+|          | weakest (``bushenv.search.guided``; a sweep for models it cannot read)           |
 | ppo, sac | stable-baselines3 agents acting sample by sample in the target's vector env      |
 |          | (``bushenv.search.rl``)                                                           |
 
@@ -122,6 +124,13 @@ class SearcherEntry:
 SEARCHERS: Registry[SearcherEntry] = Registry("searcher", SearchError)
 SEARCHERS.add("random", SearcherEntry(RandomSearch, "uniform random families and parameters"))
 SEARCHERS.add("cma", SearcherEntry(CMASearch, "CMA-ES over the target's search family"))
+SEARCHERS.add(
+    "certificate",
+    SearcherEntry(
+        "bushenv.search.guided:CertificateSearch",
+        "steps to the holds and sines in the bands the model's certificates find weakest",
+    ),
+)
 SEARCHERS.add(
     "ppo",
     SearcherEntry("bushenv.search.rl:PPOSearch", "PPO agent (SB3)", episodes=True, cost=8.0),

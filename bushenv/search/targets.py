@@ -89,7 +89,7 @@ class RigTarget(Target):
     env_id = "BushRig-v0"
     profile_label = "deflection [mm]"
     cma_family = "any"
-    default_searchers = ("random", "cma", "ppo", "sac")
+    default_searchers = ("random", "cma", "certificate", "ppo", "sac")
     float32 = True
     paper_step = True
     reference_free = True
