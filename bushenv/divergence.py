@@ -8,7 +8,8 @@ reference force ``f_ref`` [N], sample time ``dt`` [s]. Profiles shorter than T a
 ``lengths`` (samples past a profile's length are ignored), so a padded batch judges each profile
 exactly as if it ran alone (models are causal).
 
-The force scale of a profile is ``scale = max(max_t |f_ref|, FORCE_FLOOR_N)``.
+The force scale of a profile is ``scale = max(max_t |f_ref|, floor)``; the floor and the rig's
+force limit are the bushing's (``bushenv.scales``: the papers' machine by default).
 
 | criterion        | flagged when                                                           |
 |------------------|------------------------------------------------------------------------|
@@ -22,10 +23,20 @@ The force scale of a profile is ``scale = max(max_t |f_ref|, FORCE_FLOOR_N)``.
 |                  | ``W(t) = int_0^t f dx``, is below ``min(0, min W_ref)`` minus 5 % of   |
 |                  | the reference's total absolute work (at least 200 N x the travel): it  |
 |                  | gave back more energy than it took                                     |
+| ``static``       | in a hold, after 1 s, the model's force is not along the reference's   |
+|                  | static force at that displacement (``static_curve``) or holds less     |
+|                  | than 0.5 or more than 2.5 times it, each widened by the floor and by   |
+|                  | how far the reference's own history moved its force (``static_margin``)|
+
+Without a reference (``f_ref=None``) the criteria that compare with one (``deviation``,
+``static``) do not run; ``energy`` then asks that the model's own work never go below zero at a
+return, and the scale is the bushing's typical peak force. A profile on which the reference
+itself is not finite gets no verdict (``reference_unusable``).
 
 Why these constants (all physical, none tuned on a model; the linear model and the reference
 itself are the control: no profile the search can produce may flag them, see
-``tests/search/test_divergence.py`` and the campaign's ``linear`` rows):
+``tests/test_divergence.py``, ``tests/search/test_references.py`` and the campaign's
+``linear`` rows):
 
 - ``FORCE_FLOOR_N = 200``: the resolution at which the models mean anything. The papers'
   smallest test amplitude is 0.5 mm (seed 001 §3.2.1), where the axial bushing gives
@@ -51,6 +62,11 @@ itself are the control: no profile the search can produce may flag them, see
   the papers' NN "diverges after 7.3 s" of a 4 mm step hold (seed 000 §5.2). The first second
   of a hold -- one period of the lowest frequency of the papers' harmonic programme (1 Hz,
   seed 001 §3.2.1) -- is left for a stable model's transient to die out.
+- ``STATIC_LOW_FRACTION = 0.5``, ``STATIC_HIGH_FACTOR = 2.5``: a held force of the wrong
+  sign, or below half of what the real part holds at that displacement, is no bushing (NARX
+  models trained the papers' way hold -1044 N where the rubber holds +927 N); above, filled
+  rubber's dynamic-to-static stiffness ratio reaches 2.5, so a model identified on dynamic
+  records may hold up to that much (the Table-1 linear model holds 1.65 times the rubber).
 - ``ENERGY_TOLERANCE_FRACTION = 0.05`` at returns within ``CLOSURE_FRACTION = 2 %`` of the
   deflection range to the start: a passive element starting at rest satisfies
   ``int f dx >= 0`` (work in = stored + dissipated, both >= 0). Rubber dissipates ~10 % of the

@@ -1,54 +1,21 @@
 """Reinforcement-learning searchers: stable-baselines3 PPO and SAC acting in the target's env.
 
-The environment the agents act in belongs to the target (``targets.py``): the rig's is built in
-``rl_rig.py``, the quarter car's in ``rl_road.py``.
+The environment the agents act in belongs to the target (``targets.py``): on the rig
+(``rl_rig.py``) ``N_ENVS`` rigs of BushRig-v0's vector env, steered through an oscillator --
+the episode's first action sets a sine's frequency and amplitude, later ones move them -- because
+the NN's failures need many coherent cycles, which a policy on raw displacement steps does not
+find (docs/search.md measured why); on the quarter car (``rl_road.py``) the road under the
+wheel, with a gentler action than the env's.
 
-The agents act sample by sample in BushRig-v0, ``N_ENVS`` (32) rigs at once through the rig's
-vector env (``gym.make_vec(..., vectorization_mode="vector_entry_point")``: the models' batched
-kernels, ~40 us per rig-step instead of ~600 us for a wrapped single env), adapted to SB3's
-``VecEnv`` by ``RigVecEnv`` and steered through ``OscillatorActions``: the episode's first action
-sets the frequency and amplitude of a sine, later ones move them ("rate") or set targets they
-follow ("follow"), and the rig is sent the velocity action that tracks the sine (within the
-machine's stroke and velocity limit; at the lowest amplitude the rig holds). Why not the rig's
-raw action (the displacement change per step): a Gaussian policy on it draws white-noise random
-walks, and measured on the shipped NN, 64 such walks per noise level (std 0.1-1) and
-rate-limited random positions (+-1 to +-12.5 mm) never diverged -- the NN's failures need many
-coherent cycles at 45-70 Hz, which an agent on raw increments must first learn to phase-lock
-(PPO and SAC did not, in 64 episodes of 10 s or 256 of 0.25-1 s).
+Reward (the rig's ``DivergenceReward``): a dense deviation term normalised as ``divergence.py``
+does, an energy-shaping term (the work the model gave back beyond the reference's at returns to
+the start), and at each episode's end ``-min(clip(robustness), 0.25)`` from the evaluator's
+verdict on the whole profile: graded only below the hold term's margin, or holding still would
+score best.
 
-Reward (``DivergenceReward``, the env's ``reward_fn`` hook):
-
-- every step, a dense deviation term: ``min(|F_model - F_ref| / scale_so_far, 5) / steps``,
-  scale_so_far the reference's running peak |F| (floored at ``FORCE_FLOOR_N``), the same
-  normalisation as ``divergence.py``;
-- every step, energy shaping: the change of the potential "work the model gave back beyond the
-  reference's, at the last return to the start deflection" (see the class);
-- at the end of every episode, the episode's whole displacement profile is evaluated ONCE by
-  the ``BatchEvaluator`` (the prescribed-motion path and ``divergence.judge``, the single
-  definition of divergence) and the agent gets ``-min(clip(robustness, -10, 10), 0.25)``: the
-  STL robustness, graded only below 0.25 -- every profile ending in a hold has robustness
-  <= 0.25 (the hold term's margin), so uncapped, PPO learned to hold still. Robustness alone is
-  flat until a profile fails, so without the shaping the agents settled on slow large strokes,
-  where the NN is merely inaccurate.
-
-The same reward and actions are used for every model (target, hybrid, control).
-
-An episode is one model evaluation: the budget is the number of episodes, and the evaluator's
-verdicts on those profiles are what the result records (so a "failure" found by an agent
-means exactly what it means for random search). The rig itself ends an episode early only
-for non-finite or > 25 kN model forces; the profile up to there is judged the same way.
-
-Seeded: SB3's ``seed``, ``torch.set_num_threads(1)`` and a deterministic CPU run give the same
-episodes for the same seed. The vector env auto-resets on
-the step after an episode ends ("next-step" mode); SB3 sees that step as one extra no-op
-transition from the rest state (observation zeros, reward 0), which is harmless: the rig truly
-is at rest then.
-
-For road searches (``env="quartercar"``) the agents drive QuarterCar-v0's car through
-``QuarterCarBatch``, its array integrator (the pymunk env itself costs milliseconds per step;
-there is no vector entry point), with QuarterCar-v0's 12 observations and a gentler action
-(``ROAD_ACTION_SCALE``, ``ROAD_DEAD_ZONE``); the episodes' roads are judged like any other
-road profile.
+An episode is one model evaluation: the budget counts episodes, and what the result records is
+the evaluator's verdict on those profiles, so a failure found by an agent means what it means
+for random search. Seeded (SB3's seed, one torch thread): the same episodes for the same seed.
 """
 
 from __future__ import annotations
