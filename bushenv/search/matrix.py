@@ -3,8 +3,9 @@
     bushenv campaign --models nn,hybrid,boucwen --axes axial,radial \\
         --searchers random,cma,ppo --seeds 0-9 --budget 256 --out runs/matrix [--ray]
 
-Each cell is one search run (``run_cell``): the model's default for the axis against the
-reference rubber bushing, one searcher, one seed, ``budget`` model evaluations. Cells are pure
+Each cell is one search run (``run_cell``): the model (a name's default for the axis, or a
+file) against ``--reference`` (default the rubber; a name, a file, or none), one searcher, one
+seed, ``budget`` model evaluations. Cells are pure
 functions of their description, so the local process pool and a Ray cluster give the same
 results for the same seeds (wall-clock fields aside: ``seconds``, ``seconds_to_failure``).
 
@@ -30,10 +31,10 @@ from typing import Any
 import numpy as np
 
 from bushenv.execution import get_backend
-from bushenv.models import AXES, MODELS, ModelError, check_axis, get_model
+from bushenv.models import AXES, MODELS, ModelError, check_axis, get_model, get_reference
 from bushenv.persist import json_default, write_json, write_text
 from bushenv.progress import Progress
-from bushenv.search.corpus import truth_reference
+from bushenv.scales import scales_of_reference
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import SEARCHERS, get_searcher
 from bushenv.search.targets import TARGETS
@@ -43,7 +44,7 @@ EXAMPLE = (
     "--seeds 0-3 --budget 128 --out runs/matrix"
 )
 WALL_CLOCK_FIELDS = ("seconds", "seconds_to_failure", "wall_s", "worker_backend")
-CELL_KEYS = ("model", "axis", "searcher", "seed", "budget", "env")
+CELL_KEYS = ("model", "axis", "searcher", "seed", "budget", "env", "reference")
 MAX_SEEDS = 100_000  # a typo like 0-1000000000 must not build a billion cells
 
 
@@ -93,9 +94,19 @@ def make_cells(
     seeds: list[int],
     budget: int,
     env: str = "rig",
+    reference: str | None = "rubber",
 ) -> list[dict[str, Any]]:
+    """One cell per model x axis x searcher x seed; ``reference`` None: judged without one."""
     return [
-        {"model": m, "axis": a, "searcher": s, "seed": int(seed), "budget": int(budget), "env": env}
+        {
+            "model": m,
+            "axis": a,
+            "searcher": s,
+            "seed": int(seed),
+            "budget": int(budget),
+            "env": env,
+            "reference": reference,
+        }
         for m, a, s, seed in product(models, axes, searchers, seeds)
     ]
 
@@ -105,10 +116,13 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     import torch
 
     torch.set_num_threads(1)
-    reference = truth_reference(cell["axis"])
-    model = get_model(cell["model"], axis=cell["axis"], dt=reference.dt)
+    spec, axis = cell.get("reference", "rubber"), cell["axis"]
+    model = get_model(cell["model"], axis=axis)
+    reference = None if spec is None else get_reference(spec, axis=axis, dt=model.dt)
+    scales = scales_of_reference(reference, builtin=spec == "rubber")
     t0 = time.perf_counter()
-    with BatchEvaluator(model, reference, target=cell["env"], threads=1, axis=cell["axis"]) as ev:
+    evaluator = BatchEvaluator(model, reference, cell["env"], 1, axis, scales=scales)
+    with evaluator as ev:
         result = get_searcher(cell["searcher"]).run(ev, cell["budget"], seed=cell["seed"])
     out = {**cell, **result.summary()}
     out["wall_s"] = time.perf_counter() - t0
@@ -312,6 +326,7 @@ class MatrixConfig:
     seeds: tuple[int, ...] = (0, 1, 2, 3)
     budget: int = 128
     target: str = "rig"
+    reference: str | None = "rubber"  # a name or model file; None: judged without one
     out: Path = Path("runs/matrix")
     resume: bool = False
 
@@ -334,6 +349,12 @@ class MatrixConfig:
                     raise MatrixError(registry.unknown_message(n))
         if not self.axes:
             raise MatrixError("--axes names nothing")
+        for a in self.axes:
+            if self.reference is not None:
+                try:
+                    get_reference(self.reference, axis=check_axis(a))
+                except ModelError as exc:
+                    raise MatrixError(f"--reference {self.reference!r} ({a}): {exc}") from None
         for m, a in product(self.models, self.axes):
             check_axis(a)
             try:
@@ -368,6 +389,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seeds", default="0-3", help="e.g. 0-9 or 1,4,7")
     p.add_argument("--budget", type=int, default=d.budget, help="model evaluations per cell (> 0)")
     p.add_argument("--env", choices=TARGETS.names(), default=d.target)
+    p.add_argument(
+        "--reference",
+        default=d.reference,
+        help="the bushing every cell is judged against: a registered name or a model file; "
+        "'none' judges with the criteria that need no reference",
+    )
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--resume", action="store_true", help="continue an interrupted matrix")
     p.add_argument("--workers", type=int, default=None, help="local worker processes")
@@ -391,6 +418,7 @@ def run(args: argparse.Namespace) -> int:
         seeds=tuple(parse_seeds(args.seeds)),
         budget=args.budget,
         target=args.env,
+        reference=None if args.reference == "none" else args.reference,
         out=Path(args.out),
         resume=args.resume,
     ).checked()

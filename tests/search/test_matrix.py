@@ -78,3 +78,18 @@ def test_ray_backend_gives_identical_results_to_local(tmp_path):
         backend.close()
     assert not ray.is_initialized()
     assert [comparable(r) for r in local] == [comparable(r) for r in remote]
+
+
+def test_cells_are_judged_against_the_reference_they_name(tmp_path):
+    from bushenv.models.linear import LinearBushing
+    from bushenv.search.matrix import make_cells, run_cell
+
+    ref = LinearBushing.preset("axial").save(tmp_path / "ref.npz")
+    free, own = (
+        run_cell(make_cells(["linear"], ["axial"], ["random"], [0], 16, reference=r)[0])
+        for r in (None, str(ref))
+    )
+    assert free["reference"] is None and own["reference"] == str(ref)
+    assert not free["diverged"] and not own["diverged"]
+    # the linear model judged against itself: the deviation it can reach is zero
+    assert own["worst_deviation"] == 0.0
