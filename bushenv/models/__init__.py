@@ -13,7 +13,7 @@ from importlib import resources
 from pathlib import Path
 
 from bushenv.models.base import AXES, DT_TOLERANCE, PAPER_DT, BushingModel, ModelError
-from bushenv.models.files import file_hash, load_model
+from bushenv.models.files import file_hash, load_model, params_sha
 from bushenv.models.registry import MODELS, ModelEntry
 
 ModelSpec = str | os.PathLike | BushingModel
@@ -122,4 +122,5 @@ __all__ = [
     "load_model",
     "model_file",
     "model_names",
+    "params_sha",
 ]

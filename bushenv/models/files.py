@@ -171,3 +171,14 @@ def _check_parameter(path: Path, name: str, key: str, files: dict, want) -> None
 def file_hash(path: str | os.PathLike) -> str:
     """sha256 of a model file (regression cases record which model they judged)."""
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def params_sha(model: BushingModel) -> str:
+    """sha256 of a model's parameters and settings (for presets such as the reference)."""
+    blob = {
+        "class": type(model).__name__,
+        "dt": model.dt,
+        "params": {k: np.asarray(v, dtype=np.float64).tolist() for k, v in model.params.items()},
+        "extra": model.extra_meta(),
+    }
+    return hashlib.sha256(json.dumps(blob, sort_keys=True, default=str).encode()).hexdigest()

@@ -19,8 +19,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from bushenv.models import file_hash, model_file
-from bushenv.search.corpus import params_sha, reference_identity
+from bushenv.models import file_hash, model_file, params_sha
+from bushenv.search.corpus import reference_identity
 
 REPORT_FORMAT = "bushenv-attack-report"
 REPORT_VERSION = 1

@@ -44,7 +44,14 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models import BushingModel, file_hash, get_model, get_reference, model_file
+from bushenv.models import (
+    BushingModel,
+    file_hash,
+    get_model,
+    get_reference,
+    model_file,
+    params_sha,
+)
 from bushenv.models.base import PAPER_DT
 from bushenv.persist import write_json
 from bushenv.scales import MACHINE, BushingScales
@@ -96,17 +103,6 @@ def model_sha(name: str, axis: str) -> str | None:
     """sha256 of the file behind a model name (a shipped default or a path; None for presets)."""
     path = model_file(name, axis)
     return file_hash(path) if path is not None and path.is_file() else None
-
-
-def params_sha(model: BushingModel) -> str:
-    """sha256 of a model's parameters and settings (for presets such as the reference)."""
-    blob = {
-        "class": type(model).__name__,
-        "dt": model.dt,
-        "params": {k: np.asarray(v, dtype=np.float64).tolist() for k, v in model.params.items()},
-        "extra": model.extra_meta(),
-    }
-    return hashlib.sha256(json.dumps(blob, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def truth_reference(axis: str, dt: float = PAPER_DT) -> BushingModel:
