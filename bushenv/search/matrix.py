@@ -20,8 +20,6 @@ the divergence rate and the median evaluations to failure.
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import time
 from dataclasses import dataclass
 from itertools import product
@@ -32,8 +30,9 @@ import numpy as np
 
 from bushenv.execution import get_backend
 from bushenv.models import AXES, MODELS, ModelError, check_axis, get_model, get_reference
-from bushenv.persist import json_default, write_json, write_text
+from bushenv.persist import write_json, write_text
 from bushenv.progress import Progress
+from bushenv.runlog import RunLog, run_cells
 from bushenv.scales import scales_of_reference
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import SEARCHERS, get_searcher
@@ -139,69 +138,25 @@ def comparable(row: dict[str, Any]) -> dict[str, Any]:
 RESULT_KEYS = ("diverged", "evaluations", "evaluations_to_failure")
 
 
+def _log(path: Path, progress: Progress | None = None) -> RunLog:
+    say = progress.say if progress is not None else None
+    return RunLog(path, CELL_KEYS, RESULT_KEYS, error=MatrixError, say=say)
+
+
 def read_results(path: Path, require_results: bool = False) -> dict[str, dict[str, Any]]:
-    """Finished cells by key; drops a torn final line, refuses corruption elsewhere.
-
-    A line is a finished cell when it is a JSON object holding the cell's keys (``CELL_KEYS``)
-    and, with ``require_results`` (as ``run_matrix`` reads), the result fields
-    ``RESULT_KEYS``. Only the last line may be torn (a kill mid-write): it is dropped and cut
-    from the file, so the cell runs again on resume. A complete last line that lost only its
-    newline is kept and the newline restored, so the next append starts a line of its own.
-    """
-    done: dict[str, dict[str, Any]] = {}
-    if not path.exists():
-        return done
-    if not path.is_file():
-        raise MatrixError(f"{path}: not a regular file")
-    raw = path.read_bytes()
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise MatrixError(
-            f"{path}: not a results file (not UTF-8 text at byte {exc.start}); "
-            "move it away or pass another --out"
-        ) from None
-    lines = text.splitlines()
-    for i, line in enumerate(lines, start=1):
-        if not line.strip():
-            continue
-        row = _result_row(line, require_results)
-        if row is None:
-            if i == len(lines):
-                print(f"{path} line {i}: incomplete last line (interrupted write) dropped")
-                _truncate_last_line(path)
-                continue
-            raise MatrixError(f"{path} line {i}: corrupt result line; fix or remove it") from None
-        done[cell_key(row)] = row
-    if text and not text.endswith("\n") and path.read_bytes() == raw:
-        with path.open("a") as fh:
-            fh.write("\n")
-    return done
+    """Finished cells by key (``RunLog.read``): holding ``CELL_KEYS`` and, with
+    ``require_results``, ``RESULT_KEYS``; a torn last line is dropped, other corruption refused."""
+    log = _log(path)
+    if not require_results:
+        log.result_keys = ()
+    return log.read()
 
 
-def _result_row(line: str, require_results: bool) -> dict[str, Any] | None:
-    """The row a results line holds, or None when it is not a complete result."""
-    try:
-        row = json.loads(line)
-    except json.JSONDecodeError:
-        return None
-    needed = (*CELL_KEYS, *RESULT_KEYS) if require_results else CELL_KEYS
-    if not isinstance(row, dict) or any(k not in row for k in needed):
-        return None
-    return row
-
-
-def _truncate_last_line(path: Path) -> None:
-    text = path.read_text()
-    keep = text[: text.rstrip("\n").rfind("\n") + 1] if "\n" in text.rstrip("\n") else ""
-    write_text(path, keep)
-
-
-def _append(path: Path, row: dict[str, Any]) -> None:
-    with path.open("a") as fh:
-        fh.write(json.dumps(row, sort_keys=True, default=json_default) + "\n")
-        fh.flush()
-        os.fsync(fh.fileno())
+def _describe(row: dict[str, Any]) -> str:
+    return (
+        f"{row['model']:8s} {row['axis']:6s} {row['searcher']:6s} seed {row['seed']}: "
+        f"{'DIVERGED' if row['diverged'] else 'bounded'} ({row['evaluations']} evals)"
+    )
 
 
 def run_matrix(
@@ -212,30 +167,9 @@ def run_matrix(
     progress: Progress | None = None,
 ) -> list[dict[str, Any]]:
     """Run every cell not yet in ``out/cells.jsonl``; returns all rows in cell order."""
-    out.mkdir(parents=True, exist_ok=True)
-    results_path = out / "cells.jsonl"
-    done = read_results(results_path, require_results=True) if resume else {}
-    if not resume and results_path.exists():
-        raise MatrixError(f"{results_path} exists; pass --resume to continue or --out elsewhere")
-    todo = [c for c in cells if cell_key(c) not in done]
     progress = progress or Progress(quiet=True)
-    progress.total = len(todo)
-    progress.say(
-        f"matrix: {len(cells)} cells, {len(cells) - len(todo)} already done, "
-        f"{len(todo)} to run on {backend.name} ({backend.workers} workers)"
-    )
-    for n, (i, row) in enumerate(backend.imap_unordered(run_cell, todo), start=1):
-        row["worker_backend"] = backend.name
-        _append(results_path, row)
-        done[cell_key(todo[i])] = row
-        progress.update(
-            n,
-            f"[{n}/{len(todo)}] {row['model']:8s} {row['axis']:6s} {row['searcher']:6s} "
-            f"seed {row['seed']}: {'DIVERGED' if row['diverged'] else 'bounded'} "
-            f"({row['evaluations']} evals)",
-            force=True,
-        )
-    return [done[cell_key(c)] for c in cells]
+    log = _log(Path(out) / "cells.jsonl", progress)
+    return run_cells(cells, run_cell, log, backend, resume, progress, _describe, "matrix")
 
 
 def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:

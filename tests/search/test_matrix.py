@@ -52,7 +52,7 @@ def test_interrupted_matrix_resumes_and_drops_a_torn_line(tmp_path):
             run_matrix(CELLS, out, one, progress=Progress(quiet=True))
         msgs = []
         rows = run_matrix(CELLS, out, one, resume=True, progress=Progress(sink=msgs.append))
-    assert "2 already done, 2 to run" in msgs[0]
+    assert "interrupted write" in msgs[0] and "2 already done, 2 to run" in msgs[1]
     assert len(rows) == 4
     assert len(read_results(out / "cells.jsonl")) == 4
 
