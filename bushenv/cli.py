@@ -24,6 +24,7 @@ COMMANDS = {
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
     "measure": ("bushenv.machine", "run a test programme on a model and write CSV records"),
     "certify": ("bushenv.certify.command", "hold-stability and passivity certificates of a NARX"),
+    "zoo": ("bushenv.zoo.command", "population study: how often NARX models fail, by recipe"),
 }
 
 
