@@ -17,7 +17,8 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 from bushenv import excitation
 from bushenv.models import get_model
 from bushenv.models.linear import LinearBushing
-from bushenv.rigs.common import RigError, load_spec
+from bushenv.rigs.common import RigError
+from bushenv.rigs.specs import load_spec
 
 DT = 1.0 / 204.8
 MAX_STEP = excitation.MAX_VELOCITY_M_PER_S * DT
@@ -249,7 +250,7 @@ def test_reference_beyond_the_machine_force_truncates_without_a_verdict():
 
 
 def test_episode_truncates_after_episode_steps():
-    env = make(episode_steps=30)
+    env = make(max_episode_steps=30)
     out = run(env, np.zeros((100, 1), np.float32))
     assert len(out) == 31 and out[-1][3] and not out[-1][2]
 
@@ -296,7 +297,7 @@ def test_info_holds_plain_python_values():
 
 
 def test_memory_stays_flat_over_a_long_rollout():
-    env = make(model="linear", reference="rubber", episode_steps=10**9)
+    env = make(model="linear", reference="rubber", max_episode_steps=-1)
     env.reset(seed=0)
     a = np.array([0.3], np.float32)
     b = np.array([-0.3], np.float32)
@@ -314,7 +315,7 @@ def test_memory_stays_flat_over_a_long_rollout():
 
 @pytest.mark.slow
 def test_memory_stays_flat_over_a_million_steps():
-    env = make(model="linear", reference="rubber", episode_steps=10**9, render_mode="rgb_array")
+    env = make(model="linear", reference="rubber", max_episode_steps=-1, render_mode="rgb_array")
     env.reset(seed=0)
     a = np.array([0.3], np.float32)
     b = np.array([-0.3], np.float32)

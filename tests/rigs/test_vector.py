@@ -58,7 +58,7 @@ def test_vector_columns_equal_single_envs_bit_for_bit(name, axis):
     actions = rng.uniform(-1.3, 1.3, size=(steps, n, 1)).astype(np.float32)
     actions[3, 0, 0] = np.nan
     actions[4, 1, 0] = np.inf
-    kw = dict(model=name, axis=axis, episode_steps=60)
+    kw = dict(model=name, axis=axis, max_episode_steps=60)
     venv = make_vec(n, **kw)
     venv.reset(seed=5)
     vec = [venv.step(a) for a in actions]
@@ -74,7 +74,7 @@ def test_vector_columns_equal_single_envs_bit_for_bit(name, axis):
 
 
 def test_vector_autoreset_is_next_step_and_restarts_from_rest():
-    env = make_vec(2, episode_steps=5)
+    env = make_vec(2, max_episode_steps=5)
     env.reset(seed=0)
     a = np.ones((2, 1), np.float32)
     for _ in range(4):
