@@ -201,16 +201,17 @@ class BushRigEnv(gym.Env):
     ## Example
 
     >>> import gymnasium as gym
+    >>> import numpy as np
     >>> import bushenv
-    >>> env = gym.make("bushenv/BushRig-v0", model="linear", axis="radial")
+    >>> env = gym.make("bushenv/BushRig-v0", model="linear", axis="axial")
     >>> env.spec.max_episode_steps, env.metadata["render_fps"]
     (2048, 204.8)
     >>> obs, info = env.reset(seed=0)
     >>> obs.shape, obs.dtype, float(abs(obs).max())
     ((12,), dtype('float32'), 0.0)
-    >>> obs, reward, terminated, truncated, info = env.step(env.action_space.high)
+    >>> obs, reward, terminated, truncated, info = env.step(np.array([0.5], np.float32))
     >>> round(info["displacement_m"] * 1e3, 3), terminated, truncated
-    (6.136, False, False)
+    (3.068, False, False)
 
     ## Version History
 

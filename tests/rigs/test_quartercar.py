@@ -18,8 +18,8 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 from bushenv import excitation
 from bushenv.models import get_model
 from bushenv.models.linear import TABLE1, LinearBushing
-from bushenv.rigs.common import RigError
 from bushenv.rigs.car import CarParameters
+from bushenv.rigs.common import RigError
 from bushenv.rigs.quartercar_batch import QuarterCarBatch
 
 DT = 1.0 / 204.8

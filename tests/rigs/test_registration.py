@@ -15,8 +15,8 @@ from setuptools import find_namespace_packages
 
 import bushenv
 from bushenv.rigs.common import RigError
-from bushenv.rigs.specs import read_spec, spec_directory, spec_files
 from bushenv.rigs.registration import register_all
+from bushenv.rigs.specs import read_spec, spec_directory, spec_files
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC_IDS = sorted(p.stem for p in (ROOT / "envs").glob("*.toml"))
