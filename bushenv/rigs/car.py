@@ -1,7 +1,8 @@
 """The quarter car of QuarterCar-v0: its parameters, its pymunk bodies, and its bounds.
 
 ``CarParameters`` checks the spec's kwargs (shared by the pymunk env, the array integrator
-``quartercar_batch`` and the vector env); ``Car`` builds one car in a pymunk space; ``car_verdict``
+``quartercar_batch`` and the vector env); ``Car`` builds one car in a pymunk space, ``CarPair``
+steps a model car beside its reference twin; ``car_verdict``
 decides an episode's end from both cars' bushing forces (``divergence.force_termination``) and
 bounds, for one car pair (floats) or N pairs ((N,) arrays) alike.
 """
@@ -20,6 +21,7 @@ from bushenv.models import BushingModel
 from bushenv.models.linear import TABLE1
 from bushenv.rigs.actions import check_profile
 from bushenv.rigs.common import (
+    MODEL_ERRORS,
     RigError,
     model_label,
     positive,
@@ -32,6 +34,7 @@ from bushenv.rigs.coupling import (
     SplitBushing,
     implicit_euler_damping,
     inverse_mass_along,
+    space_stepper,
 )
 
 AXES = ("radial", "axial")  # radial: vertical at the arm's inner end; axial: along the arm
@@ -271,6 +274,62 @@ class Car:
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__(state["p"])
         self.restore(state["snapshot"])
+
+
+class CarPair:
+    """The model car and its reference twin over one road, each in its own pymunk space:
+    nothing the model car does (a blow-up, a NaN) can reach the twin through a shared solver or
+    body. Built fresh at every episode (no warm-start impulses from the last one); pickles and
+    deep-copies as its two cars do."""
+
+    def __init__(self, p: CarParameters) -> None:
+        self.p = p
+        self.car = Car(p, pymunk.Space())
+        self.twin = Car(p, pymunk.Space())
+        self._connect()
+
+    def _connect(self) -> None:
+        self._space_steps = (space_stepper(self.car.space), space_stepper(self.twin.space))
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"p": self.p, "car": self.car, "twin": self.twin}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._connect()
+
+    def sample(self, car: Car, models: dict[str, BushingModel]):
+        """(motion, forces, why) of ``car`` at t_k: the bushing's (x, v) per axis, both axis
+        models' forces, and why they cannot be applied ("" if they can). A force that raised,
+        is not finite or exceeds ``force_limit_n`` is judged *before* it is applied and never
+        applied (the car keeps the last held remainder, so its state stays finite); otherwise
+        the remainders are held for the coming step."""
+        car.update_damping()
+        motion = car.bushing_motion()
+        xr, vr, xa, va = motion
+        try:
+            forces = (models["radial"].step(xr, vr), models["axial"].step(xa, va))
+        except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
+            return motion, (math.nan, math.nan), f"model raised {type(exc).__name__}: {exc}"
+        why = force_reason(*forces, self.p.force_limit)
+        if not why:
+            car.radial.hold(forces[0], xr, vr)
+            car.axial.hold(forces[1], xa, va)
+        return motion, forces, why
+
+    def integrate(self, h0: float, h: float) -> None:
+        """Both cars through ``physics_substeps`` pymunk steps, the road moving h0 -> h."""
+        p = self.p
+        road_v = (h - h0) / p.dt
+        self.car.road.velocity = (0.0, road_v)
+        self.twin.road.velocity = (0.0, road_v)
+        h_sub = p.h
+        for step in self._space_steps:
+            for _ in range(p.substeps):
+                step(h_sub)
+        for car in (self.car, self.twin):  # exact road position, no drift from integrating
+            car.road.position = (p.L, h)
+            car.road.velocity = (0.0, 0.0)
 
 
 def force_reason(fr: float, fa: float, limit_n: float) -> str:

@@ -12,33 +12,28 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
-import pymunk
 from gymnasium import spaces
 
-from bushenv.models import BushingModel
 from bushenv.rigs.actions import check_options, unit_action
 from bushenv.rigs.car import (
     AXES,
     Car,
+    CarPair,
     CarParameters,
     axis_label,
     axis_models,
     beyond_bounds,
     car_verdict,
     check_road,
-    force_reason,
     out_of_bounds,
 )
-from bushenv.rigs.common import MODEL_ERRORS, ForceDeviationReward, RigError, call_reset, check_hook
-from bushenv.rigs.coupling import space_stepper
+from bushenv.rigs.common import ForceDeviationReward, RigError, call_reset, check_hook
 from bushenv.rigs.drawing import Canvas, Trace
 from bushenv.rigs.scenes import draw_quartercar
 from bushenv.rigs.specs import spec_kwargs
 
 ENV_ID = "QuarterCar-v0"
 OBS_SIZE = 12
-# rebuilt on unpickling from the cars (which pickle themselves), not pickled
-PHYSICS_ATTRS = ("space", "_space_steps")
 __all__ = ["AXES", "ENV_ID", "QuarterCarEnv", "axis_label", "axis_models", "check_road"]
 
 
@@ -217,7 +212,7 @@ class QuarterCarEnv(gym.Env):
             p.force_scale, p.reward_cap
         )
         self.divergence_monitor = check_hook("divergence_monitor", divergence_monitor)
-        self._build_cars()
+        self.cars = CarPair(p)
         self._road = 0.0
         self._t = 0
         self._replay: np.ndarray | None = None
@@ -228,14 +223,8 @@ class QuarterCarEnv(gym.Env):
         self._info_last: dict[str, Any] = {}
 
     def __getstate__(self) -> dict[str, Any]:
-        """Everything but the chipmunk call handles; the cars pickle their own state."""
-        state = {k: v for k, v in self.__dict__.items() if k not in PHYSICS_ATTRS}
-        state["_canvas"] = None
-        return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__dict__.update(state)
-        self._connect_cars()
+        """Everything but the drawing window; the cars pickle their own state."""
+        return {**self.__dict__, "_canvas": None}
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
@@ -253,7 +242,7 @@ class QuarterCarEnv(gym.Env):
             m.reset(1)
         call_reset(self.reward_fn)
         call_reset(self.divergence_monitor)
-        self._build_cars()  # fresh bodies: no warm-start impulses from the last episode
+        self.cars = CarPair(p)  # fresh bodies: no warm-start impulses from the last episode
         self._road = 0.0
         self._t = 0
         self._obs[:] = 0.0
@@ -266,35 +255,15 @@ class QuarterCarEnv(gym.Env):
             self.render()
         return self._obs.copy(), info
 
-    def _build_cars(self) -> None:
-        """The model car and its twin, each in its own pymunk space: nothing the model car
-        does (a blow-up, a NaN) can reach the twin through a shared solver or body."""
-        self.car = Car(self.params, pymunk.Space())
-        self.twin = Car(self.params, pymunk.Space())
-        self._connect_cars()
+    @property
+    def car(self) -> Car:
+        """The model car (pymunk bodies)."""
+        return self.cars.car
 
-    def _connect_cars(self) -> None:
-        self.space = self.car.space
-        self._space_steps = (space_stepper(self.car.space), space_stepper(self.twin.space))
-
-    def _sample_bushing(self, car: Car, models: dict[str, BushingModel]):
-        """(motion, forces, why): the bushing's (x, v) per axis at t_k, both axis models'
-        forces, and why they cannot be applied ("" if they can). A force that raised, is not
-        finite or exceeds ``force_limit_n`` is judged *before* it is applied and never applied
-        (the car keeps the last held remainder, so its state stays finite); otherwise the
-        remainders are held for the coming step."""
-        car.update_damping()
-        motion = car.bushing_motion()
-        xr, vr, xa, va = motion
-        try:
-            forces = (models["radial"].step(xr, vr), models["axial"].step(xa, va))
-        except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
-            return motion, (math.nan, math.nan), f"model raised {type(exc).__name__}: {exc}"
-        why = force_reason(*forces, self.params.force_limit)
-        if not why:
-            car.radial.hold(forces[0], xr, vr)
-            car.axial.hold(forces[1], xa, va)
-        return motion, forces, why
+    @property
+    def twin(self) -> Car:
+        """The reference car (pymunk bodies)."""
+        return self.cars.twin
 
     def _next_road(self, action) -> float:
         """This step's road height: the action's change, clipped, or the replayed sample."""
@@ -304,20 +273,6 @@ class QuarterCarEnv(gym.Env):
         h = self._road + unit_action(action, ENV_ID) * p.max_road_step
         return max(-p.max_road, min(p.max_road, h))
 
-    def _integrate(self, h0: float, h: float) -> None:
-        """Both cars through ``physics_substeps`` pymunk steps, the road moving h0 -> h."""
-        p = self.params
-        road_v = (h - h0) / p.dt
-        self.car.road.velocity = (0.0, road_v)
-        self.twin.road.velocity = (0.0, road_v)
-        h_sub = p.h
-        for step in self._space_steps:
-            for _ in range(p.substeps):
-                step(h_sub)
-        for car in (self.car, self.twin):  # exact road position, no drift from integrating
-            car.road.position = (p.L, h)
-            car.road.velocity = (0.0, 0.0)
-
     def step(self, action):
         p = self.params
         h0 = self._road
@@ -325,9 +280,9 @@ class QuarterCarEnv(gym.Env):
         self._road = h
         self._t += 1
         # sample both bushings at t_k (the state the previous step left), then integrate
-        motion_m, force_m, why_m = self._sample_bushing(self.car, self.models)
-        motion_r, force_r, why_r = self._sample_bushing(self.twin, self.references)
-        self._integrate(h0, h)
+        motion_m, force_m, why_m = self.cars.sample(self.car, self.models)
+        motion_r, force_r, why_r = self.cars.sample(self.twin, self.references)
+        self.cars.integrate(h0, h)
         body_m, body_r = self.car.body_state(), self.twin.body_state()
         bounds = [
             beyond_bounds(p, body[0], body[2], motion[0], motion[2])
