@@ -357,8 +357,14 @@ class BushRigEnv(gym.Env):
         obs[1, 0] = force_observation(f_m, p.force_limit)
         obs[2, 0] = force_observation(f_r, p.force_limit)
 
-        non_finite, model_over, ref_over = force_termination(f_m, f_r, p.force_limit)
-        finite, model_over, ref_over = not non_finite, bool(model_over), bool(ref_over)
+        if abs(f_m) <= p.force_limit and abs(f_r) <= p.force_limit:
+            # both finite and within the limit: force_termination cannot fire (tested); not
+            # calling it saves its ~3 us of numpy scalar calls, a fifth of the step
+            non_finite = model_over = ref_over = False
+        else:
+            verdict = force_termination(f_m, f_r, p.force_limit)
+            non_finite, model_over, ref_over = (bool(v) for v in verdict)
+        finite = not non_finite
         terminated = non_finite or model_over
         truncated = ref_over and finite
         if non_finite:

@@ -392,3 +392,25 @@ def test_rgb_array_frame_shows_the_rig_and_changes_with_its_state():
     second = env.render()
     assert (first != second).any(axis=2).sum() > 500
     assert len(np.unique(second.reshape(-1, 3), axis=0)) > 5
+
+
+def test_force_termination_cannot_fire_where_the_single_env_skips_calling_it():
+    """BushRigEnv.step calls divergence.force_termination only when a force is not finite or
+    beyond the limit; within it, the function must decide "go on" (so skipping it is exact)."""
+    from bushenv.divergence import force_termination
+
+    limit = 25e3
+    rng = np.random.default_rng(0)
+    edges = np.array([0.0, -0.0, 5e-324, limit, -limit, np.nextafter(limit, 0), 1e-300])
+    f_m = np.concatenate([edges, rng.uniform(-limit, limit, 10_000), edges[::-1]])
+    f_r = np.concatenate([edges[::-1], rng.uniform(-limit, limit, 10_000), edges])
+    assert np.all(np.abs(f_m) <= limit) and np.all(np.abs(f_r) <= limit)
+    for flags in force_termination(f_m, f_r, limit):
+        assert not flags.any()
+    # and just beyond it, it does fire: the skip is no wider than the criteria
+    over = np.nextafter(limit, np.inf)
+    non_finite, model_over, reference_over = force_termination(
+        np.array([over, np.nan, 0.0]), np.array([0.0, 0.0, over]), limit
+    )
+    assert list(model_over) == [True, False, False] and list(non_finite) == [False, True, False]
+    assert list(reference_over) == [False, False, True]
