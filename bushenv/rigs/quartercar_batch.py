@@ -1,6 +1,7 @@
-"""QuarterCarBatch: the QuarterCar-v0 car for many roads at once, as arrays (B,), for road searches.
+"""QuarterCarBatch: the QuarterCar-v0 car for many roads at once, as (B,) arrays (road searches,
+the vector env).
 
-The same car as ``quartercar.Car`` (parameters from ``envs/QuarterCar-v0.toml``) written as its
+The same car as ``car.Car`` (parameters from ``envs/QuarterCar-v0.toml``) written as its
 own small ODE in generalised coordinates q = (y_c, X, Y, theta): chassis height, the unsprung
 body's centre of mass and its angle (the chassis' horizontal motion is held by its groove, so
 it is not a coordinate). One compiled kernel integrates ``physics_substeps`` sub-steps of B cars
@@ -11,9 +12,7 @@ its own (``implicit_euler_damping``). The bushing coupling is the env's: at ever
 axis models get (x, v) of the arm's inner end relative to the chassis, and the remainder
 F - (k_in x + c_in v) is held over the sub-steps while k_in x + c_in v acts inside them.
 
-Agreement with the pymunk env (tests/rigs/test_quartercar_batch.py): with the linear bushing
-over a 100 mm bump and a harsh random road, chassis and wheel motion within 2 % and bushing
-forces within 5 % of their peaks.
+Its agreement with the pymunk env is stated and tested as in docs/envs.md.
 
 Like the env the batch can carry a twin car with the reference bushing (``with_reference``).
 """

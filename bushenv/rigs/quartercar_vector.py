@@ -4,8 +4,8 @@ The cars are ``QuarterCarBatch`` (the QuarterCar-v0 car as one compiled array in
 model car and its reference twin per column); actions, observations, rewards, hooks, info keys,
 reset options and the episode's end (``car.car_verdict``) are ``QuarterCarEnv``'s, on (N,)
 arrays. The integrator solves the three dampers together where pymunk solves them one by one,
-so a column follows the pymunk env within 1 % of each signal's peak over an episode (measured
-0.1-0.3 %; tests/rigs/test_quartercar_vector.py), not bit for bit.
+so a column follows the pymunk env within 1 % of each signal's peak over an episode
+(tests/rigs/test_quartercar_vector.py; docs/envs.md), not bit for bit.
 """
 
 from __future__ import annotations
