@@ -175,3 +175,20 @@ def test_the_docstring_examples_run(module):
     mod = importlib.import_module(f"bushenv.rigs.{module}")
     result = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_human_mode_shows_the_simulated_time_in_real_time():
+    """204.8 frames per second of wall time (pygame's Clock.tick would wait 4 ms, not 4.88)."""
+    import time
+
+    from bushenv.rigs.drawing import Canvas
+
+    canvas = Canvas(60, 40, "human", 204.8, "pace")
+    canvas.clear()
+    canvas.frame()
+    t0 = time.perf_counter()
+    for _ in range(103):  # 0.5 s of simulated time
+        canvas.frame()
+    elapsed = time.perf_counter() - t0
+    canvas.close()
+    assert 0.495 <= elapsed < 1.5  # never faster than real time; slower only under load
