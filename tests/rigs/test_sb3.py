@@ -25,6 +25,7 @@ def one_thread():
     torch.set_num_threads(before)
 
 
+@pytest.mark.filterwarnings("ignore:Evaluation environment is not wrapped")
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_ppo_and_sac_learn_on_the_vector_env_for_a_few_hundred_steps(env_id):
     venv = make_sb3_vec_env(env_id, 4, model="linear", max_episode_steps=50)
