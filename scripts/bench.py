@@ -10,8 +10,9 @@ and its numpy-vectorised form); the papers' verification task (6.44 s at 204.8 H
 identification times, with the identified models' accuracy on an unseen n = 1 record (the
 papers' protocol) and on an n = 1.5 record (extrapolation), beside the sensor-noise floor;
 a campaign's evaluations/s and time to the first NN divergence; peak memory of a 10^6-step
-rollout and of a B = 1024 batch. This machine is shared and noisy: compare ratios measured in
-the same run, not absolute figures across runs.
+rollout and of a B = 1024 batch; reading a 500k-row record file beside np.loadtxt. This
+machine is shared and noisy: compare ratios measured in the same run, not absolute figures
+across runs.
 """
 
 from __future__ import annotations
@@ -525,6 +526,42 @@ def bench_memory(fig: Figures, quick: bool) -> None:
     fig.add(f"memory.batch_B1024_T{T}.peak", peak / 2**20, "MiB", note="input itself excluded")
 
 
+def bench_records(fig: Figures, quick: bool) -> None:
+    """load_csv on a valid record file beside np.loadtxt on the same file (best of 3 each,
+    interleaved): the plain-number path must stay within 2x of numpy's own parser."""
+    import tempfile
+
+    from bushenv.records import Record, load_csv, save_csv
+
+    print("\n== record files: load_csv beside np.loadtxt (same file, same run)")
+    n = 20_000 if quick else 500_000
+    rng = np.random.default_rng(0)
+    x = rng.uniform(-0.01, 0.01, n)
+    record = Record.from_arrays(x, 4e5 * x + rng.normal(0.0, 50.0, n), 1 / 204.8)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = save_csv(record, Path(tmp) / "record.csv")
+        best = {"load_csv": np.inf, "loadtxt": np.inf}
+        for _ in range(3):
+            t0 = time.perf_counter()
+            got = load_csv(path)
+            best["load_csv"] = min(best["load_csv"], time.perf_counter() - t0)
+            t0 = time.perf_counter()
+            ref = np.loadtxt(path, delimiter=",", skiprows=1)
+            best["loadtxt"] = min(best["loadtxt"], time.perf_counter() - t0)
+    if not np.array_equal(got.force, ref[:, 2]):
+        raise RuntimeError("load_csv and np.loadtxt read different values")
+    label = f"{n // 1000}k"
+    fig.add(f"records.load_csv_{label}_rows", best["load_csv"], "s", better="lower")
+    fig.add(f"records.loadtxt_{label}_rows", best["loadtxt"], "s", better="lower")
+    fig.add(
+        f"records.load_csv_{label}_over_loadtxt",
+        best["load_csv"] / best["loadtxt"],
+        "ratio",
+        2.0,
+        better="lower",
+    )
+
+
 SECTIONS = {
     "models": bench_models,
     "envs": bench_envs,
@@ -533,6 +570,7 @@ SECTIONS = {
     "float32": bench_float32_verdicts,
     "memory": bench_memory,
     "certify": bench_certify,
+    "records": bench_records,
 }
 
 

@@ -106,6 +106,14 @@ class BushingModel:
         self._advance(self._x1, self._v1, self._f1)
         return self._f1[0].copy()
 
+    @property
+    def last_force_n(self) -> np.ndarray:
+        """(B,) the force of each history at the last ``step``, N (a copy of the output buffer).
+
+        Also after a batched ``step`` that raised part-way: what the kernel had written by then
+        (a kernel that refuses a non-finite force leaves it there for its history)."""
+        return self._f1[0].copy()
+
     def simulate(self, x: np.ndarray, v: np.ndarray | None = None) -> np.ndarray:
         """Free run from rest over a whole profile: (T,) -> (T,) or (T, B) -> (T, B).
 
