@@ -7,9 +7,13 @@ point, adapted to SB3, with ``DivergenceReward`` as the env's reward hook.
 
 from __future__ import annotations
 
+import gymnasium as gym
 import numpy as np
+from gymnasium import spaces
+from stable_baselines3.common.vec_env import VecEnvWrapper
 
 from bushenv.divergence import CLOSURE_FRACTION, SETTLE_FRACTION
+from bushenv.rigs.sb3 import SB3VecEnv
 from bushenv.scales import MACHINE
 from bushenv.search.base import SearchError
 from bushenv.search.rl import (
@@ -40,7 +44,7 @@ def rig_agent_env(evaluator, n_envs, episode_steps, on_episodes, actions):
         reward,
         evaluator.scales,
     )
-    return _oscillator_env(_sb3_vec_env(venv), reward, venv.params, actions)
+    return OscillatorActions(SB3VecEnv(venv), reward, venv.params, actions)
 
 
 class DivergenceReward:
@@ -139,94 +143,95 @@ class DivergenceReward:
         return reward
 
 
+class OscillatorActions(VecEnvWrapper):
+    """The agent steers a sine: action (2,) in [-1, 1] for ln f and ln A over their ranges.
+
+    The episode's first action sets them; later ones move them (``mode`` "rate") or set targets
+    they follow ("follow"). The rig is sent the velocity action that moves it toward
+    ``A sin(phase)``; A is capped so the sine is drivable, and is 0 at its lowest (the rig
+    holds). Observation: the rig's 12 values + sin, cos of the phase, ln f and ln A scaled to
+    [-1, 1], and 1 on an episode's first step (else 0).
+    """
+
+    def __init__(self, venv, reward, params, mode: str) -> None:
+        if mode not in ("rate", "follow"):
+            raise SearchError(f"oscillator actions must be 'rate' or 'follow', got {mode!r}")
+        self.mode, self.reward = mode, reward
+        self.lo_f, self.hi_f = np.log(OSC_F_HZ[0]), np.log(OSC_F_HZ[1])
+        self.lo_a, self.hi_a = np.log(OSC_A_M[0]), np.log(OSC_A_M[1])
+        self.max_x, self.max_step, self.dt = params.max_x, params.max_step, params.dt
+        self.a_cap_factor = VELOCITY_MARGIN * params.max_v / (2.0 * np.pi)
+        n_obs = venv.observation_space.shape[0] + 5
+        obs = spaces.Box(-np.inf, np.inf, shape=(n_obs,), dtype=np.float32)
+        act = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+        super().__init__(venv, observation_space=obs, action_space=act)
+        n = venv.num_envs
+        self.phase = np.zeros(n)
+        self.log_f = np.full(n, self.lo_f)
+        self.log_a = np.full(n, self.lo_a)
+        self.first = np.ones(n, dtype=bool)
+
+    def _extra(self) -> np.ndarray:
+        return np.stack(
+            [
+                np.sin(self.phase),
+                np.cos(self.phase),
+                2.0 * (self.log_f - self.lo_f) / (self.hi_f - self.lo_f) - 1.0,
+                2.0 * (self.log_a - self.lo_a) / (self.hi_a - self.lo_a) - 1.0,
+                self.first.astype(np.float64),
+            ],
+            axis=1,
+        )
+
+    def reset(self):
+        self.phase[:] = 0.0
+        self.first[:] = True
+        return np.hstack([self.venv.reset(), self._extra()]).astype(np.float32)
+
+    def _targets(self, a: np.ndarray) -> None:
+        """ln f and ln A after action ``a`` (n, 2)."""
+        lo_f, hi_f, lo_a, hi_a = self.lo_f, self.hi_f, self.lo_a, self.hi_a
+        target_f = lo_f + 0.5 * (a[:, 0] + 1.0) * (hi_f - lo_f)
+        target_a = lo_a + 0.5 * (a[:, 1] + 1.0) * (hi_a - lo_a)
+        if self.mode == "follow":
+            log_f = self.log_f + OSC_FOLLOW * (target_f - self.log_f)
+            log_a = self.log_a + OSC_FOLLOW * (target_a - self.log_a)
+        else:
+            log_f = np.clip(self.log_f + OSC_LOG_RATE * a[:, 0], lo_f, hi_f)
+            log_a = np.clip(self.log_a + OSC_LOG_RATE * a[:, 1], lo_a, hi_a)
+        self.log_f = np.where(self.first, target_f, log_f)
+        self.log_a = np.where(self.first, target_a, log_a)
+        self.first[:] = False
+
+    def step_async(self, actions) -> None:
+        a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, 2)
+        self._targets(np.clip(np.nan_to_num(a, nan=0.0), -1.0, 1.0))
+        f = np.exp(self.log_f)
+        amp = np.minimum(np.exp(self.log_a), self.a_cap_factor / f)
+        amp[self.log_a <= self.lo_a] = 0.0
+        self.phase = np.mod(self.phase + 2.0 * np.pi * f * self.dt, 2.0 * np.pi)
+        target = np.clip(amp * np.sin(self.phase), -self.max_x, self.max_x)
+        u = np.clip((target - self.reward.x_now) / self.max_step, -1.0, 1.0)
+        self.venv.step_async(u[:, None])
+
+    def step_wait(self):
+        obs, rew, done, infos = self.venv.step_wait()
+        extra = self._extra()
+        for i in np.flatnonzero(done):
+            term = infos[i]["terminal_observation"]
+            infos[i]["terminal_observation"] = np.r_[term, extra[i]].astype(np.float32)
+        self.phase[done] = 0.0
+        self.first[done] = True
+        obs = np.hstack([obs, self._extra()]).astype(np.float32)
+        return obs, rew, done, infos
+
+
 def _oscillator_env(venv, reward, params, mode):
-    """Wrap an SB3 rig ``VecEnv`` so the agent steers a sine oscillator (``OscillatorActions``)."""
-    from gymnasium import spaces
-    from stable_baselines3.common.vec_env import VecEnvWrapper
-
-    if mode not in ("rate", "follow"):
-        raise SearchError(f"oscillator actions must be 'rate' or 'follow', got {mode!r}")
-    lo_f, hi_f = np.log(OSC_F_HZ[0]), np.log(OSC_F_HZ[1])
-    lo_a, hi_a = np.log(OSC_A_M[0]), np.log(OSC_A_M[1])
-    max_x, max_step, dt = params.max_x, params.max_step, params.dt
-    a_cap_factor = VELOCITY_MARGIN * params.max_v / (2.0 * np.pi)
-
-    class OscillatorActions(VecEnvWrapper):
-        """Action (2,) in [-1, 1] for ln f and ln A over their ranges. The episode's first action
-        sets them; later ones move them (``mode``). The rig is sent the velocity action that
-        moves it toward ``A sin(phase)``; A is capped so the sine is drivable, and is 0 at its
-        lowest (the rig holds). Observation: the rig's 12 values + sin, cos of the phase, ln f and
-        ln A scaled to [-1, 1], and 1 on an episode's first step (else 0)."""
-
-        def __init__(self) -> None:
-            n_obs = venv.observation_space.shape[0] + 5
-            obs = spaces.Box(-np.inf, np.inf, shape=(n_obs,), dtype=np.float32)
-            act = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
-            super().__init__(venv, observation_space=obs, action_space=act)
-            n = venv.num_envs
-            self.phase = np.zeros(n)
-            self.log_f = np.full(n, lo_f)
-            self.log_a = np.full(n, lo_a)
-            self.first = np.ones(n, dtype=bool)
-
-        def _extra(self) -> np.ndarray:
-            return np.stack(
-                [
-                    np.sin(self.phase),
-                    np.cos(self.phase),
-                    2.0 * (self.log_f - lo_f) / (hi_f - lo_f) - 1.0,
-                    2.0 * (self.log_a - lo_a) / (hi_a - lo_a) - 1.0,
-                    self.first.astype(np.float64),
-                ],
-                axis=1,
-            )
-
-        def reset(self):
-            self.phase[:] = 0.0
-            self.first[:] = True
-            return np.hstack([self.venv.reset(), self._extra()]).astype(np.float32)
-
-        def step_async(self, actions) -> None:
-            a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, 2)
-            a = np.clip(np.nan_to_num(a, nan=0.0), -1.0, 1.0)
-            target_f = lo_f + 0.5 * (a[:, 0] + 1.0) * (hi_f - lo_f)
-            target_a = lo_a + 0.5 * (a[:, 1] + 1.0) * (hi_a - lo_a)
-            if mode == "follow":
-                log_f = self.log_f + OSC_FOLLOW * (target_f - self.log_f)
-                log_a = self.log_a + OSC_FOLLOW * (target_a - self.log_a)
-            else:
-                log_f = np.clip(self.log_f + OSC_LOG_RATE * a[:, 0], lo_f, hi_f)
-                log_a = np.clip(self.log_a + OSC_LOG_RATE * a[:, 1], lo_a, hi_a)
-            self.log_f = np.where(self.first, target_f, log_f)
-            self.log_a = np.where(self.first, target_a, log_a)
-            self.first[:] = False
-            f = np.exp(self.log_f)
-            amp = np.minimum(np.exp(self.log_a), a_cap_factor / f)
-            amp[self.log_a <= lo_a] = 0.0
-            self.phase = np.mod(self.phase + 2.0 * np.pi * f * dt, 2.0 * np.pi)
-            target = np.clip(amp * np.sin(self.phase), -max_x, max_x)
-            u = np.clip((target - reward.x_now) / max_step, -1.0, 1.0)
-            self.venv.step_async(u[:, None])
-
-        def step_wait(self):
-            obs, rew, done, infos = self.venv.step_wait()
-            extra = self._extra()
-            for i in np.flatnonzero(done):
-                term = infos[i]["terminal_observation"]
-                infos[i]["terminal_observation"] = np.r_[term, extra[i]].astype(np.float32)
-            self.phase[done] = 0.0
-            self.first[done] = True
-            obs = np.hstack([obs, self._extra()]).astype(np.float32)
-            return obs, rew, done, infos
-
-    return OscillatorActions()
+    """An SB3 rig ``VecEnv`` the agent steers through a sine (``OscillatorActions``)."""
+    return OscillatorActions(venv, reward, params, mode)
 
 
 def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward, scales=MACHINE):
-    import gymnasium as gym
-
-    import bushenv  # noqa: F401  (registers BushRig-v0)
-
     return gym.make_vec(
         "BushRig-v0",
         num_envs=n_envs,
@@ -234,7 +239,7 @@ def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward, scales=M
         model=model,
         reference=reference,
         axis=axis,
-        episode_steps=episode_steps,
+        max_episode_steps=episode_steps,
         reward_fn=reward,
         **_limits_kwargs(scales),
     )
@@ -250,56 +255,3 @@ def _limits_kwargs(scales) -> dict:
         "max_velocity_m_per_s": scales.velocity_m_per_s,
         "force_limit_n": scales.force_limit_n,
     }
-
-
-def _sb3_vec_env(venv):
-    """SB3 ``VecEnv`` over a next-step-autoreset gymnasium vector env."""
-    from stable_baselines3.common.vec_env.base_vec_env import VecEnv
-
-    class RigVecEnv(VecEnv):
-        def __init__(self, inner) -> None:
-            self.inner = inner
-            super().__init__(
-                inner.num_envs, inner.single_observation_space, inner.single_action_space
-            )
-            self._actions = None
-            self._seed = None
-
-        def reset(self):
-            obs, _ = self.inner.reset(seed=self._seed)
-            self._seed = None
-            return obs
-
-        def step_async(self, actions) -> None:
-            self._actions = np.asarray(actions, dtype=np.float32).reshape(self.num_envs, -1)
-
-        def step_wait(self):
-            obs, rew, term, trunc, info = self.inner.step(self._actions)
-            done = term | trunc
-            infos = [{} for _ in range(self.num_envs)]
-            for i in np.flatnonzero(done):
-                infos[i]["terminal_observation"] = obs[i].copy()
-                infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
-                obs[i] = 0.0  # the rest state the rig returns to (next-step autoreset)
-            return obs, rew.astype(np.float32), done, infos
-
-        def close(self) -> None:
-            self.inner.close()
-
-        def seed(self, seed=None):
-            self._seed = seed
-            return [seed] * self.num_envs
-
-        def get_attr(self, attr_name, indices=None):
-            return [getattr(self.inner, attr_name, None)] * self.num_envs
-
-        def set_attr(self, attr_name, value, indices=None) -> None:
-            setattr(self.inner, attr_name, value)
-
-        def env_method(self, method_name, *args, indices=None, **kwargs):
-            return [None] * self.num_envs
-
-        def env_is_wrapped(self, wrapper_class, indices=None):
-            return [False] * self.num_envs
-
-    return RigVecEnv(venv)

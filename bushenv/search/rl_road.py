@@ -1,132 +1,100 @@
-"""The quarter car's environment for RL agents: the road under the wheel, as arrays.
+"""The quarter car's environment for RL agents: QuarterCar-v0's vector env, road by road.
 
-``road_agent_env`` builds what ``RLSearch`` acts in on the quarter car: ``QuarterCarBatch``
-cars (the QuarterCar-v0 car as one compiled integrator), QuarterCar-v0's observations and a
-gentler action than the env's (``ROAD_ACTION_SCALE``, ``ROAD_DEAD_ZONE``).
+``road_agent_env`` builds what ``RLSearch`` acts in on the quarter car: ``n_envs`` cars of
+QuarterCar-v0's vector entry point (``QuarterCarBatch``, within 1 % of the pymunk env), the model
+under test on the attacked axis and a twin on the reference, adapted to SB3 by the public
+``SB3VecEnv``. The agent's action is gentler than the env's (``ROAD_ACTION_SCALE``; below
+``ROAD_DEAD_ZONE`` it holds the road, where the free response is judged). Each car's road is
+judged by the evaluator when its episode ends -- at the episode's length, or earlier when either
+car leaves its bounds -- like any other road profile.
 """
 
 from __future__ import annotations
 
+import gymnasium as gym
 import numpy as np
+from stable_baselines3.common.vec_env import VecEnvWrapper
 
-from bushenv.scales import FORCE_FLOOR_N
+from bushenv.models import get_reference
+from bushenv.rigs.sb3 import SB3VecEnv
 from bushenv.search.rl import DENSE_CAP, ROAD_ACTION_SCALE, ROAD_DEAD_ZONE, ROBUSTNESS_CLIP
+
+
+class RoadReward:
+    """``reward_fn`` hook: dense force deviation on the attacked axis, and when a car's episode
+    ends, ``-robustness`` of its road from the evaluator (ended roads judged in one batch)."""
+
+    def __init__(self, n_envs: int, episode_steps: int, evaluator, on_episodes) -> None:
+        self.n, self.episode_steps = n_envs, episode_steps
+        self.evaluator, self.on_episodes = evaluator, on_episodes
+        self.axis = evaluator.axis
+        self.floor = evaluator.scales.force_floor_n
+        self.reset()
+
+    def reset(self) -> None:
+        self.roads: list[list[float]] = [[] for _ in range(self.n)]
+        self.peak = np.full(self.n, self.floor)
+
+    def reset_columns(self, mask) -> None:
+        for i in np.flatnonzero(mask):
+            self.roads[i] = []
+            self.peak[i] = self.floor
+
+    def __call__(self, info) -> np.ndarray:
+        fm = np.asarray(info[f"force_{self.axis}_model_n"], dtype=np.float64)
+        fr = np.asarray(info[f"force_{self.axis}_reference_n"], dtype=np.float64)
+        for i, h in enumerate(np.asarray(info["road_height_m"], dtype=np.float64)):
+            self.roads[i].append(float(h))
+        np.maximum(self.peak, np.abs(fr), out=self.peak)
+        with np.errstate(invalid="ignore"):
+            dense = np.abs(fm - fr) / self.peak
+        dense = np.where(np.isfinite(dense), np.minimum(dense, DENSE_CAP), DENSE_CAP)
+        reward = dense / self.episode_steps
+        ended = (
+            np.asarray(info["diverged"], dtype=bool)
+            | np.asarray(info["physical_limit"], dtype=bool)
+            | (np.asarray(info["step"]) >= self.episode_steps)
+        )
+        idx = np.flatnonzero(ended)
+        if idx.size:
+            batch = self.evaluator.evaluate([np.array(self.roads[i]) for i in idx])
+            rob = np.clip(batch.verdict.robustness, -ROBUSTNESS_CLIP, ROBUSTNESS_CLIP)
+            reward[idx] -= rob
+            self.on_episodes(batch)
+        return reward
+
+
+class RoadActions(VecEnvWrapper):
+    """The agent's gentler road action: |a| < ``ROAD_DEAD_ZONE`` holds the road, the rest is
+    scaled by ``ROAD_ACTION_SCALE`` (QuarterCar-v0's full action throws the twin car against its
+    bump stops within 0.1-0.3 s on a random policy, after which nothing can be judged)."""
+
+    def reset(self):
+        return self.venv.reset()
+
+    def step_async(self, actions) -> None:
+        a = np.clip(np.nan_to_num(np.asarray(actions, np.float64), nan=0.0), -1.0, 1.0)
+        a = np.where(np.abs(a) < ROAD_DEAD_ZONE, 0.0, a) * ROAD_ACTION_SCALE
+        self.venv.step_async(a.astype(np.float32))
+
+    def step_wait(self):
+        return self.venv.step_wait()
 
 
 def road_agent_env(evaluator, n_envs, episode_steps, on_episodes, actions=None):
     """SB3 ``VecEnv`` of ``n_envs`` quarter cars (``actions`` is the rig's notion; unused)."""
-    return _road_vec_env(evaluator, n_envs, episode_steps, on_episodes)
-
-
-def _road_vec_env(evaluator, n_envs, episode_steps, on_episodes):
-    """SB3 ``VecEnv``: ``n_envs`` QuarterCar-v0 cars driven by the agent's road, as arrays.
-
-    The car is ``QuarterCarBatch`` (the QuarterCar-v0 car as one compiled array integrator,
-    agreement with the pymunk env tested in tests/rigs), the model under test on the attacked
-    axis and a twin on the rubber. Observations follow QuarterCar-v0's docstring (12 scaled
-    values); the action is the road height change per step as a fraction of
-    ``ROAD_ACTION_SCALE * max_road_step_m``, ``|a| < ROAD_DEAD_ZONE`` holding the road. All
-    cars run episodes of the same length and reset together; at the end the roads are judged
-    by ``evaluator`` (the same batched quarter-car path as random search).
-    """
-    from gymnasium import spaces
-    from stable_baselines3.common.vec_env.base_vec_env import VecEnv
-
-    from bushenv.search.roads import make_cars
-
     axis = evaluator.axis
-
-    class RoadVecEnv(VecEnv):
-        def __init__(self) -> None:
-            self.car = make_cars(
-                evaluator.model, evaluator.reference, n_envs, evaluator.dt, axis, episode_steps
-            )
-            self.p = self.car.params
-            obs = spaces.Box(-1.0, 1.0, shape=(12,), dtype=np.float32)
-            act = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
-            super().__init__(n_envs, obs, act)
-            self._actions = None
-            self._restart()
-
-        def _restart(self) -> None:
-            self.car.reset()
-            self.h = np.zeros(self.num_envs)
-            self.roads: list[np.ndarray] = []
-            self.peak = np.full(self.num_envs, FORCE_FLOOR_N)
-
-        def reset(self):
-            self._restart()
-            return np.zeros((self.num_envs, 12), dtype=np.float32)
-
-        def step_async(self, actions) -> None:
-            self._actions = np.asarray(actions, dtype=np.float64).reshape(self.num_envs)
-
-        def _observe(self, out) -> np.ndarray:
-            p = self.p
-            cols = [
-                out["road_height_m"] / p.max_road,
-                out["chassis_y_m"] / p.max_body,
-                out["chassis_vy_m_per_s"] / p.v_scale,
-                out["wheel_y_m"] / p.max_body,
-                out["wheel_vy_m_per_s"] / p.v_scale,
-                out["radial_deflection_m"] / p.max_deflection,
-                out["axial_deflection_m"] / p.max_deflection,
-                out["force_radial_model_n"] / p.force_limit,
-                out["force_axial_model_n"] / p.force_limit,
-                out["force_radial_reference_n"] / p.force_limit,
-                out["force_axial_reference_n"] / p.force_limit,
-                (out["chassis_y_m"] - out["reference_chassis_y_m"]) / p.max_body,
-            ]
-            obs = np.nan_to_num(np.stack(cols, axis=1), nan=0.0, posinf=1.0, neginf=-1.0)
-            return np.clip(obs, -1.0, 1.0).astype(np.float32)
-
-        def step_wait(self):
-            p = self.p
-            a = np.clip(np.nan_to_num(self._actions, nan=0.0), -1.0, 1.0)
-            a = np.where(np.abs(a) < ROAD_DEAD_ZONE, 0.0, a)  # lets the agent hold the road
-            step = ROAD_ACTION_SCALE * p.max_road_step
-            self.h = np.clip(self.h + a * step, -p.max_road, p.max_road)
-            out = self.car.step(self.h)
-            self.roads.append(self.h.copy())
-            obs = self._observe(out)
-            fm = out[f"force_{axis}_model_n"]
-            fr = out[f"force_{axis}_reference_n"]
-            np.maximum(self.peak, np.abs(fr), out=self.peak)
-            with np.errstate(invalid="ignore"):
-                dense = np.abs(fm - fr) / self.peak
-            dense = np.where(np.isfinite(dense), np.minimum(dense, DENSE_CAP), DENSE_CAP)
-            reward = dense / episode_steps
-            dones = np.zeros(self.num_envs, dtype=bool)
-            infos = [{} for _ in range(self.num_envs)]
-            if len(self.roads) >= episode_steps:
-                road = np.stack(self.roads, axis=1)  # (n, T)
-                batch = evaluator.evaluate(list(road))
-                rob = np.clip(batch.verdict.robustness, -ROBUSTNESS_CLIP, ROBUSTNESS_CLIP)
-                reward = reward - rob
-                on_episodes(batch)
-                dones[:] = True
-                for i in range(self.num_envs):
-                    infos[i]["terminal_observation"] = obs[i].copy()
-                    infos[i]["TimeLimit.truncated"] = True
-                obs = self.reset()
-            return obs, reward.astype(np.float32), dones, infos
-
-        def close(self) -> None:
-            pass
-
-        def seed(self, seed=None):
-            return [seed] * self.num_envs
-
-        def get_attr(self, attr_name, indices=None):
-            return [getattr(self, attr_name, None)] * self.num_envs
-
-        def set_attr(self, attr_name, value, indices=None) -> None:
-            setattr(self, attr_name, value)
-
-        def env_method(self, method_name, *args, indices=None, **kwargs):
-            return [None] * self.num_envs
-
-        def env_is_wrapped(self, wrapper_class, indices=None):
-            return [False] * self.num_envs
-
-    return RoadVecEnv()
+    other = "axial" if axis == "radial" else "radial"
+    other_ref = get_reference("rubber", axis=other, dt=evaluator.dt)
+    venv = gym.make_vec(
+        "QuarterCar-v0",
+        num_envs=n_envs,
+        vectorization_mode="vector_entry_point",
+        model={axis: evaluator.model.copy(), other: other_ref.copy()},
+        reference={axis: evaluator.reference.copy(), other: other_ref.copy()},
+        dt_s=evaluator.dt,
+        max_episode_steps=episode_steps,
+        autoreset_mode="SameStep",
+        reward_fn=RoadReward(n_envs, episode_steps, evaluator, on_episodes),
+    )
+    return RoadActions(SB3VecEnv(venv))

@@ -60,13 +60,14 @@ class _Collect:
 
 
 def _oscillator_rig(model, reference, n_envs=4, steps=200, mode="rate"):
-    from bushenv.search.rl_rig import DivergenceReward, _oscillator_env, _rig_vec_env, _sb3_vec_env
+    from bushenv.rigs.sb3 import SB3VecEnv
+    from bushenv.search.rl_rig import DivergenceReward, _oscillator_env, _rig_vec_env
 
     ev = BatchEvaluator(model, reference)
     got = _Collect(ev)
     reward = DivergenceReward(n_envs, steps, ev, got.batches.append)
     venv = _rig_vec_env(model.copy(), reference.copy(), "axial", n_envs, steps, reward)
-    env = _oscillator_env(_sb3_vec_env(venv), reward, venv.params, mode)
+    env = _oscillator_env(SB3VecEnv(venv), reward, venv.params, mode)
     return env, reward, venv.params, got
 
 
