@@ -23,6 +23,7 @@ COMMANDS = {
     "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
     "measure": ("bushenv.machine", "run a test programme on a model and write CSV records"),
+    "fit": ("bushenv.identify.command", "identify a model from measured records, with a card"),
 }
 
 

@@ -281,7 +281,7 @@ QUICK_FIT_OPTIONS = {
         "iters_per_length": (10, 10),
         "time_budget_s": 10.0,
     },
-    "boucwen": {"maxiter": 2, "popsize": 4, "polish_maxfev": 20, "time_budget_s": 10.0},
+    "boucwen": {"generations": 2, "population": 4, "polish_evaluations": 20, "time_budget_s": 10.0},
 }
 
 
