@@ -21,6 +21,16 @@ from pathlib import Path
 import numpy as np
 
 RECIPES = ("free-run", "teacher-forcing")
+# A variant is a recipe, optionally with "+lags": the first layer trained on the plain lags
+# (--input-basis lags) as the papers' network was, instead of lag differences.
+VARIANTS = RECIPES
+
+
+def variant_options(variant: str) -> dict:
+    recipe, _, basis = variant.partition("+")
+    return {"recipe": recipe, **({"input_basis": basis} if basis else {})}
+
+
 HOLD_M = 4e-3
 HOLD_S = 10.0
 TAIL_S = 1.0
@@ -37,7 +47,7 @@ def held_force(model, x_hold_m: float) -> float:
     return float(np.mean(f[-n:])) if np.all(np.isfinite(f)) else float("nan")
 
 
-def one_cell(axis: str, seed: int, models: list[str]) -> list[dict]:
+def one_cell(axis: str, seed: int, models: list[str], variants: list[str]) -> list[dict]:
     from bushenv.identify import fit
     from bushenv.metrics import rms_ratio
     from bushenv.models import get_reference
@@ -48,8 +58,8 @@ def one_cell(axis: str, seed: int, models: list[str]) -> list[dict]:
     ref_hold = {s: held_force(ref, s * HOLD_M) for s in (1, -1)}
     rows = []
     for name in models:
-        for recipe in RECIPES:
-            res = fit([train], name, {"recipe": recipe}, seed=seed, progress=False)
+        for recipe in variants:
+            res = fit([train], name, variant_options(recipe), seed=seed, progress=False)
             m = res.model
             row = {"axis": axis, "seed": seed, "model": name, "recipe": recipe}
             row["fit_s"] = res.seconds
@@ -62,7 +72,7 @@ def one_cell(axis: str, seed: int, models: list[str]) -> list[dict]:
                 row[f"reference_{tag}_n"] = ref_hold[s]
             rows.append(row)
             print(
-                f"{axis} seed {seed} {name:6s} {recipe:15s} {res.seconds:5.1f} s  unseen n=1 "
+                f"{axis} seed {seed} {name:6s} {recipe:20s} {res.seconds:5.1f} s  unseen n=1 "
                 f"{100 * row['unseen_n1']:5.2f} %  n=1.5 {100 * row['unseen_n15']:5.2f} %  "
                 f"+4 mm {row['held_plus4_n']:8.1f} N (ref {ref_hold[1]:.1f})  -4 mm "
                 f"{row['held_minus4_n']:8.1f} N (ref {ref_hold[-1]:.1f})",
@@ -122,6 +132,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seeds", default="0-3", help="seed range a-b or list (default: 0-3)")
     p.add_argument("--axes", default="axial,radial", help="comma list (default: axial,radial)")
     p.add_argument("--models", default="nn,hybrid", help="comma list (default: nn,hybrid)")
+    p.add_argument(
+        "--recipes",
+        default=",".join(VARIANTS),
+        help="comma list of recipes, each optionally +lags (default: free-run,teacher-forcing)",
+    )
     p.add_argument("--json", type=Path, default=None, help="write every row here")
     p.add_argument("--md", type=Path, default=None, help="write the summary table here")
     args = p.parse_args(argv)
@@ -132,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for axis in args.axes.split(","):
         for seed in seeds_of(args.seeds):
-            rows += one_cell(axis, seed, args.models.split(","))
+            rows += one_cell(axis, seed, args.models.split(","), args.recipes.split(","))
             if args.json:
                 args.json.write_text(json.dumps(rows, indent=1))
     command = "python scripts/fit_recipes.py " + " ".join(argv or sys.argv[1:])

@@ -313,6 +313,7 @@ def save_fit(
 # What of a model's training log goes on its card (the rest is per-iteration detail).
 _TRAINING_SUMMARY = (
     "recipe",
+    "input_basis",
     "best_validation_rms_ratio",
     "validation_after_teacher",
     "best_teacher_validation_mse",

@@ -32,20 +32,32 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
             f"--{sym}-scale-{unit}",
             type=float,
             default=None,
-            help=f"{what} scale, {unit.upper()}: scaled = ({what} - offset) / scale",
+            metavar="X",
+            help=f"{what} scale, {'m' if unit == 'm' else 'N'}: scaled = ({what} - offset) / "
+            f"scale (default: none; this or --{sym}-range-{unit} is required)",
         )
         p.add_argument(
-            f"--{sym}-offset-{unit}", type=float, default=None, help=f"{what} offset (default: 0)"
+            f"--{sym}-offset-{unit}",
+            type=float,
+            default=None,
+            metavar="X",
+            help=f"{what} offset, {'m' if unit == 'm' else 'N'} (default: 0)",
         )
         p.add_argument(
             f"--{sym}-range-{unit}",
             default=None,
             metavar="LO,HI",
             help=f"instead of scale and offset: the {what} range mapped to [-1, 1] (mapminmax; "
-            f"write --{sym}-range-{unit}=-LO,HI when LO is negative)",
+            f"write --{sym}-range-{unit}=-LO,HI when LO is negative; default: none)",
         )
-    p.add_argument("--k-n-per-m", type=float, default=None, help="hybrid backbone stiffness, N/m")
-    p.add_argument("--c-ns-per-m", type=float, default=None, help="hybrid backbone damping, N s/m")
+    for flag, what in (("--k-n-per-m", "stiffness, N/m"), ("--c-ns-per-m", "damping, N s/m")):
+        p.add_argument(
+            flag,
+            type=float,
+            default=None,
+            metavar="X",
+            help=f"hybrid backbone {what} (default: none; required for a hybrid)",
+        )
     p.add_argument(
         "--rate-hz", type=float, default=1.0 / PAPER_DT, help="sample rate, Hz (default: 204.8)"
     )
@@ -61,7 +73,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=BLOCK_ORDERS[0],
         help="displacements before past forces or after (default: x-then-f)",
     )
-    p.add_argument("--force", action="store_true", help="replace an existing model file")
+    p.add_argument(
+        "--force", action="store_true", help="replace an existing model file and its card"
+    )
 
 
 def _pair(text: str, flag: str, kind: type = float) -> tuple:

@@ -12,7 +12,7 @@ from bushenv.models.narx import HIDDEN, N_PAST_F, N_PAST_X
 
 ENGINES = ("numba", "torch")
 RECIPES = ("free-run", "teacher-forcing")
-INPUT_BASES = ("lags", "differences")
+INPUT_BASES = ("auto", "lags", "differences")
 EARLY_STOPS = ("training", "stage")
 
 
@@ -46,9 +46,10 @@ class NarxOptions:
         1.0, "free-run learning rate at the end, as a fraction of --free-run-lr (cosine)"
     )
     input_basis: str = option(
-        "differences",
+        "auto",
         "variables the first layer trains in: lags, or the current value and lag differences "
-        "(same network, exported in lags)",
+        "(same network, exported in lags); auto: lags under teacher-forcing (the papers' "
+        "network), differences under free-run",
         choices=INPUT_BASES,
     )
     engine: str = option(
@@ -66,6 +67,12 @@ class NarxOptions:
     threads: int = option(1, "torch threads")
     time_budget_s: float = option(120.0, "wall-time cap, s (a safety stop, reported)")
     progress_every_s: float = option(3.0, "seconds between progress lines")
+
+    def basis(self) -> str:
+        """The input basis training uses ("auto" resolved by the recipe)."""
+        if self.input_basis != "auto":
+            return self.input_basis
+        return "lags" if self.recipe == "teacher-forcing" else "differences"
 
     def check(self) -> None:
         if len(self.window_lengths) != len(self.iters_per_length):

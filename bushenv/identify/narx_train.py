@@ -40,7 +40,7 @@ class Trainer:
         self.rng = np.random.default_rng(seed)
         nx, nf = problem.n_past_x, problem.n_past_f
         basis = None
-        if opt.input_basis == "differences":
+        if opt.basis() == "differences":
             parts = problem.train
             basis = difference_basis(
                 nx,
@@ -53,6 +53,7 @@ class Trainer:
         self.log: dict[str, Any] = {
             "options": as_dict(opt),
             "recipe": opt.recipe,
+            "input_basis": opt.basis(),
             "records": problem.data.labels,
             "teacher_losses": [],
             "free_run_losses": [],

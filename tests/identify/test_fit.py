@@ -70,6 +70,7 @@ def test_two_records_train_together_and_one_record_gives_the_same_as_fit_model()
     assert np.array_equal(one.w1, same.w1)
     two = fit([a, b], "nn", QUICK, seed=3, progress=False)
     assert two.model.training["records"] == ["rec0", "rec1"]
+    assert two.model.training["input_basis"] == "differences"  # "auto" under free-run
     assert not np.array_equal(two.model.w1, one.w1)
     held = record(3.0, 9)
     assert rms_ratio(held.force, two.model.simulate(held.displacement)) < 0.5
@@ -111,6 +112,7 @@ def test_teacher_forcing_recipe_trains_one_step_ahead_only_and_keeps_its_best_ch
     m = fit([a], "nn", dict(QUICK, recipe="teacher-forcing"), seed=0, progress=False).model
     tr = m.training
     assert tr["recipe"] == "teacher-forcing" and tr["free_run_losses"] == []
+    assert tr["input_basis"] == "lags"  # "auto": the papers' network trains on the lags
     history = tr["teacher_validation_mse"]
     assert history and tr["best_teacher_validation_mse"] == min(v for _, v in history)
     assert tr["stopped"].startswith("one step ahead only")
