@@ -270,17 +270,19 @@ def save_fit(
     held_out: list | None = None,
     plots: bool = True,
 ) -> dict[str, Any]:
-    """Write a ``FitResult``'s model file, its card (JSON + markdown) and figures.
+    """Write a ``FitResult``'s figures, model file and card (JSON + markdown), in that order
+    (a failure leaves no model file without its card).
 
     ``held_out``: records never seen in training; the card gives the model's metrics on each
     and a figure pair per record (without held-out records, the first training record is
     plotted, marked as seen in training). Returns the card.
     """
     from bushenv.identify.options import as_dict
-    from bushenv.identify.plots import record_figures, safe_name
 
     model_path = Path(model_path)
     model = result.model
+    held_out = list(held_out or [])
+    figures = _figures(model, model_path, result.records, held_out) if plots else []
     model.save(model_path)
     training = getattr(model, "training", {}) or {}
     source = {
@@ -292,22 +294,26 @@ def save_fit(
         "training": {k: training[k] for k in _TRAINING_SUMMARY if k in training},
     }
     card = new_card(model, model_path, source)
-    held_out = list(held_out or [])
     card["records"] = [record_entry(r, "train", model) for r in result.records]
     card["records"] += [record_entry(r, "held-out", model) for r in held_out]
-    if plots:
-        shown = [(r, "held-out") for r in held_out] or [
-            (result.records[0], "training record, seen in training")
-        ]
-        stem = model_path.name[: -len(model_path.suffix)] if model_path.suffix else model_path.name
-        for i, (rec, role) in enumerate(shown):
-            model.reset(1)
-            f_model = model.simulate(rec.displacement)
-            prefix = model_path.with_name(f"{stem}.{i + 1}-{safe_name(rec.name or 'record')}")
-            paths = record_figures(rec, f_model, model.name, prefix, role)
-            card["plots"] += [p.name for p in paths]
+    card["plots"] = figures
     write_card(card, model_path)
     return card
+
+
+def _figures(model: Any, model_path: Path, train: list, held_out: list) -> list[str]:
+    """The figure pair of each held-out record (or of the first training record)."""
+    from bushenv.identify.plots import record_figures, safe_name
+
+    shown = [(r, "held-out") for r in held_out] or [(train[0], "seen in training")]
+    stem = model_path.name[: -len(model_path.suffix)] if model_path.suffix else model_path.name
+    names = []
+    for i, (rec, role) in enumerate(shown):
+        model.reset(1)
+        f_model = model.simulate(rec.displacement)
+        prefix = model_path.with_name(f"{stem}.{i + 1}-{safe_name(rec.name or 'record')}")
+        names += [p.name for p in record_figures(rec, f_model, model.name, prefix, role)]
+    return names
 
 
 # What of a model's training log goes on its card (the rest is per-iteration detail).

@@ -26,7 +26,9 @@ safety cap (reported if hit). docs/fit.md explains each option and what the reci
 
 Extra loss terms plug in through ``loss_terms`` (objects with ``name``, ``stages`` and
 ``__call__(net, problem) -> tensor``, added to the data loss of the stages they name);
-``weight_decay`` is one (``WeightDecay``).
+``weight_decay`` is one (``WeightDecay``). A term a flag turns on is a ``NarxOptions`` field
+(``narx_options.py``) that ``loss_terms_of`` reads; ``problem`` (``narx_data.NarxProblem``)
+gives it the scaling, the lags, the backbone and the records.
 """
 
 from __future__ import annotations

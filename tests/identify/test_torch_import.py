@@ -197,3 +197,11 @@ def test_import_nn_command_refuses_a_wrong_shape_in_one_line_and_writes_nothing(
     assert main(args[:-3] + ["5,5", "--out", str(out), "--f-scale-n", "900"]) == 2
     assert "--x-scale-m" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_a_hybrid_needs_its_backbone_and_a_pure_nn_takes_none():
+    sd = make_net(11, (9,), seed=5).state_dict()
+    with pytest.raises(TorchImportError, match="a hybrid needs its backbone"):
+        import_torch_narx(sd, (5, 5), SCALING, model="hybrid", k_n_per_m=1e5)
+    with pytest.raises(TorchImportError, match="a pure nn takes neither"):
+        import_torch_narx(sd, (5, 5), SCALING, model="nn", k_n_per_m=1e5, c_ns_per_m=1e3)
