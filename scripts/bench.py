@@ -396,23 +396,30 @@ def _option_flags(options: dict) -> list[str]:
 FIT_COMMAND_TARGETS_S = {"nn": 30.0, "hybrid": 40.0, "boucwen": 120.0}
 
 
-def _run_fit_command(argv: list[str], quick: bool, quick_flags: list[str]) -> float:
-    """Seconds of one ``bushenv fit``: a fresh process as a user runs it (the full run), or
-    in this process with a tiny budget (--quick: only that the figures come out)."""
+def _run_fit_command(argv: list[str], quick: bool, quick_flags: list[str]) -> tuple[float, float]:
+    """(wall s, CPU s) of one ``bushenv fit``: a fresh process as a user runs it (the full
+    run; CPU = its user + system time, which other jobs on the machine do not inflate), or in
+    this process with a tiny budget (--quick: only that the figures come out)."""
+    import resource
     import subprocess
 
     t0 = time.perf_counter()
     if quick:
         from bushenv.cli import main as cli_main
 
+        c0 = time.process_time()
         code = cli_main(argv + quick_flags)
         if code != 0:
             raise RuntimeError(f"bushenv {' '.join(argv)} exited {code}")
-        return time.perf_counter() - t0
+        return time.perf_counter() - t0, time.process_time() - c0
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     done = subprocess.run([sys.executable, "-m", "bushenv.cli", *argv], capture_output=True)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:
         raise RuntimeError(f"bushenv {' '.join(argv)}: {done.stderr.decode()[-500:]}")
-    return time.perf_counter() - t0
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
 
 
 def bench_fit_command(fig: Figures, quick: bool) -> None:
@@ -436,7 +443,7 @@ def bench_fit_command(fig: Figures, quick: bool) -> None:
             out = tmp / f"{name}.npz"
             argv = ["fit", str(tmp / "train.csv"), "--model", name, "--out", str(out)]
             argv += ["--validate", str(tmp / "unseen_n1.csv"), "--quiet"]
-            seconds = _run_fit_command(argv, quick, ["--no-plots", *_option_flags(opts)])
+            seconds, cpu = _run_fit_command(argv, quick, ["--no-plots", *_option_flags(opts)])
             card = json.loads((tmp / f"{name}.card.json").read_text())
             held = next(r for r in card["records"] if r["role"] == "held-out")
             ratio = 100.0 * held["metrics"]["rms_ratio"]
@@ -447,7 +454,8 @@ def bench_fit_command(fig: Figures, quick: bool) -> None:
                 None if quick else target,
                 better="lower",
                 note=f"held-out (unseen n = 1) RMS ratio {ratio:.2f} %; training alone "
-                f"{card['source']['wall_time_s']:.1f} s",
+                f"{card['source']['wall_time_s']:.1f} s; CPU {cpu:.1f} s; load average "
+                f"{os.getloadavg()[0]:.1f}",
             )
             fig.add(
                 f"fit_command.{name}.rms_ratio_unseen_n1",

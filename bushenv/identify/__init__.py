@@ -56,14 +56,20 @@ def fittable_models() -> list[str]:
     return [n for n, e in MODELS.items() if e.fit is not None]
 
 
-def fit_method(name: str) -> tuple[Any, type]:
-    """(identification function, options class) of the registered model ``name``."""
+def options_class(name: str) -> type:
+    """The options dataclass of the registered model ``name`` (imports no training code)."""
     entry = MODELS[name] if name in MODELS else None
     if entry is None or entry.fit is None:
         raise IdentificationError(
             f"no identification for model {name!r}; known: {', '.join(fittable_models())}"
         )
-    return entry.fit_function(), entry.options_class()
+    return entry.options_class()
+
+
+def fit_method(name: str) -> tuple[Any, type]:
+    """(identification function, options class) of the registered model ``name``."""
+    cls = options_class(name)
+    return MODELS[name].fit_function(), cls
 
 
 def fit(
@@ -145,4 +151,5 @@ __all__ = [
     "fit_model",
     "fittable_models",
     "load_card",
+    "options_class",
 ]

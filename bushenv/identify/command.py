@@ -14,7 +14,7 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-from bushenv.identify import fit_method, fittable_models
+from bushenv.identify import fittable_models, options_class
 from bushenv.identify.options import describe, flag_of, option_fields
 
 EXAMPLE = "bushenv fit train1.csv train2.csv --model hybrid --validate held.csv --out my_hybrid.npz"
@@ -25,7 +25,7 @@ def model_options() -> dict[str, list[tuple[str, Any]]]:
     """Option name -> [(model, dataclass field)] for every model with an identification."""
     table: dict[str, list[tuple[str, Any]]] = defaultdict(list)
     for name in fittable_models():
-        for f in option_fields(fit_method(name)[1]):
+        for f in option_fields(options_class(name)):
             table[f.name].append((name, f))
     return dict(table)
 

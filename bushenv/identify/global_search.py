@@ -33,14 +33,12 @@ steps in a sample, or a solution that blows up) score ``inf``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
+from bushenv.identify.boucwen_options import BoucWenOptions
 from bushenv.identify.data import IdentificationError, TrainingSet
 from bushenv.identify.linear import least_squares_kc
-from bushenv.identify.options import option
 from bushenv.identify.progress import Progress, ProgressSpec
 from bushenv.models.boucwen import BoucWenBushing, simulate_population
 from bushenv.models.kernels import BW_ORDER
@@ -120,34 +118,6 @@ def satisfies_constraints(vector: np.ndarray) -> bool:
         and p["beta1"] + p["gamma1"] > 0
         and p["beta2"] - p["gamma2"] > 0
     )
-
-
-@dataclass(frozen=True)
-class BoucWenOptions:
-    """Options of the Bouc-Wen global search; each is a flag of ``bushenv fit``."""
-
-    generations: int = option(400, "differential-evolution generations")
-    population: int = option(
-        8, "population per search variable (scipy's popsize: 8 x 14 = 112 members)"
-    )
-    fit_seconds: float = option(
-        8.0, "seconds of the records the search scores on (from the start, record after record)"
-    )
-    polish_evaluations: int = option(
-        500, "Powell polish evaluations on all of every record (0: no polish)"
-    )
-    max_substeps: int = option(
-        400, "integrator trial steps allowed per sample before a member scores inf"
-    )
-    time_budget_s: float = option(110.0, "wall-time cap of the search, s (reported if hit)")
-    progress_every_s: float = option(3.0, "seconds between progress lines")
-
-    def check(self) -> None:
-        for name in ("generations", "population", "max_substeps"):
-            if getattr(self, name) < 1:
-                raise IdentificationError(f"{name} must be >= 1, got {getattr(self, name)}")
-        if self.polish_evaluations < 0 or not self.fit_seconds > 0:
-            raise IdentificationError("polish_evaluations must be >= 0 and fit_seconds > 0")
 
 
 class PopulationCost:

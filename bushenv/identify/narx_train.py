@@ -34,7 +34,7 @@ class Trainer:
         work = opt.teacher_steps * problem.n_train
         work += sum(n * opt.batch_windows * length for length, n in stages)
         self.progress = Progress(
-            problem.kind, work, progress, opt.progress_every_s, opt.time_budget_s
+            problem.kind, work, progress, opt.progress_every_s, opt.time_budget_s, True
         )
         self.work = 0.0
         self.rng = np.random.default_rng(seed)
@@ -222,6 +222,7 @@ class Trainer:
             self.free_run()
             self.net.load_state_dict(self.best_state)
         elapsed = self.progress.elapsed()
+        self.work = self.progress.total_work
         self.say(
             f"done in {elapsed:.1f} s ({self.log['stopped']}); best validation free-run RMS "
             f"ratio {self.best_val:.4f}",

@@ -30,6 +30,9 @@ class Progress:
         Least time between two lines (``force=True`` lines always print).
     budget_s : float, optional
         The method stops at this wall time at the latest; caps the estimate.
+    upper_bound : bool
+        Early stopping can skip part of the work: the estimate is shown as a bound ("<= 40 s
+        left") rather than a guess ("~40 s left").
     """
 
     def __init__(
@@ -39,12 +42,14 @@ class Progress:
         spec: ProgressSpec = True,
         every_s: float = 3.0,
         budget_s: float | None = None,
+        upper_bound: bool = False,
     ) -> None:
         self.label = label
         self.total_work = float(total_work)
         self.spec = spec
         self.every_s = float(every_s)
         self.budget_s = budget_s
+        self.upper_bound = upper_bound
         self.t0 = time.perf_counter()
         self.last = self.t0
         self.done = 0.0
@@ -72,7 +77,9 @@ class Progress:
             return
         self.last = now
         left = self.left_s()
-        eta = f", ~{left:.0f} s left" if left is not None and self.done < self.total_work else ""
+        eta = ""
+        if left is not None and self.done < self.total_work:
+            eta = f", {'<=' if self.upper_bound else '~'}{left:.0f} s left"
         line = f"[{self.label} {now - self.t0:6.1f} s{eta}] {message}"
         if callable(self.spec):
             self.spec(line)

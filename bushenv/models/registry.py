@@ -93,7 +93,7 @@ MODELS.add(
         "bushenv.models.boucwen:BoucWenBushing",
         "16-parameter Bouc-Wen model with two hysteretic variables (seed 002 eqs 1-5)",
         fit="bushenv.identify.global_search:fit_boucwen",
-        options="bushenv.identify.global_search:BoucWenOptions",
+        options="bushenv.identify.boucwen_options:BoucWenOptions",
         shipped=True,
     ),
 )
