@@ -20,6 +20,7 @@ lines with an estimate of the time left on stderr.
 from __future__ import annotations
 
 import inspect
+import os
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -81,7 +82,8 @@ def fit(
     velocities: Sequence | None = None,
     loss_terms: Sequence = (),
 ) -> FitResult:
-    """Identify ``model`` from ``records`` (``bushenv.records.Record`` objects, one rate).
+    """Identify ``model`` from ``records`` (``bushenv.records.Record`` objects or CSV file
+    paths, one sample rate).
 
     Parameters
     ----------
@@ -95,8 +97,9 @@ def fit(
     loss_terms : sequence, optional
         Extra training losses (NARX models only; ``bushenv.identify.neural.LossTerm``).
     """
-    fit_function, options_class = fit_method(model)
-    opts = options_of(options_class, options, model)
+    fit_function, options_type = fit_method(model)
+    opts = options_of(options_type, options, model)
+    records = [_as_record(r) for r in records]
     data = training_set(records, velocities)
     extra = {}
     if loss_terms:
@@ -106,7 +109,15 @@ def fit(
     t0 = time.perf_counter()
     fitted = fit_function(data, opts, seed=seed, progress=progress, **extra)
     seconds = time.perf_counter() - t0
-    return FitResult(fitted, model, opts, list(records), data, int(seed), seconds)
+    return FitResult(fitted, model, opts, records, data, int(seed), seconds)
+
+
+def _as_record(item: Any) -> Any:
+    if isinstance(item, str | os.PathLike):
+        from bushenv.records import load_csv
+
+        return load_csv(item)
+    return item
 
 
 def fit_model(

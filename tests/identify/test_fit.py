@@ -169,5 +169,6 @@ def test_progress_lines_go_to_stderr_with_the_time_left(capsys):
 
 def test_torch_threads_are_restored_after_training():
     before = torch.get_num_threads()
-    fit([record(2.0, 0)], "nn", dict(QUICK, threads=2), progress=False)
+    short = dict(QUICK, threads=2, teacher_steps=10, iters_per_length=(2, 2))
+    fit([record(2.0, 0)], "nn", short, progress=False)
     assert torch.get_num_threads() == before

@@ -114,6 +114,19 @@ def test_card_command_exits_2_naming_a_record_that_does_not_match(
     assert err.count("\n") == 0 and "record train_a.csv does not match the card" in err
 
 
+def test_the_library_takes_record_files_and_saves_the_same_card(records, tmp_path):
+    from bushenv.identify import fit
+    from bushenv.identify.card import save_fit
+
+    result = fit([records["a"]], "linear", progress=False)
+    card = save_fit(result, tmp_path / "lin.npz", held_out=[load_csv(records["held"])], plots=False)
+    assert [r["sha256"] for r in card["records"]] == [
+        sha256_file(records["a"]),
+        sha256_file(records["held"]),
+    ]
+    assert load_card(tmp_path / "lin.npz", records=[records["a"]]).data == card
+
+
 def test_a_replaced_model_file_no_longer_matches_its_card(fitted, tmp_path):
     copy = tmp_path / "my_nn.npz"
     copy.write_bytes(fitted.read_bytes())

@@ -156,6 +156,7 @@ class _Boom:
         return (os.system, ("touch BOOM_RAN",))
 
 
+@pytest.mark.filterwarnings("ignore:Detected pickle protocol")
 def test_loading_a_torch_file_never_runs_code(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     bad = tmp_path / "evil.pt"
