@@ -23,6 +23,9 @@ COMMANDS = {
     "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
     "measure": ("bushenv.machine", "run a test programme on a model and write CSV records"),
+    "fit": ("bushenv.identify.command", "identify a model from measured records, with a card"),
+    "import-nn": ("bushenv.identify.import_command", "a torch NARX network to a model file"),
+    "card": ("bushenv.identify.card_command", "show a model card; check its model and records"),
     "certify": ("bushenv.certify.command", "hold-stability and passivity certificates of a NARX"),
     "zoo": ("bushenv.zoo.command", "population study: how often NARX models fail, by recipe"),
 }

@@ -282,7 +282,7 @@ QUICK_FIT_OPTIONS = {
         "iters_per_length": (10, 10),
         "time_budget_s": 10.0,
     },
-    "boucwen": {"maxiter": 2, "popsize": 4, "polish_maxfev": 20, "time_budget_s": 10.0},
+    "boucwen": {"generations": 2, "population": 4, "polish_evaluations": 20, "time_budget_s": 10.0},
 }
 
 
@@ -383,6 +383,87 @@ def bench_paper_tasks(fig: Figures, quick: bool) -> None:
                 better="lower",
                 note=f"theirs {paper} % (seed 002 Table 4); fit on 40 s at n = 1, judged on "
                 + what[key],
+            )
+
+
+def _option_flags(options: dict) -> list[str]:
+    flags = []
+    for k, v in options.items():
+        text = ",".join(str(i) for i in v) if isinstance(v, tuple) else str(v)
+        flags += ["--" + k.replace("_", "-"), text]
+    return flags
+
+
+FIT_COMMAND_TARGETS_S = {"nn": 30.0, "hybrid": 40.0, "boucwen": 120.0}
+
+
+def _run_fit_command(argv: list[str], quick: bool, quick_flags: list[str]) -> tuple[float, float]:
+    """(wall s, CPU s) of one ``bushenv fit``: a fresh process as a user runs it (the full
+    run; CPU = its user + system time, which other jobs on the machine do not inflate), or in
+    this process with a tiny budget (--quick: only that the figures come out)."""
+    import resource
+    import subprocess
+
+    t0 = time.perf_counter()
+    if quick:
+        from bushenv.cli import main as cli_main
+
+        c0 = time.process_time()
+        code = cli_main(argv + quick_flags)
+        if code != 0:
+            raise RuntimeError(f"bushenv {' '.join(argv)} exited {code}")
+        return time.perf_counter() - t0, time.process_time() - c0
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    done = subprocess.run([sys.executable, "-m", "bushenv.cli", *argv], capture_output=True)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if done.returncode != 0:
+        raise RuntimeError(f"bushenv {' '.join(argv)}: {done.stderr.decode()[-500:]}")
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
+
+
+def bench_fit_command(fig: Figures, quick: bool) -> None:
+    """``bushenv fit`` end to end (a fresh process: imports, training, card, figures) on the
+    radial 40 s n = 1 record ``bushenv reproduce`` measures (seed 0), held out: its unseen
+    n = 1 record; the held-out RMS ratio read from the card beside each time."""
+    import tempfile
+
+    from bushenv.records import save_csv
+    from bushenv.reproduce import _records
+
+    print("\n== bushenv fit on the reproduce records (radial, seed 0; wall time of the command)")
+    length = QUICK_RECORD_S if quick else 40.0
+    train, same, _ = _records("radial", 0, length, QUICK_RECORD_S if quick else 20.0)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        save_csv(train, tmp / "train.csv")
+        save_csv(same, tmp / "unseen_n1.csv")
+        for name, target in FIT_COMMAND_TARGETS_S.items():
+            opts = QUICK_FIT_OPTIONS["boucwen" if name == "boucwen" else "nn"] if quick else {}
+            out = tmp / f"{name}.npz"
+            argv = ["fit", str(tmp / "train.csv"), "--model", name, "--out", str(out)]
+            argv += ["--validate", str(tmp / "unseen_n1.csv"), "--quiet"]
+            seconds, cpu = _run_fit_command(argv, quick, ["--no-plots", *_option_flags(opts)])
+            card = json.loads((tmp / f"{name}.card.json").read_text())
+            held = next(r for r in card["records"] if r["role"] == "held-out")
+            ratio = 100.0 * held["metrics"]["rms_ratio"]
+            fig.add(
+                f"fit_command.{name}",
+                seconds,
+                "s",
+                None if quick else target,
+                better="lower",
+                note=f"held-out (unseen n = 1) RMS ratio {ratio:.2f} %; training alone "
+                f"{card['source']['wall_time_s']:.1f} s; CPU {cpu:.1f} s; load average "
+                f"{os.getloadavg()[0]:.1f}",
+            )
+            fig.add(
+                f"fit_command.{name}.rms_ratio_unseen_n1",
+                ratio,
+                "%",
+                better="lower",
+                note=f"the card of the {seconds:.0f} s fit above",
             )
 
 
@@ -566,6 +647,7 @@ SECTIONS = {
     "models": bench_models,
     "envs": bench_envs,
     "paper": bench_paper_tasks,
+    "fit": bench_fit_command,
     "campaign": bench_campaign,
     "float32": bench_float32_verdicts,
     "memory": bench_memory,

@@ -47,6 +47,11 @@ EXPECTED = [
         for m in ("noise_floor", "nn", "boucwen")
         for k in ("unseen_same_amplitude", "unseen_n1.5")
     ),
+    *(
+        f"fit_command.{m}{k}"
+        for m in ("nn", "hybrid", "boucwen")
+        for k in ("", ".rms_ratio_unseen_n1")
+    ),
     "campaign.random.threads2.evaluations_per_s",
     "campaign.nn.random.seconds_to_first_divergence",
     "campaign.nn.float32_verdict_changes",

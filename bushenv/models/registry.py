@@ -28,7 +28,11 @@ class ModelEntry:
     summary : str
         One line for ``--help`` and the docs' tables.
     fit : str, callable or None
-        Identification ``fit(records, seed=..., progress=..., **options) -> model``, or None.
+        Identification ``fit(data, options, seed, progress) -> model`` (``data`` a
+        ``bushenv.identify.data.TrainingSet``), or None. ``bushenv.identify.fit`` calls it.
+    options : str, type or None
+        The dataclass of ``fit``'s options (``bushenv.identify.options``): the one declaration
+        ``bushenv fit`` builds the model's flags from.
     shipped : bool
         Trained defaults ship in the package; the name loads ``<axis>_<name>.npz``.
     reference_preset : dict
@@ -38,6 +42,7 @@ class ModelEntry:
     entry_point: str | type
     summary: str
     fit: Any = None
+    options: Any = None
     shipped: bool = False
     reference_preset: dict[str, Any] = field(default_factory=dict)
 
@@ -48,6 +53,9 @@ class ModelEntry:
     def fit_function(self) -> Any:
         return load_entry_point(self.fit) if isinstance(self.fit, str) else self.fit
 
+    def options_class(self) -> Any:
+        return load_entry_point(self.options) if isinstance(self.options, str) else self.options
+
 
 MODELS: Registry[ModelEntry] = Registry("model", ModelError)
 MODELS.add(
@@ -56,6 +64,7 @@ MODELS.add(
         "bushenv.models.linear:LinearBushing",
         "Kelvin-Voigt spring and dashpot, F = k x + c v (seed 000 eqs 1-3)",
         fit="bushenv.identify.linear:fit_linear",
+        options="bushenv.identify.options:NoOptions",
     ),
 )
 MODELS.add(
@@ -64,6 +73,7 @@ MODELS.add(
         "bushenv.models.narx:NarxBushing",
         "NARX network fed with its own past forces (seed 000 eqs 4-6)",
         fit="bushenv.identify.neural:fit_nn",
+        options="bushenv.identify.narx_options:NarxOptions",
         shipped=True,
     ),
 )
@@ -73,6 +83,7 @@ MODELS.add(
         "bushenv.models.hybrid:HybridBushing",
         "linear backbone plus a bounded NARX residual network (seed 000 §3)",
         fit="bushenv.identify.neural:fit_hybrid",
+        options="bushenv.identify.narx_options:NarxOptions",
         shipped=True,
     ),
 )
@@ -82,6 +93,7 @@ MODELS.add(
         "bushenv.models.boucwen:BoucWenBushing",
         "16-parameter Bouc-Wen model with two hysteretic variables (seed 002 eqs 1-5)",
         fit="bushenv.identify.global_search:fit_boucwen",
+        options="bushenv.identify.boucwen_options:BoucWenOptions",
         shipped=True,
     ),
 )
