@@ -30,9 +30,9 @@ import numpy as np
 
 from bushenv.identify.data import IdentificationError, TrainingSet, check_record, training_set
 from bushenv.identify.options import options_of
-from bushenv.identify.progress import ProgressSpec
 from bushenv.models.base import BushingModel
 from bushenv.models.registry import MODELS
+from bushenv.progress import ProgressSpec
 
 
 @dataclass

@@ -39,9 +39,9 @@ from scipy.optimize import differential_evolution, minimize
 from bushenv.identify.boucwen_options import BoucWenOptions
 from bushenv.identify.data import IdentificationError, TrainingSet
 from bushenv.identify.linear import least_squares_kc
-from bushenv.identify.progress import Progress, ProgressSpec
 from bushenv.models.boucwen import BoucWenBushing, simulate_population
 from bushenv.models.kernels import BW_ORDER
+from bushenv.progress import Progress, ProgressSpec
 
 SEARCH_NAMES = (
     "log_k0",
@@ -183,7 +183,13 @@ def fit_boucwen(
     whole = PopulationCost([(s.x, s.v, s.f) for s in data.segments], *args)
     members = opt.population * len(SEARCH_BOUNDS)
     work = (opt.generations + 1) * members * search.samples + opt.polish_evaluations * whole.samples
-    prog = Progress("boucwen", work, progress, opt.progress_every_s, opt.time_budget_s)
+    prog = Progress.of(
+        progress,
+        total=work,
+        label="boucwen",
+        every_s=opt.progress_every_s,
+        budget_s=opt.time_budget_s,
+    )
     u_best, log = _evolve(search, whole, opt, seed, prog)
     u_best, log["cost_before_polish_n"], log["cost_n"] = _polish(whole, search, u_best, opt, prog)
     vector = search_to_parameters(u_best, k_ref, c_ref)
@@ -194,7 +200,7 @@ def fit_boucwen(
     log.update(
         rms_ratio=log["cost_n"] / f_rms,
         evaluations=search.evaluations + whole.evaluations,
-        seconds=prog.elapsed(),
+        seconds=prog.elapsed_s(),
         search_vector=u_best.tolist(),
         options={k: getattr(opt, k) for k in opt.__dataclass_fields__},
         records=data.labels,
@@ -229,7 +235,7 @@ def _evolve(search, whole, opt: BoucWenOptions, seed: int, prog: Progress):
 
     def callback(intermediate_result) -> bool:
         gen[0] += 1
-        if prog.elapsed() > opt.time_budget_s:
+        if prog.elapsed_s() > opt.time_budget_s:
             stopped[0] = f"time budget {opt.time_budget_s} s hit after {gen[0]} generations"
             return True
         return False

@@ -8,8 +8,8 @@ import numpy as np
 
 from bushenv.identify.data import IdentificationError, TrainingSet, check_record
 from bushenv.identify.options import NoOptions
-from bushenv.identify.progress import ProgressSpec
 from bushenv.models.linear import LinearBushing
+from bushenv.progress import ProgressSpec
 
 __all__ = ["IdentificationError", "check_record", "fit_linear", "least_squares_kc"]
 

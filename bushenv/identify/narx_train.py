@@ -14,8 +14,8 @@ import torch
 from bushenv.identify.narx_data import NarxProblem
 from bushenv.identify.narx_torch import TorchNarx, difference_basis
 from bushenv.identify.options import as_dict
-from bushenv.identify.progress import Progress, ProgressSpec
 from bushenv.metrics import rms_ratio
+from bushenv.progress import Progress, ProgressSpec
 
 
 class Trainer:
@@ -33,8 +33,13 @@ class Trainer:
         self.problem, self.opt, self.terms, self.stages = problem, opt, loss_terms, stages
         work = opt.teacher_steps * problem.n_train
         work += sum(n * opt.batch_windows * length for length, n in stages)
-        self.progress = Progress(
-            problem.kind, work, progress, opt.progress_every_s, opt.time_budget_s, True
+        self.progress = Progress.of(
+            progress,
+            total=work,
+            label=problem.kind,
+            every_s=opt.progress_every_s,
+            budget_s=opt.time_budget_s,
+            upper_bound=True,
         )
         self.work = 0.0
         self.rng = np.random.default_rng(seed)
@@ -171,7 +176,7 @@ class Trainer:
                         f"early stop at iteration {self.it} (patience {opt.patience})"
                     )
                     return True
-            if self.progress.elapsed() > opt.time_budget_s:
+            if self.progress.elapsed_s() > opt.time_budget_s:
                 self.log["stopped"] = (
                     f"time budget {opt.time_budget_s} s hit at iteration {self.it}"
                 )
@@ -221,8 +226,8 @@ class Trainer:
         if self.opt.recipe == "free-run":
             self.free_run()
             self.net.load_state_dict(self.best_state)
-        elapsed = self.progress.elapsed()
-        self.work = self.progress.total_work
+        elapsed = self.progress.elapsed_s()
+        self.work = self.progress.total
         self.say(
             f"done in {elapsed:.1f} s ({self.log['stopped']}); best validation free-run RMS "
             f"ratio {self.best_val:.4f}",

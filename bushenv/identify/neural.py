@@ -44,9 +44,9 @@ from bushenv.identify.narx_data import NarxProblem, narx_problem
 from bushenv.identify.narx_options import NarxOptions
 from bushenv.identify.narx_torch import TorchNarx
 from bushenv.identify.narx_train import Trainer
-from bushenv.identify.progress import ProgressSpec
 from bushenv.models.hybrid import HybridBushing
 from bushenv.models.narx import NarxBushing
+from bushenv.progress import ProgressSpec
 
 
 class LossTerm(Protocol):
