@@ -11,7 +11,7 @@ when every cell is done, ``DIR/summary.json``, ``summary.md`` and
 from __future__ import annotations
 
 import argparse
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from itertools import product
 from pathlib import Path
 from typing import Any
@@ -49,6 +49,7 @@ class ZooConfig:
     budget: int = 256
     out: Path = Path("runs/zoo")
     resume: bool = False
+    train_options: dict = field(default_factory=dict)  # NARX options beyond the recipe
 
     def checked(self) -> ZooConfig:
         for flag, names, known in (
@@ -76,6 +77,7 @@ class ZooConfig:
                 "budget": self.budget,
                 "searchers": ",".join(self.searchers),
                 "out": str(self.out),
+                "train_options": dict(self.train_options),
             }
             for r, m, a, s in product(self.recipes, self.models, self.axes, self.seeds)
         ]
