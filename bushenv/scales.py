@@ -147,3 +147,23 @@ def scales_of_records(scales: BushingScales, x_m, dt: float) -> BushingScales:
         velocity_m_per_s=min(RECORD_MARGIN * speed, ex.MAX_VELOCITY_M_PER_S),
         source=scales.source + f"; stroke and velocity 1.5 x the records' ({peak * 1e3:.3g} mm)",
     )
+
+
+def scales_of_card(scales: BushingScales, card: dict) -> BushingScales:
+    """``scales`` with stroke and velocity from a model card's training records (their largest
+    |x| and |dx/dt| times ``RECORD_MARGIN``, within the machine) and their peak force as the
+    typical force; a card without those figures leaves ``scales`` as they are."""
+    train = [r for r in card.get("records", []) if r.get("role") == "train"]
+    if not train or any("max_abs_displacement_m" not in r for r in train):
+        return scales
+    peak = max(r["max_abs_displacement_m"] for r in train)
+    speed = max(r["max_abs_velocity_m_per_s"] for r in train)
+    return replace(
+        scales,
+        stroke_m=min(RECORD_MARGIN * peak, ex.MAX_DISPLACEMENT_M),
+        velocity_m_per_s=min(RECORD_MARGIN * speed, ex.MAX_VELOCITY_M_PER_S),
+        force_scale_n=max(r["max_abs_force_n"] for r in train),
+        source=scales.source
+        + f"; stroke and velocity 1.5 x the card's training records ({peak * 1e3:.3g} mm, "
+        f"{speed:.3g} m/s)",
+    )

@@ -76,6 +76,12 @@ def record_entry(record: Any, role: str, model: Any | None = None) -> dict[str, 
         "samples": len(record.force),
         "sample_rate_hz": float(record.sample_rate_hz),
         "duration_s": float(record.duration_s),
+        # the bushing's range on this record: attacks scale their search to it (bushenv.scales)
+        "max_abs_displacement_m": float(np.max(np.abs(record.displacement))),
+        "max_abs_velocity_m_per_s": float(
+            np.max(np.abs(np.diff(record.displacement))) * record.sample_rate_hz
+        ),
+        "max_abs_force_n": float(np.max(np.abs(record.force))),
     }
     if model is not None:
         entry["metrics"] = free_run_metrics(model, record)

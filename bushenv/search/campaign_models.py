@@ -11,6 +11,7 @@ given). Rows of another bushing's models would say nothing about this one.
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -19,7 +20,7 @@ from bushenv.identify.linear import least_squares_kc
 from bushenv.models import MODELS
 from bushenv.models.base import velocity_of
 from bushenv.models.linear import LinearBushing
-from bushenv.scales import BushingScales, scales_of_reference
+from bushenv.scales import BushingScales, scales_of_card, scales_of_reference
 
 FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
 CONTROL_RECORD_S = 40.0  # the papers' identification record length (seed 000 §4.1)
@@ -73,8 +74,12 @@ def reference_spec(config) -> str | None:
 
 
 def campaign_scales(config, reference, builtin: bool) -> BushingScales:
-    """The reference's scales (``bushenv.scales``), with the flags' values on top."""
+    """The reference's scales (``bushenv.scales``), its model card's records' range when it
+    is a file with a card beside it, and the flags' values on top of both."""
     scales = scales_of_reference(reference, builtin)
+    card = _card_of(reference_spec(config))
+    if card is not None:
+        scales = scales_of_card(scales, card)
     flags = {
         "stroke_m": None if config.stroke_mm is None else config.stroke_mm * 1e-3,
         "velocity_m_per_s": config.max_velocity_m_per_s,
@@ -85,6 +90,17 @@ def campaign_scales(config, reference, builtin: bool) -> BushingScales:
     if not given:
         return scales
     return replace(scales, **given, source=scales.source + f"; flags: {sorted(given)}")
+
+
+def _card_of(spec: str | None) -> dict | None:
+    """The model card beside a reference file (checked against the file), or None."""
+    if spec is None or spec in MODELS or not Path(spec).is_file():
+        return None
+    from bushenv.identify.card import card_paths, load_card
+
+    if not card_paths(spec)[0].is_file():
+        return None
+    return load_card(spec).data
 
 
 def fitted_linear(source, scales: BushingScales, seed: int = 0) -> LinearBushing:

@@ -173,3 +173,23 @@ def test_attack_with_a_users_reference_file_records_it_and_fits_the_control(tmp_
     assert not any(
         s["diverged"] for e in report["models"].values() for s in e["searchers"].values()
     )
+
+
+def test_a_reference_with_a_model_card_sets_the_search_to_its_records_range(tmp_path):
+    from bushenv.machine import random_test
+    from bushenv.records import save_csv
+    from bushenv.reference.rubber import RubberBushing
+
+    rec = random_test(RubberBushing.preset("axial", seed=3), 1.0, duration_s=8.0, seed=3)
+    train = save_csv(rec, tmp_path / "train.csv")
+    ref = tmp_path / "ref.npz"
+    assert main(["fit", str(train), "--model", "linear", "--out", str(ref), "--quiet"]) == 0
+    model = LinearBushing(k_n_per_m=4e5, c_ns_per_m=4e3).save(tmp_path / "mine.npz")
+    out = tmp_path / "run"
+    argv = ["attack", "--model", str(model), "--reference", str(ref), "--budget", "8"]
+    argv += ["--searchers", "random", "--out", str(out), "--no-plots", "--max-shrink", "0"]
+    assert main(argv) == 0
+    scales = json.loads((out / "report.json").read_text())["scales"]
+    peak = float(np.max(np.abs(rec.displacement)))
+    assert scales["stroke_m"] == pytest.approx(1.5 * peak, rel=1e-9)
+    assert "card's training records" in scales["source"]
