@@ -149,6 +149,25 @@ def scales_of_records(scales: BushingScales, x_m, dt: float) -> BushingScales:
     )
 
 
+QUASI_STATIC_SHARE = 0.01  # displacement power at or below 1 Hz that shows static behaviour
+HOLD_FOR_STATIC_S = 1.0  # a hold this long shows it too (the static criterion judges after 1 s)
+
+
+def static_identified(card: dict) -> bool:
+    """Whether a model card's training records show the bushing's static behaviour: holds of
+    at least a second, or 1 % of the displacement's power at or below 1 Hz. A model fitted on
+    records without either (a 5-150 Hz multisine, a 0.5-20 Hz random drive) extrapolates its
+    static force; it cannot be the yardstick of the ``static`` criterion. A card without those
+    figures (older cards) is taken at its word."""
+    train = [r for r in card.get("records", []) if r.get("role") == "train"]
+    if not train or any("quasi_static_share" not in r for r in train):
+        return True
+    return any(
+        r["quasi_static_share"] >= QUASI_STATIC_SHARE or r["longest_hold_s"] >= HOLD_FOR_STATIC_S
+        for r in train
+    )
+
+
 def scales_of_card(scales: BushingScales, card: dict) -> BushingScales:
     """``scales`` with stroke and velocity from a model card's training records (their largest
     |x| and |dx/dt| times ``RECORD_MARGIN``, within the machine) and their peak force as the

@@ -82,10 +82,36 @@ def record_entry(record: Any, role: str, model: Any | None = None) -> dict[str, 
             np.max(np.abs(np.diff(record.displacement))) * record.sample_rate_hz
         ),
         "max_abs_force_n": float(np.max(np.abs(record.force))),
+        # what the record says about the bushing's static behaviour (bushenv.scales)
+        "quasi_static_share": quasi_static_share(record.displacement, record.sample_rate_hz),
+        "longest_hold_s": longest_hold_s(record.displacement, record.sample_rate_hz),
     }
     if model is not None:
         entry["metrics"] = free_run_metrics(model, record)
     return entry
+
+
+def quasi_static_share(x: np.ndarray, rate_hz: float, below_hz: float = 1.0) -> float:
+    """Share of the displacement's power at or below ``below_hz`` (Welch estimate)."""
+    from scipy import signal
+
+    x = np.asarray(x, dtype=np.float64)
+    n = min(x.size, int(rate_hz * 16))
+    if n < 8:
+        return 0.0
+    f, p = signal.welch(x - x.mean(), fs=rate_hz, nperseg=n)
+    total = float(np.sum(p))
+    return float(np.sum(p[f <= below_hz]) / total) if total > 0 else 0.0
+
+
+def longest_hold_s(x: np.ndarray, rate_hz: float, tolerance_m: float = 1e-9) -> float:
+    """Longest run of samples at one displacement, s."""
+    moving = np.abs(np.diff(np.asarray(x, dtype=np.float64))) >= tolerance_m
+    longest = run = 0
+    for m in moving:
+        run = 0 if m else run + 1
+        longest = max(longest, run)
+    return longest / rate_hz
 
 
 def free_run_metrics(model: Any, record: Any) -> dict[str, float]:

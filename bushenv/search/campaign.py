@@ -38,6 +38,7 @@ from bushenv.search.campaign_models import (
     fitted_linear,
     reference_spec,
     roles,
+    static_trusted,
 )
 from bushenv.search.campaign_report import fresh_report, report_markdown, resumed_report
 from bushenv.search.corpus import DEFAULT_CORPUS
@@ -145,7 +146,14 @@ class Campaign:
             else get_reference(self.reference_spec, axis=c.axis, dt=self.dt)
         )
         self.scales = campaign_scales(c, self.reference, builtin_reference(c))
+        self.static = self.reference is not None and static_trusted(c)
         self.notes: list[str] = []
+        if self.reference is not None and not self.static:
+            self.notes.append(
+                "static not judged: the reference's model card shows no quasi-static content "
+                "in its training records (no hold of 1 s, under 1 % of the displacement power "
+                "at or below 1 Hz), so its held force is an extrapolation"
+            )
         self._models()
         fresh = fresh_report(self)
         if c.resume and self.report_path.exists():
@@ -200,6 +208,7 @@ class Campaign:
             threads=self.config.threads or local_cores(),
             axis=self.config.axis,
             scales=self.scales,
+            static=self.static,
         )
 
     # ----- progress accounting -----------------------------------------------------------------
@@ -352,6 +361,9 @@ class Campaign:
         if not self.target.judges_static and "static" in run:
             run.remove("static")
             why += f"; static is judged on the rig only (the {self.target.name} has no hold)"
+        elif "static" in run and not self.static:
+            run.remove("static")
+            why += "; static not judged: the reference's records show no static behaviour"
         return {"run": run, "why": why}
 
     def control_flagged(self) -> bool:

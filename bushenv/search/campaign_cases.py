@@ -72,6 +72,7 @@ def _case(campaign, profile, family, params, found_by, **extra) -> Case:
         reference=campaign.reference,
         reference_spec=campaign.reference_spec,
         scales=campaign.scales,
+        static=campaign.static,
         shas={campaign.specs[k]: shas[k] for k in campaign.models},
         **extra,
     )

@@ -20,7 +20,12 @@ from bushenv.identify.linear import least_squares_kc
 from bushenv.models import MODELS
 from bushenv.models.base import velocity_of
 from bushenv.models.linear import LinearBushing
-from bushenv.scales import BushingScales, scales_of_card, scales_of_reference
+from bushenv.scales import (
+    BushingScales,
+    scales_of_card,
+    scales_of_reference,
+    static_identified,
+)
 
 FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
 CONTROL_RECORD_S = 40.0  # the papers' identification record length (seed 000 §4.1)
@@ -71,6 +76,12 @@ def reference_spec(config) -> str | None:
     if config.reference is None:
         return "rubber" if config.model in MODELS else None
     return config.reference
+
+
+def static_trusted(config) -> bool:
+    """Whether the reference's static force may judge (``scales.static_identified``)."""
+    card = _card_of(reference_spec(config))
+    return card is None or static_identified(card)
 
 
 def campaign_scales(config, reference, builtin: bool) -> BushingScales:

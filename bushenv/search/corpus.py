@@ -154,6 +154,7 @@ class Case:
     shrink: dict[str, Any] | None = None
     notes: str = ""
     scales: BushingScales = MACHINE
+    static: bool = True  # the static criterion judged (the reference's static is trusted)
     path: Path | None = field(default=None, compare=False)
 
     def to_json(self) -> dict[str, Any]:
@@ -171,6 +172,7 @@ class Case:
             "expect": self.expect,
             "reference": self.reference,
             "scales": self.scales.to_json(),
+            "static": self.static,
             "shrink": self.shrink,
             "notes": self.notes,
         }
@@ -190,11 +192,12 @@ def judge_profile(
     axis: str,
     reference: BushingModel | None,
     scales: BushingScales = MACHINE,
+    static: bool = True,
 ) -> dict[str, dict[str, Any]]:
     """Verdict row of ``profile`` for each model (prescribed-motion or quarter-car path)."""
     out = {}
     for name, model in models.items():
-        ev = BatchEvaluator(model, reference, target=env, axis=axis, scales=scales)
+        ev = BatchEvaluator(model, reference, env, axis=axis, scales=scales, static=static)
         out[name] = ev.evaluate([profile]).verdict.row(0)
     return out
 
@@ -211,6 +214,7 @@ def make_case(
     reference: BushingModel | None,
     reference_spec: str | None = "rubber",
     scales: BushingScales = MACHINE,
+    static: bool = True,
     shas: dict[str, str | None] | None = None,
     shrink: dict[str, Any] | None = None,
     notes: str = "",
@@ -218,7 +222,7 @@ def make_case(
     """A case whose ``expect`` holds what each model does on the decoded profile now, against
     ``reference`` (given by ``reference_spec``; None: judged without one) at ``scales``."""
     x = decode_profile(encode_profile(profile))
-    rows = judge_profile(x, models, env, axis, reference, scales)
+    rows = judge_profile(x, models, env, axis, reference, scales, static)
     shas = shas or {}
     expect = {
         name: {
@@ -245,6 +249,7 @@ def make_case(
         shrink=shrink,
         notes=notes,
         scales=scales,
+        static=static,
     )
 
 
@@ -295,6 +300,7 @@ def load_case(path: str | os.PathLike) -> Case:
         expect=d["expect"],
         reference=d.get("reference", {}),
         scales=_scales(d.get("scales"), path),
+        static=bool(d.get("static", True)),
         shrink=d.get("shrink"),
         notes=d.get("notes", ""),
         path=path,
@@ -342,7 +348,9 @@ def replay(
     sha_of = sha_of or model_sha
     reference = case_reference(case)
     models = {name: resolve(name, case.axis, case.dt) for name in case.expect}
-    rows = judge_profile(case.profile, models, case.env, case.axis, reference, case.scales)
+    rows = judge_profile(
+        case.profile, models, case.env, case.axis, reference, case.scales, case.static
+    )
     return [
         Replay(
             model=name,

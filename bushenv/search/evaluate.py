@@ -72,13 +72,15 @@ class ReferenceRuns:
         cache: OrderedDict,
         lock: threading.Lock,
         scales: BushingScales = MACHINE,
+        static: bool = True,
     ) -> None:
         self.model, self._cache, self._lock, self.scales = model, cache, lock, scales
-        self._curve: tuple[np.ndarray, np.ndarray] | None = None
+        self.static = static
 
     def static_forces(self, x: np.ndarray) -> np.ndarray | None:
-        """The reference's static force at every sample's displacement (``static_curve``)."""
-        if self.model is None:
+        """The reference's static force at every sample's displacement (``static_curve``);
+        None without a reference or when its static behaviour is not to be trusted."""
+        if self.model is None or not self.static:
             return None
         with self._lock:
             if "static curve" not in self._cache:
@@ -124,6 +126,7 @@ class BatchEvaluator:
         axis: str = "axial",
         dtype: str = "float64",
         scales: BushingScales = MACHINE,
+        static: bool = True,
     ) -> None:
         self.target = get_target(target)
         if reference is None and not self.target.reference_free:
@@ -156,7 +159,10 @@ class BatchEvaluator:
         cache: OrderedDict[str, np.ndarray] = OrderedDict()
         lock = threading.Lock()
         self._copies = [
-            (model.copy(), ReferenceRuns(reference and reference.copy(), cache, lock, scales))
+            (
+                model.copy(),
+                ReferenceRuns(reference and reference.copy(), cache, lock, scales, static),
+            )
             for _ in range(self.threads)
         ]
 

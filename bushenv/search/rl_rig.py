@@ -239,6 +239,7 @@ def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward, scales=M
         model=model,
         reference=reference,
         axis=axis,
+        dt_s=model.dt,
         max_episode_steps=episode_steps,
         reward_fn=reward,
         **_limits_kwargs(scales),
