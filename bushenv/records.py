@@ -8,7 +8,9 @@ The format (one record per file):
     ...
 
 - The header is exactly ``time,displacement,force`` (spaces around names are tolerated, nothing
-  else: no extra columns, no units in the names, no other order). Columns are s, m, N.
+  else: no extra columns, no other order). Columns are s, m, N, unless a column's unit is
+  written after its name in brackets, ``displacement [mm]`` or ``force (kN)`` (``UNITS``): the
+  values are then converted to SI on load.
 - Values are decimal numbers (anything Python's ``float`` reads except NaN and inf), comma
   separated, one sample per line; blank lines are allowed only at the end.
 - Time strictly increases with a uniform step, at any rate: the step dt is read from the time
@@ -16,7 +18,9 @@ The format (one record per file):
   ``STEP_ATOL_S`` (1e-9 s). At least two samples.
 - Plausibility: ``max |displacement| <= MAX_PLAUSIBLE_DISPLACEMENT_M`` (0.1 m, eight times the
   test machine's stroke; larger values are almost always millimetres) and
-  ``max |force| <= MAX_PLAUSIBLE_FORCE_N`` (1 MN, forty times the machine's 25 kN).
+  ``max |force| <= MAX_PLAUSIBLE_FORCE_N`` (1 MN, forty times the machine's 25 kN). These are
+  overridable checks: ``load_csv(..., max_displacement_m=0.5)`` raises a limit, and a column
+  whose unit is written in the header is taken as stated (no limit).
 - Files larger than ``MAX_RECORD_BYTES`` (256 MiB, about five million samples) are refused
   before reading; below that the file is parsed line by line into compact arrays.
 
@@ -34,6 +38,7 @@ import csv
 import difflib
 import io
 import os
+import re
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -48,6 +53,13 @@ STEP_ATOL_S = 1e-9  # ... plus 1 ns (printed times lose digits)
 MAX_PLAUSIBLE_DISPLACEMENT_M = 0.1
 MAX_PLAUSIBLE_FORCE_N = 1.0e6
 MAX_RECORD_BYTES = 256 * 2**20
+# units a header may state per column, and their factor to SI
+UNITS = {
+    "time": {"s": 1.0, "ms": 1e-3},
+    "displacement": {"m": 1.0, "mm": 1e-3, "um": 1e-6},
+    "force": {"N": 1.0, "kN": 1e3},
+}
+_NAME_UNIT = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]*?)\s*[\])]\s*$")
 _SNIFF_BYTES = 8192
 # First bytes of files people hand over by mistake, so the message can say what it is.
 _BINARY_MAGIC = (
@@ -156,7 +168,15 @@ class Record:
 
 
 # ----- checks shared by load and save ----------------------------------------------------------
-def _check_columns(t: np.ndarray, x: np.ndarray, f: np.ndarray, label: str, where) -> None:
+def _check_columns(
+    t: np.ndarray,
+    x: np.ndarray,
+    f: np.ndarray,
+    label: str,
+    where,
+    max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
+    max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+) -> None:
     """Semantic checks; ``where(i)`` names sample i (a file line or a sample index)."""
     if t.size < 2:
         raise RecordError(f"{label}: {t.size} sample(s); need at least 2 to know the sample time")
@@ -188,17 +208,22 @@ def _check_columns(t: np.ndarray, x: np.ndarray, f: np.ndarray, label: str, wher
         (
             "displacement",
             x,
-            MAX_PLAUSIBLE_DISPLACEMENT_M,
+            max_displacement_m,
             "m",
-            "looks like millimetres (the column must be metres)",
+            "looks like millimetres (the column must be metres). If it really is metres, say "
+            "so: raise the limit (bushenv diagnose --max-displacement 0.5; "
+            "load_csv(..., max_displacement_m=0.5)) or write the unit in the header: "
+            "'displacement [m]' ('displacement [mm]' converts millimetres)",
         ),
         (
             "force",
             f,
-            MAX_PLAUSIBLE_FORCE_N,
+            max_force_n,
             "N",
             "that is 40 times the test machine's 25 kN: wrong units (the column must be "
-            "newtons) or a diverged run",
+            "newtons) or a diverged run. If it is right, raise the limit (bushenv diagnose "
+            "--max-force; load_csv(..., max_force_n=...)) or write the unit in the header: "
+            "'force [N]' or 'force [kN]'",
         ),
     )
     for key, a, limit, unit, hint in plausible:
@@ -209,10 +234,32 @@ def _check_columns(t: np.ndarray, x: np.ndarray, f: np.ndarray, label: str, wher
             )
 
 
+def header_units(fields: list[str]) -> tuple[list[str], dict[str, float], str | None]:
+    """(names without units, {column: factor to SI} for stated units, problem or None)."""
+    names, factors = [], {}
+    for text in fields:
+        m = _NAME_UNIT.match(text)
+        if m is None:
+            names.append(text.strip())
+            continue
+        name, unit = m.group(1), m.group(2)
+        names.append(name)
+        known = UNITS.get(name)
+        if known is not None and unit not in known:
+            shown = ",".join(fields)
+            problem = f"unknown unit {unit!r} for {name} in header '{shown}'; known: "
+            return names, factors, problem + ", ".join(known)
+        if known is not None:
+            factors[name] = known[unit]
+    return names, factors, None
+
+
 def _header_problem(fields: list[str]) -> str | None:
-    """None if ``fields`` is the header, else what is wrong with it."""
-    names = [s.strip() for s in fields]
-    if tuple(names) == HEADER:
+    """None if ``fields`` is the header (units allowed), else what is wrong with it."""
+    names, _, problem = header_units(fields)
+    if problem:
+        return problem
+    if tuple(n.strip() for n in names) == HEADER:
         return None
     shown = ",".join(fields)
     expected = f"expected exactly '{HEADER_TEXT}'"
@@ -259,11 +306,18 @@ def _header_problem(fields: list[str]) -> str | None:
 
 
 # ----- load ------------------------------------------------------------------------------------
-def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Record:
+def load_csv(
+    path: str | os.PathLike,
+    max_bytes: int = MAX_RECORD_BYTES,
+    max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
+    max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+) -> Record:
     """Read and validate one record file; refuse anything off-format with ``RecordError``.
 
     The file is parsed line by line (memory ~ 32 bytes per sample); files above ``max_bytes``
-    are refused before reading.
+    are refused before reading. ``max_displacement_m`` and ``max_force_n`` are the
+    plausibility limits; a column whose unit the header states is converted to SI and not
+    limited.
     """
     path = Path(path)
     if not path.exists():
@@ -291,7 +345,7 @@ def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Reco
     lines = array.array("q")
     try:
         with open(path, encoding="utf-8-sig", newline="") as fh:
-            _parse(fh, path, t, x, f, lines)
+            factors = _parse(fh, path, t, x, f, lines)
     except UnicodeDecodeError as exc:
         raise RecordError(
             f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start} of a read block); "
@@ -301,9 +355,9 @@ def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Reco
         raise RecordError(f"{path}: not a readable CSV file: {exc}") from None
 
     record = Record(
-        time=np.frombuffer(t, dtype=np.float64).copy(),
-        displacement=np.frombuffer(x, dtype=np.float64).copy(),
-        force=np.frombuffer(f, dtype=np.float64).copy(),
+        time=np.frombuffer(t, dtype=np.float64) * factors.get("time", 1.0),
+        displacement=np.frombuffer(x, dtype=np.float64) * factors.get("displacement", 1.0),
+        force=np.frombuffer(f, dtype=np.float64) * factors.get("force", 1.0),
         name=path.stem,
         path=path,
     )
@@ -319,11 +373,14 @@ def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Reco
         record.force,
         str(path),
         where=lambda i: f"{path} line {int(line_of[i])}",
+        max_displacement_m=np.inf if "displacement" in factors else max_displacement_m,
+        max_force_n=np.inf if "force" in factors else max_force_n,
     )
     return record
 
 
-def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> None:
+def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> dict[str, float]:
+    """Fill the columns; returns the header's stated units as factors to SI."""
     reader = csv.reader(fh, strict=True)
     header = None
     for row in reader:
@@ -340,6 +397,7 @@ def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> None:
     problem = _header_problem(header)
     if problem:
         raise RecordError(f"{path} line 1: {problem}")
+    factors = header_units(header)[1]
     blank_at = 0
     columns = (t, x, f)
     last_line = 1
@@ -377,6 +435,7 @@ def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> None:
                 f"{path} line {line}: time goes backwards ({t[-1]!r} after {t[-2]!r})"
             )
         lines.append(line)
+    return factors
 
 
 # ----- save ------------------------------------------------------------------------------------

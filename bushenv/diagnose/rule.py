@@ -1,0 +1,101 @@
+"""The naming rule: which candidate is named, and the two effects ranked first.
+
+Gaps are ``rms_ratio(measured, predicted)`` (seed 000 eq. 8) over all judged samples; the
+*null* is the baseline with its spring and damper refitted. A candidate set ``S`` with ``p``
+extra parameters, judged mean squared error ``MSE_S`` and fitted on ``N`` samples:
+
+1. **passes** when it shrinks the null's gap by at least ``SHRINK_MIN`` and its cut in judged
+   MSE exceeds what fitting ``p`` weights to noise could explain,
+   ``MSE_null - MSE_S > NOISE_MARGIN p MSE_S / N`` (``MSE_S`` bounds the noise variance);
+2. a **pair** ``{A, B}`` is named when the best single effect leaves more than
+   ``PAIR_TRY_IF_LEFT`` of the null's gap (or none passes), the pair passes, closes at least
+   ``PAIR_GAIN_MIN`` of the gap the best single leaves, and **each member adds** more than
+   the noise margin to the other alone (``MSE_A - MSE_AB > NOISE_MARGIN p_B MSE_AB / N``,
+   and the same for B): a single effect does not gain a second one that fits noise;
+3. otherwise the best single is named if it passes, else ``none``.
+
+``top_two``: a named pair's members (the better single first); for a named single ``A``,
+``A`` and the effect whose pair with ``A`` is best (ties: the better single); for ``none``,
+the two best singles.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+SHRINK_MIN = 0.05
+NOISE_MARGIN = 2.0
+PAIR_GAIN_MIN = 0.25
+PAIR_TRY_IF_LEFT = 0.10  # a pair is not named for the last tenth of the null's gap
+MOSTLY_UNEXPLAINED = 0.5  # the best candidates leave more than this share of the gap
+
+RULE_TEXT = (
+    f"A candidate passes when it shrinks the held-out gap of the baseline with its spring and "
+    f"damper refitted (the null) by at least {100 * SHRINK_MIN:.0f} % and its cut in held-out "
+    f"mean squared error exceeds {NOISE_MARGIN:g} x (extra parameters) x (remaining MSE) / "
+    f"(samples fitted), the most that fitting noise could explain. A pair is named when it "
+    f"passes, the best single effect leaves more than {100 * PAIR_TRY_IF_LEFT:.0f} % of the "
+    f"null's gap, the pair closes at least {100 * PAIR_GAIN_MIN:.0f} % of what it leaves, and "
+    f"each of its effects adds more than that noise margin to the other alone; "
+    f"otherwise the best single effect if it passes; otherwise 'none'."
+)
+
+
+def margin(n_extra: int, mse_after: float, n_fit: int) -> float:
+    """The most a cut in MSE from fitting ``n_extra`` weights to noise could be."""
+    return NOISE_MARGIN * max(n_extra, 1) * mse_after / max(n_fit, 1)
+
+
+def mark_passes(rows: list[dict[str, Any]], mse_null: float, n_fit: int) -> None:
+    """Set ``beats_noise_margin`` and ``passes`` (rule 1) on every row."""
+    for r in rows:
+        r["beats_noise_margin"] = bool(
+            mse_null - r["_mse"] > margin(r["n_extra_parameters"], r["_mse"], n_fit)
+        )
+        r["passes"] = bool(r["shrink_vs_null"] >= SHRINK_MIN and r["beats_noise_margin"])
+
+
+def mark_pairs(
+    singles: list[dict[str, Any]], pairs: list[dict[str, Any]], n_fit: int, gap_null: float
+) -> None:
+    """Rule 2 on every pair row: ``members_add`` and ``passes``."""
+    by_name = {r["effect"]: r for r in singles}
+    best_gap = singles[0]["gap_after"] if singles else float("inf")
+    open_for_pairs = not (singles and singles[0]["passes"]) or (
+        best_gap > PAIR_TRY_IF_LEFT * gap_null
+    )
+    for r in pairs:
+        adds = []
+        for m in r["members"]:
+            alone = by_name[m]
+            extra = r["n_extra_parameters"] - alone["n_extra_parameters"]
+            adds.append(alone["_mse"] - r["_mse"] > margin(extra, r["_mse"], n_fit))
+        r["members_add"] = bool(all(adds))
+        closes = r["gap_after"] <= (1.0 - PAIR_GAIN_MIN) * best_gap
+        r["passes"] = bool(open_for_pairs and r["passes"] and r["members_add"] and closes)
+
+
+def rank(rows: list[dict[str, Any]], order: list[str]) -> list[dict[str, Any]]:
+    """Best first: by judged gap, then fitting error, then the members' single ranks."""
+
+    def key(r: dict[str, Any]):
+        return (r["gap_after"], r["gap_train"], [order.index(m) for m in r["members"]])
+
+    return sorted(rows, key=key)
+
+
+def named_and_top_two(
+    singles: list[dict[str, Any]], pairs: list[dict[str, Any]]
+) -> tuple[dict[str, Any] | None, list[str]]:
+    """(the named row or None, top_two). ``singles`` and ``pairs`` are ranked best first."""
+    winners = [r for r in pairs if r["passes"]]
+    if winners:
+        return winners[0], list(winners[0]["members"])
+    if singles and singles[0]["passes"]:
+        first = singles[0]["effect"]
+        with_first = [r for r in pairs if first in r["members"]]
+        if with_first:
+            partner = next(m for m in with_first[0]["members"] if m != first)
+            return singles[0], [first, partner]
+        return singles[0], [first] + [r["effect"] for r in singles[1:2]]
+    return None, [r["effect"] for r in singles[:2]]
