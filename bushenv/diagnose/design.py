@@ -9,6 +9,7 @@ not a new pass over the data; each block product is computed once.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from itertools import count
 from typing import Any
@@ -25,15 +26,15 @@ SPRING = ("spring", "x,v")  # the linear spring and damper block (or the baselin
 DAMPER = ("spring", "v")  # the damper alone, when a backbone replaces the spring
 
 Block = tuple[str, Any]
-TARGETS_KEPT = 96  # force targets (one per record and delay) kept
+TARGETS_KEPT = 256  # force targets (one per record and delay) kept
 
 
 @dataclass
 class Prepared:
     """One record ready for fitting: signals, measured force, baseline force ``b0``.
 
-    ``role`` is ``"train"`` or ``"test"``; ``fit_filter`` a zero-phase low-pass (sos) applied
-    to both sides of a regression on this record, when its displacement has a noise floor.
+    ``role`` is ``"train"`` or ``"test"``; ``band_edge_hz`` the low-pass edge applied to the
+    displacement before differentiating, when it has a noise floor (else None).
     """
 
     name: str
@@ -42,7 +43,7 @@ class Prepared:
     signals: Signals
     force: np.ndarray
     b0: np.ndarray
-    fit_filter: Any = None
+    band_edge_hz: float | None = None
     uid: int = field(default_factory=lambda: next(_UIDS))
 
     @property
@@ -72,17 +73,17 @@ def noise_band_edge(x: np.ndarray, dt: float) -> float | None:
     return edge if edge < 0.8 * f[-1] else None
 
 
-def fit_filter(x: np.ndarray, dt: float):
-    """Low-pass below a displacement's noise floor (sos), or None.
+def smoothed_displacement(x: np.ndarray, dt: float) -> tuple[np.ndarray, float | None]:
+    """(x, None), or x low-passed (zero phase) below its noise floor and the edge (Hz).
 
-    A noisy displacement, twice differentiated, would bias the inertia weight toward zero
-    (errors in variables); filtering the force and every column with the same linear filter
-    keeps the regression exact in the signal band and drops the noise above it.
+    A measured displacement's noise, twice differentiated, swamps the acceleration: it biases
+    a fitted mass toward zero (errors in variables) and turns every prediction that uses the
+    acceleration into noise. Every column is computed from the smoothed displacement.
     """
     edge = noise_band_edge(x, dt)
     if edge is None:
-        return None
-    return signal.butter(4, edge, fs=1.0 / dt, output="sos")
+        return x, None
+    return signal.sosfiltfilt(signal.butter(4, edge, fs=1.0 / dt, output="sos"), x), edge
 
 
 class ColumnStore:
@@ -93,15 +94,12 @@ class ColumnStore:
         self._cols: dict[tuple, np.ndarray] = {}
         self._gram: dict[tuple, np.ndarray] = {}
         self._rhs: dict[tuple, np.ndarray] = {}
-        self._targets: dict[tuple, tuple[np.ndarray, float]] = {}
+        self._targets: OrderedDict[tuple, tuple[np.ndarray, float]] = OrderedDict()
 
-    def columns(self, prep: Prepared, block: Block, filtered: bool = False) -> np.ndarray:
-        key = (prep.uid, block, filtered)
+    def columns(self, prep: Prepared, block: Block) -> np.ndarray:
+        key = (prep.uid, block)
         if key not in self._cols:
-            if filtered:
-                raw = self.columns(prep, block)
-                cols = signal.sosfiltfilt(prep.fit_filter, raw, axis=0) if raw.shape[1] else raw
-            elif block == SPRING:
+            if block == SPRING:
                 cols = np.stack([prep.signals.x, prep.signals.v], axis=1)
             elif block == DAMPER:
                 cols = prep.signals.v[:, None].copy()
@@ -110,51 +108,45 @@ class ColumnStore:
             self._cols[key] = np.ascontiguousarray(cols)
         return self._cols[key]
 
-    def design(self, prep: Prepared, blocks: tuple[Block, ...], filtered: bool = False):
+    def design(self, prep: Prepared, blocks: tuple[Block, ...]):
         """(T, p) columns of ``blocks`` side by side."""
-        return np.concatenate([self.columns(prep, b, filtered) for b in blocks], axis=1)
+        return np.concatenate([self.columns(prep, b) for b in blocks], axis=1)
 
     def gram(self, prep: Prepared, blocks: tuple[Block, ...]) -> np.ndarray:
-        """A^T A of the (filtered, if the record has a fit filter) design, (p, p)."""
-        filt = prep.fit_filter is not None
+        """A^T A of the design, (p, p)."""
         rows = []
         for b1 in blocks:
             row = []
             for b2 in blocks:
-                key = (prep.uid, b1, b2, filt)
+                key = (prep.uid, b1, b2)
                 if key not in self._gram:
-                    tkey = (prep.uid, b2, b1, filt)
+                    tkey = (prep.uid, b2, b1)
                     if tkey in self._gram:
                         self._gram[key] = self._gram[tkey].T
                     else:
-                        c1 = self.columns(prep, b1, filt)
-                        c2 = self.columns(prep, b2, filt)
-                        self._gram[key] = c1.T @ c2
+                        self._gram[key] = self.columns(prep, b1).T @ self.columns(prep, b2)
                 row.append(self._gram[key])
             rows.append(np.concatenate(row, axis=1))
         return np.concatenate(rows, axis=0)
 
     def target(self, prep: Prepared, delay_s: float) -> tuple[np.ndarray, float]:
-        """(y, y^T y): the force advanced by the delay, minus b0 (filtered if noisy)."""
+        """(y, y^T y): the force advanced by the delay, minus b0."""
         key = (prep.uid, delay_s)
         if key not in self._targets:
             if len(self._targets) >= TARGETS_KEPT:  # a delay search visits many values once
-                self._targets.pop(next(iter(self._targets)))
+                self._targets.popitem(last=False)
             y = shift_columns(prep.force, -delay_s, prep.dt) - prep.b0
-            if prep.fit_filter is not None:
-                y = signal.sosfiltfilt(prep.fit_filter, y)
             self._targets[key] = (y, float(y @ y))
         return self._targets[key]
 
     def rhs(self, prep: Prepared, blocks: tuple[Block, ...], delay_s: float):
         """(A^T y (p,), y^T y) for the target at ``delay_s``."""
-        filt = prep.fit_filter is not None
         parts = []
         for b in blocks:
             key = (prep.uid, b, delay_s)
             if key not in self._rhs:
                 y = self.target(prep, delay_s)[0]
-                self._rhs[key] = self.columns(prep, b, filt).T @ y
+                self._rhs[key] = self.columns(prep, b).T @ y
             parts.append(self._rhs[key])
         return np.concatenate(parts), self.target(prep, delay_s)[1]
 

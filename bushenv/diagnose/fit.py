@@ -18,190 +18,33 @@ discrete-time, so TESTs must share TRAIN's rate; not with ``cross``).
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 from bushenv.diagnose import regimes, rule
-from bushenv.diagnose.candidates import candidate_sets, effect_names, get_effect
-from bushenv.diagnose.design import ColumnStore, Prepared, fit_filter, noise_band_edge
-from bushenv.diagnose.effects.base import NULL, STENCILS, Scales, Signals
+from bushenv.diagnose.candidates import candidate_sets
+from bushenv.diagnose.design import ColumnStore, Prepared
+from bushenv.diagnose.effects.base import NULL, Scales
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fitting import Fold, Judged, best_shapes, describe_shapes, judge, predict
 from bushenv.diagnose.fitting import parameters as fit_parameters
+from bushenv.diagnose.inputs import (
+    LINEAR,
+    Progress,
+    baseline_names,
+    check_inputs,
+    fit_nonlinear_baseline,
+    make_folds,
+    names_of,
+    prepare_records,
+    record_name,
+)
 from bushenv.diagnose.shift import shift_warnings
 from bushenv.metrics import rms_ratio
-from bushenv.models.base import DT_TOLERANCE
-
-MIN_SAMPLES = 64
-LINEAR = "linear"
-Progress = Callable[[str], None]
 
 __all__ = ["DiagnoseError", "diagnose", "baseline_names"]
-
-
-def baseline_names() -> list[str]:
-    """Baselines ``diagnose`` accepts: the registered bushing models (``linear`` first)."""
-    from bushenv.models import model_names
-
-    return [LINEAR] + [n for n in model_names() if n != LINEAR]
-
-
-# ----- inputs ----------------------------------------------------------------------------------
-def _check_record(rec: Any, label: str) -> None:
-    for attr in ("time", "displacement", "force", "dt"):
-        if not hasattr(rec, attr):
-            raise DiagnoseError(f"{label}: not a record (no .{attr})")
-    n = np.asarray(rec.displacement).size
-    if n < MIN_SAMPLES:
-        raise DiagnoseError(f"{label}: {n} samples; the diagnosis needs at least {MIN_SAMPLES}")
-    for attr in ("displacement", "force"):
-        a = np.asarray(getattr(rec, attr), dtype=np.float64)
-        if a.shape != (n,):
-            raise DiagnoseError(f"{label}: {attr} has shape {a.shape}, expected ({n},)")
-        if not np.all(np.isfinite(a)):
-            raise DiagnoseError(f"{label}: {attr} holds NaN or inf")
-    if not (np.isfinite(rec.dt) and rec.dt > 0):
-        raise DiagnoseError(f"{label}: sample time {rec.dt!r} is not a positive number")
-    if np.sqrt(np.mean(np.asarray(rec.force, dtype=np.float64) ** 2)) == 0:
-        raise DiagnoseError(f"{label}: force is zero throughout; nothing to diagnose")
-    if np.ptp(np.asarray(rec.displacement, dtype=np.float64)) == 0:
-        raise DiagnoseError(f"{label}: displacement is constant; nothing identifies a baseline")
-
-
-def _record_name(rec: Any, default: str) -> str:
-    path = getattr(rec, "path", None) or getattr(rec, "source", None)
-    if path:
-        from pathlib import Path
-
-        return Path(str(path)).stem
-    return getattr(rec, "name", None) or default
-
-
-def _names(recs: Sequence[Any], given: Sequence[str] | None, prefix: str) -> list[str]:
-    names = list(given) if given is not None else []
-    for i, rec in enumerate(recs):
-        if i >= len(names):
-            names.append(_record_name(rec, f"{prefix}{i + 1}"))
-    return names
-
-
-def _check_inputs(trains, tests, train_names, test_names, baseline, cross, effects) -> None:
-    if baseline != LINEAR and baseline not in baseline_names():
-        raise DiagnoseError(f"unknown baseline {baseline!r}; known: {', '.join(baseline_names())}")
-    if not tests:
-        raise DiagnoseError("no TEST record given; the gap is judged on held-out records only")
-    for rec, n in zip(trains, train_names, strict=True):
-        _check_record(rec, f"TRAIN {n}")
-    for rec, n in zip(tests, test_names, strict=True):
-        _check_record(rec, f"TEST {n}")
-    if len(set(test_names)) != len(test_names):
-        raise DiagnoseError(f"TEST records need distinct names (file stems), got {test_names}")
-    if cross and len(set(train_names + test_names)) != len(trains) + len(tests):
-        raise DiagnoseError(
-            f"--cross judges every record: TRAIN and TEST names must all differ, got "
-            f"{train_names} and {test_names}"
-        )
-    if effects is not None:
-        for e in effects:
-            get_effect(e)  # raises with the known names
-        if not effects:
-            raise DiagnoseError("no candidate effect chosen; known: " + ", ".join(effect_names()))
-    if baseline == LINEAR:
-        return
-    if cross:
-        raise DiagnoseError(
-            f"cross mode refits the baseline on every fold, which only the linear baseline "
-            f"does; use --baseline linear, or drop --cross to judge baseline {baseline!r} on "
-            "the TESTs"
-        )
-    dt0 = float(trains[0].dt)
-    for n, rec in zip(train_names[1:] + test_names, list(trains[1:]) + list(tests), strict=True):
-        if abs(float(rec.dt) - dt0) > DT_TOLERANCE * dt0 * 1e3:
-            raise DiagnoseError(
-                f"{n}: sampled at {1 / rec.dt:.6g} Hz but TRAIN at {1 / dt0:.6g} Hz; baseline "
-                f"{baseline!r} is a discrete-time model identified at the TRAIN rate. Resample "
-                "the record or use --baseline linear (continuous-time)."
-            )
-
-
-def _fit_nonlinear_baseline(name: str, rec: Any, seed: int):
-    try:
-        from bushenv.identify import fit_model  # the baselines' identification dispatcher
-    except ImportError:
-        raise DiagnoseError(
-            f"baseline {name!r} needs bushenv.identify.fit_model, which is not available in "
-            "this checkout; use --baseline linear"
-        ) from None
-    x = np.asarray(rec.displacement, dtype=np.float64)
-    return fit_model(name, x, np.asarray(rec.force, dtype=np.float64), float(rec.dt), seed)
-
-
-def _simulate(model: Any, x: np.ndarray) -> np.ndarray:
-    out = np.asarray(model.simulate(x), dtype=np.float64)
-    if not np.all(np.isfinite(out)):
-        raise DiagnoseError(f"baseline {model.name!r} diverged (NaN/inf) in free run")
-    return out
-
-
-# ----- records ready for fitting ---------------------------------------------------------------
-def _prepare(rec: Any, name: str, role: str, stencil: str, model: Any) -> Prepared:
-    x = np.asarray(rec.displacement, dtype=np.float64)
-    sig = Signals(x, float(rec.dt), stencil)
-    b0 = np.zeros_like(x) if model is None else _simulate(model, x)
-    prep = Prepared(name, role, np.asarray(rec.time, float), sig, np.asarray(rec.force, float), b0)
-    prep.fit_filter = fit_filter(x, prep.dt)
-    return prep
-
-
-def _stencil_error(preps: list[Prepared]) -> float:
-    """Relative MSE of a spring, damper and mass fitted on the records (filtered if noisy)."""
-    from scipy import signal
-
-    aa, yy = [], []
-    for p in preps:
-        a = np.stack([p.signals.x, p.signals.v, p.signals.a], axis=1)
-        y = p.force - p.b0
-        if p.fit_filter is not None:
-            a = signal.sosfiltfilt(p.fit_filter, a, axis=0)
-            y = signal.sosfiltfilt(p.fit_filter, y)
-        aa.append(a)
-        yy.append(y)
-    a, y = np.concatenate(aa), np.concatenate(yy)
-    w = np.linalg.lstsq(a / np.sqrt(np.mean(a * a, axis=0)), y, rcond=None)[0]
-    r = y - (a / np.sqrt(np.mean(a * a, axis=0))) @ w
-    return float(np.mean(r * r) / np.mean(y * y))
-
-
-def prepare_records(trains, tests, train_names, test_names, model, cross: bool, say: Progress):
-    """(train preps, test preps, stencil): the stencil fits the fitting records better."""
-    fitting = list(trains) + (list(tests) if cross else [])
-    fit_names = list(train_names) + (list(test_names) if cross else [])
-    errors = {}
-    for stencil in STENCILS:
-        preps = [
-            _prepare(r, n, "fit", stencil, model) for r, n in zip(fitting, fit_names, strict=True)
-        ]
-        errors[stencil] = _stencil_error(preps)
-    stencil = min(errors, key=errors.get)
-    say(f"derivatives by the {stencil} stencil (better fit of spring, damper and mass)")
-    tr = [_prepare(r, n, "train", stencil, model) for r, n in zip(trains, train_names, strict=True)]
-    te = [_prepare(r, n, "test", stencil, model) for r, n in zip(tests, test_names, strict=True)]
-    for p in tr + te:
-        if p.fit_filter is not None and (p.role == "train" or cross):
-            edge = noise_band_edge(p.signals.x, p.dt)
-            say(f"{p.name}: displacement has a noise floor above {edge:.4g} Hz: fitting below it")
-        elif p.role == "test" and not cross:
-            p.fit_filter = None  # a held-out record is never fitted on
-    return tr, te, stencil
-
-
-def make_folds(tr: list[Prepared], te: list[Prepared], cross: bool) -> list[Fold]:
-    if not cross:
-        return [Fold(tuple(tr), tuple(te))]
-    every = tr + te
-    return [Fold(tuple(q for q in every if q is not p), (p,)) for p in every]
 
 
 # ----- judging the candidates ------------------------------------------------------------------
@@ -226,7 +69,9 @@ class Run:
         return np.concatenate([preds[p.uid] for p in self.judged])
 
     def row(self, j: Judged) -> dict[str, Any]:
-        gap = rms_ratio(self.force, self.stack(j.predictions))
+        pred = self.stack(j.predictions)
+        gap = rms_ratio(self.force, pred)
+        blocks = np.array_split((self.force - pred) ** 2, rule.BLOCKS)
         return {
             "effect": j.combo.name,
             "members": list(j.combo.names),
@@ -238,6 +83,7 @@ class Run:
             "shape": describe_shapes(j.fits[0]),
             "gap_train": j.gap_train,
             "_mse": j.mse,
+            "_block_mse": np.array([b.mean() for b in blocks]),
             "_judged": j,
         }
 
@@ -353,17 +199,17 @@ def diagnose(
         raise DiagnoseError("no TRAIN record given")
     t_names = (
         list(train_names or [])
-        + [_record_name(r, "train" if i == 0 else f"train{i + 1}") for i, r in enumerate(trains)][
+        + [record_name(r, "train" if i == 0 else f"train{i + 1}") for i, r in enumerate(trains)][
             len(train_names or []) :
         ]
     )
-    names = _names(tests, test_names, "test")
+    names = names_of(tests, test_names, "test")
     eff = tuple(effects) if effects is not None else None
-    _check_inputs(trains, list(tests), t_names, names, baseline, cross, eff)
+    check_inputs(trains, list(tests), t_names, names, baseline, cross, eff)
     linear_base = baseline == LINEAR
     n_train = sum(np.size(r.force) for r in trains)
     say(f"identifying baseline {baseline!r} on TRAIN ({n_train} samples)")
-    model = None if linear_base else _fit_nonlinear_baseline(baseline, trains[0], seed)
+    model = None if linear_base else fit_nonlinear_baseline(baseline, trains[0], seed)
     tr, te, stencil = prepare_records(trains, tests, t_names, names, model, cross, say)
     fitting = tr + (te if cross else [])
     store = ColumnStore(Scales.of([p.signals for p in fitting]))
@@ -385,8 +231,8 @@ def diagnose(
         "judged": [p.name for p in run.judged],
     }
     result["derivative_stencil"] = stencil
-    result["fit_band_hz"] = {
-        p.name: noise_band_edge(p.signals.x, p.dt) for p in fitting if p.fit_filter is not None
+    result["displacement_band_hz"] = {
+        p.name: p.band_edge_hz for p in tr + te if p.band_edge_hz is not None
     }
     result["notes"] = _notes(tr, te, baseline, cross)
     return result

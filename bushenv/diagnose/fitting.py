@@ -125,10 +125,13 @@ def best_shapes(
 ) -> Fit:
     """The shapes with the lowest fitting error over the product of the members' grids."""
     grids = [m.shapes(store.scales) for m in combo.members]
-    best = min(
-        (fit(store, combo, c, records, linear_base) for c in _product(grids)),
-        key=lambda f: f.mse,
-    )
+
+    def delay_of(shapes: tuple) -> float:
+        return sum(m.delay_s(s) for m, s in zip(combo.members, shapes, strict=True))
+
+    # by delay, so that the shifted force targets of one delay are used together
+    combos = sorted(_product(grids), key=delay_of)
+    best = min((fit(store, combo, c, records, linear_base) for c in combos), key=lambda f: f.mse)
     for i, member in enumerate(combo.members):
         if member.continuous_shape and len(grids[i]) >= 3:
             best = _refine(store, combo, grids, i, best, records, linear_base)

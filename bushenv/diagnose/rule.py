@@ -14,6 +14,10 @@ extra parameters, judged mean squared error ``MSE_S`` and fitted on ``N`` sample
    and the same for B): a single effect does not gain a second one that fits noise;
 3. otherwise the best single is named if it passes, else ``none``.
 
+Ranking: by judged gap; but of two rows whose judged errors the data cannot tell apart
+(the mean difference of their MSE over ``BLOCKS`` contiguous blocks of the judged samples
+is within ``TIE_T`` standard errors), the one with fewer parameters goes first.
+
 ``top_two``: a named pair's members (the better single first); for a named single ``A``,
 ``A`` and the effect whose pair with ``A`` is best (ties: the better single); for ``none``,
 the two best singles.
@@ -23,11 +27,15 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 SHRINK_MIN = 0.05
 NOISE_MARGIN = 2.0
 PAIR_GAIN_MIN = 0.25
 PAIR_TRY_IF_LEFT = 0.10  # a pair is not named for the last tenth of the null's gap
 MOSTLY_UNEXPLAINED = 0.5  # the best candidates leave more than this share of the gap
+BLOCKS = 20  # contiguous blocks of the judged samples, for the spread of an MSE difference
+TIE_T = 2.0  # a difference within TIE_T standard errors cannot tell two rows apart
 
 RULE_TEXT = (
     f"A candidate passes when it shrinks the held-out gap of the baseline with its spring and "
@@ -75,13 +83,37 @@ def mark_pairs(
         r["passes"] = bool(open_for_pairs and r["passes"] and r["members_add"] and closes)
 
 
+def indistinguishable(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    """Whether the judged errors of two rows differ by less than their spread explains.
+
+    The judged samples are cut into BLOCKS contiguous blocks (neighbouring residuals are
+    correlated); the mean of the blocks' MSE differences is compared with TIE_T times its
+    standard error.
+    """
+    d = a["_block_mse"] - b["_block_mse"]
+    se = float(np.std(d, ddof=1)) / np.sqrt(d.size)
+    return bool(abs(float(np.mean(d))) <= TIE_T * se)
+
+
 def rank(rows: list[dict[str, Any]], order: list[str]) -> list[dict[str, Any]]:
-    """Best first: by judged gap, then fitting error, then the members' single ranks."""
+    """Best first: by judged gap (then fitting error, then the members' single ranks); a row
+    with fewer extra parameters whose judged error is indistinguishable from a better row's
+    goes before it -- of two explanations the data cannot tell apart, the simpler."""
 
     def key(r: dict[str, Any]):
         return (r["gap_after"], r["gap_train"], [order.index(m) for m in r["members"]])
 
-    return sorted(rows, key=key)
+    ranked = sorted(rows, key=key)
+    for i in range(1, len(ranked)):
+        j = i
+        while (
+            j > 0
+            and ranked[j]["n_extra_parameters"] < ranked[j - 1]["n_extra_parameters"]
+            and indistinguishable(ranked[j], ranked[j - 1])
+        ):
+            ranked[j - 1], ranked[j] = ranked[j], ranked[j - 1]
+            j -= 1
+    return ranked
 
 
 def named_and_top_two(

@@ -73,8 +73,8 @@ def second_derivative(x: np.ndarray, dt: float) -> np.ndarray:
 class Scales:
     """Scales of the identification records, fixed for every record judged (SI units).
 
-    ``x_pos`` / ``x_neg``: quantiles (30, 60, 90, 100 %) of the positive / negative deflections
-    (m, as magnitudes; empty when that side is never reached); ``sigma_x`` the deflection's
+    ``x_pos`` / ``x_neg``: ``(largest deflection,)`` on the positive / negative side (m, as
+    a magnitude; empty when that side is barely reached); ``sigma_x`` the deflection's
     standard deviation (m); ``duration_s`` the longest record; ``dt`` the largest sample time.
     """
 
@@ -94,7 +94,7 @@ class Scales:
             # a side counts when it holds a few percent of the samples
             if mag.size < max(0.02 * x.size, 16) or float(mag.max()) <= 0:
                 return ()
-            return tuple(float(q) for q in np.quantile(mag, [0.3, 0.6, 0.9, 1.0]))
+            return (float(mag.max()),)
 
         return cls(
             sigma_x=float(np.std(x)) or float(np.max(np.abs(x))) or 1.0,
