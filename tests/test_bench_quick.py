@@ -51,6 +51,7 @@ EXPECTED = [
     "campaign.nn.random.seconds_to_first_divergence",
     "campaign.nn.float32_verdict_changes",
     "memory.batch_B1024_T512.peak",
+    "diagnose.cross.4_records.seconds",
 ]
 
 

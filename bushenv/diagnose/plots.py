@@ -10,7 +10,7 @@ import numpy as np
 
 from bushenv.diagnose.regimes import residual_spectrum
 
-MAX_POINTS = 6000  # points per curve drawn (records are decimated for the figure only)
+MAX_POINTS = 3000  # points per curve drawn (records are decimated for the figure only)
 
 
 def _plt():

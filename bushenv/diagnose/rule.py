@@ -15,12 +15,13 @@ extra parameters, judged mean squared error ``MSE_S`` and fitted on ``N`` sample
 3. otherwise the best single is named if it passes, else ``none``.
 
 Ranking: by judged gap; but of two rows whose judged errors the data cannot tell apart
-(the mean difference of their MSE over ``BLOCKS`` contiguous blocks of the judged samples
-is within ``TIE_T`` standard errors), the one with fewer parameters goes first.
+(gaps within ``TIE_GAP`` of each other, and the mean difference of their MSE over
+``BLOCKS`` contiguous blocks of the judged samples within ``TIE_T`` standard errors), the
+one with fewer parameters goes first.
 
 ``top_two``: a named pair's members (the better single first); for a named single ``A``,
-``A`` and the effect whose pair with ``A`` is best (ties: the better single); for ``none``,
-the two best singles.
+``A`` and the effect whose pair with ``A`` is best (of pairs the data cannot tell apart from
+the best, the better single); for ``none``, the two best singles.
 """
 
 from __future__ import annotations
@@ -35,7 +36,8 @@ PAIR_GAIN_MIN = 0.25
 PAIR_TRY_IF_LEFT = 0.10  # a pair is not named for the last tenth of the null's gap
 MOSTLY_UNEXPLAINED = 0.5  # the best candidates leave more than this share of the gap
 BLOCKS = 20  # contiguous blocks of the judged samples, for the spread of an MSE difference
-TIE_T = 2.0  # a difference within TIE_T standard errors cannot tell two rows apart
+TIE_T = 2.0  # a difference within TIE_T standard errors cannot tell two rows apart ...
+TIE_GAP = 0.1  # ... if their gaps are also within 10 % of each other
 
 RULE_TEXT = (
     f"A candidate passes when it shrinks the held-out gap of the baseline with its spring and "
@@ -86,10 +88,13 @@ def mark_pairs(
 def indistinguishable(a: dict[str, Any], b: dict[str, Any]) -> bool:
     """Whether the judged errors of two rows differ by less than their spread explains.
 
-    The judged samples are cut into BLOCKS contiguous blocks (neighbouring residuals are
-    correlated); the mean of the blocks' MSE differences is compared with TIE_T times its
-    standard error.
+    Their gaps must be within TIE_GAP of each other, and the mean of their MSE differences
+    over BLOCKS contiguous blocks of the judged samples (neighbouring residuals are
+    correlated) within TIE_T standard errors.
     """
+    lo, hi = sorted((a["gap_after"], b["gap_after"]))
+    if hi > (1.0 + TIE_GAP) * lo:
+        return False
     d = a["_block_mse"] - b["_block_mse"]
     se = float(np.std(d, ddof=1)) / np.sqrt(d.size)
     return bool(abs(float(np.mean(d))) <= TIE_T * se)
@@ -116,6 +121,15 @@ def rank(rows: list[dict[str, Any]], order: list[str]) -> list[dict[str, Any]]:
     return ranked
 
 
+def runner_up(first: str, with_first: list[dict], singles: list[dict]) -> str:
+    """The effect that adds most to ``first``: the partner in its best pair; among pairs the
+    data cannot tell apart from that one, the partner that is the better single effect."""
+    order = [r["effect"] for r in singles]
+    close = [r for r in with_first if r is with_first[0] or indistinguishable(r, with_first[0])]
+    partners = [next(m for m in r["members"] if m != first) for r in close]
+    return min(partners, key=order.index)
+
+
 def named_and_top_two(
     singles: list[dict[str, Any]], pairs: list[dict[str, Any]]
 ) -> tuple[dict[str, Any] | None, list[str]]:
@@ -127,7 +141,6 @@ def named_and_top_two(
         first = singles[0]["effect"]
         with_first = [r for r in pairs if first in r["members"]]
         if with_first:
-            partner = next(m for m in with_first[0]["members"] if m != first)
-            return singles[0], [first, partner]
+            return singles[0], [first, runner_up(first, with_first, singles)]
         return singles[0], [first] + [r["effect"] for r in singles[1:2]]
     return None, [r["effect"] for r in singles[:2]]

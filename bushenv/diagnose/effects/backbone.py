@@ -72,7 +72,7 @@ class Hardening(Effect):
 
     name = "hardening"
     form = (
-        "F(x) = int_0^x k_t(s) ds replacing k x; k_t(|x|) >= 0 piecewise linear on knots at "
+        "F(x) = int_0^x k_t(s) ds replacing k x; k_t(abs(x)) >= 0 piecewise linear on knots at "
         "0, 25, 50, 80 % of the range + (x/x80)^2, (x/x80)^4, + a constant per side"
     )
     weights = "tangent stiffnesses >= 0 (N/m): monotone, softening or stiffening"

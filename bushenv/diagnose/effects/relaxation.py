@@ -10,7 +10,7 @@ from scipy import signal
 from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 PER_DECADE = 3  # Maxwell branches per decade of relaxation time
-TAU_MIN_S = 2e-3
+TAU_MIN_S = 1e-2  # shorter times look like damping and a negative mass (a delay)
 TAU_MAX_S = 1e4
 
 
@@ -23,7 +23,8 @@ def maxwell_state(x: np.ndarray, dt: float, tau: float) -> np.ndarray:
 
 
 def tau_grid_s(scales: Scales) -> np.ndarray:
-    """Relaxation times from 2 dt to twice the longest record, PER_DECADE per decade (s)."""
+    """Relaxation times from max(2 dt, TAU_MIN_S) to twice the longest record, PER_DECADE per
+    decade (s)."""
     lo = max(2.0 * scales.dt, TAU_MIN_S)
     hi = min(max(2.0 * scales.duration_s, 4.0 * lo), TAU_MAX_S)
     n = int(np.floor(np.log10(hi / lo) * PER_DECADE)) + 1
@@ -33,14 +34,18 @@ def tau_grid_s(scales: Scales) -> np.ndarray:
 class Relaxation(Effect):
     """A relaxation spectrum: ``sum_i k_i h_i``, ``h_i' = v - h_i / tau_i`` (Maxwell branches).
 
-    The relaxation times cover the records' whole time scale densely (three per decade, from
-    2 dt to twice the longest record), so any smooth spectrum -- power-law, stretched
+    The relaxation times cover the records' time scale densely (three per decade, from 10 ms
+    or 2 dt to twice the longest record; shorter ones act as a damper and a negative mass,
+    like a delay), so any smooth spectrum -- power-law, stretched
     exponential, log-normal, off-grid Prony -- is a non-negative combination of them; the
     relaxation modulus ``G(t) = sum_i k_i exp(-t / tau_i)`` is monotone by construction.
     """
 
     name = "relaxation"
-    form = "sum_i k_i h_i, h_i' = v - h_i / tau_i; tau_i 3 per decade, 2 dt .. 2 x longest record"
+    form = (
+        "sum_i k_i h_i, h_i' = v - h_i / tau_i; tau_i 3 per decade from max(2 dt, 10 ms) "
+        "to 2 x the longest record"
+    )
     weights = "k_i >= 0 (N/m)"
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:

@@ -35,7 +35,7 @@ class Thermal(Effect):
     """
 
     name = "thermal"
-    form = "-theta (b_k x + b_c v), theta' = P - theta / tau_th, P = v^2 or |v| v_rms"
+    form = "-theta (b_k x + b_c v), theta' = P - theta / tau_th, P = v^2 or abs(v) v_rms"
     weights = "b_k, b_c >= 0"
     shape_text = "tau_th in {10, 30, 100, 300, inf} s x heating {viscous, hysteretic}"
 
