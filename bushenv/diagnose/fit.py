@@ -225,6 +225,11 @@ def diagnose(
     )
     if not cross:
         result["shift_warnings"] += _test_only_hint(run, te, singles)
+        if result["shift_warnings"] and result["unexplained"]["mostly_outside_candidates"]:
+            result["unexplained"]["text"].append(
+                "The TESTs hold regimes the TRAIN records lack (shift warning): an effect only "
+                "they excite cannot be identified on TRAIN; --cross fits on them too."
+            )
     result["records"] = {
         "train": [{"name": p.name, "samples": p.n, "rate_hz": 1.0 / p.dt} for p in tr],
         "tests": [{"name": p.name, "samples": p.n, "rate_hz": 1.0 / p.dt} for p in te],

@@ -19,6 +19,7 @@ AMPLITUDE_MARGIN = 1.15
 RATE_MARGIN = 1.5
 BAND_MARGIN = 1.3
 HOLD_MIN_S = 1.0
+SIDE_FLOOR = 0.05  # a side reached by less than this fraction of TRAIN's peak is not a regime
 
 
 def record_regimes(x: np.ndarray, dt: float) -> dict[str, float]:
@@ -68,9 +69,11 @@ def shift_warnings(
                 f"holds after a step for {r['hold_s']:.3g} s; the identification records "
                 f"hold for {ref['hold_s']:.3g} s",
             )
+        span = max(ref["peak_pos_m"], ref["peak_neg_m"])
         for side in ("pos", "neg"):
             lim = ref[f"peak_{side}_m"]
-            if r[f"peak_{side}_m"] > AMPLITUDE_MARGIN * lim and r[f"peak_{side}_m"] > 0:
+            peak = r[f"peak_{side}_m"]
+            if peak > AMPLITUDE_MARGIN * lim and peak > SIDE_FLOOR * span:
                 sign = "+" if side == "pos" else "-"
                 warn(
                     "amplitude_beyond",
