@@ -160,6 +160,4 @@ def test_a_softening_backbone_is_named_hardening_with_a_monotone_falling_tangent
     for side in ("positive_side", "negative_side"):
         k = [p["tangent_stiffness_n_per_m"] for p in back[side]]
         assert min(k) >= 0 and k[0] > k[3]
-    assert back["positive_side"][0]["tangent_stiffness_n_per_m"] == pytest.approx(
-        K, rel=0.15
-    )
+    assert back["positive_side"][0]["tangent_stiffness_n_per_m"] == pytest.approx(K, rel=0.15)
