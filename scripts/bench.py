@@ -643,6 +643,47 @@ def bench_records(fig: Figures, quick: bool) -> None:
     )
 
 
+def bench_diagnose(fig: Figures, quick: bool) -> None:
+    """``bushenv diagnose --cross`` on 4 records of 20-60 s at 1024 Hz (the full command:
+    loading, every single effect and pair, each left out in turn, report, plots and CSVs),
+    target under 60 s on the shared 2 cores; --quick: 4 records of 4-8 s."""
+    print("\n== gap diagnosis: 4 records, cross mode (leave one record out)")
+    import tempfile
+
+    from bushenv import excitation as ex
+    from bushenv.cli import main
+    from bushenv.records import Record, save_csv
+    from bushenv.reference.rubber import RubberBushing
+
+    dt = 1.0 / 1024
+    lengths = (4.0, 5.0, 6.0, 8.0) if quick else (60.0, 40.0, 30.0, 20.0)
+    ref = RubberBushing.preset("axial", dt=dt, seed=0)
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = []
+        for i, (seconds, n) in enumerate(zip(lengths, (1.0, 1.0, 1.3, 1.5), strict=True)):
+            x = ex.random_rpc(n, seconds, dt, seed=i)
+            if i == 3:  # the last TEST holds a step too
+                x = ex.sequence(x, ex.step_hold(3e-3, 0.25 * seconds, dt, rise_s=0.05))
+            ref.reset()
+            rec = Record.from_arrays(x, ref.simulate(x), dt, name=f"rec{i}")
+            paths.append(str(save_csv(rec, Path(tmp) / f"rec{i}.csv")))
+        args = ["diagnose", paths[0], paths[2], paths[3], "--train", paths[1], "--cross"]
+        t0 = time.perf_counter()
+        code = main(args + ["--out", str(Path(tmp) / "out"), "--quiet"])
+        seconds = time.perf_counter() - t0
+        if code != 0:
+            raise RuntimeError(f"bushenv diagnose exited {code}")
+    samples = sum(int(round(s / dt)) for s in lengths)
+    fig.add(
+        "diagnose.cross.4_records.seconds",
+        seconds,
+        "s",
+        target=60.0,
+        better="lower",
+        note=f"{samples} samples in all at 1024 Hz, report and plots included",
+    )
+
+
 SECTIONS = {
     "models": bench_models,
     "envs": bench_envs,
@@ -653,6 +694,7 @@ SECTIONS = {
     "memory": bench_memory,
     "certify": bench_certify,
     "records": bench_records,
+    "diagnose": bench_diagnose,
 }
 
 

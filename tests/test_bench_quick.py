@@ -57,6 +57,7 @@ EXPECTED = [
     "campaign.nn.float32_verdict_changes",
     "memory.batch_B1024_T512.peak",
     "records.load_csv_20k_over_loadtxt",
+    "diagnose.cross.4_records.seconds",
 ]
 
 
