@@ -400,7 +400,11 @@ def _first_blank_line(chunk: bytes) -> int:
     return min(hits, default=-1)
 
 
-def _load_plain(path: Path, max_displacement_m: float, max_force_n: float) -> Record | None:
+def _load_plain(
+    path: Path,
+    max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
+    max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+) -> Record | None:
     """A file of plain numbers through numpy's parser (the same correctly rounded values as
     ``float``), checked like any record; None if numpy refuses it (a wrong count of values, an
     empty field, ...), which the line-by-line parser then names."""
@@ -435,7 +439,11 @@ def _load_plain(path: Path, max_displacement_m: float, max_force_n: float) -> Re
     return record
 
 
-def _load_line_by_line(path: Path, max_displacement_m: float, max_force_n: float) -> Record:
+def _load_line_by_line(
+    path: Path,
+    max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
+    max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+) -> Record:
     """Parse ``path`` line by line (``_parse``), naming the first problem's line."""
     t, x, f = array.array("d"), array.array("d"), array.array("d")
     lines = array.array("q")
