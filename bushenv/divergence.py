@@ -125,6 +125,7 @@ class Verdict:
     scale_n: np.ndarray | None = None
     criteria_run: tuple[str, ...] = CRITERIA  # without a reference: not NEEDS_REFERENCE
     reference_unusable: np.ndarray | None = None  # the reference's own force is not finite
+    criterion_first_s: dict[str, np.ndarray] = field(default_factory=dict)  # nan: never
 
     def row(self, b: int) -> dict:
         """Plain-JSON summary of profile ``b``."""
@@ -466,4 +467,7 @@ def judge(
         scale_n=scale,
         criteria_run=run,
         reference_unusable=unusable,
+        criterion_first_s={
+            c: np.where(flags[c], np.maximum(first[c], 0) * dt, np.nan) for c in CRITERIA
+        },
     )

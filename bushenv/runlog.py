@@ -111,21 +111,28 @@ def run_cells(
     progress: Progress,
     describe: Callable[[dict[str, Any]], str],
     what: str = "cells",
+    weight: Callable[[dict[str, Any]], float] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run ``fn`` on every cell not yet in ``log`` over ``backend``; all rows in cell order."""
+    """Run ``fn`` on every cell not yet in ``log`` over ``backend``; all rows in cell order.
+
+    ``weight(cell)``: the cell's expected cost relative to the others, for the time left
+    (default: every cell the same)."""
+    weight = weight or (lambda cell: 1.0)
     log.path.parent.mkdir(parents=True, exist_ok=True)
     if not resume and log.path.exists():
         raise log.error(f"{log.path} exists; pass --resume to continue or --out elsewhere")
     done = log.read() if resume else {}
     todo = [c for c in cells if log.key(c) not in done]
-    progress.total = len(todo)
+    progress.total = sum(weight(c) for c in todo)
     progress.say(
         f"{what}: {len(cells)} cells, {len(cells) - len(todo)} already done, "
         f"{len(todo)} to run on {backend.name} ({backend.workers} workers)"
     )
+    work = 0.0
     for n, (i, row) in enumerate(backend.imap_unordered(fn, todo), start=1):
         row["worker_backend"] = backend.name
         log.append(row)
         done[log.key(todo[i])] = row
-        progress.update(n, f"[{n}/{len(todo)}] {describe(row)}", force=True)
+        work += weight(todo[i])
+        progress.update(work, f"[{n}/{len(todo)}] {describe(row)}", force=True)
     return [done[log.key(c)] for c in cells]

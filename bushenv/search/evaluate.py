@@ -226,4 +226,7 @@ def _merge_verdicts(parts: list[Verdict]) -> Verdict:
         scale_n=cat([p.scale_n for p in parts]),
         criteria_run=parts[0].criteria_run,
         reference_unusable=cat([p.reference_unusable for p in parts]),
+        criterion_first_s={
+            k: cat([p.criterion_first_s[k] for p in parts]) for k in parts[0].criterion_first_s
+        },
     )

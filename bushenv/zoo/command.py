@@ -33,6 +33,9 @@ RECIPES = ("teacher-forcing", "free-run")
 NARX_MODELS = ("nn", "hybrid")  # the models with a recipe and a certificate
 CELL_KEYS = ("recipe", "model", "axis", "seed", "budget", "searchers")
 RESULT_KEYS = ("accuracy", "attacks", "step", "certificate")
+# Training time relative to teacher forcing, for the time left only (median of the 10-seed
+# run in docs/recipes.md: teacher forcing 11 s, free run 52-72 s per model on a loaded machine).
+RECIPE_EFFORT = {"teacher-forcing": 1.0, "free-run": 6.0}
 
 
 class ZooError(ValueError):
@@ -132,7 +135,15 @@ def run(args: argparse.Namespace) -> int:
     )
     with backend:
         rows = run_cells(
-            config.cells(), run_cell, log, backend, config.resume, progress, _describe, "zoo"
+            config.cells(),
+            run_cell,
+            log,
+            backend,
+            config.resume,
+            progress,
+            _describe,
+            "zoo",
+            weight=lambda cell: RECIPE_EFFORT.get(cell["recipe"], 6.0),
         )
     write(config.out, rows)
     print((config.out / "summary.md").read_text())
