@@ -20,6 +20,7 @@ COMMANDS = {
     "reproduce": ("bushenv.reproduce", "identify every model and reproduce the papers' tables"),
     "attack": ("bushenv.search.attack", "adversarial campaign: excitations that break a model"),
     "campaign": ("bushenv.search.matrix", "campaign matrix: models x axes x searchers x seeds"),
+    "replay": ("bushenv.search.replay", "replay a regression corpus; name every changed verdict"),
     "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
     "measure": ("bushenv.machine", "run a test programme on a model and write CSV records"),
