@@ -168,21 +168,32 @@ def static_identified(card: dict) -> bool:
     )
 
 
+FLOOR_FRACTION = FLOOR_AMPLITUDE_M / ex.MAX_DISPLACEMENT_M  # 0.5 of 12.5 mm: 4 %
+
+
 def scales_of_card(scales: BushingScales, card: dict) -> BushingScales:
-    """``scales`` with stroke and velocity from a model card's training records (their largest
-    |x| and |dx/dt| times ``RECORD_MARGIN``, within the machine) and their peak force as the
-    typical force; a card without those figures leaves ``scales`` as they are."""
+    """``scales`` from a model card's training records: stroke and velocity their largest |x|
+    and |dx/dt| times ``RECORD_MARGIN`` (within the machine), their peak force the typical
+    force, and -- when they do not show static behaviour (``static_identified``), so the
+    static stiffness is an extrapolation -- the floor at ``FLOOR_FRACTION`` of that peak (the
+    papers' rule, 0.5 mm of a 12.5 mm stroke, as a share of force). A card without those
+    figures leaves ``scales`` as they are."""
     train = [r for r in card.get("records", []) if r.get("role") == "train"]
     if not train or any("max_abs_displacement_m" not in r for r in train):
         return scales
     peak = max(r["max_abs_displacement_m"] for r in train)
     speed = max(r["max_abs_velocity_m_per_s"] for r in train)
+    force = max(r["max_abs_force_n"] for r in train)
+    floor, source = scales.force_floor_n, scales.source
+    if not static_identified(card):
+        floor = FLOOR_FRACTION * force
+        source = f"4 % of the card's training records' peak force ({force:.4g} N) as the floor"
     return replace(
         scales,
         stroke_m=min(RECORD_MARGIN * peak, ex.MAX_DISPLACEMENT_M),
         velocity_m_per_s=min(RECORD_MARGIN * speed, ex.MAX_VELOCITY_M_PER_S),
-        force_scale_n=max(r["max_abs_force_n"] for r in train),
-        source=scales.source
-        + f"; stroke and velocity 1.5 x the card's training records ({peak * 1e3:.3g} mm, "
-        f"{speed:.3g} m/s)",
+        force_scale_n=force,
+        force_floor_n=floor,
+        source=source + f"; stroke and velocity 1.5 x the card's training records "
+        f"({peak * 1e3:.3g} mm, {speed:.3g} m/s)",
     )

@@ -35,6 +35,7 @@ from bushenv.search.campaign_models import (
     FITTED_CONTROL,
     builtin_reference,
     campaign_scales,
+    card_displacements,
     fitted_linear,
     reference_spec,
     roles,
@@ -180,7 +181,7 @@ class Campaign:
                 continue
             self.models[key], spec = self._resolve(spec)
             self.roles[key], self.specs[key] = role, spec
-            if self.reference is not None:
+            if self.static:  # static stiffness means something only where static is known
                 warning = stiffness_mismatch(self.models[key], self.reference)
                 if warning:
                     self.notes.append(f"{key}: {warning}")
@@ -192,7 +193,8 @@ class Campaign:
         """The model ``spec`` names, and the spec to record (a fitted control's saved file)."""
         c = self.config
         if spec == FITTED_CONTROL:
-            model = fitted_linear(self.reference, self.scales)
+            records = card_displacements(self.reference_spec)
+            model = fitted_linear(self.reference, self.scales, records)
             return model, str(model.save(self.out / "models" / "control-linear.npz"))
         return get_model(spec, axis=c.axis, dt=self.dt), spec
 

@@ -50,8 +50,9 @@ def roles(config, notes: list[str]) -> list[tuple[str, str]]:
         out.append(("control", "linear"))
     elif config.reference is not None:
         notes.append(
-            "control: a linear model fitted by least squares to the reference's response to a "
-            f"{CONTROL_RECORD_S:.0f} s random record within the bushing's stroke"
+            "control: a linear model fitted by least squares to the reference's response to "
+            "the records of its model card (without a card: a "
+            f"{CONTROL_RECORD_S:.0f} s random record within the bushing's stroke)"
         )
         out.append(("control", FITTED_CONTROL))
     else:
@@ -114,16 +115,42 @@ def _card_of(spec: str | None) -> dict | None:
     return load_card(spec).data
 
 
-def fitted_linear(source, scales: BushingScales, seed: int = 0) -> LinearBushing:
-    """Least-squares Kelvin-Voigt fit of ``source``'s response to an n = 1 random record
-    scaled to the bushing's stroke (the papers' n = 1 peak is 2 mm of a 12.5 mm stroke)."""
+def card_displacements(spec: str | None) -> list[np.ndarray] | None:
+    """The displacement of the training records a reference file's card names, when they are
+    all still there (checked against the card's hashes), else None."""
+    card = _card_of(spec)
+    if card is None:
+        return None
+    paths = [r.get("file") for r in card["records"] if r.get("role") == "train"]
+    if not paths or not all(p and Path(p).is_file() for p in paths):
+        return None
+    from bushenv.identify.card import load_card
+    from bushenv.records import load_csv
+
+    load_card(spec, records=paths)  # CardError naming a record that changed since
+    return [load_csv(p).displacement for p in paths]
+
+
+def fitted_linear(
+    source, scales: BushingScales, displacements: list | None = None, seed: int = 0
+) -> LinearBushing:
+    """Least-squares Kelvin-Voigt fit of ``source``'s response, from rest, to
+    ``displacements`` (the records the reference was identified on, so the control sees the
+    same band), else to an n = 1 random record scaled to the bushing's stroke (the papers'
+    n = 1 peak is 2 mm of a 12.5 mm stroke)."""
     dt = source.dt
-    x = ex.random_rpc(1.0, CONTROL_RECORD_S, dt, seed)
-    x = x * (scales.stroke_m / ex.MAX_DISPLACEMENT_M)
-    speed = np.max(np.abs(np.diff(x))) / dt
-    if speed > scales.velocity_m_per_s:
-        x = x * (scales.velocity_m_per_s / speed)
-    v = velocity_of(x, dt)
-    f = source.copy().simulate(x, v)
-    k, c = least_squares_kc(x, f, v)
+    if not displacements:
+        x = ex.random_rpc(1.0, CONTROL_RECORD_S, dt, seed)
+        x = x * (scales.stroke_m / ex.MAX_DISPLACEMENT_M)
+        speed = np.max(np.abs(np.diff(x))) / dt
+        if speed > scales.velocity_m_per_s:
+            x = x * (scales.velocity_m_per_s / speed)
+        displacements = [x]
+    xs, vs, fs = [], [], []
+    for x in displacements:
+        v = velocity_of(np.asarray(x, dtype=np.float64), dt)
+        xs.append(x)
+        vs.append(v)
+        fs.append(source.copy().simulate(x, v))
+    k, c = least_squares_kc(np.concatenate(xs), np.concatenate(fs), np.concatenate(vs))
     return LinearBushing(k_n_per_m=k, c_ns_per_m=c, dt=dt)

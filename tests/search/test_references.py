@@ -194,6 +194,8 @@ def test_a_reference_with_a_model_card_sets_the_search_to_its_records_range(tmp_
     peak = float(np.max(np.abs(rec.displacement)))
     assert scales["stroke_m"] == pytest.approx(1.5 * peak, rel=1e-9)
     assert "card's training records" in scales["source"]
-    # a 0.5-20 Hz random drive shows no static behaviour: its fit cannot judge held forces
+    # a 0.5-20 Hz random drive shows no static behaviour: its fit cannot judge held forces,
+    # nor set the floor by its static stiffness (4 % of the records' peak force instead)
+    assert scales["force_floor_n"] == pytest.approx(0.04 * np.max(np.abs(rec.force)), rel=1e-9)
     assert "static" not in report["criteria"]["run"]
     assert any("static not judged" in n for n in report["notes"])
