@@ -89,7 +89,9 @@ def campaign_scales(config, reference, builtin: bool) -> BushingScales:
     """The reference's scales (``bushenv.scales``), its model card's records' range when it
     is a file with a card beside it, and the flags' values on top of both."""
     scales = scales_of_reference(reference, builtin)
-    card = _card_of(reference_spec(config))
+    # the reference's card; with no reference, the card of the model under attack: its records
+    # are the only word on the bushing's range
+    card = _card_of(reference_spec(config) if reference is not None else config.model)
     if card is not None:
         scales = scales_of_card(scales, card)
     flags = {

@@ -199,3 +199,22 @@ def test_a_reference_with_a_model_card_sets_the_search_to_its_records_range(tmp_
     assert scales["force_floor_n"] == pytest.approx(0.04 * np.max(np.abs(rec.force)), rel=1e-9)
     assert "static" not in report["criteria"]["run"]
     assert any("static not judged" in n for n in report["notes"])
+
+
+def test_without_a_reference_the_attacked_models_card_sets_the_scales(tmp_path):
+    from bushenv.machine import random_test
+    from bushenv.records import save_csv
+    from bushenv.reference.rubber import RubberBushing
+
+    rec = random_test(RubberBushing.preset("axial", seed=4), 1.0, duration_s=8.0, seed=4)
+    train = save_csv(rec, tmp_path / "train.csv")
+    mine = tmp_path / "mine.npz"
+    assert main(["fit", str(train), "--model", "linear", "--out", str(mine), "--quiet"]) == 0
+    out = tmp_path / "run"
+    argv = ["attack", "--model", str(mine), "--budget", "8", "--searchers", "random"]
+    assert main([*argv, "--out", str(out), "--no-plots", "--max-shrink", "0"]) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert report["reference"]["spec"] is None
+    peak = float(np.max(np.abs(rec.displacement)))
+    assert report["scales"]["stroke_m"] == pytest.approx(1.5 * peak, rel=1e-9)
+    assert report["scales"]["force_scale_n"] == pytest.approx(np.max(np.abs(rec.force)))
