@@ -14,18 +14,16 @@ radius rho of the companion matrix of dy_t = sum_j a_j dy_{t-j}, a_j = dN/dy_{t-
 
 and every hold whose free run, after the test machine's step from rest (``certify.holds``),
 does not end at a fixed point: a stable fixed point is only a local attractor, and a network
-can also have a limit cycle the step kicks it into (measured: a net trained without this part
-held +1 mm with a stable fixed point, rho 0.95, and oscillated about it at 68 Hz, 860 N peak to
-peak, for as long as it was held). The run is short (``SETTLE_HOLD_S``) and differentiable (the
-training's own free-run unroll); its last half must stay within ``SETTLE_TOLERANCE`` of the
-fixed point it is nearest to at its end.
+can also have a limit cycle the step kicks it into (docs/fit.md has one). The run is short
+(``SETTLE_HOLD_S``) and differentiable (the training's own free-run unroll); its last half must
+stay within ``SETTLE_TOLERANCE`` of the fixed point it is nearest to at its end.
 
 All three as squared hinges: zero inside the band, below the radius and once settled, so the
 data fit is not traded away where the model already holds right. The loss is the weight times
 [the mean over the fixed points of ((distance outside the band) / max(|F_s|, floor))^2 +
 ((rho - radius) / (1 - radius))^2] plus the weight times the mean over the holds and the late
 samples of ((|y_t - y*| - tolerance)^+)^2 (y in the network's scaled output, in units of
-f_scale: a 5 % oscillation costs 0.0016, ten times a good free-run data loss).
+f_scale, as the free-run data loss is).
 
 **Differentiable fixed points.** The fixed points are found without gradients by the
 certificate's exhaustive search (``certify.fixed_points``, few cells: a training term needs
@@ -35,9 +33,9 @@ constant: its value is y0 and its gradient the implicit function theorem's, dy*/
 / phi'. **Differentiable spectral radius.** The eigenvalue lambda of largest modulus of the
 companion matrix is a root of p(z) = z^n - sum_j a_j z^(n-j); by the same theorem dlambda/da_j =
 lambda^(n-j) / p'(lambda), so rho enters as |lambda0 + sum_j dlambda/da_j (a_j - a_j0)|. The
-sufficient bound sum |a_j| < 1 is not used: the shipped networks have sum |a_j| of 2.5-2.7 at
-fixed points whose rho is 0.94-0.99 (lags of alternating sign: damping), so the bound would
-forbid the networks that fit.
+sufficient bound sum |a_j| < 1 is not used: networks that fit have lags of alternating sign
+(damping) with sum |a_j| well above 1 at stable fixed points (docs/fit.md), so the bound would
+forbid them.
 
 Holds: ``holds`` per call, one in each of as many equal strata of u in [-1, 1], mapped to
 x = stroke u |u| (denser near rest, where small forces change sign), the strata shifted by the

@@ -61,8 +61,8 @@ class NarxOptions:
     certified: str = option(
         "off",
         "on: a loss term holding every fixed point of the held network, over the stroke, "
-        "within a band of the records' static force and below a spectral radius "
-        "(certified.py; docs/fit.md)",
+        "within a band of the records' static force and below a spectral radius, and every "
+        "held run after a step settled (certified.py; docs/fit.md)",
         choices=SWITCH,
     )
     certified_weight: float = option(1.0, "weight of the certified-hold term")

@@ -15,10 +15,11 @@ can show. Here, per record (its training part),
 The static estimate is F_s(x) = F_0 + k_s x, extrapolated linearly over the whole stroke. Only
 the slope can be estimated: at n = 1 the slow content is a few hundredths of a millimetre
 (0.03 mm RMS below 2 Hz), too small to show a curve. Rubber is stiffer at the drive's
-frequencies than in a hold (relaxation) and stiffens at large deflection (hardening), so F_s
-sits within about 0.8-1.5 of a rubber's static curve (measured on the reference rubber in
-``tests/identify/test_static_estimate.py`` and docs/fit.md); the certified training term
-(``certified.py``) judges the model's held force in a band about F_s wide enough for that.
+frequencies than in a hold (relaxation), stiffens at large deflection (hardening) and, through
+friction, near rest: a rubber's static curve lies about 0.8-1.3 times F_s beyond 1 mm and up to
+1.8 times within 0.25 mm (the reference rubber: docs/fit.md, tested in
+``tests/identify/test_static_estimate.py``); the certified training term (``certified.py``)
+judges the model's held force in a band about F_s wide enough for that.
 """
 
 from __future__ import annotations
