@@ -475,7 +475,10 @@ def bench_campaign(fig: Figures, quick: bool) -> None:
     from bushenv.search.searchers import get_searcher
 
     ref = truth_reference("axial")
-    model = get_model("nn", axis="axial", dt=ref.dt)
+    # a NN with known failures (the shipped NNs, trained certified, fail rarely): the axial NN
+    # shipped before certified training, which the regression corpus keeps
+    failing = ROOT / "tests" / "regressions" / "models" / "axial_nn-6f15bf3.npz"
+    model = get_model(str(failing), axis="axial", dt=ref.dt)
     for threads in (1, 2):
         with BatchEvaluator(model, ref, target="rig", threads=threads, axis="axial") as ev:
             res = get_searcher("random").run(ev, 64 if quick else 512, seed=0)

@@ -14,6 +14,7 @@ ENGINES = ("numba", "torch")
 RECIPES = ("free-run", "teacher-forcing")
 INPUT_BASES = ("auto", "lags", "differences")
 EARLY_STOPS = ("training", "stage")
+SWITCH = ("off", "on")
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,27 @@ class NarxOptions:
     )
     grad_clip: float = option(1.0, "gradient norm clip in the free-run stage")
     weight_decay: float = option(0.0, "L2 weight on the hidden-layer weights (a loss term)")
+    certified: str = option(
+        "off",
+        "on: a loss term holding every fixed point of the held network, over the stroke, "
+        "within a band of the records' static force and below a spectral radius, and every "
+        "held run after a step settled (certified.py; docs/fit.md)",
+        choices=SWITCH,
+    )
+    certified_weight: float = option(1.0, "weight of the certified-hold term")
+    certified_low: float = option(
+        0.8, "held force at least this fraction of the records' static estimate, same sign"
+    )
+    certified_high: float = option(
+        1.9, "held force at most this multiple of the records' static estimate"
+    )
+    certified_radius: float = option(
+        0.98, "spectral radius of a held fixed point above which the term grows"
+    )
+    certified_stroke_m: float = option(
+        0.0125, "holds span +-this displacement, m (the test machine's stroke)"
+    )
+    certified_holds: int = option(24, "holds per training step, denser near rest")
     eval_every: int = option(25, "iterations between two validations")
     patience: int = option(8, "validations without improvement before a stop")
     early_stop: str = option(
@@ -93,3 +115,22 @@ class NarxOptions:
                 raise IdentificationError(f"{name} must be >= 1, got {getattr(self, name)}")
         if self.teacher_steps < 0 or min(self.iters_per_length, default=0) < 0:
             raise IdentificationError("teacher_steps and iters_per_length must be >= 0")
+        self._check_certified()
+
+    def _check_certified(self) -> None:
+        if not 0.0 <= self.certified_low < 1.0 < self.certified_high:
+            raise IdentificationError(
+                "certified_low and certified_high must satisfy 0 <= low < 1 < high, got "
+                f"{self.certified_low} and {self.certified_high}"
+            )
+        if not 0.0 < self.certified_radius < 1.0:
+            raise IdentificationError(
+                f"certified_radius must be in (0, 1), got {self.certified_radius}"
+            )
+        if not (self.certified_stroke_m > 0.0 and self.certified_weight >= 0.0):
+            raise IdentificationError(
+                "certified_stroke_m must be > 0 and certified_weight >= 0, got "
+                f"{self.certified_stroke_m} and {self.certified_weight}"
+            )
+        if self.certified_holds < 2:
+            raise IdentificationError(f"certified_holds must be >= 2, got {self.certified_holds}")

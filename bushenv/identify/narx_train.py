@@ -18,6 +18,33 @@ from bushenv.metrics import rms_ratio
 from bushenv.progress import Progress, ProgressSpec
 
 
+class Keeper:
+    """The weights a training keeps: admitted ones (every loss term with ``admits`` admits
+    them) beat any others, then the lower validation error wins. Patience is a separate
+    matter: ``offer`` says whether the error improved on the lowest seen, admitted or not, so
+    a stage is not ended early only because its weights are not admitted yet."""
+
+    def __init__(self, trainer: Trainer) -> None:
+        self.trainer = trainer
+        self.judged = any(hasattr(t, "admits") for t in trainer.terms)
+        self.val, self.ok, self.state, self.lowest = np.inf, False, trainer.state(), np.inf
+
+    def offer(self, val: float) -> bool:
+        """Keep the current weights if they are better; True when ``val`` is the lowest yet."""
+        if not self.judged:
+            ok, better = True, val < self.val
+        elif self.ok and not val < self.val:
+            ok, better = False, False  # cannot win: admission not checked
+        else:
+            ok = self.trainer.admitted()
+            better = (not ok, val) < (not self.ok, self.val)
+        if better:
+            self.val, self.ok, self.state = val, ok, self.trainer.state()
+        progress = val < self.lowest
+        self.lowest = min(self.lowest, val)
+        return progress
+
+
 class Trainer:
     """State of one NARX training: the net, its optimiser stages, the best weights so far."""
 
@@ -81,6 +108,10 @@ class Trainer:
                 loss = loss + term(self.net, self.problem)
         return loss
 
+    def admitted(self) -> bool:
+        """Whether every term that judges weights (``admits``) admits the current ones."""
+        return all(t.admits(self.net, self.problem) for t in self.terms if hasattr(t, "admits"))
+
     def state(self) -> dict[str, torch.Tensor]:
         return {k: t.detach().clone() for k, t in self.net.state_dict().items()}
 
@@ -107,7 +138,7 @@ class Trainer:
         inp, tgt = p.one_step_batch(p.train)
         select = opt.recipe == "teacher-forcing"
         v_inp, v_tgt = p.one_step_batch(p.val) if select else (None, None)
-        best, best_state, stale, history = np.inf, self.state(), 0, []
+        keep, stale, history = Keeper(self), 0, []
         adam = torch.optim.Adam(self.net.parameters(), lr=opt.teacher_lr)
         sched = torch.optim.lr_scheduler.CosineAnnealingLR(adam, max(1, opt.teacher_steps))
         for i in range(opt.teacher_steps):
@@ -124,16 +155,14 @@ class Trainer:
             with torch.no_grad():
                 val = torch.mean((self.net(v_inp) - v_tgt) ** 2).item()
             history.append((i + 1, val))
-            best, best_state, stale = (
-                (val, self.state(), 0) if val < best else (best, best_state, stale + 1)
-            )
+            stale = 0 if keep.offer(val) else stale + 1
             if stale >= opt.patience:
                 self.say(f"one-step validation: patience {opt.patience} ran out at {i + 1}", True)
                 break
         if select:
-            self.net.load_state_dict(best_state)
+            self.net.load_state_dict(keep.state)
             self.log["teacher_validation_mse"] = history
-            self.log["best_teacher_validation_mse"] = float(best)
+            self.log["best_teacher_validation_mse"] = float(keep.val)
 
     # ----- stage 2: free-run fine-tuning -------------------------------------------------------
     def free_run(self) -> None:
@@ -200,13 +229,10 @@ class Trainer:
     def _evaluate(self, length: int, loss: float) -> None:
         val = self.validate_free_run()
         self.history.append((self.it, val))
-        if val < self.best_val:
-            self.best_val, self.best_state, self.stale = val, self.state(), 0
-        else:
-            self.stale += 1
+        self.stale = 0 if self.keep.offer(val) else self.stale + 1
         self.say(
             f"free-run iter {self.it} (window {length}): loss {loss:.3e}, "
-            f"validation RMS ratio {val:.4f} (best {self.best_val:.4f})"
+            f"validation RMS ratio {val:.4f} (kept {self.keep.val:.4f})"
         )
 
     # ----- the whole training ------------------------------------------------------------------
@@ -221,23 +247,28 @@ class Trainer:
             else f"validation free-run RMS ratio {val:.4f} before free-run training",
             force=True,
         )
-        self.best_val, self.best_state, self.history = val, self.state(), [(0, val)]
+        self.keep, self.history = Keeper(self), [(0, val)]
+        self.keep.offer(val)
         self.log["stopped"] = "one step ahead only (teacher-forcing recipe)"
         if self.opt.recipe == "free-run":
             self.free_run()
-            self.net.load_state_dict(self.best_state)
+            self.net.load_state_dict(self.keep.state)
         elapsed = self.progress.elapsed_s()
         self.work = self.progress.total
         self.say(
             f"done in {elapsed:.1f} s ({self.log['stopped']}); best validation free-run RMS "
-            f"ratio {self.best_val:.4f}",
+            f"ratio {self.keep.val:.4f}",
             force=True,
         )
         with torch.no_grad():
             terms = {t.name: float(t(self.net, self.problem)) for t in self.terms}
+        self.log["term_reports"] = {
+            t.name: t.report(self.net, self.problem) for t in self.terms if hasattr(t, "report")
+        }
         self.log.update(
+            kept_weights_admitted=self.admitted(),
             validation_rms_ratio=self.history,
-            best_validation_rms_ratio=self.best_val,
+            best_validation_rms_ratio=self.keep.val,
             validation_after_teacher=val,
             loss_terms=terms,
             seconds=elapsed,

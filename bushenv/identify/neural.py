@@ -26,9 +26,13 @@ safety cap (reported if hit). docs/fit.md explains each option and what the reci
 
 Extra loss terms plug in through ``loss_terms`` (objects with ``name``, ``stages`` and
 ``__call__(net, problem) -> tensor``, added to the data loss of the stages they name);
-``weight_decay`` is one (``WeightDecay``). A term a flag turns on is a ``NarxOptions`` field
-(``narx_options.py``) that ``loss_terms_of`` reads; ``problem`` (``narx_data.NarxProblem``)
-gives it the scaling, the lags, the backbone and the records.
+``weight_decay`` is one (``WeightDecay``), ``certified`` another (``certified.CertifiedHolds``:
+held static force and spectral radius over the stroke). A term a flag turns on is a
+``NarxOptions`` field (``narx_options.py``) that ``loss_terms_of`` reads; ``problem``
+(``narx_data.NarxProblem``) gives it the scaling, the lags, the backbone and the records. A term
+with an ``admits(net, problem) -> bool`` method also judges checkpoints: the trainer keeps the
+best weights among those every such term admits (any weights if none is admitted), and a
+``report(net, problem) -> dict`` goes into the training log.
 """
 
 from __future__ import annotations
@@ -73,7 +77,21 @@ class WeightDecay:
 
 def loss_terms_of(opt: NarxOptions) -> list[LossTerm]:
     """The loss terms the options ask for."""
-    return [WeightDecay(opt.weight_decay)] if opt.weight_decay else []
+    terms: list[LossTerm] = [WeightDecay(opt.weight_decay)] if opt.weight_decay else []
+    if opt.certified == "on":
+        from bushenv.identify.certified import CertifiedHolds
+
+        terms.append(
+            CertifiedHolds(
+                weight=opt.certified_weight,
+                low=opt.certified_low,
+                high=opt.certified_high,
+                radius=opt.certified_radius,
+                stroke_m=opt.certified_stroke_m,
+                holds=opt.certified_holds,
+            )
+        )
+    return terms
 
 
 def fit_nn(

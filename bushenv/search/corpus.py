@@ -13,8 +13,11 @@ A case file (``tests/regressions/corpus/<name>.json``) holds:
 |               | by a float64 cumulative sum from 0 (holds stay exactly constant)            |
 | family, params| the excitation family and its physical parameters (or the agent's name)     |
 | found_by      | searcher, seed, model name and the sha256 of the model file it was found on |
-| expect        | per model name: ``diverged`` (bool), the ``criterion`` it fired (or null),  |
-|               | ``sha256`` of the model file the verdict was recorded with                  |
+| expect        | per model spec: ``diverged`` (bool), the ``criterion`` it fired (or null),  |
+|               | ``sha256`` of the model file the verdict was recorded with. A spec is a     |
+|               | registered name (its shipped file) or a model file; a relative file path is |
+|               | relative to the case's own folder (``../models/old.npz``), so a case keeps  |
+|               | replaying a model that is no longer shipped                                 |
 | reference     | ``spec``: the reference the verdicts were judged against (a registered name |
 |               | or a model file; null: judged without one, by the criteria that need none), |
 |               | ``file_sha256`` and ``params_sha256``; replay refuses when it is missing    |
@@ -45,6 +48,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.models import (
+    MODELS,
     BushingModel,
     file_hash,
     get_model,
@@ -183,6 +187,16 @@ Resolver = Callable[[str, str, float], BushingModel]
 
 def _default_resolver(name: str, axis: str, dt: float) -> BushingModel:
     return get_model(name, axis=axis, dt=dt)
+
+
+def model_spec(case: Case, spec: str) -> str:
+    """The model an ``expect`` key names: a registered name (or any other name a resolver
+    knows) as it is; a relative file path (``.npz``, or a path with a folder) taken relative to
+    the case's folder (absolute paths and cases not read from a file: as given)."""
+    is_path = spec.endswith(".npz") or "/" in spec or os.sep in spec
+    if spec in MODELS or not is_path or case.path is None or Path(spec).is_absolute():
+        return spec
+    return str(case.path.parent / spec)
 
 
 def judge_profile(
@@ -347,7 +361,11 @@ def replay(
     resolve = resolve or _default_resolver
     sha_of = sha_of or model_sha
     reference = case_reference(case)
-    models = {name: resolve(name, case.axis, case.dt) for name in case.expect}
+    specs = {name: model_spec(case, name) for name in case.expect}
+    try:
+        models = {name: resolve(spec, case.axis, case.dt) for name, spec in specs.items()}
+    except ValueError as exc:
+        raise CorpusError(f"case {case.name}: a model it names cannot be loaded: {exc}") from None
     rows = judge_profile(
         case.profile, models, case.env, case.axis, reference, case.scales, case.static
     )
@@ -358,7 +376,7 @@ def replay(
             diverged=bool(rows[name]["diverged"]),
             row=rows[name],
             sha_recorded=case.expect[name].get("sha256"),
-            sha_now=sha_of(name, case.axis),
+            sha_now=sha_of(specs[name], case.axis),
         )
         for name in case.expect
     ]

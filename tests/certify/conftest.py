@@ -10,12 +10,22 @@ run starts on the lower branch, which vanishes at x = +u_f mm.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from bushenv.models.hybrid import HybridBushing
 from bushenv.models.narx import NarxBushing
 
 X_SCALE_M = 1e-3
+
+OLD_MODELS = Path(__file__).resolve().parents[1] / "regressions" / "models"
+
+
+def old_nn(axis: str) -> str:
+    """The NN shipped before certified training, kept with the corpus cases found on it: a
+    network with known energy failures, whatever the shipped models are today."""
+    return str(OLD_MODELS / f"{axis}_nn-6f15bf3.npz")
 
 
 def fold_u(g: float) -> float:

@@ -3,6 +3,8 @@ of each signal's peak over an episode, with BushRigVectorEnv's reset, options an
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -69,9 +71,22 @@ def worst_relative_errors(single, vector):
     return dict(zip(SIGNALS, np.abs(s - v).max(axis=0) / np.abs(s).max(axis=0), strict=True))
 
 
-@pytest.mark.parametrize("model", ["linear", "nn"])
+# A NARX pair whose car self-oscillates (the "even on a flat road") regularly enough
+# for two implementations to agree: the NNs shipped before certified training, kept with the
+# regression corpus. The NNs shipped today make this car flip at Nyquist with an irregular
+# amplitude (up to +-7 kN radial, on a flat road too): a motion two implementations cannot
+# follow to 1 % of its peak over 2048 steps, whichever of them is right.
+OLD_NN = {
+    axis: str(
+        Path(__file__).resolve().parents[1] / "regressions" / "models" / f"{axis}_nn-6f15bf3.npz"
+    )
+    for axis in ("radial", "axial")
+}
+
+
+@pytest.mark.parametrize("model", ["linear", "nn-6f15bf3"])
 def test_a_column_follows_the_pymunk_env_over_an_episode_of_a_bump_and_a_rough_road(model):
-    model_or_skip(model, "radial")
+    model = OLD_NN if model == "nn-6f15bf3" else model_or_skip(model, "radial")
     single, vector = run_both(model, road=bump_then_rough_road())
     errors = worst_relative_errors(single, vector)
     assert max(errors.values()) < PEAK_TOLERANCE, errors
