@@ -18,16 +18,26 @@ import threading
 COMMANDS = {
     # name: (module, one-line help)
     "reproduce": ("bushenv.reproduce", "identify every model and reproduce the papers' tables"),
-    "attack": ("bushenv.search.campaign", "adversarial campaign: excitations that break a model"),
+    "attack": ("bushenv.search.attack", "adversarial campaign: excitations that break a model"),
     "campaign": ("bushenv.search.matrix", "campaign matrix: models x axes x searchers x seeds"),
+    "replay": ("bushenv.search.replay", "replay a regression corpus; name every changed verdict"),
     "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
     "measure": ("bushenv.machine", "run a test programme on a model and write CSV records"),
+    "fit": ("bushenv.identify.command", "identify a model from measured records, with a card"),
+    "import-nn": ("bushenv.identify.import_command", "a torch NARX network to a model file"),
+    "card": ("bushenv.identify.card_command", "show a model card; check its model and records"),
+    "certify": ("bushenv.certify.command", "hold-stability and passivity certificates of a NARX"),
+    "zoo": ("bushenv.zoo.command", "population study: how often NARX models fail, by recipe"),
 }
 
 
 class CliError(Exception):
     """A user-facing problem: printed as one line, exit code 2."""
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    """Descriptions as written, and every option's default in ``--help``."""
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
@@ -52,7 +62,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             name,
             help=help_text,
             description=help_text,
-            formatter_class=argparse.RawDescriptionHelpFormatter,
+            formatter_class=HelpFormatter,
             allow_abbrev=False,
         )
         mod = _command_module(name)

@@ -564,12 +564,18 @@ def _slew_limit(x, max_step, out):  # pragma: no cover - compiled
                 out[t, b] = x[t, b]
 
 
-def clip_to_limits(x: np.ndarray, dt: float) -> np.ndarray:
+def clip_to_limits(
+    x: np.ndarray,
+    dt: float,
+    max_displacement_m: float = MAX_DISPLACEMENT_M,
+    max_velocity_m_per_s: float = MAX_VELOCITY_M_PER_S,
+) -> np.ndarray:
     """The nearest drivable version of ``x``: (T,) or (T, B) -> same shape, m.
 
-    Clips to +-``MAX_DISPLACEMENT_M``, then limits the rate: each sample moves at most
-    ``MAX_VELOCITY_M_PER_S * dt`` from the previous output (a slew-rate limiter, like a servo's
-    rate limit). The result passes ``within_limits``; non-finite input is refused.
+    Clips to +-``max_displacement_m``, then limits the rate: each sample moves at most
+    ``max_velocity_m_per_s * dt`` from the previous output (a slew-rate limiter, like a servo's
+    rate limit). With the default (the machine's) limits the result passes ``within_limits``;
+    non-finite input is refused.
     """
     dt = _check_dt(dt)
     a = np.asarray(x, dtype=np.float64)
@@ -579,10 +585,10 @@ def clip_to_limits(x: np.ndarray, dt: float) -> np.ndarray:
         raise ExcitationError("clip_to_limits: x holds NaN or inf")
     one_d = a.ndim == 1
     a2 = np.ascontiguousarray(
-        np.clip(a[:, None] if one_d else a, -MAX_DISPLACEMENT_M, MAX_DISPLACEMENT_M)
+        np.clip(a[:, None] if one_d else a, -max_displacement_m, max_displacement_m)
     )
     out = np.empty_like(a2)
     if a2.shape[0] > 0:
         # 1e-12 relative margin so the clipped signal never fails within_limits by a rounding.
-        _slew_limit(a2, MAX_VELOCITY_M_PER_S * dt * (1 - 1e-12), out)
+        _slew_limit(a2, max_velocity_m_per_s * dt * (1 - 1e-12), out)
     return out[:, 0] if one_d else out

@@ -22,7 +22,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any
 
 
-class BackendError(RuntimeError):
+class BackendError(ValueError):
     """A backend cannot start (Ray missing, cluster unreachable, bad worker count)."""
 
 

@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -44,6 +43,7 @@ import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.models.base import DT_TOLERANCE, PAPER_DT, BushingModel
+from bushenv.persist import write_json
 from bushenv.records import Record, RecordError, save_csv
 
 HARMONIC_FREQUENCIES_HZ = (1.0, 5.0, 10.0, 15.0, 20.0)  # seed 001 §3.2.1
@@ -320,12 +320,9 @@ def programme_items(args: argparse.Namespace, dt: float) -> list[ProgrammeItem]:
 
 def cli_run(args: argparse.Namespace) -> int:
     from bushenv.models import get_model
+    from bushenv.progress import Progress
 
-    start = time.monotonic()
-
-    def progress(msg: str) -> None:
-        if not args.quiet:
-            print(f"[{time.monotonic() - start:6.1f} s] {msg}", file=sys.stderr, flush=True)
+    progress = Progress(quiet=args.quiet)
 
     if not (np.isfinite(args.rate) and args.rate > 0):
         raise MachineError(f"--rate must be a positive number of Hz, got {args.rate!r}")
@@ -365,4 +362,29 @@ def cli_run(args: argparse.Namespace) -> int:
             f"max |F| = {record.info['max_abs_force_n']:.4g} N"
         )
         print(path)
+    write_json(out / "measure.json", _manifest(args, model, records, paths))
     return 0
+
+
+def _manifest(args, model, records, paths) -> dict:
+    """What made the records: the model (spec, class, file and parameter hashes), the
+    programme and its settings, and each record's file, length and peak force."""
+    from bushenv.models import file_hash, model_file, params_sha
+
+    path = model_file(args.model, args.axis)
+    return {
+        "model": {
+            "spec": args.model,
+            "class": type(model).__name__,
+            "file_sha256": file_hash(path) if path is not None and path.is_file() else None,
+            "params_sha256": params_sha(model),
+            "axis": args.axis,
+        },
+        "sample_rate_hz": 1.0 / model.dt,
+        "programme": args.programme,
+        "seed": args.seed,
+        "records": [
+            {"file": p.name, "samples": len(r), "max_abs_force_n": r.info["max_abs_force_n"]}
+            for r, p in zip(records, paths, strict=True)
+        ],
+    }

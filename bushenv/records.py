@@ -8,7 +8,9 @@ The format (one record per file):
     ...
 
 - The header is exactly ``time,displacement,force`` (spaces around names are tolerated, nothing
-  else: no extra columns, no units in the names, no other order). Columns are s, m, N.
+  else: no extra columns, no other order). Columns are s, m, N, unless a column's unit is
+  written after its name in brackets, ``displacement [mm]`` or ``force (kN)`` (``UNITS``): the
+  values are then converted to SI on load.
 - Values are decimal numbers (anything Python's ``float`` reads except NaN and inf), comma
   separated, one sample per line; blank lines are allowed only at the end.
 - Time strictly increases with a uniform step, at any rate: the step dt is read from the time
@@ -16,9 +18,13 @@ The format (one record per file):
   ``STEP_ATOL_S`` (1e-9 s). At least two samples.
 - Plausibility: ``max |displacement| <= MAX_PLAUSIBLE_DISPLACEMENT_M`` (0.1 m, eight times the
   test machine's stroke; larger values are almost always millimetres) and
-  ``max |force| <= MAX_PLAUSIBLE_FORCE_N`` (1 MN, forty times the machine's 25 kN).
+  ``max |force| <= MAX_PLAUSIBLE_FORCE_N`` (1 MN, forty times the machine's 25 kN). These are
+  overridable checks: ``load_csv(..., max_displacement_m=0.5)`` raises a limit, and a column
+  whose unit is written in the header is taken as stated (no limit).
 - Files larger than ``MAX_RECORD_BYTES`` (256 MiB, about five million samples) are refused
-  before reading; below that the file is parsed line by line into compact arrays.
+  before reading. A file of plain numbers (the common case, and what ``save_csv`` writes) is
+  read by numpy's parser after one scan for anything unusual; any other file is parsed line by
+  line, which finds and names the problem. Both keep ~24-32 bytes per sample.
 
 Every problem raises ``RecordError`` (a ``ValueError``) naming the file, the line and the value,
 e.g. ``train.csv line 17: time goes backwards (0.123 after 0.1235)``. ``save_csv`` applies the
@@ -34,7 +40,9 @@ import csv
 import difflib
 import io
 import os
+import re
 import tempfile
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -48,7 +56,20 @@ STEP_ATOL_S = 1e-9  # ... plus 1 ns (printed times lose digits)
 MAX_PLAUSIBLE_DISPLACEMENT_M = 0.1
 MAX_PLAUSIBLE_FORCE_N = 1.0e6
 MAX_RECORD_BYTES = 256 * 2**20
+# units a header may state per column, and their factor to SI
+UNITS = {
+    "time": {"s": 1.0, "ms": 1e-3},
+    "displacement": {"m": 1.0, "mm": 1e-3, "um": 1e-6},
+    "force": {"N": 1.0, "kN": 1e3},
+}
+_NAME_UNIT = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]*?)\s*[\])]\s*$")
 _SNIFF_BYTES = 8192
+# What numpy's parser reads exactly as the line-by-line parser does (digits, signs, points,
+# exponents, commas, blanks, LF and CRLF); a file holding anything else takes the slow path.
+_PLAIN_BYTES = b"0123456789+-.eE,\n\r \t"
+_BOM = b"\xef\xbb\xbf"
+_SCAN_CHUNK_BYTES = 8 * 2**20
+_BLANK_LINE = re.compile(rb"(?m)^[ \t\r]*\n")
 # First bytes of files people hand over by mistake, so the message can say what it is.
 _BINARY_MAGIC = (
     (b"PK\x03\x04", "a zip archive (an .npz model, an .xlsx workbook or a zipped CSV?)"),
@@ -156,7 +177,15 @@ class Record:
 
 
 # ----- checks shared by load and save ----------------------------------------------------------
-def _check_columns(t: np.ndarray, x: np.ndarray, f: np.ndarray, label: str, where) -> None:
+def _check_columns(
+    t: np.ndarray,
+    x: np.ndarray,
+    f: np.ndarray,
+    label: str,
+    where,
+    max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
+    max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+) -> None:
     """Semantic checks; ``where(i)`` names sample i (a file line or a sample index)."""
     if t.size < 2:
         raise RecordError(f"{label}: {t.size} sample(s); need at least 2 to know the sample time")
@@ -188,17 +217,22 @@ def _check_columns(t: np.ndarray, x: np.ndarray, f: np.ndarray, label: str, wher
         (
             "displacement",
             x,
-            MAX_PLAUSIBLE_DISPLACEMENT_M,
+            max_displacement_m,
             "m",
-            "looks like millimetres (the column must be metres)",
+            "looks like millimetres (the column must be metres). If it really is metres, say "
+            "so: raise the limit (bushenv diagnose --max-displacement 0.5; "
+            "load_csv(..., max_displacement_m=0.5)) or write the unit in the header: "
+            "'displacement [m]' ('displacement [mm]' converts millimetres)",
         ),
         (
             "force",
             f,
-            MAX_PLAUSIBLE_FORCE_N,
+            max_force_n,
             "N",
             "that is 40 times the test machine's 25 kN: wrong units (the column must be "
-            "newtons) or a diverged run",
+            "newtons) or a diverged run. If it is right, raise the limit (bushenv diagnose "
+            "--max-force; load_csv(..., max_force_n=...)) or write the unit in the header: "
+            "'force [N]' or 'force [kN]'",
         ),
     )
     for key, a, limit, unit, hint in plausible:
@@ -209,10 +243,32 @@ def _check_columns(t: np.ndarray, x: np.ndarray, f: np.ndarray, label: str, wher
             )
 
 
+def header_units(fields: list[str]) -> tuple[list[str], dict[str, float], str | None]:
+    """(names without units, {column: factor to SI} for stated units, problem or None)."""
+    names, factors = [], {}
+    for text in fields:
+        m = _NAME_UNIT.match(text)
+        if m is None:
+            names.append(text.strip())
+            continue
+        name, unit = m.group(1), m.group(2)
+        names.append(name)
+        known = UNITS.get(name)
+        if known is not None and unit not in known:
+            shown = ",".join(fields)
+            problem = f"unknown unit {unit!r} for {name} in header '{shown}'; known: "
+            return names, factors, problem + ", ".join(known)
+        if known is not None:
+            factors[name] = known[unit]
+    return names, factors, None
+
+
 def _header_problem(fields: list[str]) -> str | None:
-    """None if ``fields`` is the header, else what is wrong with it."""
-    names = [s.strip() for s in fields]
-    if tuple(names) == HEADER:
+    """None if ``fields`` is the header (units allowed), else what is wrong with it."""
+    names, _, problem = header_units(fields)
+    if problem:
+        return problem
+    if tuple(n.strip() for n in names) == HEADER:
         return None
     shown = ",".join(fields)
     expected = f"expected exactly '{HEADER_TEXT}'"
@@ -259,11 +315,20 @@ def _header_problem(fields: list[str]) -> str | None:
 
 
 # ----- load ------------------------------------------------------------------------------------
-def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Record:
+def load_csv(
+    path: str | os.PathLike,
+    max_bytes: int = MAX_RECORD_BYTES,
+    max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
+    max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+) -> Record:
     """Read and validate one record file; refuse anything off-format with ``RecordError``.
 
-    The file is parsed line by line (memory ~ 32 bytes per sample); files above ``max_bytes``
-    are refused before reading.
+    Files above ``max_bytes`` are refused before reading. A file of plain numbers under the
+    plain header goes through numpy's parser (``_load_plain``: within 2x of ``np.loadtxt``,
+    scripts/bench.py); anything else line by line (``_load_line_by_line``), which names the
+    first problem's line. Both give the same values and the same messages
+    (tests/test_records.py). ``max_displacement_m`` and ``max_force_n`` are the plausibility
+    limits; a column whose unit the header states is converted to SI and not limited.
     """
     path = Path(path)
     if not path.exists():
@@ -287,11 +352,104 @@ def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Reco
     if nul >= 0:
         raise RecordError(f"{path}: binary data (NUL byte at byte {nul}); expected a text CSV file")
 
+    limits = {"max_displacement_m": max_displacement_m, "max_force_n": max_force_n}
+    if _plain_numbers(path):
+        record = _load_plain(path, **limits)
+        if record is not None:
+            return record
+    return _load_line_by_line(path, **limits)
+
+
+def _plain_numbers(path: Path) -> bool:
+    """Whether numpy's parser reads ``path`` exactly as ``_parse`` would: the header on line 1,
+    then only plain-number bytes, LF or CRLF line ends, no blank line before the end and no
+    line beyond the csv module's field limit. Scanned in chunks of whole lines (memory flat)."""
+    limit = csv.field_size_limit()
+    with open(path, "rb") as fh:
+        head = fh.readline()
+        head = head[len(_BOM) :] if head.startswith(_BOM) else head
+        if not head.endswith(b"\n") or b'"' in head or not head.isascii():
+            return False
+        fields = head.decode("ascii").removesuffix("\n").removesuffix("\r")
+        if "\r" in fields or tuple(n.strip() for n in fields.split(",")) != HEADER:
+            return False  # units in the header, or a header to complain about: line by line
+        blank_seen = False
+        while chunk := fh.read(_SCAN_CHUNK_BYTES) + fh.readline():
+            if chunk.translate(None, _PLAIN_BYTES) or chunk.count(b"\r") != chunk.count(b"\r\n"):
+                return False
+            blank = _first_blank_line(chunk)
+            if blank_seen or blank >= 0:  # blank lines only at the end
+                if chunk[max(blank, 0) :].strip():
+                    return False
+                blank_seen = True
+            ends = np.flatnonzero(np.frombuffer(chunk, np.uint8) == 10)
+            if np.diff(ends, prepend=-1, append=len(chunk)).max() > limit:
+                return False
+    return True
+
+
+def _first_blank_line(chunk: bytes) -> int:
+    """Where the first blank (empty or blanks-only) line of ``chunk`` starts, -1 if none;
+    ``chunk`` starts at a line start."""
+    if b" " in chunk or b"\t" in chunk:  # rare in record files: the slower regex
+        m = _BLANK_LINE.search(chunk)
+        return m.start() if m else -1
+    if chunk.startswith((b"\n", b"\r\n")):
+        return 0
+    hits = [i + 1 for i in (chunk.find(b"\n\n"), chunk.find(b"\n\r\n")) if i >= 0]
+    return min(hits, default=-1)
+
+
+def _load_plain(
+    path: Path,
+    max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
+    max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+) -> Record | None:
+    """A file of plain numbers through numpy's parser (the same correctly rounded values as
+    ``float``), checked like any record; None if numpy refuses it (a wrong count of values, an
+    empty field, ...), which the line-by-line parser then names."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "input contained no data": the slow path says more
+            a = np.loadtxt(
+                path, delimiter=",", skiprows=1, comments=None, ndmin=2, encoding="utf-8-sig"
+            )
+    except ValueError:
+        return None
+    if a.shape[1] != 3 or a.shape[0] < 2 or not np.isfinite(a).all():
+        return None
+    record = Record(
+        time=a[:, 0].copy(),
+        displacement=a[:, 1].copy(),
+        force=a[:, 2].copy(),
+        name=path.stem,
+        path=path,
+    )
+    # no blank lines before the data ends: sample i is on line i + 2
+    where = lambda i: f"{path} line {i + 2}"  # noqa: E731
+    _check_columns(
+        record.time,
+        record.displacement,
+        record.force,
+        str(path),
+        where=where,
+        max_displacement_m=max_displacement_m,
+        max_force_n=max_force_n,
+    )
+    return record
+
+
+def _load_line_by_line(
+    path: Path,
+    max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
+    max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+) -> Record:
+    """Parse ``path`` line by line (``_parse``), naming the first problem's line."""
     t, x, f = array.array("d"), array.array("d"), array.array("d")
     lines = array.array("q")
     try:
         with open(path, encoding="utf-8-sig", newline="") as fh:
-            _parse(fh, path, t, x, f, lines)
+            factors = _parse(fh, path, t, x, f, lines)
     except UnicodeDecodeError as exc:
         raise RecordError(
             f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start} of a read block); "
@@ -301,9 +459,9 @@ def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Reco
         raise RecordError(f"{path}: not a readable CSV file: {exc}") from None
 
     record = Record(
-        time=np.frombuffer(t, dtype=np.float64).copy(),
-        displacement=np.frombuffer(x, dtype=np.float64).copy(),
-        force=np.frombuffer(f, dtype=np.float64).copy(),
+        time=np.frombuffer(t, dtype=np.float64) * factors.get("time", 1.0),
+        displacement=np.frombuffer(x, dtype=np.float64) * factors.get("displacement", 1.0),
+        force=np.frombuffer(f, dtype=np.float64) * factors.get("force", 1.0),
         name=path.stem,
         path=path,
     )
@@ -319,11 +477,14 @@ def load_csv(path: str | os.PathLike, max_bytes: int = MAX_RECORD_BYTES) -> Reco
         record.force,
         str(path),
         where=lambda i: f"{path} line {int(line_of[i])}",
+        max_displacement_m=np.inf if "displacement" in factors else max_displacement_m,
+        max_force_n=np.inf if "force" in factors else max_force_n,
     )
     return record
 
 
-def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> None:
+def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> dict[str, float]:
+    """Fill the columns; returns the header's stated units as factors to SI."""
     reader = csv.reader(fh, strict=True)
     header = None
     for row in reader:
@@ -340,6 +501,7 @@ def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> None:
     problem = _header_problem(header)
     if problem:
         raise RecordError(f"{path} line 1: {problem}")
+    factors = header_units(header)[1]
     blank_at = 0
     columns = (t, x, f)
     last_line = 1
@@ -377,6 +539,7 @@ def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> None:
                 f"{path} line {line}: time goes backwards ({t[-1]!r} after {t[-2]!r})"
             )
         lines.append(line)
+    return factors
 
 
 # ----- save ------------------------------------------------------------------------------------

@@ -12,7 +12,7 @@
    Table 2/3 of seed 000 (linear, NN, hybrid), Table 4 of seed 002 (NN vs Bouc-Wen, radial),
    Table 5 (identification and verification times; the verification record is 6.44 s long).
 4. The 4 mm step held 10 s: each model beside the reference; bounded or not, and when the NN
-   departs (seed 000 saw 7.3 s), decided by ``bushenv.search.divergence`` (defined once there).
+   departs (seed 000 saw 7.3 s), decided by ``bushenv.divergence`` (defined once there).
 
 ``DIR/report.json`` layout (every number of the printed tables)::
 
@@ -33,8 +33,6 @@ Ratios are fractions (0.051 = 5.1 %); forces in N; times in s.
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import time
 from pathlib import Path
 from typing import Any
@@ -42,11 +40,20 @@ from typing import Any
 import numpy as np
 
 from bushenv import metrics
-from bushenv.models import AXES, get_model
+from bushenv.models import AXES, MODELS, get_model
+from bushenv.persist import json_text, write_text
+from bushenv.progress import Progress
 
 EXAMPLE = "bushenv reproduce --out runs/reproduce"
+# Identification time relative to the linear least squares, for the time-left estimate only.
+EFFORT = {"linear": 1.0, "nn": 12.0, "hybrid": 15.0, "boucwen": 45.0}
 
-MODELS = ("linear", "nn", "hybrid", "boucwen")
+
+def identified_models() -> tuple[str, ...]:
+    """Every registered model that can be identified from a record (``MODELS`` with a fit)."""
+    return tuple(name for name, entry in MODELS.items() if entry.fit is not None)
+
+
 # Published figures (percent unless stated): seed 000 Tables 2-3, seed 002 Tables 4-5.
 PAPER = {
     "table2": {  # prediction error on unseen random data, %
@@ -87,10 +94,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="use the trained models shipped in the package instead of identifying anew",
     )
     p.add_argument("--force", action="store_true", help="overwrite an existing report in --out")
-
-
-def _say(msg: str) -> None:
-    print(msg, flush=True)
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
 
 
 def _records(axis: str, seed: int, ident_s: float, verif_s: float):
@@ -112,7 +116,7 @@ def _identify(name: str, axis: str, train, seed: int, shipped: bool):
     from bushenv.identify import fit_model
 
     t0 = time.perf_counter()
-    if shipped and name != "linear":
+    if shipped and MODELS[name].shipped:
         model = get_model(name, axis=axis, dt=train.dt)
     else:
         model = fit_model(name, train.displacement, train.force, train.dt, seed=seed, progress=True)
@@ -133,8 +137,8 @@ def _verification_time(model, dt: float) -> float:
 
 
 def _step_verdicts(axis: str, models: dict[str, Any], dt: float) -> dict[str, Any]:
+    from bushenv.divergence import judge
     from bushenv.excitation import step_hold
-    from bushenv.search.divergence import judge
 
     x = step_hold(4e-3, 10.0, dt, pre_s=1.0)
     from bushenv.reference.rubber import RubberBushing
@@ -166,19 +170,32 @@ def run(args: argparse.Namespace) -> int:
         if a not in AXES:
             raise CliError(f"unknown axis {a!r}; choose from {list(AXES)}")
     out.mkdir(parents=True, exist_ok=True)
+    progress = Progress(quiet=args.quiet)
     report = reproduce(
-        out, axes, args.seed, args.identification_s, args.verification_s, args.shipped
+        out, axes, args.seed, args.identification_s, args.verification_s, args.shipped, progress
     )
     print(format_tables(report))
-    _say(f"\nwrote {out / 'report.json'}, {out / 'report.md'} and plots")
+    print(f"\nwrote {out / 'report.json'}, {out / 'report.md'} and plots")
     return 0
 
 
 def reproduce(
-    out: Path, axes: list[str], seed: int, ident_s: float, verif_s: float, shipped: bool
+    out: Path,
+    axes: list[str],
+    seed: int,
+    ident_s: float,
+    verif_s: float,
+    shipped: bool,
+    progress: Progress | None = None,
 ) -> dict[str, Any]:
+    """Identify (or load) every model per axis, judge it on the unseen records and the step;
+    writes ``out/report.json``, ``report.md`` and the plots; returns the report."""
     import torch
 
+    progress = progress or Progress(quiet=True)
+    names = identified_models()
+    progress.total = len(axes) * sum(EFFORT.get(n, 10.0) for n in names)
+    _say = progress.say
     torch.manual_seed(seed)
     report: dict[str, Any] = {"paper": PAPER, "step": {}}
     report["settings"] = {
@@ -198,7 +215,7 @@ def reproduce(
         train, same, test = _records(axis, seed, ident_s, verif_s)
         report["settings"]["dt_s"] = train.dt
         models, rows = {}, {}
-        for name in MODELS:
+        for name in names:
             _say(f"[{axis}] identifying {name} ...")
             model, t_ident = _identify(name, axis, train, seed, shipped)
             models[name] = model
@@ -223,6 +240,7 @@ def reproduce(
                 f"{time.perf_counter() - t_start:.0f} s total)"
             )
             plots.setdefault(axis, {})[name] = f_sim
+            progress.update(progress.done + EFFORT.get(name, 10.0), f"[{axis}] {name} judged")
         report[axis] = rows
         _say(f"[{axis}] 4 mm step held 10 s ...")
         step = _step_verdicts(axis, models, train.dt)
@@ -242,22 +260,12 @@ def reproduce(
     return report
 
 
-def _json_default(o: Any) -> Any:
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(type(o))
-
-
 def _write(out: Path, report: dict[str, Any], plots: dict[str, Any]) -> None:
-    tmp = out / "report.json.tmp"
-    tmp.write_text(json.dumps(report, indent=2, default=_json_default))
-    os.replace(tmp, out / "report.json")
+    write_text(out / "report.json", json_text(report, indent=2))
     figures = _plot(out, plots)
     md = ["# The papers reproduced\n", "```", format_tables(report), "```\n"]
     md += [f"![{name}]({name})\n" for name in figures]
-    (out / "report.md").write_text("\n".join(md))
+    write_text(out / "report.md", "\n".join(md))
 
 
 def _plot(out: Path, plots: dict[str, Any]) -> list[str]:
@@ -274,7 +282,8 @@ def _plot(out: Path, plots: dict[str, Any]) -> list[str]:
         ax[0].plot(t, 1e3 * test.displacement, "k", lw=0.8)
         ax[0].set_ylabel("displacement [mm]")
         ax[1].plot(t, test.force, "k", lw=1.2, label="reference (measured)")
-        for name in MODELS:
+        models = [n for n in data if not n.startswith("_")]
+        for name in models:
             ax[1].plot(t, data[name], lw=0.8, label=name)
         ax[1].set_xlim(0, min(t[-1], 5.0))
         ax[1].set_ylabel("force [N]")
@@ -285,8 +294,9 @@ def _plot(out: Path, plots: dict[str, Any]) -> list[str]:
         fig.savefig(out / names[-1], dpi=110)
         plt.close(fig)
 
-        fig, axs = plt.subplots(1, len(MODELS), figsize=(14, 3.6), sharey=True)
-        for a, name in zip(axs, MODELS, strict=True):
+        fig, axs = plt.subplots(1, len(models), figsize=(14, 3.6), sharey=True, squeeze=False)
+        axs = axs[0]
+        for a, name in zip(axs, models, strict=True):
             a.plot(1e3 * test.displacement, test.force, "k", lw=0.5, label="reference")
             a.plot(1e3 * test.displacement, data[name], "r", lw=0.5, label=name)
             a.set_title(name)
@@ -302,7 +312,7 @@ def _plot(out: Path, plots: dict[str, Any]) -> list[str]:
         ts = np.arange(len(step["reference"])) * test.dt
         fig, ax = plt.subplots(figsize=(10, 4))
         ax.plot(ts, step["reference"], "k", lw=1.5, label="reference")
-        for name in MODELS:
+        for name in models:
             ax.plot(ts, step[name]["force"], lw=0.9, label=name)
         ax.set_xlabel("time [s]")
         ax.set_ylabel("force [N]")
@@ -339,7 +349,8 @@ def format_tables(report: dict[str, Any]) -> str:
             lines.append(f"{name:10s}" + "".join(cells))
         lines.append("")
     lines.append("ESR (seed 000 Table 3 reports 0.2-0.5 %), ours on the n = 1.5 record, %:")
-    for name in MODELS:
+    models = list(report[axes[0]]) if axes else []
+    for name in models:
         lines.append(
             f"  {name:8s}" + "".join(f"  {a}: {_pct(report[a][name]['esr'])}" for a in axes)
         )
@@ -361,7 +372,7 @@ def format_tables(report: dict[str, Any]) -> str:
                 )
     lines.append("")
     lines.append("Table 5 (seed 002): identification / verification (6.44 s record) time")
-    for name in MODELS:
+    for name in models:
         for a in axes:
             r = report[a][name]
             paper = PAPER["table5"].get(name)

@@ -2,8 +2,9 @@
 
 Measures, in one run on this machine: Gymnasium's CartPole-v1 (single env through gym.make, and
 its numpy-vectorised CartPoleVectorEnv), BushRig-v0 single and vectorised (the array
-VectorEnv), QuarterCar-v0 single, and the QuarterCarBatch integrator. Random actions are drawn
-in bulk beforehand; episodes that end are reset inside the timed loop (as a rollout would).
+VectorEnv), QuarterCar-v0 single, its vector env and the QuarterCarBatch integrator under it
+(road searches call it directly). Random actions are drawn in bulk beforehand; episodes that
+end are reset inside the timed loop (as a rollout would).
 Each figure is the best of ``--repeats`` runs (other jobs on shared cores only ever slow a run
 down). Prints a table; ``--json FILE`` also writes the rows.
 
@@ -144,6 +145,13 @@ def main(argv: list[str] | None = None) -> int:
         batch.simulate(road[:20])  # warm-up
         jobs.append(
             ("QuarterCar-v0", m, "QuarterCarBatch", n, lambda b=batch, r=road: time_batch(b, r))
+        )
+        qvenv = gym.make_vec(
+            "QuarterCar-v0", num_envs=n, vectorization_mode="vector_entry_point", model=m
+        )
+        qacts = rng.uniform(-0.3, 0.3, (args.vector_steps, n, 1)).astype(np.float32)
+        jobs.append(
+            ("QuarterCar-v0", m, "vector (arrays)", n, lambda e=qvenv, a=qacts: time_vector(e, a))
         )
 
     best = [float("inf")] * len(jobs)

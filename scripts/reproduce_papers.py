@@ -1,6 +1,6 @@
 """Reproduce the papers' tables: the same as ``bushenv reproduce``.
 
-    python scripts/reproduce_papers.py --out runs/reproduce
+python scripts/reproduce_papers.py --out runs/reproduce
 """
 
 import sys

@@ -75,8 +75,7 @@ def push(env, steps, a=0.3):
     [
         ({"dt_s": 0}, RigError, "dt_s must be a positive finite number, got 0"),
         ({"dt_s": math.nan}, RigError, "dt_s must be a positive finite number, got nan"),
-        ({"episode_steps": 0}, RigError, "episode_steps must be a positive integer, got 0"),
-        ({"episode_steps": 2.5}, RigError, "episode_steps must be a positive integer, got 2.5"),
+        ({"episode_steps": 100}, RigError, "episode_steps: the episode length is Gymnasium's"),
         ({"history": -1}, RigError, "history must be a positive integer, got -1"),
         ({"physics_substeps": 0}, RigError, "physics_substeps must be a positive integer"),
         ({"force_limit_n": math.inf}, RigError, "force_limit_n must be a positive finite"),
@@ -212,7 +211,7 @@ def memory_growth(step, steps: int, warmup: int = 2000) -> int:
 
 
 def test_bushrig_memory_stays_flat_over_5e4_steps():
-    env = rig(model="linear", reference="rubber", episode_steps=10**9)
+    env = rig(model="linear", reference="rubber", max_episode_steps=-1)
     env.reset(seed=0)
     plus, minus = np.array([0.3], np.float32), np.array([-0.3], np.float32)
     grown = memory_growth(lambda i: env.step(plus if (i // 4) % 2 else minus), 50_000)
@@ -220,7 +219,7 @@ def test_bushrig_memory_stays_flat_over_5e4_steps():
 
 
 def test_bushrig_memory_stays_flat_over_2e4_steps_after_a_nan_verdict():
-    env = rig(model=BadAfter(after=10), reference="linear", episode_steps=10**9)
+    env = rig(model=BadAfter(after=10), reference="linear", max_episode_steps=-1)
     env.reset(seed=0)
     a = np.array([0.3], np.float32)
     grown = memory_growth(lambda i: env.step(a if (i // 4) % 2 else -a), 20_000)
@@ -229,7 +228,7 @@ def test_bushrig_memory_stays_flat_over_2e4_steps_after_a_nan_verdict():
 
 def test_vector_env_memory_stays_flat_over_5e3_steps():
     venv = gym.make_vec(
-        "BushRig-v0", num_envs=4, vectorization_mode="vector_entry_point", episode_steps=500
+        "BushRig-v0", num_envs=4, vectorization_mode="vector_entry_point", max_episode_steps=500
     )
     venv.reset(seed=0)  # 500-step episodes: autoreset happens 10 times in the run
     a = np.full((4, 1), 0.3, np.float32)
@@ -241,7 +240,7 @@ def test_vector_env_memory_stays_flat_over_5e3_steps():
 def test_vector_env_memory_stays_flat_over_1e6_steps(request):
     skip_slow_unless_asked(request)
     venv = gym.make_vec(
-        "BushRig-v0", num_envs=4, vectorization_mode="vector_entry_point", episode_steps=2048
+        "BushRig-v0", num_envs=4, vectorization_mode="vector_entry_point", max_episode_steps=2048
     )
     venv.reset(seed=0)
     a = np.full((4, 1), 0.3, np.float32)

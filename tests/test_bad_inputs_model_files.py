@@ -150,7 +150,7 @@ def _meta_case(linear_file, **changes):
         ({"version": 2}, "format version 2, this bushenv reads version 1"),
         ({"version": "1"}, "format version '1'"),
         ({"format": "other"}, r"not a bushenv model file \(format tag missing\)"),
-        ({"model": "lstm"}, r"unknown model 'lstm'; known: \['boucwen', 'hybrid', 'linear'"),
+        ({"model": "lstm"}, r"unknown model 'lstm'; known names: linear, nn, hybrid, boucwen"),
         ({"model": ["linear"]}, r"unknown model \['linear'\]"),
         ({"dt": "fast"}, r"invalid dt 'fast' in the header"),
         ({"dt": -0.1}, r"invalid dt -0\.1"),
@@ -253,7 +253,7 @@ def test_file_of_a_model_in_a_module_not_yet_imported_loads(tmp_path):
 
     path = BoucWenBushing.preset("radial").save(tmp_path / "bw.npz")
     code = (
-        "import sys; from bushenv.models.base import load_model; "
+        "import sys; from bushenv.models.files import load_model; "
         "print(type(load_model(sys.argv[1])).__name__)"
     )
     done = subprocess.run(
@@ -266,7 +266,7 @@ def test_file_of_a_model_in_a_module_not_yet_imported_loads(tmp_path):
 @pytest.mark.parametrize(
     ("spec", "kwargs", "message"),
     [
-        ("lstm", {}, r"unknown model 'lstm'; known names: \['boucwen'"),
+        ("lstm", {}, r"unknown model 'lstm'; known names: linear, nn"),
         ("", {}, r"empty model name"),
         ("linear", {"axis": "sideways"}, r"unknown axis 'sideways'"),
         ("missing.npz", {}, r"missing\.npz: no such model file"),
@@ -278,5 +278,5 @@ def test_get_model_refuses_bad_names_axes_and_paths(spec, kwargs, message):
 
 
 def test_model_object_of_another_dt_is_refused():
-    with pytest.raises(ModelError, match=r"runs at dt=0\.001 s, expected 0\.00488281 s"):
+    with pytest.raises(ModelError, match=r"runs at 1000 Hz \(dt=0\.001 s\), expected 204\.8 Hz"):
         get_model(LinearBushing.preset("axial", dt=1e-3), dt=DT)

@@ -20,6 +20,7 @@ from pathlib import Path
 import pytest
 
 from bushenv.execution import LocalBackend
+from bushenv.progress import Progress
 from bushenv.search.matrix import (
     CELL_KEYS,
     MatrixError,
@@ -39,7 +40,7 @@ def skip_slow_unless_asked(request) -> None:
 
 
 CELLS = make_cells(["linear"], ["axial"], ["random"], [0, 1, 2], budget=16)
-QUIET = {"progress": lambda s: None}
+QUIET = {"progress": Progress(quiet=True)}
 N_SIGNAL_CELLS = 40  # far more than can finish between the first result and a signal
 
 
@@ -144,7 +145,7 @@ def test_signalled_campaign_keeps_finished_cells_and_resume_completes_it(
 
     resumed = subprocess.run([*cmd, "--resume"], capture_output=True, text=True, timeout=300)
     assert resumed.returncode == 0, resumed.stderr
-    assert f"{len(kept)} already done, {N_SIGNAL_CELLS - len(kept)} to run" in resumed.stdout
+    assert f"{len(kept)} already done, {N_SIGNAL_CELLS - len(kept)} to run" in resumed.stderr
     final = lines_of(results)
     assert final[: len(kept)] == kept  # earlier results untouched
     seeds = sorted(json.loads(line)["seed"] for line in final)
@@ -176,7 +177,7 @@ def test_complete_last_line_without_newline_is_kept_and_the_next_append_starts_a
         path = out / "cells.jsonl"
         path.write_text(path.read_text().rstrip("\n"))  # cut exactly before the newline
         msgs: list[str] = []
-        run_matrix(CELLS, out, one, resume=True, progress=msgs.append)
+        run_matrix(CELLS, out, one, resume=True, progress=Progress(sink=msgs.append))
     assert "2 already done, 1 to run" in msgs[0]
     assert [json.loads(line)["seed"] for line in lines_of(path)] == [0, 1, 2]
 

@@ -60,10 +60,17 @@ EXPECTED = [
         for m in ("noise_floor", "nn", "boucwen")
         for k in ("unseen_same_amplitude", "unseen_n1.5")
     ),
+    *(
+        f"fit_command.{m}{k}"
+        for m in ("nn", "hybrid", "boucwen")
+        for k in ("", ".rms_ratio_unseen_n1")
+    ),
     "campaign.random.threads2.evaluations_per_s",
     "campaign.nn.random.seconds_to_first_divergence",
     "campaign.nn.float32_verdict_changes",
     "memory.batch_B1024_T512.peak",
+    "records.load_csv_20k_over_loadtxt",
+    "diagnose.cross.4_records.seconds",
 ]
 
 
@@ -100,3 +107,28 @@ def test_quick_benchmark_produces_every_figure_with_units_and_targets(tmp_path):
     for m in ("LSODA", "Radau"):
         assert rows[f"compare.boucwen.scipy_{m}"]["note"].startswith("rtol")
     assert "| verification_6.44s.nn |" in md.read_text()
+
+
+def test_quick_certify_benchmark_produces_its_figures(tmp_path):
+    out = tmp_path / "bench.json"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "scripts" / "bench.py"),
+            "--quick",
+            "--only",
+            "certify",
+            "--json",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    rows = {r["name"]: r for r in json.loads(out.read_text())["figures"]}
+    for name in ("nn", "hybrid"):
+        for axis in ("axial", "radial"):
+            r = rows[f"certify.{name}.{axis}.holds20"]
+            assert r["unit"] == "s" and r["target"] == 1.0 and isinstance(r["met"], bool)
+            assert math.isfinite(rows[f"certify.{name}.{axis}.analysis_holds20"]["value"])

@@ -150,3 +150,17 @@ def test_reference_rubber_runs_the_papers_programme():
     for record in records:
         assert record.info["force_finite"]
         record.validate()
+
+
+def test_measure_writes_a_manifest_of_what_made_the_records(tmp_path):
+    import json
+
+    from bushenv.cli import main
+
+    out = tmp_path / "rec"
+    argv = ["measure", "--model", "linear", "--programme", "step", "--out", str(out), "--quiet"]
+    assert main(argv) == 0
+    manifest = json.loads((out / "measure.json").read_text())
+    assert manifest["model"]["spec"] == "linear" and manifest["model"]["params_sha256"]
+    assert manifest["records"][0]["file"].endswith(".csv")
+    assert manifest["sample_rate_hz"] == 204.8

@@ -242,3 +242,111 @@ def test_arbitrary_bytes_give_a_record_or_record_error(blob):
         except RecordError:
             return
         assert len(r) >= 2 and np.all(np.diff(r.time) > 0)
+
+
+# ----- the plain-number fast path agrees with the line-by-line parser ---------------------------
+def outcome(load, path):
+    """(time, displacement, force) as bytes, or the RecordError message."""
+    try:
+        r = load(path)
+    except RecordError as exc:
+        return str(exc)
+    return tuple(a.tobytes() for a in (r.time, r.displacement, r.force))
+
+
+PLAIN_BODY = "0.0,0.0,0.0\n0.1,1e-3,1.5E+1\n0.2,+2.5e-3,-0.0\n0.3,.001,10.\n"
+VARIANTS = {
+    "plain": "time,displacement,force\n" + PLAIN_BODY,
+    "crlf": ("time,displacement,force\n" + PLAIN_BODY).replace("\n", "\r\n"),
+    "bom": "\ufefftime,displacement,force\n" + PLAIN_BODY,
+    "blank tail": "time,displacement,force\n" + PLAIN_BODY + "\n  \n\t\n",
+    "spaces": "time , displacement , force\n" + PLAIN_BODY.replace(",", " , "),
+    "blank inside": "time,displacement,force\n0.0,0,0\n\n0.1,0,0\n0.2,0,0\n",
+    "crlf blank inside": "time,displacement,force\r\n0.0,0,0\r\n\r\n0.1,0,0\r\n0.2,0,0\r\n",
+    "blank first": "time,displacement,force\n\n0.0,0,0\n0.1,0,0\n",
+    "spaces line inside": "time,displacement,force\n0.0,0,0\n   \n0.1,0,0\n0.2,0,0\n",
+    "two values": "time,displacement,force\n0.0,0\n0.1,0\n",
+    "four values": "time,displacement,force\n0.0,0,0,0\n0.1,0,0,0\n",
+    "empty value": "time,displacement,force\n0.0,,0\n0.1,0,0\n",
+    "overflow": "time,displacement,force\n0.0,0,0\n0.1,0,1e999\n",
+    "nan": "time,displacement,force\n0.0,0,0\n0.1,nan,0\n",
+    "backwards": "time,displacement,force\n0.0,0,0\n0.1,0,0\n0.05,0,0\n",
+    "repeats": "time,displacement,force\n0.0,0,0\n0.1,0,0\n0.1,0,0\n",
+    "uneven": "time,displacement,force\n0.0,0,0\n0.1,0,0\n0.2,0,0\n0.35,0,0\n0.45,0,0\n",
+    "millimetres": "time,displacement,force\n0.0,0,0\n0.1,2.5,0\n0.2,0,0\n",
+    "one row": "time,displacement,force\n0.0,0,0\n",
+    "header only": "time,displacement,force\n",
+    "quoted": 'time,displacement,force\n"0.0",0,0\n0.1,0,0\n',
+    "underscore": "time,displacement,force\n0.0,0,0\n0.1,1_0,0\n",
+    "lone cr": "time,displacement,force\r0.0,0,0\r0.1,0,0\r",
+    "bad header": "time,displacment,force\n0.0,0,0\n0.1,0,0\n",
+    "signs": "time,displacement,force\n0.0,0,0\n0.1,+-1,0\n",
+    "long value": "time,displacement,force\n0.0,0,0\n0.1,0." + "0" * 140_000 + "1,0\n",
+}
+
+
+@pytest.mark.parametrize("chunk_bytes", [8 * 2**20, 7])  # the scan in one chunk or many
+@pytest.mark.parametrize("name", sorted(VARIANTS))
+def test_load_gives_what_the_line_by_line_parser_gives(tmp_path, monkeypatch, name, chunk_bytes):
+    from bushenv import records
+    from bushenv.records import _load_line_by_line
+
+    monkeypatch.setattr(records, "_SCAN_CHUNK_BYTES", chunk_bytes)
+    path = tmp_path / "r.csv"
+    path.write_bytes(VARIANTS[name].encode("utf-8"))
+    assert outcome(load_csv, path) == outcome(_load_line_by_line, path)
+
+
+def test_files_save_csv_writes_take_the_plain_number_path(tmp_path):
+    from bushenv.records import _plain_numbers
+
+    path = save_csv(sample_record(n=2000), tmp_path / "r.csv")
+    assert _plain_numbers(path)
+    for name in ("crlf", "bom", "blank tail", "spaces"):
+        (tmp_path / "v.csv").write_bytes(VARIANTS[name].encode("utf-8"))
+        assert _plain_numbers(tmp_path / "v.csv"), name
+    for name in ("blank inside", "quoted", "underscore", "lone cr", "nan", "long value"):
+        (tmp_path / "v.csv").write_bytes(VARIANTS[name].encode("utf-8"))
+        assert not _plain_numbers(tmp_path / "v.csv"), name
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.lists(
+        st.sampled_from(
+            [
+                "0.0",
+                "0.1",
+                "1e-3",
+                "-2.5E+2",
+                "+.5",
+                "5.",
+                "1e999",
+                "",
+                " 1",
+                "1 ",
+                "1 2",
+                "-",
+                "nan",
+                "0x1",
+                "1_0",
+                '"1"',
+                "\t3",
+            ]  # fmt: skip
+        ),
+        min_size=2,
+        max_size=40,
+    ),
+    st.lists(st.sampled_from([",", "\n", "\r\n", "\n\n", ",,", "\r"]), min_size=2, max_size=40),
+    st.booleans(),
+)
+def test_any_mix_of_numbers_and_separators_loads_as_the_line_by_line_parser_does(
+    tmp_path_factory, values, separators, bom
+):
+    from bushenv.records import _load_line_by_line
+
+    body = "".join(v + s for v, s in zip(values, separators, strict=False))
+    text = ("\ufeff" if bom else "") + "time,displacement,force\n" + body
+    path = tmp_path_factory.mktemp("mix") / "r.csv"
+    path.write_bytes(text.encode("utf-8"))
+    assert outcome(load_csv, path) == outcome(_load_line_by_line, path)

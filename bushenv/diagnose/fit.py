@@ -1,564 +1,283 @@
-"""Identify a baseline on TRAIN, augment it with candidate effects, judge on TESTs.
+"""``diagnose()``: where a baseline's held-out gap lies, which candidate closes it, how far.
 
-``diagnose(train, tests, baseline="linear")`` is the library core behind ``bushenv diagnose``
-(``report.py`` only writes files). Records are any objects with ``.time``, ``.displacement``,
-``.force`` (``(T,)`` arrays, s, m, N) and ``.dt`` (s), such as ``bushenv.records.Record``.
+Records are any objects with ``.time``, ``.displacement``, ``.force`` ((T,) arrays, s, m, N)
+and ``.dt`` (s), such as ``bushenv.records.Record``. ``report.py`` writes the files; the
+naming rule is ``rule.py``, the fitting ``fitting.py``, the candidates ``candidates.py``.
 
-How an augmented model is fitted
---------------------------------
-- ``linear`` baseline: ``F = k x + c v + sum(effect columns * weights)``, all weights (k and c
-  included) by bounded linear least squares on TRAIN: the baseline's own parameters are
-  re-identified together with the effect, as a bench engineer would refit.
-- any other baseline ``b`` (``boucwen``, ``hybrid``, ``nn`` from ``bushenv.identify``):
-  ``F = b + dk x + dc v + sum(effect columns * weights)``: the baseline kept as identified, plus
-  a spring/damper correction (a baseline identified without the effect has absorbed part of
-  it into its stiffness and damping).
-- ``delay`` shifts the whole predicted force by ``d`` seconds (``F(t - d)``).
+Two modes. **Held out** (default): weights and shapes fitted on the TRAIN records, every gap
+measured on the TESTs. **Cross** (``cross=True``): each record, TRAIN or TEST, is judged by
+weights fitted on all the others (leave one record out), so an effect only some records
+excite is identified and still judged on a record it was not fitted on.
 
-Shape settings (tau grids, delays, heating time constants) are chosen by TRAIN error; every
-gap number in the result is measured on the TESTs only (all TEST records concatenated):
-``gap = bushenv.metrics.rms_ratio(measured, predicted)`` (seed 000 eq. 8) and
-``shrink = 1 - gap_after / gap_before``.
-
-The null augmentation is the spring/damper part alone: for the linear baseline it is the
-baseline itself; for the others, ``b + dk x + dc v``, whose gap is ``gap_null``. The rule
-judges candidates against the null, so a correction every candidate gets is not credited to
-any of them.
-
-Rule for naming an effect (``none`` otherwise)
-----------------------------------------------
-The best single effect (lowest TEST gap) is named when
-1. it shrinks the null's gap by at least ``SHRINK_MIN`` (5 %: a 10 % cut in held-out error
-   energy): ``1 - gap_after / gap_null >= 0.05``, and
-2. its held-out cut in mean squared error exceeds the most that fitting ``p`` extra weights to
-   noise could explain: ``MSE_null - MSE_after > NOISE_MARGIN * p * sigma2 / N_train``, with
-   ``sigma2`` the held-out MSE that remains (an upper bound on the noise variance).
-When the named single ``A`` leaves more than ``PAIR_TRY_IF_LEFT`` (10 %) of the null's gap,
-each of the two best singles is paired with every other effect (fitted jointly, shapes
-searched jointly); the best pair replaces ``A`` when it closes at least ``PAIR_GAIN_MIN``
-(25 %) of the gap that ``A`` leaves and passes rule 2 with its own ``p``. The member that is
-the better single comes first in the pair's name.
-
-``top_two``: the named pair's members; for a named single ``A``, ``A`` and the effect that
-closes most of the gap when fitted together with ``A`` (``A``'s pairs are always fitted for
-this ranking, even when none may be named); for ``none``, the two best singles.
-
-Rates: candidate columns are continuous-time, and the linear baseline is too, so a TEST at
-another sample rate than TRAIN is handled (columns are recomputed at the TEST's dt). Other
-baselines are discrete-time models identified at TRAIN's rate; a TEST at another rate is
-refused with ``DiagnoseError`` naming both rates.
+Baselines: ``linear`` (``F = k x + c v``, refitted with every candidate: continuous-time, so
+TESTs at other sample rates are handled) or a registered model identified on the first TRAIN
+by ``bushenv.identify.fit_model`` (then every candidate also gets a spring/damper correction;
+discrete-time, so TESTs must share TRAIN's rate; not with ``cross``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from itertools import count
+import time
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from scipy import linalg, signal
-from scipy.optimize import lsq_linear, minimize_scalar
 
-from bushenv.diagnose import regimes
-from bushenv.diagnose.candidates import (
-    EFFECTS,
-    STENCILS,
-    Scales,
-    Signals,
-    get_candidate,
-    shift_columns,
+from bushenv.diagnose import regimes, rule
+from bushenv.diagnose.candidates import candidate_sets
+from bushenv.diagnose.design import ColumnStore, Prepared
+from bushenv.diagnose.effects.base import NULL, Scales
+from bushenv.diagnose.errors import DiagnoseError
+from bushenv.diagnose.fitting import Fold, Judged, best_shapes, describe_shapes, judge, predict
+from bushenv.diagnose.fitting import parameters as fit_parameters
+from bushenv.diagnose.inputs import (
+    LINEAR,
+    Progress,
+    baseline_names,
+    check_inputs,
+    fit_nonlinear_baseline,
+    make_folds,
+    names_of,
+    prepare_records,
+    record_name,
 )
+from bushenv.diagnose.shift import shift_warnings
 from bushenv.metrics import rms_ratio
-from bushenv.models.base import DT_TOLERANCE
 
-BASELINES = ("linear", "boucwen", "hybrid", "nn")
-SHRINK_MIN = 0.05
-NOISE_MARGIN = 2.0
-PAIR_GAIN_MIN = 0.25
-PAIR_TRY_IF_LEFT = 0.10  # try pairs when the best single leaves more than this fraction of the gap
-PAIR_LEADS = 2  # pairs hold at least one of the PAIR_LEADS best singles
-MIN_SAMPLES = 64
-
-Progress = Callable[[str], None]
-_UIDS = count()
+__all__ = ["DiagnoseError", "diagnose", "baseline_names"]
 
 
-class DiagnoseError(ValueError):
-    """The records cannot be diagnosed as given; the message names the record and the reason."""
+# ----- judging the candidates ------------------------------------------------------------------
+class Run:
+    """What every step of one diagnosis shares: records, folds, the null's numbers."""
+
+    def __init__(self, store: ColumnStore, folds: list[Fold], linear_base: bool) -> None:
+        self.store = store
+        self.folds = folds
+        self.linear_base = linear_base
+        self.judged = [p for f in folds for p in f.judged]
+        self.force = np.concatenate([p.force for p in self.judged])
+        self.n_fit = int(np.mean([sum(p.n for p in f.fit) for f in folds]))
+        self.null = judge(store, NULL, folds, linear_base)
+        self.base_pred = {
+            p.uid: (self.null.predictions[p.uid] if linear_base else p.b0) for p in self.judged
+        }
+        self.gap_before = rms_ratio(self.force, self.stack(self.base_pred))
+        self.gap_null = rms_ratio(self.force, self.stack(self.null.predictions))
+
+    def stack(self, preds: dict[int, np.ndarray]) -> np.ndarray:
+        return np.concatenate([preds[p.uid] for p in self.judged])
+
+    def row(self, j: Judged) -> dict[str, Any]:
+        pred = self.stack(j.predictions)
+        gap = rms_ratio(self.force, pred)
+        blocks = np.array_split((self.force - pred) ** 2, rule.BLOCKS)
+        return {
+            "effect": j.combo.name,
+            "members": list(j.combo.names),
+            "gap_before": self.gap_before,
+            "gap_after": gap,
+            "shrink": 1.0 - gap / self.gap_before if self.gap_before > 0 else 0.0,
+            "shrink_vs_null": 1.0 - gap / self.gap_null if self.gap_null > 0 else 0.0,
+            "n_extra_parameters": j.n_extra,
+            "shape": describe_shapes(j.fits[0]),
+            "gap_train": j.gap_train,
+            "_mse": j.mse,
+            "_block_mse": np.array([b.mean() for b in blocks]),
+            "_judged": j,
+        }
 
 
-@dataclass
-class Prepared:
-    """One record ready for fitting: signals, measured force, baseline force ``b0``."""
+def _judge_all(run: Run, effects, say: Progress) -> tuple[list[dict], list[dict]]:
+    """Rows of every single effect and every pair, ranked best first (rule applied)."""
+    sets = candidate_sets(effects)
+    rows = []
+    start = time.monotonic()
+    for i, combo in enumerate(sets):
+        elapsed = time.monotonic() - start
+        left = f" (about {elapsed / i * (len(sets) - i):.0f} s left)" if i else ""
+        say(f"which: candidate {i + 1}/{len(sets)} {combo.name}{left}")
+        rows.append(run.row(judge(run.store, combo, run.folds, run.linear_base)))
+    singles = [r for r in rows if len(r["members"]) == 1]
+    pairs = [r for r in rows if len(r["members"]) == 2]
+    mse_null = run.null.mse
+    rule.mark_passes(rows, mse_null, run.n_fit)
+    singles = rule.rank(singles, [r["effect"] for r in singles])
+    order = [r["effect"] for r in singles]
+    for r in pairs:  # the better single first
+        r["members"] = sorted(r["members"], key=order.index)
+        r["effect"] = "+".join(r["members"])
+    rule.mark_pairs(singles, pairs, run.n_fit, run.gap_null)
+    return singles, rule.rank(pairs, order)
 
-    name: str
-    time: np.ndarray
-    signals: Signals
-    force: np.ndarray
-    b0: np.ndarray  # simulated non-linear baseline; zeros for the linear baseline
-    fit_filter: Any = None  # TRAIN only: low-pass applied to both sides of the regression
-    uid: int = field(default_factory=lambda: next(_UIDS))
 
-    @property
-    def dt(self) -> float:
-        return self.signals.dt
-
-
-@dataclass
-class Augmentation:
-    """Effects with chosen shapes and fitted weights (the baseline's own k, c for linear)."""
-
-    effects: tuple[str, ...]
-    shapes: tuple
-    linear_base: bool
-    theta: np.ndarray
-    n_extra: int  # weights (and shape settings) added to the baseline
-
-    @property
-    def label(self) -> str:
-        return "+".join(self.effects) if self.effects else "none"
-
-    @property
-    def delay_s(self) -> float:
-        return sum(
-            get_candidate(e).delay_s(s) for e, s in zip(self.effects, self.shapes, strict=True)
+def _unexplained(named: dict | None, rows: list[dict], gap_before: float) -> dict[str, Any]:
+    """The share of the gap the named effect(s) leave, and what the best candidates leave."""
+    best = min(rows, key=lambda r: r["gap_after"]) if rows else None
+    share = named["gap_after"] / gap_before if named and gap_before > 0 else 1.0
+    best_share = best["gap_after"] / gap_before if best and gap_before > 0 else 1.0
+    best_share = min(best_share, 1.0)
+    text = []
+    if named is None:
+        text.append(
+            "No candidate passes the rule: the whole gap stays unexplained"
+            + (
+                f" (the best, {best['effect']}, would leave {100 * best_share:.0f} %)."
+                if best
+                else "."
+            )
         )
-
-
-class ColumnCache:
-    """Effect columns per (record, effect, shape): the grids reuse them many times."""
-
-    def __init__(self, scales: Scales) -> None:
-        self.scales = scales
-        self._store: dict[tuple, np.ndarray] = {}
-
-    def get(self, prep: Prepared, effect: str, shape) -> np.ndarray:
-        key = (prep.uid, effect, shape)
-        if key not in self._store:
-            self._store[key] = get_candidate(effect).columns(prep.signals, shape, self.scales)
-        return self._store[key]
-
-    def clear(self) -> None:
-        self._store.clear()
-
-
-def _design(
-    prep: Prepared, effects: Sequence[str], shapes: Sequence, linear_base: bool, cache: ColumnCache
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Regressors A (T, p), fixed offset (T,), lower bounds (p,) for one record, unshifted.
-
-    A delay d is not applied here: the prediction is ``shift(offset + A w, d)``, and the fit
-    advances the measured force instead (``f(t + d) = offset(t) + A(t) w``), which shifts one
-    column instead of all of them.
-    """
-    cols = []
-    lower = []
-    # a spring and a damper always: the linear baseline's own k, c, or a correction of k, c to
-    # a fixed nonlinear baseline (identified without the effect, its k and c absorbed some of it)
-    cols.append(np.stack([prep.signals.x, prep.signals.v], axis=1))
-    lower.append(np.full(2, -np.inf))
-    for e, s in zip(effects, shapes, strict=True):
-        cand = get_candidate(e)
-        c = cache.get(prep, e, s)
-        if c.shape[1]:
-            cols.append(c)
-            lower.append(cand.lower(s, cache.scales))
-    A = np.concatenate(cols, axis=1) if cols else np.zeros((prep.force.size, 0))
-    offset = prep.b0
-    lo = np.concatenate(lower) if lower else np.zeros(0)
-    return A, offset, lo
-
-
-def _bounded_lstsq(A: np.ndarray, y: np.ndarray, lower: np.ndarray) -> np.ndarray:
-    """min |A w - y| subject to w >= lower, on column-scaled A (normal equations, tiny ridge)."""
-    p = A.shape[1]
-    if p == 0:
-        return np.zeros(0)
-    scale = np.sqrt(np.mean(A * A, axis=0))
-    scale[scale == 0] = 1.0
-    As = A / scale
-    # normal equations on unit-RMS columns (p <= ~20): the Gram matrix costs one pass over T
-    # where a QR costs p; a small ridge steadies near-collinear columns (a 100 s Maxwell branch
-    # next to the spring) without biasing the fit
-    n = A.shape[0]
-    G = As.T @ As + 1e-8 * n * np.eye(p)
-    R = linalg.cholesky(G, lower=False)
-    Rr = R
-    qyr = linalg.solve_triangular(R, As.T @ y, trans="T")
-    lo = lower * scale  # lower bounds are 0 or -inf, so scaling keeps them
-    if np.all(np.isneginf(lo)):
-        w = np.linalg.lstsq(Rr, qyr, rcond=None)[0]
     else:
-        w = lsq_linear(Rr, qyr, bounds=(lo, np.full(p, np.inf)), method="bvls").x
-    return w / scale
-
-
-def noise_band_edge(x: np.ndarray, dt: float) -> float | None:
-    """Upper edge (Hz) of a displacement's signal band when a noise floor lies above it.
-
-    The floor is the median Welch PSD over the top fifth of the band; the edge is the highest
-    frequency 10 dB above it (+20 %). None when there is no clear floor (less than 40 dB below
-    the peak) or the edge is within 80 % of Nyquist: then there is nothing to filter away.
-    """
-    fs = 1.0 / dt
-    nper = int(min(x.size, 4096))
-    if nper < 64:
-        return None
-    f, p = signal.welch(x, fs=fs, nperseg=nper)
-    floor = float(np.median(p[f >= 0.8 * f[-1]]))
-    if not (floor > 0 and floor < 1e-4 * p.max()):
-        return None
-    edge = 1.2 * float(f[np.nonzero(p >= 10.0 * floor)[0][-1]])
-    return edge if edge < 0.8 * f[-1] else None
-
-
-def _fit_filter(prep: Prepared):
-    """Zero-phase low-pass (sos) applied to both sides of the TRAIN regression, or None.
-
-    Noise on a measured displacement, twice differentiated, would bias the inertia weight
-    toward zero (errors in variables); filtering the force and every column with the same
-    linear filter keeps the regression exact in the signal band and drops the noise above it.
-    """
-    edge = noise_band_edge(prep.signals.x, prep.dt)
-    if edge is None:
-        return None
-    return signal.butter(4, edge, fs=1.0 / prep.dt, output="sos")
-
-
-def fit_augmentation(
-    effects: Sequence[str],
-    shapes: Sequence,
-    train: Sequence[Prepared],
-    linear_base: bool,
-    cache: ColumnCache,
-) -> tuple[Augmentation, float]:
-    """Weights by bounded least squares on TRAIN; returns the model and its TRAIN MSE."""
-    As, ys, lo = [], [], None
-    for prep in train:
-        A, off, lo = _design(prep, effects, shapes, linear_base, cache)
-        delay = sum(get_candidate(e).delay_s(s) for e, s in zip(effects, shapes, strict=True))
-        y = shift_columns(prep.force, -delay, prep.dt) - off
-        if prep.fit_filter is not None:
-            A = signal.sosfiltfilt(prep.fit_filter, A, axis=0) if A.shape[1] else A
-            y = signal.sosfiltfilt(prep.fit_filter, y)
-        As.append(A)
-        ys.append(y)
-    A = np.concatenate(As)
-    y = np.concatenate(ys)
-    theta = _bounded_lstsq(A, y, lo)
-    mse = float(np.mean((y - A @ theta) ** 2))
-    n_extra = A.shape[1] - 2
-    n_extra += sum(1 for e, s in zip(effects, shapes, strict=True) if s is not None)
-    aug = Augmentation(tuple(effects), tuple(shapes), linear_base, theta, n_extra)
-    return aug, mse
-
-
-def predict(aug: Augmentation, prep: Prepared, cache: ColumnCache) -> np.ndarray:
-    A, off, _ = _design(prep, aug.effects, aug.shapes, aug.linear_base, cache)
-    return shift_columns(off + A @ aug.theta, aug.delay_s, prep.dt)
-
-
-def best_shapes(
-    effects: Sequence[str], train: Sequence[Prepared], linear_base: bool, cache: ColumnCache
-) -> tuple[Augmentation, float]:
-    """Search the product of the effects' shape grids by TRAIN error."""
-    grids = [get_candidate(e).shapes(cache.scales) for e in effects]
-    best: tuple[Augmentation, float] | None = None
-    for combo in _product(grids):
-        aug, mse = fit_augmentation(effects, combo, train, linear_base, cache)
-        if best is None or mse < best[1]:
-            best = (aug, mse)
-    assert best is not None
-    # a continuous shape (the delay) is refined between its grid neighbours by TRAIN error
-    for i, e in enumerate(effects):
-        grid = grids[i]
-        if not get_candidate(e).continuous_shape or len(grid) < 3:
-            continue
-        k = grid.index(best[0].shapes[i])
-        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
-
-        def train_mse(log_d: float, i: int = i, base: tuple = best[0].shapes) -> float:
-            combo = list(base)
-            combo[i] = float(np.exp(log_d))
-            return fit_augmentation(effects, combo, train, linear_base, cache)[1]
-
-        res = minimize_scalar(
-            train_mse, bounds=(np.log(lo), np.log(hi)), method="bounded", options={"xatol": 0.01}
+        text.append(f"{named['effect']} leaves {100 * share:.0f} % of the gap unexplained.")
+    mostly = best_share > rule.MOSTLY_UNEXPLAINED
+    if mostly:
+        text.append(
+            f"The gap lies mostly outside the candidate set: even the best candidates "
+            f"({best['effect'] if best else 'none'}) leave {100 * best_share:.0f} % of it."
         )
-        if res.fun < best[1]:
-            combo = list(best[0].shapes)
-            combo[i] = float(np.exp(res.x))
-            best = fit_augmentation(effects, combo, train, linear_base, cache)
-            # the other effects' grid choices were made at a grid delay: choose them again
-            for j in range(len(effects)):
-                if j == i or len(grids[j]) < 2:
-                    continue
-                for shape in grids[j]:
-                    combo = list(best[0].shapes)
-                    combo[j] = shape
-                    trial = fit_augmentation(effects, combo, train, linear_base, cache)
-                    if trial[1] < best[1]:
-                        best = trial
-    return best
+    return {
+        "unexplained_share": float(share),
+        "best_candidate": best["effect"] if best else "none",
+        "best_unexplained_share": float(best_share),
+        "mostly_outside_candidates": bool(mostly),
+        "text": text,
+    }
 
 
-def _product(grids: list[list]) -> list[tuple]:
-    out: list[tuple] = [()]
-    for g in grids:
-        out = [o + (s,) for o in out for s in g]
+def _test_only_hint(run: Run, te: list[Prepared], singles: list[dict]) -> list[dict]:
+    """Fitted on the TESTs themselves, does some effect close far more than held out?"""
+    force = np.concatenate([p.force for p in te])
+    null = best_shapes(run.store, NULL, tuple(te), run.linear_base)
+    gap0 = rms_ratio(force, np.concatenate([predict(run.store, null, p) for p in te]))
+    held = {r["effect"]: r["shrink_vs_null"] for r in singles}
+    out: list[dict] = []
+    if max(held.values()) >= 0.3:  # TRAIN already explains a good part: no hint
+        return out
+    for r in singles:
+        combo = r["_judged"].combo
+        f = best_shapes(run.store, combo, tuple(te), run.linear_base)
+        gap = rms_ratio(force, np.concatenate([predict(run.store, f, p) for p in te]))
+        inside = 1.0 - gap / gap0 if gap0 > 0 else 0.0
+        if inside >= 0.5 and inside - held[r["effect"]] >= 0.3:
+            out.append(
+                {
+                    "test": "all",
+                    "regime": "test_only_behaviour",
+                    "text": f"Fitted on the TESTs themselves, {r['effect']} would close "
+                    f"{100 * inside:.0f} % of their gap, against {100 * held[r['effect']]:.0f} % "
+                    "when fitted on TRAIN: the TESTs show behaviour the identification records "
+                    "do not excite (--cross fits on them too).",
+                }
+            )
     return out
 
 
-# ----- baselines -------------------------------------------------------------------------
-def _fit_nonlinear_baseline(name: str, train_rec: Any, seed: int):
-    try:
-        from bushenv.identify import fit_model  # the baselines' identification dispatcher
-    except ImportError:
-        raise DiagnoseError(
-            f"baseline {name!r} needs bushenv.identify.fit_model, which is not available in "
-            "this checkout; use --baseline linear"
-        ) from None
-    return fit_model(
-        name,
-        np.asarray(train_rec.displacement, dtype=np.float64),
-        np.asarray(train_rec.force, dtype=np.float64),
-        float(train_rec.dt),
-        seed,
-    )
-
-
-def _check_record(rec: Any, label: str) -> None:
-    for attr in ("time", "displacement", "force", "dt"):
-        if not hasattr(rec, attr):
-            raise DiagnoseError(f"{label}: not a record (no .{attr})")
-    n = np.asarray(rec.displacement).size
-    if n < MIN_SAMPLES:
-        raise DiagnoseError(f"{label}: {n} samples; the diagnosis needs at least {MIN_SAMPLES}")
-    for attr in ("displacement", "force"):
-        a = np.asarray(getattr(rec, attr), dtype=np.float64)
-        if a.shape != (n,):
-            raise DiagnoseError(f"{label}: {attr} has shape {a.shape}, expected ({n},)")
-        if not np.all(np.isfinite(a)):
-            raise DiagnoseError(f"{label}: {attr} holds NaN or inf")
-    if not (np.isfinite(rec.dt) and rec.dt > 0):
-        raise DiagnoseError(f"{label}: sample time {rec.dt!r} is not a positive number")
-    if np.sqrt(np.mean(np.asarray(rec.force, dtype=np.float64) ** 2)) == 0:
-        raise DiagnoseError(f"{label}: force is zero throughout; nothing to diagnose")
-    if np.ptp(np.asarray(rec.displacement, dtype=np.float64)) == 0:
-        raise DiagnoseError(f"{label}: displacement is constant; nothing identifies a baseline")
-
-
-def _record_name(rec: Any, default: str) -> str:
-    path = getattr(rec, "path", None) or getattr(rec, "source", None)
-    if path:
-        from pathlib import Path
-
-        return Path(str(path)).stem
-    return getattr(rec, "name", None) or default
-
-
-# ----- the diagnosis ---------------------------------------------------------------------
+# ----- the diagnosis ---------------------------------------------------------------------------
 def diagnose(
     train: Any,
     tests: Sequence[Any],
-    baseline: str = "linear",
+    baseline: str = LINEAR,
     progress: Progress | None = None,
     seed: int = 0,
     test_names: Sequence[str] | None = None,
+    *,
+    cross: bool = False,
+    effects: Sequence[str] | None = None,
+    train_names: Sequence[str] | None = None,
 ) -> dict[str, Any]:
     """Where the held-out gap lies, which candidate effect closes it, and by how much.
 
-    Returns a JSON-ready dict (see docs/diagnose.md) plus ``"predictions"``: one dict per TEST
-    record with ``name`` and (T,) arrays ``time``, ``force_measured``, ``force_baseline``,
-    ``force_augmented`` (arrays are not JSON; ``report.py`` writes them as CSV).
+    ``train`` is one record or a sequence of identification records. Returns a JSON-ready
+    dict (docs/diagnose.md) plus ``"predictions"``: one dict per judged record (the TESTs;
+    in cross mode every record) with ``name``, ``role`` and (T,) arrays ``time``,
+    ``displacement``, ``force_measured``, ``force_baseline``, ``force_augmented`` (the named
+    model's held-out prediction).
     """
     say = progress or (lambda msg: None)
-    if baseline not in BASELINES:
-        raise DiagnoseError(f"unknown baseline {baseline!r}; known: {list(BASELINES)}")
-    if not tests:
-        raise DiagnoseError("no TEST record given; the gap is judged on held-out records only")
-    _check_record(train, "TRAIN")
-    names = list(test_names) if test_names is not None else []
-    for i, rec in enumerate(tests):
-        if i >= len(names):
-            names.append(_record_name(rec, f"test{i + 1}"))
-        _check_record(rec, f"TEST {names[i]}")
-    if len(set(names)) != len(names):
-        raise DiagnoseError(f"TEST records need distinct names (file stems), got {names}")
-    train_dt = float(train.dt)
-    linear_base = baseline == "linear"
-    if not linear_base:
-        for n, rec in zip(names, tests, strict=True):
-            if abs(float(rec.dt) - train_dt) > DT_TOLERANCE * train_dt * 1e3:
-                raise DiagnoseError(
-                    f"TEST {n}: sampled at {1 / rec.dt:.6g} Hz but TRAIN at {1 / train_dt:.6g} "
-                    f"Hz; baseline {baseline!r} is a discrete-time model identified at the "
-                    "TRAIN rate. Resample the record or use --baseline linear (continuous-time)."
-                )
-
-    say(f"identifying baseline {baseline!r} on TRAIN ({np.size(train.force)} samples)")
-    x_tr = np.asarray(train.displacement, dtype=np.float64)
-    scales = Scales(
-        sigma_x=float(np.std(x_tr)) or float(np.max(np.abs(x_tr))),
-        duration_s=float(x_tr.size * train_dt),
-        dt=train_dt,
+    trains = list(train) if isinstance(train, list | tuple) else [train]
+    if not trains:
+        raise DiagnoseError("no TRAIN record given")
+    t_names = (
+        list(train_names or [])
+        + [record_name(r, "train" if i == 0 else f"train{i + 1}") for i, r in enumerate(trains)][
+            len(train_names or []) :
+        ]
     )
-    cache = ColumnCache(scales)
-    model = _fit_nonlinear_baseline(baseline, train, seed) if not linear_base else None
-
-    stencil = "central"
-
-    def prepare(rec: Any, name: str) -> Prepared:
-        x = np.asarray(rec.displacement, dtype=np.float64)
-        sig = Signals(x, float(rec.dt), stencil)
-        b0 = np.zeros_like(x) if model is None else _simulate(model, x)
-        return Prepared(
-            name, np.asarray(rec.time, dtype=np.float64), sig, np.asarray(rec.force, float), b0
-        )
-
-    # the derivative stencil: whichever fits TRAIN better with spring, damper and mass
-    tried = {}
-    for stencil in STENCILS:
-        prep = prepare(train, "train")
-        prep.fit_filter = _fit_filter(prep)
-        tried[stencil] = (fit_augmentation(("inertia",), (None,), [prep], True, cache)[1], prep)
-        cache.clear()
-    stencil = min(tried, key=lambda k: tried[k][0])
-    tr = [tried[stencil][1]]
-    say(f"derivatives by the {stencil} stencil (better TRAIN fit)")
-    if tr[0].fit_filter is not None:
-        edge = noise_band_edge(tr[0].signals.x, tr[0].dt)
-        say(f"TRAIN displacement has a noise floor above {edge:.4g} Hz: fitting below it")
-    te = [prepare(rec, n) for rec, n in zip(tests, names, strict=True)]
-    f_test = np.concatenate([p.force for p in te])
-    n_train = tr[0].force.size
-
-    # the null augmentation: k, c only. For the linear baseline it is the baseline itself; for
-    # the others, the baseline plus a spring/damper correction, which every candidate also
-    # gets, so the rule judges candidates against it
-    base_aug, _ = fit_augmentation((), (), tr, linear_base, cache)
-    null_pred = [predict(base_aug, p, cache) for p in te]
-    base_pred = null_pred if linear_base else [p.b0 for p in te]
-    base_all = np.concatenate(base_pred)
-    gap_before = rms_ratio(f_test, base_all)
-    null_all = np.concatenate(null_pred)
-    gap_null = rms_ratio(f_test, null_all)
-    mse_null = float(np.mean((f_test - null_all) ** 2))
-    say(f"baseline gap on TESTs: {100 * gap_before:.2f} % (RMS ratio)")
-
-    say("where: splitting the gap by regime, frequency and time")
-    where = regimes.where_analysis(
-        [p.signals.x for p in te],
-        [p.force - b for p, b in zip(te, base_pred, strict=True)],
-        [p.dt for p in te],
-    )
-
-    def judge(aug: Augmentation, train_mse: float) -> dict[str, Any]:
-        pred = np.concatenate([predict(aug, p, cache) for p in te])
-        gap_after = rms_ratio(f_test, pred)
-        mse_after = float(np.mean((f_test - pred) ** 2))
-        margin = NOISE_MARGIN * aug.n_extra * mse_after / n_train
-        return {
-            "effect": aug.label,
-            "gap_before": gap_before,
-            "gap_after": gap_after,
-            "shrink": 1.0 - gap_after / gap_before if gap_before > 0 else 0.0,
-            "shrink_vs_null": 1.0 - gap_after / gap_null if gap_null > 0 else 0.0,
-            "n_extra_parameters": aug.n_extra,
-            "shape": [
-                get_candidate(e).describe(s) for e, s in zip(aug.effects, aug.shapes, strict=True)
-            ],
-            "gap_train": float(np.sqrt(train_mse / np.mean(tr[0].force ** 2))),
-            "beats_noise_margin": bool(mse_null - mse_after > margin),
-            "_aug": aug,
-        }
-
-    singles = []
-    for i, effect in enumerate(EFFECTS):
-        say(f"which: candidate {i + 1}/{len(EFFECTS)} {effect}")
-        aug, mse = best_shapes((effect,), tr, linear_base, cache)
-        singles.append(judge(aug, mse))
-    singles.sort(key=lambda r: r["gap_after"])
-    for r in singles:
-        r["passes"] = bool(r["shrink_vs_null"] >= SHRINK_MIN and r["beats_noise_margin"])
-
-    best = singles[0]
-    named = best if best["passes"] else None
-    pairs: list[dict[str, Any]] = []
-    if named is not None:
-        order = [r["effect"] for r in singles]
-        # pairs that may be named: one of the PAIR_LEADS best singles with any other effect,
-        # tried when the best single leaves a large part of the gap; the best single's pairs
-        # are always fitted, to rank the runner-up by what it adds to the first effect
-        leads = PAIR_LEADS if best["gap_after"] > PAIR_TRY_IF_LEFT * gap_null else 1
-        tried_pairs = set()
-        for first in order[:leads]:
-            for other in order:
-                key = frozenset((first, other))
-                if other == first or key in tried_pairs:
-                    continue
-                tried_pairs.add(key)
-                a, b = sorted(key, key=order.index)  # the better single first
-                say(f"which: pair {a}+{b}")
-                aug, mse = best_shapes((a, b), tr, linear_base, cache)
-                pairs.append(judge(aug, mse))
-        pairs.sort(key=lambda r: r["gap_after"])
-        for r in pairs:
-            r["passes"] = bool(
-                leads > 1
-                and r["gap_after"] <= (1.0 - PAIR_GAIN_MIN) * best["gap_after"]
-                and r["beats_noise_margin"]
-            )
-        winners = [r for r in pairs if r["passes"]]
-        if winners:
-            named = winners[0]
-
-    if named is None:
-        effect = "none"
-        aug_final = base_aug
-        top_two = [r["effect"] for r in singles[:2]]
-    else:
-        effect = named["effect"]
-        aug_final = named["_aug"]
-        if "+" in effect:
-            top_two = effect.split("+")
-        else:
-            # runner-up: the effect that adds most to the named one (its best pair)
-            with_best = [r for r in pairs if best["effect"] in r["effect"].split("+")]
-            partner = [m for m in with_best[0]["effect"].split("+") if m != best["effect"]]
-            top_two = [best["effect"], partner[0]]
+    names = names_of(tests, test_names, "test")
+    eff = tuple(effects) if effects is not None else None
+    check_inputs(trains, list(tests), t_names, names, baseline, cross, eff)
+    linear_base = baseline == LINEAR
+    n_train = sum(np.size(r.force) for r in trains)
+    say(f"identifying baseline {baseline!r} on TRAIN ({n_train} samples)")
+    model = None if linear_base else fit_nonlinear_baseline(baseline, trains[0], seed)
+    tr, te, stencil = prepare_records(trains, tests, t_names, names, model, cross, say)
+    fitting = tr + (te if cross else [])
+    store = ColumnStore(Scales.of([p.signals for p in fitting]))
+    run = Run(store, make_folds(tr, te, cross), linear_base)
+    say(f"baseline gap on the judged records: {100 * run.gap_before:.2f} % (RMS ratio)")
+    singles, pairs = _judge_all(run, eff, say)
+    named, top_two = rule.named_and_top_two(singles, pairs)
+    effect = named["effect"] if named else "none"
     say(f"named effect: {effect}")
-    notes = [
-        f"TEST {p.name} is the TRAIN record itself: its gap is not held out."
-        for p in te
-        if p.force.size == n_train
-        and np.array_equal(p.force, tr[0].force)
-        and np.array_equal(p.signals.x, tr[0].signals.x)
-    ]
+    result = _result(run, singles, pairs, named, top_two, baseline, cross)
+    result["shift_warnings"] = shift_warnings(
+        [(p.signals.x, p.dt) for p in tr], [(p.name, p.signals.x, p.dt) for p in te]
+    )
+    if not cross:
+        result["shift_warnings"] += _test_only_hint(run, te, singles)
+        if result["shift_warnings"] and result["unexplained"]["mostly_outside_candidates"]:
+            result["unexplained"]["text"].append(
+                "The TESTs hold regimes the TRAIN records lack (shift warning): an effect only "
+                "they excite cannot be identified on TRAIN; --cross fits on them too."
+            )
+    result["records"] = {
+        "train": [{"name": p.name, "samples": p.n, "rate_hz": 1.0 / p.dt} for p in tr],
+        "tests": [{"name": p.name, "samples": p.n, "rate_hz": 1.0 / p.dt} for p in te],
+        "judged": [p.name for p in run.judged],
+    }
+    result["derivative_stencil"] = stencil
+    result["displacement_band_hz"] = {
+        p.name: p.band_edge_hz for p in tr + te if p.band_edge_hz is not None
+    }
+    result["notes"] = _notes(tr, te, baseline, cross)
+    return result
 
-    predictions = []
-    for p, b in zip(te, base_pred, strict=True):
-        predictions.append(
-            {
-                "name": p.name,
-                "dt": p.dt,
-                "displacement": p.signals.x,
-                "time": p.time,
-                "force_measured": p.force,
-                "force_baseline": b,
-                "force_augmented": b if effect == "none" else predict(aug_final, p, cache),
-            }
-        )
-    aug_all = np.concatenate([q["force_augmented"] for q in predictions])
-    if effect != "none":
-        where_after = regimes.where_analysis(
-            [p.signals.x for p in te],
-            [p.force - q["force_augmented"] for p, q in zip(te, predictions, strict=True)],
-            [p.dt for p in te],
-        )
+
+def _mode(cross: bool, n_records: int) -> dict[str, str]:
+    if cross:
+        return {
+            "mode": "cross",
+            "mode_text": f"cross: each of the {n_records} records (TRAIN and TEST) is judged by "
+            f"weights fitted on the other {n_records - 1} (leave one record out)",
+        }
+    return {
+        "mode": "held_out",
+        "mode_text": "held out: weights fitted on the TRAIN records, gaps measured on the TESTs",
+    }
+
+
+def _result(run: Run, singles, pairs, named, top_two, baseline: str, cross: bool) -> dict:
+    effect = named["effect"] if named else "none"
+    aug = named["_judged"].predictions if named else run.base_pred
+    gap_after = rms_ratio(run.force, run.stack(aug))
+    rows = singles + pairs
+    if named is not None and cross:  # the physical parameters: the named model on all records
+        every = tuple(p for f in run.folds for p in f.judged)
+        final = best_shapes(run.store, named["_judged"].combo, every, run.linear_base)
     else:
-        where_after = where
+        final = (named or {"_judged": run.null})["_judged"].fits[0]
+    where = regimes.where_analysis(
+        [p.signals.x for p in run.judged],
+        [p.force - run.base_pred[p.uid] for p in run.judged],
+        [p.dt for p in run.judged],
+    )
+    where_after = where
+    if named is not None:
+        where_after = regimes.where_analysis(
+            [p.signals.x for p in run.judged],
+            [p.force - aug[p.uid] for p in run.judged],
+            [p.dt for p in run.judged],
+        )
 
     def clean(r: dict[str, Any]) -> dict[str, Any]:
         return {k: v for k, v in r.items() if not k.startswith("_")}
@@ -567,66 +286,57 @@ def diagnose(
         "effect": effect,
         "top_two": top_two,
         "baseline": baseline,
-        "gap_before": gap_before,
-        "gap_null": gap_null,
-        "gap_after": rms_ratio(f_test, aug_all),
-        "shrink": 1.0 - rms_ratio(f_test, aug_all) / gap_before if gap_before > 0 else 0.0,
+        **_mode(cross, len(run.judged) if cross else 0),
+        "gap_before": run.gap_before,
+        "gap_null": run.gap_null,
+        "gap_after": gap_after,
+        "shrink": 1.0 - gap_after / run.gap_before if run.gap_before > 0 else 0.0,
+        "unexplained": _unexplained(named, rows, run.gap_before),
         "ranking": [clean(r) for r in singles],
         "pairs": [clean(r) for r in pairs],
         "rule": {
-            "shrink_min": SHRINK_MIN,
-            "noise_margin": NOISE_MARGIN,
-            "pair_gain_min": PAIR_GAIN_MIN,
-            "pair_try_if_left": PAIR_TRY_IF_LEFT,
-            "text": RULE_TEXT,
+            "shrink_min": rule.SHRINK_MIN,
+            "noise_margin": rule.NOISE_MARGIN,
+            "pair_gain_min": rule.PAIR_GAIN_MIN,
+            "pair_try_if_left": rule.PAIR_TRY_IF_LEFT,
+            "text": rule.RULE_TEXT,
         },
         "where": where,
         "where_after": where_after,
-        "records": {
-            "train": {"samples": int(n_train), "rate_hz": 1.0 / train_dt},
-            "tests": [
-                {"name": p.name, "samples": int(p.force.size), "rate_hz": 1.0 / p.dt} for p in te
-            ],
-        },
-        "parameters": _parameters(aug_final, scales),
-        "notes": notes,
-        "derivative_stencil": stencil,
-        "train_fit_band_hz": noise_band_edge(tr[0].signals.x, tr[0].dt),
-        "predictions": predictions,
+        "parameters": fit_parameters(run.store, final, run.linear_base),
+        "predictions": [
+            {
+                "name": p.name,
+                "role": p.role,
+                "dt": p.dt,
+                "displacement": p.signals.x,
+                "time": p.time,
+                "force_measured": p.force,
+                "force_baseline": run.base_pred[p.uid],
+                "force_augmented": aug[p.uid],
+            }
+            for p in run.judged
+        ],
     }
 
 
-RULE_TEXT = (
-    f"The best single effect is named when it shrinks the held-out gap (of the baseline with "
-    f"its spring and damper refitted) by at least "
-    f"{100 * SHRINK_MIN:.0f} % and its cut in held-out mean squared error exceeds "
-    f"{NOISE_MARGIN:g} x (extra parameters) x (remaining MSE) / (TRAIN samples), the most that "
-    f"fitting noise could explain; otherwise 'none'. A pair replaces it when the best single "
-    f"leaves more than {100 * PAIR_TRY_IF_LEFT:.0f} % of the gap and the pair closes at least "
-    f"{100 * PAIR_GAIN_MIN:.0f} % of what the single leaves (and passes the noise margin); "
-    f"pairs hold one of the {PAIR_LEADS} best singles and any other effect, fitted jointly."
-)
-
-
-def _simulate(model: Any, x: np.ndarray) -> np.ndarray:
-    out = np.asarray(model.simulate(x), dtype=np.float64)
-    if not np.all(np.isfinite(out)):
-        raise DiagnoseError(f"baseline {model.name!r} diverged (NaN/inf) in free run")
-    return out
-
-
-def _parameters(aug: Augmentation, scales: Scales) -> dict[str, Any]:
-    """The augmented model's weights in plain numbers, labelled by column."""
-    labels: list[str] = []
-    if aug.linear_base:
-        labels += ["k_n_per_m", "c_ns_per_m"]
-    else:
-        labels += ["delta_k_n_per_m", "delta_c_ns_per_m"]
-    for e, s in zip(aug.effects, aug.shapes, strict=True):
-        cand = get_candidate(e)
-        n = cand.columns_count(s, scales)
-        labels += [f"{e}[{j}]" for j in range(n)]
-    out: dict[str, Any] = {lab: float(w) for lab, w in zip(labels, aug.theta, strict=True)}
-    if aug.delay_s:
-        out["delay_s"] = aug.delay_s
-    return out
+def _notes(tr: list[Prepared], te: list[Prepared], baseline: str, cross: bool) -> list[str]:
+    notes = [
+        f"TEST {p.name} is the TRAIN record {q.name} itself: its gap is not held out."
+        for p in te
+        for q in tr
+        if p.n == q.n
+        and np.array_equal(p.force, q.force)
+        and np.array_equal(p.signals.x, q.signals.x)
+    ]
+    if baseline != LINEAR and len(tr) > 1:
+        notes.append(
+            f"baseline {baseline!r} was identified on {tr[0].name} alone; the other TRAIN "
+            "records fit the candidates' weights only."
+        )
+    if cross:
+        notes.append(
+            "cross mode: every record is judged by a fit on the others, so the gaps pool TRAIN "
+            "and TEST records; the parameters are those of the named model fitted on all."
+        )
+    return notes

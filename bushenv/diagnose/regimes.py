@@ -116,7 +116,8 @@ def residual_spectrum(r: np.ndarray, x: np.ndarray, dt: float):
     if np.ptp(x) == 0 or np.ptp(r) == 0:
         coh = np.zeros_like(f)
     else:
-        _, coh = signal.coherence(x, r, fs=fs, nperseg=nper)
+        with np.errstate(invalid="ignore", divide="ignore"):  # a held x has no power
+            _, coh = signal.coherence(x, r, fs=fs, nperseg=nper)
     return f, p, np.nan_to_num(coh)
 
 

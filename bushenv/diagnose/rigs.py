@@ -205,35 +205,9 @@ def diagnose_rig(
     ``ranking``, ``top_two``, ``gap_before``, ``gap_after`` copied from ``diagnose``.
     """
     say = progress or (lambda msg: None)
-    if env_id not in RIG_IDS:
-        raise RigDiagnoseError(f"unknown rig {env_id!r}; known: {list(RIG_IDS)}")
-    if env_id == "BushRig-v0" and axis not in QC_AXES:
-        raise RigDiagnoseError(f"axis must be one of {list(QC_AXES)}, got {axis!r}")
-    if not test_profiles:
-        raise RigDiagnoseError("no TEST profile given; the gap is judged on held-out profiles")
-    names = list(test_names) if test_names is not None else []
-    names += [f"test{i + 1}" for i in range(len(names), len(test_profiles))]
-    if len(set(names)) != len(names) or "train" in names:
-        raise RigDiagnoseError(f"TEST names must be distinct and not 'train', got {names}")
-
+    names = _check_rig_args(env_id, axis, test_profiles, test_names)
     extra = dict(env_kwargs or {})
-    model_info: dict[str, Any]
-    if isinstance(model, str) and model == IDENTIFY:
-        say(f"{env_id}: replaying TRAIN with the reference to identify the linear model")
-        probe = _make(env_id, "linear", reference, axis, extra)
-        dt = float(probe.params.dt)
-        run = run_profile(probe, train_profile, "TRAIN")
-        axes = (axis,) if env_id == "BushRig-v0" else QC_AXES
-        fitted = {a: _identify_from_run(env_id, run, a, dt) for a in axes}
-        model = fitted[axis] if env_id == "BushRig-v0" else fitted
-        model_info = {
-            "identified": {
-                a: {"k_n_per_m": m.k_n_per_m, "c_ns_per_m": m.c_ns_per_m} for a, m in fitted.items()
-            }
-        }
-    else:
-        model_info = {"given": str(getattr(model, "name", model))}
-
+    model, model_info = _resolve_model(env_id, model, reference, axis, train_profile, extra, say)
     env = _make(env_id, model, reference, axis, extra)
     dt = float(env.params.dt)
     say(f"{env_id}: replaying TRAIN ({np.size(train_profile)} steps)")
@@ -242,37 +216,10 @@ def diagnose_rig(
     for i, (profile, name) in enumerate(zip(test_profiles, names, strict=True)):
         say(f"{env_id}: replaying TEST {i + 1}/{len(names)} {name} ({np.size(profile)} steps)")
         test_runs.append(run_profile(env, profile, f"TEST {name}"))
-
-    # where: held-out gap per channel over all TESTs together
-    per_test = [channel_pairs(env_id, r, dt) for r in test_runs]
-    channels = []
-    for ch in per_test[0]:
-        m = np.concatenate([p[ch][0] for p in per_test])
-        r = np.concatenate([p[ch][1] for p in per_test])
-        rms_r = float(np.sqrt(np.mean(r**2)))
-        rms_d = float(np.sqrt(np.mean((m - r) ** 2)))
-        gap = rms_ratio(r, m) if rms_r > 0 else (0.0 if rms_d == 0 else float("inf"))
-        channels.append({"channel": ch, "gap": float(gap), "rms_reference": rms_r,
-                         "rms_difference": rms_d})  # fmt: skip
-    finite = [c["gap"] ** 2 for c in channels if np.isfinite(c["gap"])]
-    total = float(sum(finite))
-    for c in channels:
-        c["share"] = c["gap"] ** 2 / total if total > 0 and np.isfinite(c["gap"]) else 0.0
-    channels.sort(key=lambda c: -c["gap"])
+    channels = channel_gaps([channel_pairs(env_id, r, dt) for r in test_runs])
     top = channels[0]["channel"]
     say(f"gap shows most on {top}: {100 * channels[0]['gap']:.2f} % (RMS ratio)")
-
-    if env_id == "BushRig-v0":
-        chosen_axis = axis
-        axis_reason = "the rig's axis"
-    elif _axis_of(top) is not None:
-        chosen_axis = _axis_of(top)
-        axis_reason = f"the top channel {top} is on this axis"
-    else:
-        gap_of = {c["channel"]: c["gap"] for c in channels}
-        chosen_axis = max(QC_AXES, key=lambda a: gap_of[f"{a}_force_n"])
-        axis_reason = f"the top channel {top} is a body channel; this axis' force gap is larger"
-
+    chosen_axis, axis_reason = _choose_axis(env_id, axis, channels)
     say(f"which: diagnosing the reference's {chosen_axis} bushing record")
     train_rec = bushing_record(env_id, train_run, chosen_axis, dt, "train", midpoint)
     test_recs = [
@@ -310,3 +257,66 @@ def diagnose_rig(
         "model": model_info,
         "bushing_diagnosis": result,
     }
+
+
+def _check_rig_args(env_id: str, axis: str, test_profiles, test_names) -> list[str]:
+    """The TEST names; RigDiagnoseError for an unknown rig or axis, no TEST, clashing names."""
+    if env_id not in RIG_IDS:
+        raise RigDiagnoseError(f"unknown rig {env_id!r}; known: {list(RIG_IDS)}")
+    if env_id == "BushRig-v0" and axis not in QC_AXES:
+        raise RigDiagnoseError(f"axis must be one of {list(QC_AXES)}, got {axis!r}")
+    if not test_profiles:
+        raise RigDiagnoseError("no TEST profile given; the gap is judged on held-out profiles")
+    names = list(test_names) if test_names is not None else []
+    names += [f"test{i + 1}" for i in range(len(names), len(test_profiles))]
+    if len(set(names)) != len(names) or "train" in names:
+        raise RigDiagnoseError(f"TEST names must be distinct and not 'train', got {names}")
+    return names
+
+
+def _resolve_model(env_id, model, reference, axis, train_profile, extra, say):
+    """(model for the env, what the report says of it); ``"identify"`` fits a linear model on
+    the reference's TRAIN replay (per axis on the car)."""
+    if not (isinstance(model, str) and model == IDENTIFY):
+        return model, {"given": str(getattr(model, "name", model))}
+    say(f"{env_id}: replaying TRAIN with the reference to identify the linear model")
+    probe = _make(env_id, "linear", reference, axis, extra)
+    dt = float(probe.params.dt)
+    run = run_profile(probe, train_profile, "TRAIN")
+    axes = (axis,) if env_id == "BushRig-v0" else QC_AXES
+    fitted = {a: _identify_from_run(env_id, run, a, dt) for a in axes}
+    info = {
+        "identified": {
+            a: {"k_n_per_m": m.k_n_per_m, "c_ns_per_m": m.c_ns_per_m} for a, m in fitted.items()
+        }
+    }
+    return (fitted[axis] if env_id == "BushRig-v0" else fitted), info
+
+
+def channel_gaps(per_test: list[dict]) -> list[dict[str, Any]]:
+    """Held-out gap per channel over all TESTs together, ranked largest first, with shares."""
+    channels = []
+    for ch in per_test[0]:
+        m = np.concatenate([p[ch][0] for p in per_test])
+        r = np.concatenate([p[ch][1] for p in per_test])
+        rms_r = float(np.sqrt(np.mean(r**2)))
+        rms_d = float(np.sqrt(np.mean((m - r) ** 2)))
+        gap = rms_ratio(r, m) if rms_r > 0 else (0.0 if rms_d == 0 else float("inf"))
+        channels.append({"channel": ch, "gap": float(gap), "rms_reference": rms_r,
+                         "rms_difference": rms_d})  # fmt: skip
+    total = float(sum(c["gap"] ** 2 for c in channels if np.isfinite(c["gap"])))
+    for c in channels:
+        c["share"] = c["gap"] ** 2 / total if total > 0 and np.isfinite(c["gap"]) else 0.0
+    channels.sort(key=lambda c: -c["gap"])
+    return channels
+
+
+def _choose_axis(env_id: str, axis: str, channels: list[dict]) -> tuple[str, str]:
+    top = channels[0]["channel"]
+    if env_id == "BushRig-v0":
+        return axis, "the rig's axis"
+    if _axis_of(top) is not None:
+        return _axis_of(top), f"the top channel {top} is on this axis"
+    gap_of = {c["channel"]: c["gap"] for c in channels}
+    chosen = max(QC_AXES, key=lambda a: gap_of[f"{a}_force_n"])
+    return chosen, f"the top channel {top} is a body channel; this axis' force gap is larger"

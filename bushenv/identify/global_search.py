@@ -25,26 +25,23 @@ beta1 + gamma1 = delta1 > 0 (gamma1 = (1 - rho1) delta1); beta2 - gamma2 = delta
 (beta, gamma) -> lambda^(n-1) (beta, gamma), a -> a lambda gives the same force, so A is a gauge.
 
 Procedure: ``scipy.optimize.differential_evolution`` (seeded, ``vectorized=True``, workers=1,
-``maxiter`` generations) on the first ``fit_seconds`` of the record, then a bounded Powell
-polish on the whole record. Why 400 generations (about 50 s alone on this machine): with 40 the
-search stopped short and the fit was a draw, 3.2-4.6 % RMS ratio on an unseen n = 1 record over
-seeds 0-11, the papers' 3.7 % met by 2 seeds of 12 (the bench's seed 0 was one); 250 gave
-2.5-3.1 % (seeds 1-8) and 400 gave 2.5-2.7 % (seeds 1-4). ``docs/fit-seed-spread.md``.
-Members that cannot be integrated (more than ``search_max_substeps`` trial steps in a sample, or
-a solution that blows up) score ``inf``.
+``generations`` generations) on the first ``fit_seconds`` of the records (record after record,
+each run from rest), then a bounded Powell polish on all of every record. Why 400 generations:
+docs/fit-seed-spread.md. Members that cannot be integrated (more than ``max_substeps`` trial
+steps in a sample, or a solution that blows up) score ``inf``.
 """
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
-from bushenv.identify.linear import IdentificationError, check_record, least_squares_kc
-from bushenv.models.base import PAPER_DT
+from bushenv.identify.boucwen_options import BoucWenOptions
+from bushenv.identify.data import IdentificationError, TrainingSet
+from bushenv.identify.linear import least_squares_kc
 from bushenv.models.boucwen import BoucWenBushing, simulate_population
 from bushenv.models.kernels import BW_ORDER
+from bushenv.progress import Progress, ProgressSpec
 
 SEARCH_NAMES = (
     "log_k0",
@@ -123,75 +120,131 @@ def satisfies_constraints(vector: np.ndarray) -> bool:
     )
 
 
+class PopulationCost:
+    """Eq. 6 RMS error, N, of search vectors over records each run from rest (pooled samples).
+
+    ``parts``: (x, v, f) arrays per record; ``__call__(u)`` takes u (14, S) and returns (S,).
+    """
+
+    def __init__(self, parts, dt: float, k_ref: float, c_ref: float, max_substeps: int) -> None:
+        self.parts, self.dt, self.k_ref, self.c_ref = parts, dt, k_ref, c_ref
+        self.max_substeps = max_substeps
+        self.samples = sum(len(x) for x, _, _ in parts)
+        self.evaluations = 0
+
+    def __call__(self, u: np.ndarray) -> np.ndarray:
+        vectors = search_to_parameters(np.atleast_2d(u.T), self.k_ref, self.c_ref)
+        errs, bad = [], np.zeros(vectors.shape[0], dtype=bool)
+        for x, v, f in self.parts:
+            out, bad_p = simulate_population(vectors, x, v, self.dt, max_substeps=self.max_substeps)
+            errs.append(out - f[:, None])
+            bad |= bad_p
+        err = errs[0] if len(errs) == 1 else np.concatenate(errs)
+        cost = np.sqrt(np.mean(err * err, axis=0))
+        cost[bad | ~np.isfinite(cost)] = np.inf
+        self.evaluations += vectors.shape[0]
+        return cost
+
+
+def first_seconds(data: TrainingSet, seconds: float) -> list[tuple]:
+    """(x, v, f) of the first ``seconds`` of the records, record after record (at least 10
+    samples)."""
+    left = max(10, int(round(seconds / data.dt)))
+    parts = []
+    for s in data.segments:
+        if left <= 0:
+            break
+        n = min(len(s), left)
+        parts.append((s.x[:n], s.v[:n], s.f[:n]))
+        left -= n
+    return parts
+
+
 def fit_boucwen(
-    x,
-    f,
-    dt: float = PAPER_DT,
-    v=None,
+    data: TrainingSet,
+    options: BoucWenOptions,
     seed: int = 0,
-    progress: bool = True,
-    maxiter: int = 400,
-    popsize: int = 8,
-    fit_seconds: float = 8.0,
-    polish_maxfev: int = 500,
-    search_max_substeps: int = 400,
-    time_budget_s: float = 110.0,
-    progress_every_s: float = 3.0,
+    progress: ProgressSpec = True,
 ) -> BoucWenBushing:
-    """Identify the 16 Bouc-Wen parameters of a record (see the module docstring).
+    """Identify the 16 Bouc-Wen parameters of ``data`` (see the module docstring).
 
     Returns the model with a ``training`` dict attribute (costs, generations, seconds).
     """
-    x, f, v = check_record(x, f, dt, v)
-    n_fit = min(len(x), max(10, int(round(fit_seconds / dt))))
+    opt = options
+    x, f, v = data.concatenated()
     k_ref, c_ref = least_squares_kc(x, f, v)
     if not (k_ref > 0 and c_ref > 0):
         raise IdentificationError(
             f"least-squares stiffness {k_ref:.4g} N/m and damping {c_ref:.4g} N s/m must be "
             "positive to scale the Bouc-Wen search"
         )
-    xs, vs, fs = x[:n_fit], v[:n_fit], f[:n_fit]
-    t0 = time.perf_counter()
-    last = [t0]
-    n_evals = [0]
-    gen = [0]
-    best_cost = [np.inf]
+    args = (data.dt, k_ref, c_ref, opt.max_substeps)
+    search = PopulationCost(first_seconds(data, opt.fit_seconds), *args)
+    whole = PopulationCost([(s.x, s.v, s.f) for s in data.segments], *args)
+    members = opt.population * len(SEARCH_BOUNDS)
+    work = (opt.generations + 1) * members * search.samples + opt.polish_evaluations * whole.samples
+    prog = Progress.of(
+        progress,
+        total=work,
+        label="boucwen",
+        every_s=opt.progress_every_s,
+        budget_s=opt.time_budget_s,
+    )
+    u_best, log = _evolve(search, whole, opt, seed, prog)
+    u_best, log["cost_before_polish_n"], log["cost_n"] = _polish(whole, search, u_best, opt, prog)
+    vector = search_to_parameters(u_best, k_ref, c_ref)
+    model = BoucWenBushing.from_vector(vector, dt=data.dt)
+    if not satisfies_constraints(vector):  # by construction; a failure here is a bug
+        raise IdentificationError(f"identified parameters break eq. 6 constraints: {vector}")
+    f_rms = float(np.sqrt(np.mean(f * f)))
+    log.update(
+        rms_ratio=log["cost_n"] / f_rms,
+        evaluations=search.evaluations + whole.evaluations,
+        seconds=prog.elapsed_s(),
+        search_vector=u_best.tolist(),
+        options={k: getattr(opt, k) for k in opt.__dataclass_fields__},
+        records=data.labels,
+    )
+    prog.update(
+        None,
+        f"done in {log['seconds']:.1f} s: RMS error {log['cost_n']:.4g} N on all records "
+        f"(RMS ratio {log['rms_ratio']:.4f}), {log['evaluations']} simulations",
+        force=True,
+    )
+    model.training = log
+    return model
 
-    def say(msg: str, force: bool = False) -> None:
-        now = time.perf_counter()
-        if progress and (force or now - last[0] >= progress_every_s):
-            print(f"[boucwen {now - t0:6.1f} s] {msg}", flush=True)
-            last[0] = now
 
-    def cost_population(u: np.ndarray, xx, vv, ff) -> np.ndarray:
-        vectors = search_to_parameters(np.atleast_2d(u.T), k_ref, c_ref)
-        out, bad = simulate_population(vectors, xx, vv, dt, max_substeps=search_max_substeps)
-        err = out - ff[:, None]
-        cost = np.sqrt(np.mean(err * err, axis=0))
-        cost[bad | ~np.isfinite(cost)] = np.inf
-        n_evals[0] += vectors.shape[0]
-        return cost
+def _work(search: PopulationCost, whole: PopulationCost) -> float:
+    return search.evaluations * search.samples + whole.evaluations * whole.samples
+
+
+def _evolve(search, whole, opt: BoucWenOptions, seed: int, prog: Progress):
+    """Differential evolution on ``search``; returns the best vector and the log so far."""
+    gen, best, stopped = [0], [np.inf], ["generations done"]
 
     def de_cost(u: np.ndarray) -> np.ndarray:  # u: (14, S)
-        c = cost_population(u, xs, vs, fs)
-        best_cost[0] = min(best_cost[0], float(np.min(c)))
-        say(f"generation {gen[0]}: {n_evals[0]} evaluations, best RMS error {best_cost[0]:.4g} N")
+        c = search(u)
+        best[0] = min(best[0], float(np.min(c)))
+        prog.update(
+            _work(search, whole),
+            f"generation {gen[0]}/{opt.generations}: {search.evaluations} evaluations, "
+            f"best RMS error {best[0]:.4g} N",
+        )
         return c
-
-    stopped = ["generations done"]
 
     def callback(intermediate_result) -> bool:
         gen[0] += 1
-        if time.perf_counter() - t0 > time_budget_s:
-            stopped[0] = f"time budget {time_budget_s} s hit after {gen[0]} generations"
+        if prog.elapsed_s() > opt.time_budget_s:
+            stopped[0] = f"time budget {opt.time_budget_s} s hit after {gen[0]} generations"
             return True
         return False
 
     result = differential_evolution(
         de_cost,
         SEARCH_BOUNDS,
-        maxiter=maxiter,
-        popsize=popsize,
+        maxiter=opt.generations,
+        popsize=opt.population,
         seed=seed,
         polish=False,
         vectorized=True,
@@ -202,50 +255,36 @@ def fit_boucwen(
         callback=callback,
     )
     u_best = np.asarray(result.x)
-    de_cost_fit = float(cost_population(u_best[:, None], xs, vs, fs)[0])
-    say(
+    de_cost_fit = float(search(u_best[:, None])[0])
+    prog.update(
+        _work(search, whole),
         f"differential evolution: {gen[0]} generations ({stopped[0]}), RMS error on the first "
-        f"{n_fit * dt:.1f} s {de_cost_fit:.4g} N",
+        f"{search.samples * search.dt:.1f} s {de_cost_fit:.4g} N",
         force=True,
     )
+    return u_best, {"generations": gen[0], "stopped": stopped[0], "de_cost_fit_n": de_cost_fit}
+
+
+def _polish(whole, search, u_best: np.ndarray, opt: BoucWenOptions, prog: Progress):
+    """Bounded Powell on all records from ``u_best``; (vector, cost before, cost after), N."""
 
     def full_cost(u: np.ndarray) -> float:
-        c = float(cost_population(np.asarray(u)[:, None], x, v, f)[0])
-        say(f"polish: {n_evals[0]} evaluations, RMS error on the whole record {c:.4g} N")
+        c = float(whole(np.asarray(u)[:, None])[0])
+        prog.update(
+            _work(search, whole),
+            f"polish: {whole.evaluations} evaluations, RMS error on all records {c:.4g} N",
+        )
         return c if np.isfinite(c) else 1e300
 
     cost_before = full_cost(u_best)
-    if polish_maxfev > 0:
+    if opt.polish_evaluations > 0:
         pol = minimize(
             full_cost,
             u_best,
             method="Powell",
             bounds=SEARCH_BOUNDS,
-            options={"maxfev": int(polish_maxfev), "xtol": 1e-4, "ftol": 1e-6},
+            options={"maxfev": int(opt.polish_evaluations), "xtol": 1e-4, "ftol": 1e-6},
         )
         if pol.fun < cost_before:
             u_best = np.asarray(pol.x)
-    cost_final = full_cost(u_best)
-    vector = search_to_parameters(u_best, k_ref, c_ref)
-    model = BoucWenBushing.from_vector(vector, dt=dt)
-    if not satisfies_constraints(vector):  # by construction; a failure here is a bug
-        raise IdentificationError(f"identified parameters break eq. 6 constraints: {vector}")
-    elapsed = time.perf_counter() - t0
-    f_rms = float(np.sqrt(np.mean(f * f)))
-    say(
-        f"done in {elapsed:.1f} s: RMS error {cost_final:.4g} N on the whole record "
-        f"(RMS ratio {cost_final / f_rms:.4f}), {n_evals[0]} simulations",
-        force=True,
-    )
-    model.training = {
-        "generations": gen[0],
-        "stopped": stopped[0],
-        "de_cost_fit_n": de_cost_fit,
-        "cost_before_polish_n": cost_before,
-        "cost_n": cost_final,
-        "rms_ratio": cost_final / f_rms,
-        "evaluations": n_evals[0],
-        "seconds": elapsed,
-        "search_vector": u_best.tolist(),
-    }
-    return model
+    return u_best, cost_before, full_cost(u_best)

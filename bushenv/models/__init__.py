@@ -1,45 +1,22 @@
-"""Bushing force models behind one protocol (see ``base.py``) and the name resolver.
+"""Bushing force models behind one protocol (``base.py``), their registry and the resolvers.
 
 ``get_model("nn", axis="axial")`` gives the default trained model shipped with the package;
-``get_model("path/to/file.npz")`` loads a saved file; a model object passes through.
+``get_model("path/to/file.npz")`` loads a saved file; a model object is copied (or passed
+through with ``copy=False``). ``get_reference`` resolves the model a verdict is judged against.
+Nothing falls back silently: an unknown name or a missing file is a ``ModelError``.
 """
 
 from __future__ import annotations
 
-import importlib
 import os
 from importlib import resources
 from pathlib import Path
 
-from bushenv.models.base import (
-    MODEL_REGISTRY,
-    PAPER_DT,
-    BushingModel,
-    ModelError,
-    file_hash,
-    load_model,
-    register,
-)
+from bushenv.models.base import AXES, DT_TOLERANCE, PAPER_DT, BushingModel, ModelError
+from bushenv.models.files import file_hash, load_model, params_sha
+from bushenv.models.registry import MODELS, ModelEntry
 
-# Modules that register models; imported lazily so a missing optional part cannot break import.
-_MODEL_MODULES = (
-    "bushenv.models.linear",
-    "bushenv.models.narx",
-    "bushenv.models.hybrid",
-    "bushenv.models.boucwen",
-    "bushenv.reference.rubber",
-)
-AXES = ("axial", "radial")
-TRAINED = ("nn", "hybrid", "boucwen")  # names whose defaults are identified files in the package
-
-
-def _load_registry() -> None:
-    for mod in _MODEL_MODULES:
-        try:
-            importlib.import_module(mod)
-        except ModuleNotFoundError as exc:
-            if exc.name != mod:  # a real missing dependency, not a model file absent here
-                raise
+ModelSpec = str | os.PathLike | BushingModel
 
 
 def default_model_path(name: str, axis: str) -> Path:
@@ -48,26 +25,62 @@ def default_model_path(name: str, axis: str) -> Path:
 
 
 def model_names() -> list[str]:
-    _load_registry()
-    return sorted(MODEL_REGISTRY)
+    return list(MODELS.names())
+
+
+def check_axis(axis: str) -> str:
+    if axis not in AXES:
+        raise ModelError(f"unknown axis {axis!r}; known: {', '.join(AXES)}")
+    return axis
+
+
+def model_file(spec: ModelSpec, axis: str) -> Path | None:
+    """The file behind ``spec``: a shipped default for a registered name, the path itself for a
+    file, None for presets and objects."""
+    if isinstance(spec, BushingModel):
+        return None
+    text = os.fspath(spec)
+    if text in MODELS:
+        return default_model_path(text, axis) if MODELS[text].shipped else None
+    return Path(text)
 
 
 def get_model(
-    spec: str | os.PathLike | BushingModel, axis: str = "axial", dt: float | None = None
+    spec: ModelSpec,
+    axis: str = "axial",
+    dt: float | None = None,
+    copy: bool = True,
+    preset: dict | None = None,
 ) -> BushingModel:
-    """Resolve a registered name, a model file or a model object to a ready model."""
+    """Resolve a registered name, a model file or a model object to a ready model.
+
+    Parameters
+    ----------
+    spec : str, path or BushingModel
+        A name in ``MODELS`` (shipped defaults load their file for ``axis``; others build their
+        ``preset``), a ``.npz`` model file, or a model object.
+    axis : {"axial", "radial"}
+    dt : float, optional
+        Required sample time, s; a model at another rate is refused, naming both rates.
+    copy : bool
+        A model object is copied (its own state) unless False.
+    preset : dict, optional
+        Extra keyword arguments of a registered preset (e.g. ``{"measurement": False}``).
+    """
     if isinstance(spec, BushingModel):
-        if dt is not None and abs(spec.dt - dt) > 1e-9 * dt:
-            raise ModelError(f"model {spec.name} runs at dt={spec.dt:.6g} s, expected {dt:.6g} s")
-        return spec
-    _load_registry()
-    if axis not in AXES:
-        raise ModelError(f"unknown axis {axis!r}; known: {list(AXES)}")
+        if dt is not None and abs(spec.dt - dt) > DT_TOLERANCE * dt:
+            raise ModelError(
+                f"model {spec.name} runs at {1 / spec.dt:.6g} Hz (dt={spec.dt:.6g} s), "
+                f"expected {1 / dt:.6g} Hz (dt={dt:.6g} s)"
+            )
+        return spec.copy() if copy else spec
+    check_axis(axis)
     text = os.fspath(spec)
     if not text.strip():
-        raise ModelError(f"empty model name; known names: {sorted(MODEL_REGISTRY)} or a .npz file")
-    if text in MODEL_REGISTRY:
-        if text in TRAINED:
+        raise ModelError(f"empty model name; {MODELS.unknown_message(text)} or a .npz file")
+    if text in MODELS:
+        entry = MODELS[text]
+        if entry.shipped:
             path = default_model_path(text, axis)
             if not path.is_file():
                 raise ModelError(
@@ -75,25 +88,39 @@ def get_model(
                     "run scripts/train_default_models.py"
                 )
             return load_model(path, dt=dt)
-        model = MODEL_REGISTRY[text].preset(axis=axis, dt=dt or PAPER_DT)
-        return model
+        return entry.model_class().preset(axis=axis, dt=dt or PAPER_DT, **(preset or {}))
     if text.endswith(".npz") or Path(text).exists():
         return load_model(text, dt=dt)
-    raise ModelError(
-        f"unknown model {text!r}; known names: {sorted(MODEL_REGISTRY)} or a .npz file"
-    )
+    raise ModelError(f"{MODELS.unknown_message(text)} or a .npz model file")
+
+
+def get_reference(
+    spec: ModelSpec = "rubber", axis: str = "axial", dt: float | None = None
+) -> BushingModel:
+    """The model a verdict is judged against: as ``get_model``, with a registered name built
+    with its entry's ``reference_preset`` (``"rubber"``: the specimen without the load cell's
+    delay, inertia and noise)."""
+    preset = None
+    if not isinstance(spec, BushingModel) and os.fspath(spec) in MODELS:
+        preset = MODELS[os.fspath(spec)].reference_preset
+    return get_model(spec, axis=axis, dt=dt, preset=preset)
 
 
 __all__ = [
     "AXES",
-    "MODEL_REGISTRY",
+    "MODELS",
     "PAPER_DT",
     "BushingModel",
+    "ModelEntry",
     "ModelError",
+    "ModelSpec",
+    "check_axis",
     "default_model_path",
     "file_hash",
     "get_model",
+    "get_reference",
     "load_model",
+    "model_file",
     "model_names",
-    "register",
+    "params_sha",
 ]

@@ -1,4 +1,4 @@
-"""The one protocol every bushing force model follows, the name registry, and save/load.
+"""The one protocol every bushing force model follows, and its file format (written by ``save``).
 
 A model is a small stateful object for ONE axis in SI units (m, m/s, N) at a fixed sample time
 ``dt`` (the papers' 204.8 Hz by default). Its memory (past inputs, past outputs, internal
@@ -16,33 +16,23 @@ version, dt, and each parameter's shape.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
-import tempfile
-import zipfile
 from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
+from bushenv.persist import atomic_write
+
 FORMAT_VERSION = 1
 PAPER_DT = 1.0 / 204.8  # s; RPC III at 204.8 Hz (seed 000 §4.1, seed 001 §3.2.2)
 DT_TOLERANCE = 1e-9  # relative; two dt values closer than this are the same rate
-
-MODEL_REGISTRY: dict[str, type[BushingModel]] = {}
+AXES = ("axial", "radial")  # the bushing directions of seed 000 Table 1
 
 
 class ModelError(ValueError):
     """A model file or a model argument is wrong; the message names the file and the problem."""
-
-
-def register(cls: type[BushingModel]) -> type[BushingModel]:
-    """Class decorator: make ``cls`` resolvable by its ``name`` (``model="nn"``)."""
-    if not getattr(cls, "name", None):
-        raise TypeError(f"{cls.__name__} has no registry name")
-    MODEL_REGISTRY[cls.name] = cls
-    return cls
 
 
 class BushingModel:
@@ -116,6 +106,14 @@ class BushingModel:
         self._advance(self._x1, self._v1, self._f1)
         return self._f1[0].copy()
 
+    @property
+    def last_force_n(self) -> np.ndarray:
+        """(B,) the force of each history at the last ``step``, N (a copy of the output buffer).
+
+        Also after a batched ``step`` that raised part-way: what the kernel had written by then
+        (a kernel that refuses a non-finite force leaves it there for its history)."""
+        return self._f1[0].copy()
+
     def simulate(self, x: np.ndarray, v: np.ndarray | None = None) -> np.ndarray:
         """Free run from rest over a whole profile: (T,) -> (T,) or (T, B) -> (T, B).
 
@@ -165,16 +163,8 @@ class BushingModel:
             "shapes": {k: list(a.shape) for k, a in arrays.items()},
             "extra": self.extra_meta(),
         }
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez(fh, __meta__=np.array(json.dumps(meta)), **arrays)
-            os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a saved model is shareable
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        payload = {"__meta__": np.array(json.dumps(meta)), **arrays}
+        atomic_write(path, lambda fh: np.savez(fh, **payload))
         return path
 
     def extra_meta(self) -> dict[str, Any]:
@@ -199,160 +189,8 @@ class BushingModel:
         return f"{type(self).__name__}(dt={self.dt:.6g})"
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def velocity_of(x: np.ndarray, dt: float) -> np.ndarray:
     """Central-difference velocity of prescribed displacement, (T, ...) -> (T, ...)."""
     if x.shape[0] < 2:
         return np.zeros_like(x)
     return np.gradient(x, dt, axis=0)
-
-
-ZIP_MAGIC = b"PK\x03\x04"
-_KNOWN_MAGIC = (
-    (b"\x93NUMPY", "a single .npy array, not an .npz archive"),
-    (b"\x80", "a Python pickle (bushenv never loads pickles: they can run code)"),
-    (b"\x89PNG", "a PNG image"),
-    (b"\x1f\x8b", "a gzip file"),
-    (b"%PDF", "a PDF document"),
-)
-
-
-def _not_npz_reason(head: bytes) -> str:
-    """What a file that is not a zip archive looks like, from its first bytes."""
-    if not head:
-        return "empty file"
-    for magic, what in _KNOWN_MAGIC:
-        if head.startswith(magic):
-            return what
-    if b"\x00" not in head:
-        try:
-            head.decode("utf-8")
-            return "a text file"
-        except UnicodeDecodeError:
-            pass
-    return f"unknown binary data (starts with {head[:8]!r})"
-
-
-def _ensure_registry() -> None:
-    # A model file names its class; make sure every model module has registered itself.
-    from bushenv.models import _load_registry
-
-    _load_registry()
-
-
-def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel:
-    """Read a model file written by ``BushingModel.save``.
-
-    Refuses with ``ModelError``, naming the file and what was expected: a missing file, a
-    folder, anything that is not an npz archive (text, an image, a pickle, a lone .npy), a
-    truncated or damaged archive, object (pickled) entries -- never unpickled --, another
-    format or version, an unknown model name, a corrupt header, missing, non-numeric or
-    wrongly shaped parameters, and (when ``dt`` is given) a sample time other than ``dt``.
-    """
-    path = Path(path)
-    if not path.exists():
-        raise ModelError(f"{path}: no such model file")
-    if not path.is_file():
-        raise ModelError(f"{path}: not a regular file; expected a bushenv model file (.npz)")
-    with open(path, "rb") as fh:
-        head = fh.read(16)
-    if not head.startswith(ZIP_MAGIC):
-        raise ModelError(
-            f"{path}: not a bushenv model file: {_not_npz_reason(head)}; expected an .npz "
-            "archive written by BushingModel.save"
-        )
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            files = {k: z[k] for k in z.files}
-    except ValueError as exc:
-        if "allow_pickle" in str(exc) or "pickled" in str(exc):
-            raise ModelError(
-                f"{path}: holds pickled (object) data, which bushenv never loads (it could run "
-                "code); expected numeric arrays written by BushingModel.save"
-            ) from None
-        raise ModelError(f"{path}: damaged .npz archive: {exc}") from None
-    except (zipfile.BadZipFile, OSError, EOFError, KeyError, TypeError) as exc:
-        raise ModelError(
-            f"{path}: damaged or truncated .npz archive ({type(exc).__name__}: {exc}); "
-            "expected a file written by BushingModel.save"
-        ) from None
-    except Exception as exc:  # zlib.error and the like from a damaged member
-        raise ModelError(f"{path}: damaged .npz archive ({type(exc).__name__}: {exc})") from None
-    if "__meta__" not in files:
-        raise ModelError(f"{path}: not a bushenv model file (no __meta__ entry)")
-    raw = files.pop("__meta__")
-    if raw.shape != () or raw.dtype.kind != "U":
-        raise ModelError(
-            f"{path}: corrupt __meta__ entry (a {raw.dtype} array of shape {list(raw.shape)}, "
-            "expected one JSON string)"
-        )
-    try:
-        meta = json.loads(str(raw))
-    except json.JSONDecodeError as exc:
-        raise ModelError(f"{path}: corrupt __meta__ entry: {exc}") from None
-    if not isinstance(meta, dict) or meta.get("format") != "bushenv-model":
-        raise ModelError(f"{path}: not a bushenv model file (format tag missing)")
-    if meta.get("version") != FORMAT_VERSION:
-        raise ModelError(
-            f"{path}: model file format version {meta.get('version')!r}, "
-            f"this bushenv reads version {FORMAT_VERSION}"
-        )
-    name = meta.get("model")
-    _ensure_registry()
-    if not isinstance(name, str) or name not in MODEL_REGISTRY:
-        raise ModelError(f"{path}: unknown model {name!r}; known: {sorted(MODEL_REGISTRY)}")
-    cls = MODEL_REGISTRY[name]
-    file_dt = meta.get("dt")
-    if isinstance(file_dt, bool) or not isinstance(file_dt, int | float):
-        raise ModelError(f"{path}: invalid dt {file_dt!r} in the header, expected seconds")
-    file_dt = float(file_dt)
-    if not (np.isfinite(file_dt) and file_dt > 0):
-        raise ModelError(f"{path}: invalid dt {meta.get('dt')!r}")
-    if dt is not None and abs(file_dt - dt) > DT_TOLERANCE * dt:
-        raise ModelError(
-            f"{path}: model sampled at {1 / file_dt:.6g} Hz (dt={file_dt:.6g} s), "
-            f"expected {1 / dt:.6g} Hz (dt={dt:.6g} s)"
-        )
-    shapes = meta.get("shapes", {})
-    extra = meta.get("extra", {})
-    if not isinstance(shapes, dict) or not isinstance(extra, dict):
-        raise ModelError(f"{path}: corrupt __meta__ entry ('shapes' and 'extra' must be objects)")
-    for key in cls.param_names:
-        if key not in files:
-            raise ModelError(f"{path}: {name} model file lacks parameter {key!r}")
-        a = files[key]
-        if a.dtype.kind not in "biuf":
-            raise ModelError(
-                f"{path}: parameter {key!r} holds {a.dtype} data, expected real numbers"
-            )
-        want = shapes.get(key)
-        if want is not None and not (
-            isinstance(want, list) and all(type(n) is int and n >= 0 for n in want)
-        ):
-            raise ModelError(
-                f"{path}: corrupt __meta__ entry (shape of {key!r} is {want!r}, "
-                "expected a list of sizes)"
-            )
-        if want is not None and list(a.shape) != list(want):
-            raise ModelError(
-                f"{path}: parameter {key!r} has shape {list(a.shape)}, "
-                f"the file's header says {want}"
-            )
-        if not np.all(np.isfinite(a)):
-            raise ModelError(f"{path}: parameter {key!r} holds NaN or inf")
-    try:
-        return cls.from_params(files, file_dt, extra)
-    except ModelError as exc:
-        raise ModelError(f"{path}: {exc}") from None
-    except (TypeError, ValueError, KeyError) as exc:
-        raise ModelError(f"{path}: parameters do not fit a {name} model: {exc}") from None
-
-
-def file_hash(path: str | os.PathLike) -> str:
-    """sha256 of a model file (regression cases record which model they judged)."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()

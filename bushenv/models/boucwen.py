@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
+from bushenv.models.base import PAPER_DT, BushingModel, ModelError
 from bushenv.models.boucwen_kernels import BW_MAX_SUBSTEPS, BW_N_STATE, boucwen_kernel
 from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare
 
@@ -87,7 +87,6 @@ class BoucWenError(ModelError):
     """The Bouc-Wen equations cannot be integrated (refused set, step limit, or a runaway)."""
 
 
-@register
 class BoucWenBushing(BushingModel):
     """seed 002 eqs. 1-5, 16 parameters in SI; z along the travel, exponential collocation.
 

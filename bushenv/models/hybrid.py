@@ -30,11 +30,10 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models.base import PAPER_DT, ModelError, register
+from bushenv.models.base import PAPER_DT, ModelError
 from bushenv.models.narx import N_PAST_F, N_PAST_X, NarxBushing
 
 
-@register
 class HybridBushing(NarxBushing):
     """seed 000 §3 hybrid: Kelvin-Voigt backbone + bounded NARX residual network."""
 

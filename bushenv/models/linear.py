@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
+from bushenv.models.base import PAPER_DT, BushingModel, ModelError
 from bushenv.models.kernels import linear_kernel
 
 TABLE1 = {  # seed 000 Table 1, SI
@@ -23,7 +23,6 @@ TABLE1 = {  # seed 000 Table 1, SI
 }
 
 
-@register
 class LinearBushing(BushingModel):
     """Kelvin-Voigt spring-damper; stateless, so its batched and looped runs trivially agree."""
 

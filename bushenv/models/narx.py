@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
+from bushenv.models.base import PAPER_DT, BushingModel, ModelError
 from bushenv.models.narx_kernels import (
     COLS_MAX_BATCH,
     DTYPES,
@@ -69,7 +69,6 @@ def _array(name: str, value: Any, shape: tuple[int, ...]) -> np.ndarray:
     return a
 
 
-@register
 class NarxBushing(BushingModel):
     """seed 000 §4.2 NARX network bushing, free-running on its own past outputs."""
 

@@ -95,30 +95,64 @@ three times Table 1 because friction and the Maxwell springs are stiff right aft
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
-from bushenv.models.base import PAPER_DT, BushingModel, ModelError, register
+from bushenv.models.base import PAPER_DT, BushingModel, ModelError
 from bushenv.reference import kernel
 from bushenv.reference.kernel import FRICTION_LAWS, HARDENING_LAWS, friction_rows, rubber_kernel
 
-EFFECTS = ("relaxation", "friction", "hardening", "thermal", "delay", "inertia", "noise")
-PHYSICAL_EFFECTS = ("relaxation", "friction", "hardening", "thermal")
-MEASUREMENT_EFFECTS = ("delay", "inertia", "noise")
 MAX_BRANCHES = 6
 MAX_DELAY_SAMPLES = 64
 
-# Parameters per effect (the backbone k, c is always on).
-EFFECT_PARAMS = {
-    "relaxation": ("relax_k_n_per_m", "relax_tau_s"),
-    "friction": ("friction_fmax_n", "friction_x2_m"),
-    "hardening": ("hardening_x_m",),
-    "thermal": ("thermal_r_k_per_w", "thermal_c_j_per_k", "thermal_ak_per_k", "thermal_ac_per_k"),
-    "delay": ("delay_s",),
-    "inertia": ("fixture_mass_kg",),
-    "noise": ("noise_std_n",),
+
+@dataclass(frozen=True)
+class ReferenceEffect:
+    """One switchable effect of the reference: its parameters, where it acts, and whether a
+    bushing's parameter values set it (``configured(bushing) -> bool``)."""
+
+    params: tuple[str, ...]
+    kind: str  # "physical" (the specimen) or "measurement" (the load cell)
+    configured: Callable[[Any], bool]
+
+
+# The reference's one list of effects: EFFECTS, PHYSICAL_EFFECTS, MEASUREMENT_EFFECTS and
+# EFFECT_PARAMS are derived from it. The kernel's order of operations is its own.
+REFERENCE_EFFECTS: dict[str, ReferenceEffect] = {
+    "relaxation": ReferenceEffect(
+        ("relax_k_n_per_m", "relax_tau_s"),
+        "physical",
+        lambda b: bool(np.any(b.relax_k_n_per_m > 0)),
+    ),
+    "friction": ReferenceEffect(
+        ("friction_fmax_n", "friction_x2_m"),
+        "physical",
+        lambda b: b.friction_fmax_n > 0 and b.friction_x2_m > 0,
+    ),
+    "hardening": ReferenceEffect(("hardening_x_m",), "physical", lambda b: b.hardening_x_m > 0),
+    "thermal": ReferenceEffect(
+        ("thermal_r_k_per_w", "thermal_c_j_per_k", "thermal_ak_per_k", "thermal_ac_per_k"),
+        "physical",
+        lambda b: (
+            b.thermal_r_k_per_w > 0
+            and b.thermal_c_j_per_k > 0
+            and (b.thermal_ak_per_k != 0 or b.thermal_ac_per_k != 0)
+        ),
+    ),
+    "delay": ReferenceEffect(("delay_s",), "measurement", lambda b: b.delay_s > 0),
+    "inertia": ReferenceEffect(
+        ("fixture_mass_kg",), "measurement", lambda b: b.fixture_mass_kg != 0
+    ),
+    "noise": ReferenceEffect(("noise_std_n",), "measurement", lambda b: b.noise_std_n > 0),
 }
+EFFECTS = tuple(REFERENCE_EFFECTS)
+PHYSICAL_EFFECTS = tuple(n for n, e in REFERENCE_EFFECTS.items() if e.kind == "physical")
+MEASUREMENT_EFFECTS = tuple(n for n, e in REFERENCE_EFFECTS.items() if e.kind == "measurement")
+# Parameters per effect (the backbone k, c is always on).
+EFFECT_PARAMS = {n: e.params for n, e in REFERENCE_EFFECTS.items()}
 
 # Presets: measured numbers in the module docstring and docs/reference.md.
 PRESETS: dict[str, dict[str, Any]] = {
@@ -181,7 +215,6 @@ def _check_names(names: Any, what: str) -> tuple[str, ...]:
     return names
 
 
-@register
 class RubberBushing(BushingModel):
     """Reference rubber bushing; see the module docstring for the force law and parameters."""
 
@@ -298,19 +331,7 @@ class RubberBushing(BushingModel):
 
     # ----- effects -----------------------------------------------------------------------
     def _has_params(self, effect: str) -> bool:
-        if effect == "relaxation":
-            return bool(np.any(self.relax_k_n_per_m > 0))
-        if effect == "friction":
-            return self.friction_fmax_n > 0 and self.friction_x2_m > 0
-        if effect == "thermal":
-            return (
-                self.thermal_r_k_per_w > 0
-                and self.thermal_c_j_per_k > 0
-                and (self.thermal_ak_per_k != 0 or self.thermal_ac_per_k != 0)
-            )
-        if effect == "inertia":
-            return self.fixture_mass_kg != 0
-        return getattr(self, EFFECT_PARAMS[effect][0]) > 0
+        return bool(REFERENCE_EFFECTS[effect].configured(self))
 
     @property
     def active_effects(self) -> tuple[str, ...]:

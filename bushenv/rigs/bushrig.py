@@ -1,4 +1,10 @@
-"""BushRig-v0: the one-axis bushing test rig (seed 001 §4, Fig. 11) as a Gymnasium env."""
+"""BushRig-v0: the one-axis bushing test rig (seed 001 §4, Fig. 11) as a Gymnasium env.
+
+The actuator's motion is prescribed, so the rig is a function of the commanded displacement:
+``BushRigEnv`` (here) and ``BushRigVectorEnv`` (``vector.py``) step the same models with the same
+arithmetic and decide the episode's end with ``divergence.force_termination``, the function the
+divergence judge calls.
+"""
 
 from __future__ import annotations
 
@@ -10,34 +16,33 @@ import numpy as np
 import pymunk
 from gymnasium import spaces
 
+from bushenv.divergence import force_termination
+from bushenv.rigs.actions import check_options, check_profile, unit_action
 from bushenv.rigs.common import (
     MODEL_ERRORS,
-    Canvas,
     ForceDeviationReward,
     RigError,
-    Trace,
     call_reset,
     check_hook,
-    check_options,
-    check_profile,
     force_observation,
     model_label,
     per_axis,
-    plot_traces,
     positive,
     positive_int,
     resolve_model,
     resolve_reference,
-    space_stepper,
-    spec_kwargs,
-    unit_action,
-    velocity_setter,
 )
+from bushenv.rigs.coupling import space_stepper, velocity_setter
+from bushenv.rigs.drawing import Canvas, Trace
+from bushenv.rigs.scenes import draw_bushrig
+from bushenv.rigs.specs import spec_kwargs
 
 ENV_ID = "BushRig-v0"
 AXES = ("axial", "radial")
 ACTUATOR_MASS_KG = 10.0  # piston and fixture; drawn only, the motion is prescribed
 MAX_HISTORY = 10_000  # samples per channel in the observation (3 x 10 000 float32 = 120 kB)
+# pymunk objects and chipmunk call handles: rebuilt on unpickling, not pickled (see __getstate__)
+PHYSICS_ATTRS = ("space", "ground", "actuator", "groove", "_space_step", "_set_actuator_velocity")
 
 
 def check_excitation(profile: Any, max_displacement_m: float, max_step_m: float) -> np.ndarray:
@@ -64,7 +69,6 @@ class RigParameters:
             raise RigError(f"{ENV_ID}: axis must be one of {AXES}, got {self.axis!r}")
         self.dt = positive("dt_s", kwargs["dt_s"])
         self.substeps = positive_int("physics_substeps", kwargs["physics_substeps"])
-        self.episode_steps = positive_int("episode_steps", kwargs["episode_steps"])
         self.history = positive_int("history", kwargs["history"])
         if self.history > MAX_HISTORY:
             raise RigError(
@@ -86,6 +90,10 @@ class RigParameters:
         action = spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
         observation = spaces.Box(-1.0, 1.0, shape=(3 * self.history,), dtype=np.float32)
         return action, observation
+
+    def metadata(self, metadata: dict[str, Any]) -> dict[str, Any]:
+        """``metadata`` with ``render_fps`` = 1 / dt: one frame per step shows real time."""
+        return {**metadata, "render_fps": 1.0 / self.dt}
 
 
 class BushRigEnv(gym.Env):
@@ -151,9 +159,13 @@ class BushRigEnv(gym.Env):
     ``ArithmeticError``: ``ZeroDivisionError``, ``FloatingPointError``, ``OverflowError``);
     |F_model| > ``force_limit_n`` (25 kN, the machine's dynamic force) while the reference
     stays within it; or ``divergence_monitor(info)`` is truthy.
-    Truncation: ``episode_steps`` steps (2048 = 10 s) or the end of a replayed excitation; or
-    the reference itself needs more than the machine's 25 kN (``info["machine_limit"]``: the
-    motion cannot be run on the real rig, so it judges nothing).
+    Truncation: the reference itself needs more than the machine's 25 kN
+    (``info["machine_limit"]``: the motion cannot be run on the real rig, so it judges
+    nothing); the end of a replayed excitation; and, through ``gym.make``, Gymnasium's
+    ``TimeLimit`` at the spec's ``max_episode_steps`` (2048 steps = 10 s;
+    ``gym.make(..., max_episode_steps=N)`` changes it, -1 removes it, e.g. to replay a longer
+    profile). The env built directly (``BushRigEnv()``) has no time limit of its own, like
+    Gymnasium's ``CartPoleEnv``.
 
     ## Info
 
@@ -165,7 +177,7 @@ class BushRigEnv(gym.Env):
     ## Arguments
 
     Every key of ``envs/BushRig-v0.toml`` ``[kwargs]`` (``model``, ``axis``, ``reference``,
-    ``dt_s``, ``physics_substeps``, ``episode_steps``, ``history``, ``max_displacement_m``,
+    ``dt_s``, ``physics_substeps``, ``history``, ``max_displacement_m``,
     ``max_velocity_m_per_s``, ``force_limit_n``, ``reward_cap``, ``force_scale_n``) plus
     ``reward_fn``, ``divergence_monitor`` (see ``bushenv.rigs.common``) and ``render_mode``::
 
@@ -178,9 +190,38 @@ class BushRigEnv(gym.Env):
     ``gym.make_vec("BushRig-v0", num_envs=N, vectorization_mode="vector_entry_point")`` gives
     ``BushRigVectorEnv``: N rigs as arrays through the models' batched step, the same kernels
     and arithmetic, bit for bit equal to N single envs (next-step autoreset).
+    ``bushenv.rigs.sb3.make_sb3_vec_env("BushRig-v0", N)`` gives it to stable-baselines3.
+
+    ## Rendering
+
+    ``render_fps`` = 1 / ``dt_s`` (204.8): one frame per step, so a video written at
+    ``render_fps`` (``gymnasium.wrappers.RecordVideo``) plays in real time, and ``"human"``
+    paces its window to the simulated time.
+
+    ## Example
+
+    >>> import gymnasium as gym
+    >>> import numpy as np
+    >>> import bushenv
+    >>> env = gym.make("bushenv/BushRig-v0", model="linear", axis="axial")
+    >>> env.spec.max_episode_steps, env.metadata["render_fps"]
+    (2048, 204.8)
+    >>> obs, info = env.reset(seed=0)
+    >>> obs.shape, obs.dtype, float(abs(obs).max())
+    ((12,), dtype('float32'), 0.0)
+    >>> obs, reward, terminated, truncated, info = env.step(np.array([0.5], np.float32))
+    >>> round(info["displacement_m"] * 1e3, 3), terminated, truncated
+    (3.068, False, False)
+
+    ## Version History
+
+    - v0: as in seed 001 §4. Since: the episode length is the spec's ``max_episode_steps``
+      (Gymnasium's ``TimeLimit``; the kwarg ``episode_steps`` is gone), ``render_fps`` is
+      1 / ``dt_s``, the env pickles and deep-copies, and the id is also registered as
+      ``bushenv/BushRig-v0``. The dynamics and every number an episode gives are unchanged.
     """
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 204.8}
 
     def __init__(
         self,
@@ -194,6 +235,7 @@ class BushRigEnv(gym.Env):
             raise RigError(f"render_mode must be one of {self.metadata['render_modes']}")
         p = RigParameters(spec_kwargs(ENV_ID, spec_overrides))
         self.params = p
+        self.metadata = p.metadata(type(self).metadata)
         self.render_mode = render_mode
         self.model, self.reference = p.model, p.reference
         self.action_space, self.observation_space = p.spaces()
@@ -206,7 +248,7 @@ class BushRigEnv(gym.Env):
         self._x = 0.0
         self._t = 0
         self._replay: np.ndarray | None = None
-        self._end = p.episode_steps
+        self._end: int | None = None  # the replay's length; no limit of its own otherwise
         self._build_space()
         self._canvas: Canvas | None = None
         self._trace = Trace(3) if render_mode else None
@@ -230,12 +272,28 @@ class BushRigEnv(gym.Env):
         self._space_step = space_stepper(self.space)
         self._set_actuator_velocity = velocity_setter(self.actuator)
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Everything but the pymunk space and the chipmunk call handles (which cannot be
+        pickled); the actuator's position and velocity stand in for them."""
+        state = {k: v for k, v in self.__dict__.items() if k not in PHYSICS_ATTRS}
+        state["_canvas"] = None
+        a = self.actuator
+        state["_actuator_state"] = (tuple(a.position), tuple(a.velocity))
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        position, velocity = state.pop("_actuator_state")
+        self.__dict__.update(state)
+        self._build_space()
+        self.actuator.position = position
+        self.actuator.velocity = velocity
+
     # ----- gymnasium -----------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
         p = self.params
         self._replay = None
-        self._end = p.episode_steps
+        self._end = None
         options = check_options(ENV_ID, options)
         if options.get("excitation") is not None:
             x = check_excitation(options["excitation"], p.max_x, p.max_step)
@@ -260,17 +318,23 @@ class BushRigEnv(gym.Env):
             self.render()
         return self._obs.ravel().copy(), info
 
+    def _next_displacement(self, action) -> float:
+        """The commanded x of this step: the action's change, clipped to the stroke, or the
+        replayed sample."""
+        if self._replay is not None:
+            return float(self._replay[min(self._t, self._end - 1)])
+        p = self.params
+        x = self._x + unit_action(action, ENV_ID) * p.max_step
+        if x > p.max_x:
+            return p.max_x
+        if x < -p.max_x:
+            return -p.max_x
+        return x
+
     def step(self, action):
         p = self.params
         x0 = self._x
-        if self._replay is None:
-            x = x0 + unit_action(action, ENV_ID) * p.max_step
-            if x > p.max_x:
-                x = p.max_x
-            elif x < -p.max_x:
-                x = -p.max_x
-        else:
-            x = float(self._replay[min(self._t, self._end - 1)])
+        x = self._next_displacement(action)
         v = (x - x0) / self._dt
         self._x = x
         self._t += 1
@@ -293,29 +357,25 @@ class BushRigEnv(gym.Env):
         obs[1, 0] = force_observation(f_m, p.force_limit)
         obs[2, 0] = force_observation(f_r, p.force_limit)
 
-        finite = math.isfinite(f_m)
-        ref_over = not (abs(f_r) <= p.force_limit)
-        model_over = finite and abs(f_m) > p.force_limit and not ref_over
-        terminated = truncated = False
-        if not finite:
-            terminated = True
+        if abs(f_m) <= p.force_limit and abs(f_r) <= p.force_limit:
+            # both finite and within the limit: force_termination cannot fire (tested); not
+            # calling it saves its ~3 us of numpy scalar calls, a fifth of the step
+            non_finite = model_over = ref_over = False
+        else:
+            verdict = force_termination(f_m, f_r, p.force_limit)
+            non_finite, model_over, ref_over = (bool(v) for v in verdict)
+        finite = not non_finite
+        terminated = non_finite or model_over
+        truncated = ref_over and finite
+        if non_finite:
             reason = reason or "model force is not finite"
-        elif ref_over:
-            truncated = True
         elif model_over:
-            terminated = True
             reason = f"|F_model| = {abs(f_m):.6g} N exceeds {p.force_limit:.6g} N"
         info = self._info(x, v, f_m, f_r, finite, model_over, ref_over, False, reason)
         if self.divergence_monitor is not None and not terminated:
-            verdict = self.divergence_monitor(info)
-            if verdict:
-                terminated = True
-                info["monitor_verdict"] = True
-                info["divergence_reason"] = (
-                    verdict if isinstance(verdict, str) else "divergence monitor"
-                )
+            terminated = self._ask_monitor(info)
         info["diverged"] = terminated
-        if self._t >= self._end:
+        if self._end is not None and self._t >= self._end:
             truncated = True
         reward = float(self.reward_fn(info))
         self._last = (x, f_m, f_r)
@@ -324,6 +384,15 @@ class BushRigEnv(gym.Env):
         if self.render_mode == "human":
             self.render()
         return obs.ravel().copy(), reward, terminated, truncated, info
+
+    def _ask_monitor(self, info: dict[str, Any]) -> bool:
+        """The divergence monitor's verdict, written into ``info``; True ends the episode."""
+        verdict = self.divergence_monitor(info)
+        if not verdict:
+            return False
+        info["monitor_verdict"] = True
+        info["divergence_reason"] = verdict if isinstance(verdict, str) else "divergence monitor"
+        return True
 
     def _info(self, x, v, f_m, f_r, finite, model_over, ref_over, monitor, reason):
         return {
@@ -352,63 +421,9 @@ class BushRigEnv(gym.Env):
             return None
         if self._canvas is None:
             self._canvas = Canvas(600, 400, self.render_mode, self.metadata["render_fps"], ENV_ID)
-        c, p = self._canvas, self.params
-        x, f_m, f_r = self._last
-        self.actuator.position = (x, 0.0)
-        c.clear()
-        c.text(
-            f"{ENV_ID}  axis={p.axis}  model={p.model_name}  reference={p.reference_name}",
-            (10, 8),
-        )
-        c.text(f"t = {self._t * self._dt:6.3f} s   x = {x * 1e3:+7.3f} mm", (10, 28), small=True)
-        # scale: the stroke +-x_max spans +-60 px (the inner sleeve's motion is exaggerated)
-        px_per_m = 60.0 / p.max_x
-        y = 130.0
-        # ground wall and load cell (left)
-        c.rect(20, y - 60, 16, 120, (120, 120, 120))
-        for k in range(8):
-            c.line((20, y - 60 + 15 * k), (8, y - 48 + 15 * k), (120, 120, 120), 2)
-        c.rect(36, y - 22, 40, 44, (70, 110, 160))
-        c.text("load cell", (30, y + 26), small=True)
-        # bushing: outer sleeve on the load cell, rubber, inner sleeve moves with x
-        xc = 150.0
-        bushing_x = xc + float(self.actuator.position.x) * px_per_m
-        c.line((76, y), (xc - 36, y), (60, 60, 60), 6)
-        c.rect(xc - 36, y - 36, 72, 72, (40, 40, 40), 4)
-        c.rect(xc - 32, y - 32, 64, 64, (60, 60, 60))
-        c.rect(bushing_x - 14, y - 14, 28, 28, (200, 200, 200))
-        # actuator rod, piston and groove (right)
-        c.line((bushing_x, y), (bushing_x + 150, y), (90, 90, 90), 8)
-        c.rect(bushing_x + 150, y - 26, 70, 52, (190, 140, 60))
-        c.line((xc + 150 - 60, y + 40), (xc + 150 + 140, y + 40), (120, 120, 120), 3)
-        c.text("actuator on groove", (xc + 150, y + 46), small=True)
-        # stroke marks: where the inner sleeve sits at x = -+x_max
-        for sgn in (-1, 1):
-            c.line((xc + sgn * 60, y - 48), (xc + sgn * 60, y - 40), (200, 0, 0), 2)
-        c.text("stroke", (xc - 18, y - 62), (200, 0, 0), small=True)
-        # force arrows on the load cell (force the bushing puts on the ground)
-        scale = 50.0 / p.force_scale
-        for f, col, dy in ((f_m, (200, 40, 40), -6), (f_r, (40, 70, 200), 6)):
-            if math.isfinite(f):
-                fx = max(-100.0, min(100.0, f * scale))
-                c.arrow((56, y + dy), (56 + fx, y + dy), col, 3)
-        # bars
-        fs = 2 * p.force_scale  # bars and traces span +-2 force_scale_n
-        c.force_bar(330, 70, 250, 16, f_m, fs, (200, 40, 40), f"F model (+-{fs / 1e3:.1f} kN)")
-        c.force_bar(330, 110, 250, 16, f_r, fs, (40, 70, 200), "F reference")
-        c.force_bar(330, 150, 250, 16, x, p.max_x, (60, 150, 60), "displacement")
-        c.text(f"{f_m / 1e3:+8.3f} kN", (500, 52), (200, 40, 40), small=True)
-        c.text(f"{f_r / 1e3:+8.3f} kN", (500, 92), (40, 70, 200), small=True)
-        if self._trace is not None:
-            plot_traces(
-                c,
-                (20, 230, 560, 150),
-                self._trace,
-                (p.max_x, fs, fs),
-                ((60, 150, 60), (200, 40, 40), (40, 70, 200)),
-                ("x / x_max", "F model", "F reference"),
-            )
-        return c.frame()
+        t_s = self._t * self._dt
+        draw_bushrig(self._canvas, self.params, ENV_ID, t_s, self._last, self._trace)
+        return self._canvas.frame()
 
     def close(self) -> None:
         if self._canvas is not None:

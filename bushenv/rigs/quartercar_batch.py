@@ -1,6 +1,7 @@
-"""QuarterCarBatch: the QuarterCar-v0 car for many roads at once, as arrays (B,), for road searches.
+"""QuarterCarBatch: the QuarterCar-v0 car for many roads at once, as (B,) arrays (road searches,
+the vector env).
 
-The same car as ``quartercar.Car`` (parameters from ``envs/QuarterCar-v0.toml``) written as its
+The same car as ``car.Car`` (parameters from ``envs/QuarterCar-v0.toml``) written as its
 own small ODE in generalised coordinates q = (y_c, X, Y, theta): chassis height, the unsprung
 body's centre of mass and its angle (the chassis' horizontal motion is held by its groove, so
 it is not a coordinate). One compiled kernel integrates ``physics_substeps`` sub-steps of B cars
@@ -11,9 +12,7 @@ its own (``implicit_euler_damping``). The bushing coupling is the env's: at ever
 axis models get (x, v) of the arm's inner end relative to the chassis, and the remainder
 F - (k_in x + c_in v) is held over the sub-steps while k_in x + c_in v acts inside them.
 
-Agreement with the pymunk env (tests/rigs/test_quartercar_batch.py): with the linear bushing
-over a 100 mm bump and a harsh random road, chassis and wheel motion within 2 % and bushing
-forces within 5 % of their peaks.
+Its agreement with the pymunk env is stated and tested as in docs/envs.md.
 
 Like the env the batch can carry a twin car with the reference bushing (``with_reference``).
 """
@@ -26,8 +25,18 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-from bushenv.rigs.common import LONG_ARM_M, MODEL_ERRORS, RigError, positive_int, spec_kwargs
-from bushenv.rigs.quartercar import AXES, ENV_ID, CarParameters, axis_models, check_road
+from bushenv.rigs.car import AXES, CarParameters, axis_models, check_road
+from bushenv.rigs.common import (
+    MODEL_ERRORS,
+    RigError,
+    positive_int,
+    reset_columns,
+    shared_state_rows,
+)
+from bushenv.rigs.coupling import LONG_ARM_M
+from bushenv.rigs.specs import spec_kwargs
+
+ENV_ID = "QuarterCar-v0"
 
 # parameter vector layout for the kernel
 P_M_S, P_M_U, P_I_U, P_XCM, P_L, P_MOUNT, P_H, P_KS, P_CS, P_KT, P_TSTAT = range(11)
@@ -171,12 +180,23 @@ class QuarterCarBatch:
     leaves its bounds stops moving (its later samples repeat the last state).
     """
 
-    def __init__(self, num_cars: int, *, with_reference: bool = True, **spec_overrides: Any):
+    def __init__(
+        self,
+        num_cars: int,
+        *,
+        with_reference: bool = True,
+        episode_steps: int | None = None,
+        **spec_overrides: Any,
+    ):
         self.num_cars = positive_int("num_cars", num_cars)
+        if episode_steps is not None:  # taken for the callers that pass it; a road sets length
+            positive_int("episode_steps", episode_steps)
         self.params = p = CarParameters(spec_kwargs(ENV_ID, spec_overrides))
         self.models = p.models
         self.references = p.references if with_reference else None
         self._prm = parameter_vector(p)
+        self._shared: dict[tuple[str, str], np.ndarray] = {}
+        self.raised = {"model": "", "reference": ""}
         self.reset()
 
     def reset(self) -> None:
@@ -197,21 +217,42 @@ class QuarterCarBatch:
             for m in self.references.values():
                 m.reset(n)
 
+    def reset_columns(self, mask: np.ndarray) -> None:
+        """Cars ``mask`` (B,) (and their twins) back to rest on a flat road, their models'
+        histories too; the other cars are left as they are."""
+        n = self.num_cars
+        mask = np.asarray(mask, dtype=bool).reshape(n)
+        both = np.concatenate([mask] * (self.state.shape[1] // n))
+        self.state[:, both] = 0.0
+        self.state[X_U, both] = self.params.x_cm
+        self.road[both] = 0.0
+        self.held[:, both] = 0.0
+        self.active[both] = True
+        self.diverged[mask] = False
+        self.reference_out[mask] = False
+        for group, models in (("model", self.models), ("reference", self.references)):
+            for axis, m in (models or {}).items():
+                if (group, axis) not in self._shared:  # probed once, on the first autoreset
+                    self._shared[group, axis] = shared_state_rows(m)
+                reset_columns(m, mask, self._shared[group, axis])
+
     def step(self, road: np.ndarray) -> dict[str, np.ndarray]:
         p, n = self.params, self.num_cars
         road = np.asarray(road, dtype=np.float64).reshape(n)
         bushing_motion_kernel(self.state, self._prm, self._motion)
         xr, vr, xa, va = self._motion
         forces = np.empty((4, self.state.shape[1]))
-        groups = [(slice(0, n), self.models)]
+        groups = [("model", slice(0, n), self.models)]
         if self.references is not None:
-            groups.append((slice(n, 2 * n), self.references))
-        for cols, models in groups:
+            groups.append(("reference", slice(n, 2 * n), self.references))
+        for group, cols, models in groups:
+            self.raised[group] = ""
             for row, axis, x, v in ((0, "radial", xr, vr), (1, "axial", xa, va)):
                 try:
                     f = np.asarray(models[axis].step(x[cols].copy(), v[cols].copy()))
-                except MODEL_ERRORS:  # a model refusing to go on, 1/0, overflow, ...
+                except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
                     f = np.full(n, np.nan)
+                    self.raised[group] = f"model raised {type(exc).__name__}: {exc}"
                 forces[row, cols] = f
                 forces[row + 2, cols] = x[cols]
                 held = f - (p.k_in[axis] * x[cols] + p.c_in[axis] * v[cols])
@@ -261,7 +302,9 @@ class QuarterCarBatch:
             out.update(
                 {
                     "reference_chassis_y_m": s[Y_C, n:].copy(),
+                    "reference_chassis_vy_m_per_s": s[VY_C, n:].copy(),
                     "reference_wheel_y_m": wheel_y[n:].copy(),
+                    "reference_wheel_vy_m_per_s": wheel_vy[n:].copy(),
                     "reference_radial_deflection_m": xr[n:].copy(),
                     "reference_axial_deflection_m": xa[n:].copy(),
                     "force_radial_reference_n": forces[0, n:].copy(),

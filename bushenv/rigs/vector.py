@@ -4,13 +4,10 @@ The rig's displacement is prescribed (see ``BushRigEnv``), so a rig needs no pym
 know its motion: N rigs are N columns of arrays, and the two models run through their batched
 ``step`` on (N,) arrays -- the same compiled kernels the single env calls with B = 1. Every
 operation on a column is the single env's operation on its floats (IEEE double, same order:
-action clean-up, x + a * step, clip, (x - x0) / dt, F / limit, the reward), so column i of this
-env equals a ``BushRigEnv`` given the same actions, bit for bit (tests/rigs/test_vector.py).
-
-Autoreset is next-step (``metadata["autoreset_mode"]``): the step after a sub-environment's
-episode ended returns its reset observation, reward 0 and no termination; its models' columns
-are returned to rest with ``initial_state``, except rows shared by all columns (a ring-buffer
-position the kernel reads from column 0; ``common.shared_state_rows``).
+action clean-up, x + a * step, clip, (x - x0) / dt, F / limit, the reward, and the episode's end
+from ``divergence.force_termination``), so column i equals a ``BushRigEnv`` given the same
+actions, bit for bit (tests/rigs/test_vector.py). An auto-reset column of a model returns to
+``initial_state`` except rows shared by all columns (``common.shared_state_rows``).
 """
 
 from __future__ import annotations
@@ -18,52 +15,64 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
+from bushenv.divergence import force_termination
+from bushenv.rigs.actions import check_options, unit_actions
 from bushenv.rigs.bushrig import ENV_ID, BushRigEnv, RigParameters, check_excitation
 from bushenv.rigs.common import (
     MODEL_ERRORS,
     ForceDeviationReward,
     RigError,
     call_reset,
-    call_reset_columns,
     check_hook,
-    check_options,
     force_observations,
-    positive_int,
     reset_columns,
     shared_state_rows,
-    spec_kwargs,
-    unit_actions,
 )
+from bushenv.rigs.specs import spec_kwargs
+from bushenv.rigs.vector_base import ArrayVectorEnv
 
-INFO_KEYS = (
-    "time_s",
-    "step",
-    "displacement_m",
-    "velocity_m_per_s",
-    "force_model_n",
-    "force_reference_n",
-    "error_n",
-    "model_force_finite",
-    "model_over_force_limit",
-    "reference_over_force_limit",
-    "monitor_verdict",
-    "diverged",
-    "machine_limit",
-    "divergence_reason",
-)
+# info keys and their values at rest (the reset info of one rig)
+REST_INFO = {
+    "time_s": 0.0,
+    "step": 0,
+    "displacement_m": 0.0,
+    "velocity_m_per_s": 0.0,
+    "force_model_n": 0.0,
+    "force_reference_n": 0.0,
+    "error_n": 0.0,
+    "model_force_finite": True,
+    "model_over_force_limit": False,
+    "reference_over_force_limit": False,
+    "monitor_verdict": False,
+    "diverged": False,
+    "machine_limit": False,
+    "divergence_reason": "",
+}
 
 
-class BushRigVectorEnv(VectorEnv):
-    """N BushRig-v0 rigs as arrays. Arguments as ``BushRigEnv`` plus ``num_envs``; ``info``
-    holds (N,) arrays under the single env's keys (and Gymnasium's ``_key`` masks).
-    ``reset(options={"excitation": x})`` takes x of shape (T,) (every rig) or (T, N)."""
+class BushRigVectorEnv(ArrayVectorEnv):
+    """N BushRig-v0 rigs as arrays.
+
+    Arguments as ``BushRigEnv`` plus ``num_envs``, ``max_episode_steps`` (default: the spec's
+    2048) and ``autoreset_mode`` (``NEXT_STEP`` by default, or ``SAME_STEP``; see
+    ``vector_base``). ``info`` holds (N,) arrays under the single env's keys (and Gymnasium's
+    ``_key`` masks); hooks get those arrays and return (N,) arrays.
+    ``reset(options={"excitation": x})`` takes x of shape (T,) (every rig) or (T, N).
+
+    >>> import gymnasium as gym
+    >>> import bushenv
+    >>> venv = gym.make_vec("BushRig-v0", num_envs=3, vectorization_mode="vector_entry_point")
+    >>> obs, info = venv.reset(seed=0)
+    >>> obs.shape, info["force_model_n"].shape, venv.unwrapped.max_episode_steps
+    ((3, 12), (3,), 2048)
+    """
 
     metadata = {
         "render_modes": ["rgb_array"],
-        "render_fps": 50,
+        "render_fps": 204.8,
         "autoreset_mode": AutoresetMode.NEXT_STEP,
     }
 
@@ -71,6 +80,9 @@ class BushRigVectorEnv(VectorEnv):
         self,
         num_envs: int = 1,
         *,
+        max_episode_steps: int | None = None,
+        episode_steps: int | None = None,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         render_mode: str | None = None,
         reward_fn=None,
         divergence_monitor=None,
@@ -78,9 +90,11 @@ class BushRigVectorEnv(VectorEnv):
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise RigError(f"render_mode must be one of {self.metadata['render_modes']}")
-        self.num_envs = n = positive_int("num_envs", num_envs)
+        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode)
+        n = self.num_envs
         p = RigParameters(spec_kwargs(ENV_ID, spec_overrides))
         self.params = p
+        self.metadata = p.metadata(self.metadata)
         self._overrides = dict(spec_overrides)
         self.render_mode = render_mode
         self.model, self.reference = p.model, p.reference
@@ -94,19 +108,15 @@ class BushRigVectorEnv(VectorEnv):
         self.divergence_monitor = check_hook("divergence_monitor", divergence_monitor)
         self._obs = np.zeros((n, 3, p.history), dtype=np.float32)
         self._x = np.zeros(n)
-        self._t = np.zeros(n, dtype=np.int64)
-        self._end = np.full(n, p.episode_steps, dtype=np.int64)
         self._replay: np.ndarray | None = None
-        self._prev_done = np.zeros(n, dtype=bool)
         self._columns = np.arange(n)
-        self._masks = {"_" + k: np.ones(n, dtype=bool) for k in INFO_KEYS}
         self._render_env: BushRigEnv | None = None
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
         p, n = self.params, self.num_envs
         self._replay = None
-        self._end[:] = p.episode_steps
+        self._end[:] = self.max_episode_steps
         options = check_options(ENV_ID, options)
         if options.get("excitation") is not None:
             x = check_excitation(options["excitation"], p.max_x, p.max_step)
@@ -124,11 +134,23 @@ class BushRigVectorEnv(VectorEnv):
         self._x[:] = 0.0
         self._t[:] = 0
         self._prev_done[:] = False
-        zeros = np.zeros(n)
-        info = self._info(
-            zeros, zeros, zeros, zeros, np.ones(n, bool), *(np.zeros(n, bool),) * 3, None
-        )
+        zeros, no = np.zeros(n), np.zeros(n, dtype=bool)
+        reasons = np.full(n, "", dtype=object)
+        info = self._info(zeros, zeros, zeros, zeros, ~no, no, no, no.copy(), reasons)
         return self._obs.reshape(n, -1).copy(), info
+
+    def _model_forces(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, str]:
+        """The model's (N,) forces and, if its batched step raised, the reason. A raise refuses
+        the whole batch; the histories that caused it show non-finite forces in what the kernel
+        wrote (``last_force_n``); all columns are judged if none do."""
+        n = self.num_envs
+        try:
+            return np.array(self.model.step(x, v), dtype=np.float64), ""
+        except MODEL_ERRORS as exc:
+            f_m = np.array(self.model.last_force_n, np.float64)
+            if f_m.shape != (n,) or np.isfinite(f_m).all():
+                f_m = np.full(n, np.nan)
+            return f_m, f"model raised {type(exc).__name__}: {exc}"
 
     def step(self, actions):
         p, n = self.params, self.num_envs
@@ -141,18 +163,7 @@ class BushRigVectorEnv(VectorEnv):
         v = (x - x0) / p.dt
         self._x = x
         self._t += 1
-
-        raised = ""
-        try:
-            f_m = np.array(self.model.step(x, v), dtype=np.float64)
-        except MODEL_ERRORS as exc:
-            # The batched step refused as a whole; the histories that caused it show non-finite
-            # forces in the model's output buffer (all columns are judged if none do).
-            raised = f"model raised {type(exc).__name__}: {exc}"
-            buffer = getattr(self.model, "_f1", None)
-            f_m = np.array(buffer[0] if buffer is not None else np.full(n, np.nan), np.float64)
-            if f_m.shape != (n,) or np.isfinite(f_m).all():
-                f_m = np.full(n, np.nan)
+        f_m, raised = self._model_forces(x, v)
         f_r = np.array(self.reference.step(x, v), dtype=np.float64)
 
         obs = self._obs
@@ -161,17 +172,15 @@ class BushRigVectorEnv(VectorEnv):
         obs[:, 1, 0] = force_observations(f_m, p.force_limit)
         obs[:, 2, 0] = force_observations(f_r, p.force_limit)
 
-        finite = np.isfinite(f_m)
-        ref_over = ~(np.abs(f_r) <= p.force_limit)
-        model_over = finite & (np.abs(np.where(finite, f_m, 0.0)) > p.force_limit) & ~ref_over
-        terminated = ~finite | (model_over & ~ref_over)
-        truncated = ref_over & finite
+        non_finite, model_over, ref_over = force_termination(f_m, f_r, p.force_limit)
+        terminated = non_finite | model_over
+        truncated = ref_over & ~non_finite
         reasons = np.full(n, "", dtype=object)
-        reasons[~finite] = raised or "model force is not finite"
-        for i in np.flatnonzero(model_over & finite):
+        reasons[non_finite] = raised or "model force is not finite"
+        for i in np.flatnonzero(model_over):
             reasons[i] = f"|F_model| = {abs(f_m[i]):.6g} N exceeds {p.force_limit:.6g} N"
         monitor = np.zeros(n, dtype=bool)
-        info = self._info(x, v, f_m, f_r, finite, model_over, ref_over, monitor, reasons)
+        info = self._info(x, v, f_m, f_r, ~non_finite, model_over, ref_over, monitor, reasons)
         if self.divergence_monitor is not None:
             verdict = np.asarray(self.divergence_monitor(info), dtype=bool)
             verdict = np.broadcast_to(verdict, (n,)) & ~terminated
@@ -179,29 +188,19 @@ class BushRigVectorEnv(VectorEnv):
             reasons[verdict] = "divergence monitor"
             terminated = terminated | verdict
         info["diverged"] = terminated.copy()
-        truncated = truncated | (self._t >= self._end)
         reward = np.asarray(self.reward_fn(info), dtype=np.float64).copy()
+        return self._end_step(obs.reshape(n, -1).copy(), reward, terminated, truncated, info)
 
-        done = self._prev_done
-        if done.any():  # next-step autoreset of the rigs whose episode ended last step
-            reset_columns(self.model, done, self._shared[0])
-            reset_columns(self.reference, done, self._shared[1])
-            call_reset_columns(self.reward_fn, done)
-            call_reset_columns(self.divergence_monitor, done)
-            obs[done] = 0.0
-            self._x[done] = 0.0
-            self._t[done] = 0
-            reward[done] = 0.0
-            terminated[done] = False
-            truncated[done] = False
-            for key in INFO_KEYS:
-                arr = info[key]
-                arr[done] = "" if key == "divergence_reason" else (key == "model_force_finite")
-        self._prev_done = terminated | truncated
-        return obs.reshape(n, -1).copy(), reward, terminated, truncated, info
+    def _reset_columns(self, mask: np.ndarray) -> None:
+        reset_columns(self.model, mask, self._shared[0])
+        reset_columns(self.reference, mask, self._shared[1])
+        self._obs[mask] = 0.0
+        self._x[mask] = 0.0
+
+    def _rest_info(self) -> dict[str, Any]:
+        return REST_INFO
 
     def _info(self, x, v, f_m, f_r, finite, model_over, ref_over, monitor, reasons):
-        n = self.num_envs
         info = {
             "time_s": self._t * self.params.dt,
             "step": self._t.copy(),
@@ -214,13 +213,11 @@ class BushRigVectorEnv(VectorEnv):
             "model_over_force_limit": model_over.copy(),
             "reference_over_force_limit": ref_over.copy(),
             "monitor_verdict": monitor,
-            "diverged": np.zeros(n, dtype=bool),
+            "diverged": np.zeros(self.num_envs, dtype=bool),
             "machine_limit": ref_over.copy(),
-            "divergence_reason": reasons if reasons is not None else np.full(n, "", object),
+            "divergence_reason": reasons,
         }
-        for k, m in self._masks.items():
-            info[k] = m.copy()
-        return info
+        return self._masks(info)
 
     def render(self):
         """A frame of rig 0 (drawn by a ``BushRigEnv`` set to its state)."""

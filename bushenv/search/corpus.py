@@ -13,10 +13,17 @@ A case file (``tests/regressions/corpus/<name>.json``) holds:
 |               | by a float64 cumulative sum from 0 (holds stay exactly constant)            |
 | family, params| the excitation family and its physical parameters (or the agent's name)     |
 | found_by      | searcher, seed, model name and the sha256 of the model file it was found on |
-| expect        | per model name: ``diverged`` (bool), the ``criterion`` it fired (or null),  |
-|               | ``sha256`` of the model file the verdict was recorded with                  |
-| reference     | the reference bushing (``rubber``, measurement effects off) and a sha256 of |
-|               | its parameters                                                              |
+| expect        | per model spec: ``diverged`` (bool), the ``criterion`` it fired (or null),  |
+|               | ``sha256`` of the model file the verdict was recorded with. A spec is a     |
+|               | registered name (its shipped file) or a model file; a relative file path is |
+|               | relative to the case's own folder (``../models/old.npz``), so a case keeps  |
+|               | replaying a model that is no longer shipped                                 |
+| reference     | ``spec``: the reference the verdicts were judged against (a registered name |
+|               | or a model file; null: judged without one, by the criteria that need none), |
+|               | ``file_sha256`` and ``params_sha256``; replay refuses when it is missing    |
+|               | (cases before this field name the built-in ``rubber``)                     |
+| scales        | the bushing's scales the verdicts used (``bushenv/scales.py``; default the  |
+|               | papers' machine)                                                            |
 | shrink        | what shrinking did (segments / samples / peak before and after)            |
 
 The verdicts in ``expect`` are measured on the DECODED profile when the case is made (float32
@@ -32,7 +39,6 @@ import base64
 import hashlib
 import json
 import os
-import tempfile
 import zlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -41,8 +47,20 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models import TRAINED, BushingModel, default_model_path, file_hash, get_model
+from bushenv.models import (
+    MODELS,
+    BushingModel,
+    file_hash,
+    get_model,
+    get_reference,
+    model_file,
+    params_sha,
+)
 from bushenv.models.base import PAPER_DT
+from bushenv.persist import write_json
+from bushenv.scales import MACHINE, BushingScales
+from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.targets import TARGETS
 
 CASE_FORMAT = "bushenv-divergence-case"
 CASE_VERSION = 1
@@ -86,29 +104,42 @@ def profile_sha(x: np.ndarray) -> str:
 
 # ----- model and reference identity -------------------------------------------------------------
 def model_sha(name: str, axis: str) -> str | None:
-    """sha256 of the shipped file behind a registered trained name (None for presets)."""
-    if name in TRAINED:
-        path = default_model_path(name, axis)
-        return file_hash(path) if path.is_file() else None
-    return None
-
-
-def params_sha(model: BushingModel) -> str:
-    """sha256 of a model's parameters and settings (for presets such as the reference)."""
-    blob = {
-        "class": type(model).__name__,
-        "dt": model.dt,
-        "params": {k: np.asarray(v, dtype=np.float64).tolist() for k, v in model.params.items()},
-        "extra": model.extra_meta(),
-    }
-    return hashlib.sha256(json.dumps(blob, sort_keys=True, default=str).encode()).hexdigest()
+    """sha256 of the file behind a model name (a shipped default or a path; None for presets)."""
+    path = model_file(name, axis)
+    return file_hash(path) if path is not None and path.is_file() else None
 
 
 def truth_reference(axis: str, dt: float = PAPER_DT) -> BushingModel:
-    """The "real" bushing every verdict is measured against: the rubber specimen alone."""
-    from bushenv.reference.rubber import RubberBushing
+    """The built-in "real" bushing: the rubber specimen alone (``get_reference("rubber")``)."""
+    return get_reference("rubber", axis=axis, dt=dt)
 
-    return RubberBushing.preset(axis, dt=dt, measurement=False)
+
+def reference_identity(spec: str | None, reference: BushingModel | None, axis: str) -> dict:
+    """What a case or report records of its reference: the spec it was given by (a registered
+    name or a model file; None: judged without one), the file's and the parameters' sha256."""
+    if reference is None:
+        return {"spec": None, "file_sha256": None, "params_sha256": None}
+    return {
+        "spec": spec,
+        "file_sha256": model_sha(spec, axis) if spec is not None else None,
+        "params_sha256": params_sha(reference),
+    }
+
+
+def case_reference(case: Case) -> BushingModel | None:
+    """The reference a case was judged against, resolved today; refuses (``CorpusError``) when
+    it is gone. Cases written before references were explicit name the built-in rubber."""
+    ref = case.reference
+    spec = ref.get("spec", ref.get("name", "rubber")) if ref else "rubber"
+    if spec is None:
+        return None
+    try:
+        return get_reference(spec, axis=case.axis, dt=case.dt)
+    except ValueError as exc:
+        raise CorpusError(
+            f"case {case.name}: its reference {spec!r} cannot be loaded ({exc}); restore the "
+            f"file (sha256 {str(ref.get('file_sha256'))[:12]}) or record the case again"
+        ) from None
 
 
 # ----- cases -------------------------------------------------------------------------------------
@@ -126,6 +157,8 @@ class Case:
     reference: dict[str, Any]
     shrink: dict[str, Any] | None = None
     notes: str = ""
+    scales: BushingScales = MACHINE
+    static: bool = True  # the static criterion judged (the reference's static is trusted)
     path: Path | None = field(default=None, compare=False)
 
     def to_json(self) -> dict[str, Any]:
@@ -142,6 +175,8 @@ class Case:
             "found_by": self.found_by,
             "expect": self.expect,
             "reference": self.reference,
+            "scales": self.scales.to_json(),
+            "static": self.static,
             "shrink": self.shrink,
             "notes": self.notes,
         }
@@ -154,19 +189,29 @@ def _default_resolver(name: str, axis: str, dt: float) -> BushingModel:
     return get_model(name, axis=axis, dt=dt)
 
 
+def model_spec(case: Case, spec: str) -> str:
+    """The model an ``expect`` key names: a registered name (or any other name a resolver
+    knows) as it is; a relative file path (``.npz``, or a path with a folder) taken relative to
+    the case's folder (absolute paths and cases not read from a file: as given)."""
+    is_path = spec.endswith(".npz") or "/" in spec or os.sep in spec
+    if spec in MODELS or not is_path or case.path is None or Path(spec).is_absolute():
+        return spec
+    return str(case.path.parent / spec)
+
+
 def judge_profile(
     profile: np.ndarray,
     models: dict[str, BushingModel],
     env: str,
     axis: str,
-    reference: BushingModel,
+    reference: BushingModel | None,
+    scales: BushingScales = MACHINE,
+    static: bool = True,
 ) -> dict[str, dict[str, Any]]:
     """Verdict row of ``profile`` for each model (prescribed-motion or quarter-car path)."""
-    from bushenv.search.evaluate import BatchEvaluator
-
     out = {}
     for name, model in models.items():
-        ev = BatchEvaluator(model, reference, env=env, axis=axis)
+        ev = BatchEvaluator(model, reference, env, axis=axis, scales=scales, static=static)
         out[name] = ev.evaluate([profile]).verdict.row(0)
     return out
 
@@ -180,14 +225,18 @@ def make_case(
     params: Any,
     found_by: dict[str, Any],
     models: dict[str, BushingModel],
-    reference: BushingModel,
+    reference: BushingModel | None,
+    reference_spec: str | None = "rubber",
+    scales: BushingScales = MACHINE,
+    static: bool = True,
     shas: dict[str, str | None] | None = None,
     shrink: dict[str, Any] | None = None,
     notes: str = "",
 ) -> Case:
-    """A case whose ``expect`` holds what each model does on the decoded profile now."""
+    """A case whose ``expect`` holds what each model does on the decoded profile now, against
+    ``reference`` (given by ``reference_spec``; None: judged without one) at ``scales``."""
     x = decode_profile(encode_profile(profile))
-    rows = judge_profile(x, models, env, axis, reference)
+    rows = judge_profile(x, models, env, axis, reference, scales, static)
     shas = shas or {}
     expect = {
         name: {
@@ -204,15 +253,17 @@ def make_case(
         name=name,
         env=env,
         axis=axis,
-        dt=float(reference.dt),
+        dt=float(next(iter(models.values())).dt),
         profile=x,
         family=family,
         params=params,
         found_by=found_by,
         expect=expect,
-        reference={"name": "rubber", "measurement": False, "params_sha256": params_sha(reference)},
+        reference=reference_identity(reference_spec, reference, axis),
         shrink=shrink,
         notes=notes,
+        scales=scales,
+        static=static,
     )
 
 
@@ -223,21 +274,10 @@ def _slug(text: str) -> str:
 
 def save_case(case: Case, directory: str | os.PathLike, force: bool = False) -> Path | None:
     """Write ``case`` atomically as ``directory/<name>.json``; None if it exists (unless force)."""
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / f"{case.name}.json"
+    path = Path(directory) / f"{case.name}.json"
     if path.exists() and not force:
         return None
-    text = json.dumps(case.to_json(), indent=1, sort_keys=False) + "\n"
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=path.name, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp makes 0600; these are ordinary shared files
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_json(path, case.to_json())
     case.path = path
     return path
 
@@ -255,8 +295,8 @@ def load_case(path: str | os.PathLike) -> Case:
     for key in ("name", "env", "axis", "dt", "profile", "expect", "found_by"):
         if key not in d:
             raise CorpusError(f"{path}: case lacks {key!r}")
-    if d["env"] not in ("rig", "quartercar"):
-        raise CorpusError(f"{path}: env must be 'rig' or 'quartercar', got {d['env']!r}")
+    if d["env"] not in TARGETS:
+        raise CorpusError(f"{path}: env {d['env']!r}: {TARGETS.unknown_message(d['env'])}")
     if not isinstance(d["expect"], dict) or not d["expect"]:
         raise CorpusError(f"{path}: 'expect' must name at least one model")
     for name, e in d["expect"].items():
@@ -273,10 +313,21 @@ def load_case(path: str | os.PathLike) -> Case:
         found_by=d["found_by"],
         expect=d["expect"],
         reference=d.get("reference", {}),
+        scales=_scales(d.get("scales"), path),
+        static=bool(d.get("static", True)),
         shrink=d.get("shrink"),
         notes=d.get("notes", ""),
         path=path,
     )
+
+
+def _scales(d: Any, path: Path) -> BushingScales:
+    if d is None:
+        return MACHINE
+    try:
+        return BushingScales(**d)
+    except (TypeError, ValueError) as exc:
+        raise CorpusError(f"{path}: 'scales' is not valid: {exc}") from None
 
 
 def case_files(directory: str | os.PathLike = DEFAULT_CORPUS) -> list[Path]:
@@ -309,9 +360,15 @@ def replay(
     """
     resolve = resolve or _default_resolver
     sha_of = sha_of or model_sha
-    reference = truth_reference(case.axis, case.dt)
-    models = {name: resolve(name, case.axis, case.dt) for name in case.expect}
-    rows = judge_profile(case.profile, models, case.env, case.axis, reference)
+    reference = case_reference(case)
+    specs = {name: model_spec(case, name) for name in case.expect}
+    try:
+        models = {name: resolve(spec, case.axis, case.dt) for name, spec in specs.items()}
+    except ValueError as exc:
+        raise CorpusError(f"case {case.name}: a model it names cannot be loaded: {exc}") from None
+    rows = judge_profile(
+        case.profile, models, case.env, case.axis, reference, case.scales, case.static
+    )
     return [
         Replay(
             model=name,
@@ -319,7 +376,7 @@ def replay(
             diverged=bool(rows[name]["diverged"]),
             row=rows[name],
             sha_recorded=case.expect[name].get("sha256"),
-            sha_now=sha_of(name, case.axis),
+            sha_now=sha_of(specs[name], case.axis),
         )
         for name in case.expect
     ]
@@ -333,7 +390,8 @@ def check(
     """Messages for every changed verdict (empty when the case still holds)."""
     problems = []
     results = replay(case, resolve, sha_of)
-    ref_now = params_sha(truth_reference(case.axis, case.dt))
+    reference = case_reference(case)
+    ref_now = None if reference is None else params_sha(reference)
     ref_changed = case.reference.get("params_sha256") not in (None, ref_now)
     for r in results:
         if r.ok:
@@ -353,6 +411,6 @@ def check(
         elif r.sha_recorded and r.sha_recorded == r.sha_now:
             msg += f"; the {r.model} model file is the one the case was recorded with"
         if ref_changed:
-            msg += "; the reference rubber bushing's parameters changed since then"
+            msg += "; the reference's parameters changed since the case was recorded"
         problems.append(msg)
     return problems

@@ -1,10 +1,10 @@
-"""Batched evaluation: a population of profiles -> one (T, B) free run per model -> verdicts.
+"""Batched evaluation: a population of profiles -> one (T, B) run per model -> verdicts.
 
-``BatchEvaluator(model, reference)`` is what every searcher calls. One call takes a list of
-profiles (each (T_i,) displacement in m for the rig, or road height for the quarter car), pads
-them into one (T, B) array (``families.pad_batch``), runs ``model.simulate`` and
-``reference.simulate`` once each over the whole batch (the compiled kernels loop over B
-innermost) and judges every column with ``divergence.judge``. It counts model evaluations
+``BatchEvaluator(model, reference, target)`` is what every searcher calls. One call takes a
+list of profiles (each (T_i,): displacement in m for the rig, road height for the quarter car),
+pads them into one (T, B) array (``families.pad_batch``), has the target simulate the model and
+the reference over the whole batch (``targets.py``; the compiled kernels loop over B innermost)
+and judges every column with ``divergence.judge``. It counts model evaluations
 (one per profile) and the wall time spent, so budgets and "evaluations to first failure" mean
 the same thing for every searcher.
 
@@ -35,10 +35,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bushenv.models.base import BushingModel
+from bushenv.divergence import Verdict, static_curve
+from bushenv.models.base import DT_TOLERANCE, BushingModel
 from bushenv.models.narx import NarxBushing
-from bushenv.search.divergence import Verdict, judge
+from bushenv.scales import MACHINE, BushingScales
+from bushenv.search.base import SearchError
 from bushenv.search.families import pad_batch
+from bushenv.search.targets import Responses, Target, get_target, simulate_or_nan
 
 REFERENCE_CACHE_SIZE = 4096
 
@@ -50,13 +53,65 @@ class BatchResult:
     x: np.ndarray  # (T, B) bushing deflection the model saw, m
     lengths: np.ndarray  # (B,)
     f_model: np.ndarray  # (T, B) N
-    f_ref: np.ndarray  # (T, B) N
+    f_ref: np.ndarray | None  # (T, B) N; None when judged without a reference
     verdict: Verdict
-    road: np.ndarray | None = None  # (T, B) road height for quarter-car batches
+    profiles: np.ndarray  # (T, B) the profiles as given (displacement or road height)
 
     def profile(self, b: int) -> np.ndarray:
-        src = self.road if self.road is not None else self.x
-        return src[: self.lengths[b], b].copy()
+        return self.profiles[: self.lengths[b], b].copy()
+
+
+class ReferenceRuns:
+    """The reference's forces on (T, B) profiles, cached by each profile's bytes (shared by the
+    evaluator's threads; each thread runs its own copy of the model), and its static curve.
+    ``model`` None: no reference (every force is None)."""
+
+    def __init__(
+        self,
+        model: BushingModel | None,
+        cache: OrderedDict,
+        lock: threading.Lock,
+        scales: BushingScales = MACHINE,
+        static: bool = True,
+    ) -> None:
+        self.model, self._cache, self._lock, self.scales = model, cache, lock, scales
+        self.static = static
+
+    def static_forces(self, x: np.ndarray) -> np.ndarray | None:
+        """The reference's static force at every sample's displacement (``static_curve``);
+        None without a reference or when its static behaviour is not to be trusted."""
+        if self.model is None or not self.static:
+            return None
+        with self._lock:
+            if "static curve" not in self._cache:
+                self._cache["static curve"] = static_curve(self.model.copy(), self.scales.stroke_m)
+            xs, fs = self._cache["static curve"]
+        return np.interp(x, xs, fs)
+
+    def forces(self, x: np.ndarray, lengths: np.ndarray) -> np.ndarray | None:
+        """Reference force for each column; only the first ``lengths[b]`` samples are real."""
+        if self.model is None:
+            return None
+        keys = [hashlib.sha1(x[: lengths[b], b].tobytes()).hexdigest() for b in range(x.shape[1])]
+        with self._lock:
+            found = {b: self._cache.get(key) for b, key in enumerate(keys)}
+        missing = [b for b, got in found.items() if got is None]
+        if missing:
+            fr_new = simulate_or_nan(self.model, np.ascontiguousarray(x[:, missing]))
+            with self._lock:
+                for j, b in enumerate(missing):
+                    found[b] = fr_new[: lengths[b], j].copy()
+                    self._cache[keys[b]] = found[b]
+                while len(self._cache) > REFERENCE_CACHE_SIZE:
+                    oldest = next(iter(self._cache))
+                    curve = self._cache.pop(oldest)
+                    if oldest == "static curve":  # kept: it serves every profile
+                        self._cache["static curve"] = curve
+        out = np.empty_like(x)
+        for b, cached in found.items():
+            out[: lengths[b], b] = cached
+            out[lengths[b] :, b] = cached[-1]  # past the profile's end: ignored by judge
+        return out
 
 
 class BatchEvaluator:
@@ -65,74 +120,58 @@ class BatchEvaluator:
     def __init__(
         self,
         model: BushingModel,
-        reference: BushingModel,
-        env: str = "rig",
+        reference: BushingModel | None,
+        target: str | Target = "rig",
         threads: int = 1,
         axis: str = "axial",
         dtype: str = "float64",
+        scales: BushingScales = MACHINE,
+        static: bool = True,
     ) -> None:
-        if abs(model.dt - reference.dt) > 1e-9 * model.dt:
-            raise ValueError(
-                f"model dt {model.dt:.6g} s differs from the reference's {reference.dt:.6g} s"
+        self.target = get_target(target)
+        if reference is None and not self.target.reference_free:
+            raise SearchError(
+                f"the {self.target.name} target needs a reference (its twin runs on it)"
             )
-        if env not in ("rig", "quartercar"):
-            raise ValueError(f"env must be 'rig' or 'quartercar', got {env!r}")
+        if reference is not None and abs(model.dt - reference.dt) > DT_TOLERANCE * model.dt:
+            raise SearchError(
+                f"the model runs at {1 / model.dt:.6g} Hz (dt {model.dt:.6g} s), the reference "
+                f"at {1 / reference.dt:.6g} Hz (dt {reference.dt:.6g} s): a verdict needs both "
+                "at one rate"
+            )
         if dtype not in ("float64", "float32"):
-            raise ValueError(f"dtype must be 'float64' or 'float32', got {dtype!r}")
-        if dtype == "float32" and not (isinstance(model, NarxBushing) and env == "rig"):
-            raise ValueError(
+            raise SearchError(f"dtype must be 'float64' or 'float32', got {dtype!r}")
+        if dtype == "float32" and not (isinstance(model, NarxBushing) and self.target.float32):
+            raise SearchError(
                 f"dtype 'float32' is for NARX models (nn, hybrid) on the rig, not {model.name!r} "
-                f"on the {env}"
+                f"on the {self.target.name}"
             )
         self.dtype = dtype
+        self.scales = scales
         self.model = model
         self.reference = reference
         self.dt = model.dt
-        self.env = env
         self.axis = axis
         self.threads = max(1, int(threads))
         self.n_evaluations = 0
         self.seconds = 0.0
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
-        self._copies = [(model.copy(), reference.copy()) for _ in range(self.threads)]
-        self._ref_cache: OrderedDict[str, np.ndarray] = OrderedDict()
-        self._lock = threading.Lock()
+        cache: OrderedDict[str, np.ndarray] = OrderedDict()
+        lock = threading.Lock()
+        self._copies = [
+            (
+                model.copy(),
+                ReferenceRuns(reference and reference.copy(), cache, lock, scales, static),
+            )
+            for _ in range(self.threads)
+        ]
 
-    # ----- one chunk --------------------------------------------------------------------------
-    def _run_chunk(self, k: int, x: np.ndarray, lengths: np.ndarray):
+    def _run_chunk(self, k: int, x: np.ndarray, lengths: np.ndarray) -> Responses:
         model, ref = self._copies[k]
-        if self.env == "rig":
-            if self.dtype == "float32":
-                fm = model.simulate(x, dtype="float32").astype(np.float64)
-            else:
-                fm = simulate_or_nan(model, x)
-            fr = self._reference_rig(ref, x, lengths)
-            return judge(x, fm, fr, self.dt, lengths=lengths), x, fm, fr, None
-        from bushenv.search.roads import quarter_car_responses
+        return self.target.responses(
+            model, ref, x, lengths, self.dt, self.axis, self.dtype, self.scales
+        )
 
-        return quarter_car_responses(model, ref, x, lengths, self.dt, self.axis)
-
-    def _reference_rig(self, ref: BushingModel, x: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-        """Reference force for each column; only the first ``lengths[b]`` samples are real."""
-        keys = [hashlib.sha1(x[: lengths[b], b].tobytes()).hexdigest() for b in range(x.shape[1])]
-        with self._lock:
-            found = {b: self._ref_cache.get(key) for b, key in enumerate(keys)}
-        missing = [b for b, got in found.items() if got is None]
-        if missing:
-            fr_new = ref.simulate(np.ascontiguousarray(x[:, missing]))
-            with self._lock:
-                for j, b in enumerate(missing):
-                    found[b] = fr_new[: lengths[b], j].copy()
-                    self._ref_cache[keys[b]] = found[b]
-                while len(self._ref_cache) > REFERENCE_CACHE_SIZE:
-                    self._ref_cache.popitem(last=False)
-        out = np.empty_like(x)
-        for b, cached in found.items():
-            out[: lengths[b], b] = cached
-            out[lengths[b] :, b] = cached[-1]  # past the profile's end: ignored by judge
-        return out
-
-    # ----- the public call --------------------------------------------------------------------
     def evaluate(self, profiles: list[np.ndarray]) -> BatchResult:
         """Judge every profile; counts ``len(profiles)`` model evaluations."""
         t0 = time.perf_counter()
@@ -149,14 +188,13 @@ class BatchEvaluator:
                 for i, (a, b) in enumerate(chunks)
             ]
             parts = [f.result() for f in futures]
-        verdict = _merge_verdicts([p[0] for p in parts])
-        xs = np.concatenate([p[1] for p in parts], axis=1)
-        fm = np.concatenate([p[2] for p in parts], axis=1)
-        fr = np.concatenate([p[3] for p in parts], axis=1)
-        road = x if self.env == "quartercar" else None
+        verdict = _merge_verdicts([p.verdict for p in parts])
+        xs = np.concatenate([p.x for p in parts], axis=1)
+        fm = np.concatenate([p.f_model for p in parts], axis=1)
+        fr = None if parts[0].f_ref is None else np.concatenate([p.f_ref for p in parts], axis=1)
         self.n_evaluations += B
         self.seconds += time.perf_counter() - t0
-        return BatchResult(xs, lengths, fm, fr, verdict, road=road)
+        return BatchResult(xs, lengths, fm, fr, verdict, profiles=x)
 
     def close(self) -> None:
         if self._pool is not None:
@@ -168,35 +206,6 @@ class BatchEvaluator:
 
     def __exit__(self, *exc) -> None:
         self.close()
-
-
-def simulate_or_nan(model: BushingModel, x: np.ndarray) -> np.ndarray:
-    """``model.simulate(x)`` for (T, B) ``x``; a model that refuses (raises ValueError, e.g.
-    Bouc-Wen's step-size control) gives NaN from the sample it refused on, in the histories that
-    made it refuse -- a non-finite output, which ``judge`` calls a divergence."""
-    try:
-        return model.simulate(x)
-    except ValueError:
-        pass
-    from bushenv.models.base import velocity_of
-
-    out = np.empty_like(x)
-    for b in range(x.shape[1]):
-        col = np.ascontiguousarray(x[:, b])
-        try:
-            out[:, b] = model.simulate(col)
-            continue
-        except ValueError:
-            pass
-        v = velocity_of(col, model.dt)  # the velocity simulate would have used
-        model.reset(1)
-        out[:, b] = np.nan
-        for t in range(col.size):
-            try:
-                out[t, b] = model.step(col[t], v[t])
-            except ValueError:
-                break
-    return out
 
 
 def _merge_verdicts(parts: list[Verdict]) -> Verdict:
@@ -215,4 +224,9 @@ def _merge_verdicts(parts: list[Verdict]) -> Verdict:
             for k in parts[0].criterion_robustness
         },
         scale_n=cat([p.scale_n for p in parts]),
+        criteria_run=parts[0].criteria_run,
+        reference_unusable=cat([p.reference_unusable for p in parts]),
+        criterion_first_s={
+            k: cat([p.criterion_first_s[k] for p in parts]) for k in parts[0].criterion_first_s
+        },
     )

@@ -5,7 +5,7 @@ within the test machine's limits (``bushenv.excitation``: |x| <= 12.5 mm, |dx/dt
 0.1-80 Hz) and builds the signal with the generators of ``bushenv.excitation``. Every rig
 profile starts at rest (x[0] = 0), ends in a hold (x constant, so the free response after the
 input stops is judged, seed 000 §5.2) and lasts at most ``max_s`` seconds. Road families
-(``env == "quartercar"``) give road height under the wheel instead.
+(target ``quartercar``) give road height under the wheel instead.
 
 | family      | d | parameters (physical range)                                                 |
 |-------------|---|-----------------------------------------------------------------------------|
@@ -43,12 +43,13 @@ import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.models.base import PAPER_DT
+from bushenv.registry import Registry
+from bushenv.scales import MACHINE, BushingScales
 
 MAX_PROFILE_S = 12.0  # the papers' step is held 10 s; 12 s covers their 7.3 s departure
 MIN_HOLD_S = 0.5
 SPEED_MARGIN = 0.98  # stay 2 % inside the machine's velocity limit
-VMAX = ex.MAX_VELOCITY_M_PER_S * SPEED_MARGIN
-XMAX = ex.MAX_DISPLACEMENT_M
+VMAX = ex.MAX_VELOCITY_M_PER_S * SPEED_MARGIN  # the papers' machine; a bushing's own: _limits
 ROAD_MAX_HEIGHT_M = 0.15  # QuarterCar-v0's max_road_height_m: kerbs, potholes, the papers' bumps
 # QuarterCar-v0 lets the road move at most max_road_step_m = 0.05 m per 1/204.8 s step
 # (10.24 m/s); road profiles stay 5 % inside that so the env can replay them.
@@ -75,7 +76,7 @@ def _hold(value: float, duration_s: float, dt: float) -> np.ndarray:
     return np.full(_n(duration_s, dt), float(value))
 
 
-def _move(start_m: float, end_m: float, dt: float, speed: float = VMAX / 2) -> np.ndarray:
+def _move(start_m: float, end_m: float, dt: float, speed: float) -> np.ndarray:
     """Half-cosine move from start (excluded) to end at mean ``speed`` (peak pi/2 times it)."""
     dist = abs(end_m - start_m)
     if dist == 0.0:
@@ -85,8 +86,13 @@ def _move(start_m: float, end_m: float, dt: float, speed: float = VMAX / 2) -> n
     return start_m + (end_m - start_m) * 0.5 * (1.0 - np.cos(np.pi * s))
 
 
-def _finish(x: np.ndarray, dt: float, max_s: float) -> np.ndarray:
-    """Trim to ``max_s`` keeping a final hold, guarantee the machine limits and x[0] = 0."""
+def _limits(lim: BushingScales) -> tuple[float, float]:
+    """The stroke and the speed (inside the velocity limit by ``SPEED_MARGIN``) profiles use."""
+    return lim.stroke_m, lim.velocity_m_per_s * SPEED_MARGIN
+
+
+def _finish(x: np.ndarray, dt: float, max_s: float, lim: BushingScales) -> np.ndarray:
+    """Trim to ``max_s`` keeping a final hold, guarantee the bushing's limits and x[0] = 0."""
     x = np.asarray(x, dtype=np.float64)
     n_max = _n(max_s, dt)
     if x.size == 0 or x[0] != 0.0:
@@ -95,12 +101,12 @@ def _finish(x: np.ndarray, dt: float, max_s: float) -> np.ndarray:
         n_hold = _n(MIN_HOLD_S, dt)
         x = np.concatenate([x[: n_max - n_hold], np.full(n_hold, x[n_max - n_hold - 1])])
     # the slew limiter only acts where a generator rounded past the limit
-    x = ex.clip_to_limits(x, dt)
-    return x
+    return ex.clip_to_limits(x, dt, lim.stroke_m, lim.velocity_m_per_s)
 
 
 # ----- rig families: u -> (x, params) ---------------------------------------------------------
-def _step(u, dt, max_s):
+def _step(u, dt, max_s, lim):
+    XMAX, VMAX = _limits(lim)  # noqa: N806
     size = _lin(u[0], -XMAX, XMAX)
     pre = _lin(u[1], 0.1, 1.0)
     rise_min = math.pi / 2 * abs(size) / VMAX  # half-cosine peak speed = pi/2 * mean speed
@@ -113,7 +119,8 @@ def _step(u, dt, max_s):
     return x, {"size_m": size, "pre_s": pre, "rise_s": rise, "hold_s": hold}
 
 
-def _ramp(u, dt, max_s):
+def _ramp(u, dt, max_s, lim):
+    XMAX, VMAX = _limits(lim)  # noqa: N806
     end = _lin(u[0], -XMAX, XMAX)
     pre = _lin(u[1], 0.0, 1.0)
     ramp_s = max(_lin(u[2], 0.02, 3.0), abs(end) / VMAX, dt)
@@ -122,7 +129,8 @@ def _ramp(u, dt, max_s):
     return x, {"end_m": end, "pre_s": pre, "ramp_s": ramp_s, "hold_s": hold}
 
 
-def _pulse(u, dt, max_s):
+def _pulse(u, dt, max_s, lim):
+    XMAX, VMAX = _limits(lim)  # noqa: N806
     size = _lin(u[0], -XMAX, XMAX)
     width = _lin(u[1], 0.01, 2.0)
     edge = _lin(u[2], 0.0, 0.5) * width
@@ -136,13 +144,14 @@ def _pulse(u, dt, max_s):
     return x, {"size_m": size, "width_s": width, "edge_s": edge, "pre_s": pre, "post_s": post}
 
 
-def _sine(u, dt, max_s):
+def _sine(u, dt, max_s, lim):
+    XMAX, VMAX = _limits(lim)  # noqa: N806
     freq = _log(u[0], ex.MIN_FREQUENCY_HZ, ex.MAX_FREQUENCY_HZ)
     amp_cap = min(XMAX, VMAX / (2 * math.pi * freq))
     amp = _lin(u[1], min(0.1e-3, amp_cap), amp_cap)
     offset = _lin(u[2], -1.0, 1.0) * (XMAX - amp)
     hold = _lin(u[4], MIN_HOLD_S, 4.0)
-    lead_in = _move(0.0, offset, dt)
+    lead_in = _move(0.0, offset, dt, VMAX / 2)
     dur = _lin(u[3], 0.5, max(0.5, min(8.0, max_s - hold - lead_in.size * dt)))
     body = ex.sine(freq, amp, dur, dt, offset_m=offset)
     x = np.concatenate([[0.0], lead_in, body])
@@ -156,7 +165,8 @@ def _sine(u, dt, max_s):
     }
 
 
-def _chirp(u, dt, max_s):
+def _chirp(u, dt, max_s, lim):
+    XMAX, VMAX = _limits(lim)  # noqa: N806
     f0 = _log(u[0], ex.MIN_FREQUENCY_HZ, ex.MAX_FREQUENCY_HZ)
     f1 = _log(u[1], ex.MIN_FREQUENCY_HZ, ex.MAX_FREQUENCY_HZ)
     amp_cap = min(XMAX, VMAX / (2 * math.pi * max(f0, f1)))
@@ -176,11 +186,12 @@ def _chirp(u, dt, max_s):
     }
 
 
-def _random_ood(u, dt, max_s):
+def _random_ood(u, dt, max_s, lim):
+    XMAX, VMAX = _limits(lim)  # noqa: N806
     n_index = _lin(u[0], 1.0, XMAX / ex.PEAK_M_AT_N1)
     lo = _log(u[1], 0.5, 40.0)
     hi = _lin(u[2], min(lo + 5.0, ex.MAX_FREQUENCY_HZ), ex.MAX_FREQUENCY_HZ)
-    peak = n_index * ex.PEAK_M_AT_N1
+    peak = min(n_index * ex.PEAK_M_AT_N1, XMAX)
     hold = _lin(u[6], MIN_HOLD_S, 4.0)
     dur = _lin(u[4], 1.0, max(1.0, min(8.0, max_s - hold)))
     seed = int(np.clip(u[5], 0.0, 1.0) * 9999)
@@ -221,26 +232,27 @@ def _pick(u0: float) -> str:
     return _SLOT_NAMES[min(len(_SLOT_NAMES) - 1, int(np.clip(u0, 0, 1) * len(_SLOT_NAMES)))]
 
 
-def _any(u, dt, max_s):
+def _any(u, dt, max_s, lim):
     name = _pick(u[0])
     d, build = _RIG_BUILDERS[name]
-    x, params = build(u[1 : 1 + d], dt, max_s)
+    x, params = build(u[1 : 1 + d], dt, max_s, lim)
     return x, {"family": name, **params}
 
 
 SEQUENCE_SLOTS = 3
 
 
-def _sequence(u, dt, max_s):
+def _sequence(u, dt, max_s, lim):
     parts: list[np.ndarray] = [np.zeros(1)]
     slots = []
     per_slot = max_s / SEQUENCE_SLOTS
     for k in range(SEQUENCE_SLOTS):
         uk = u[k * _SLOT_DIM : (k + 1) * _SLOT_DIM]
-        seg, params = _any(uk, dt, per_slot * 0.9)
+        seg, params = _any(uk, dt, per_slot * 0.9, lim)
         seg = seg[1:] if seg.size and seg[0] == 0.0 else seg
         # join: move from where we are to the segment's start at a moderate speed
-        parts.append(_move(parts[-1][-1] if parts[-1].size else 0.0, seg[0], dt))
+        start = parts[-1][-1] if parts[-1].size else 0.0
+        parts.append(_move(start, seg[0], dt, _limits(lim)[1] / 2))
         parts.append(seg)
         slots.append(params)
     x = np.concatenate(parts)
@@ -248,7 +260,7 @@ def _sequence(u, dt, max_s):
 
 
 # ----- road families (quarter car): road height under the wheel, m -------------------------------
-def _bump(u, dt, max_s):
+def _bump(u, dt, max_s, lim):
     length = _lin(u[0], 0.2, 2.0)
     height = _lin(u[1], 0.005, ROAD_MAX_HEIGHT_M)
     # (1 - cos) bump: peak road rate pi h V / L
@@ -258,7 +270,7 @@ def _bump(u, dt, max_s):
     return x, {"length_m": length, "height_m": height, "speed_m_per_s": speed, "post_s": post}
 
 
-def _pothole(u, dt, max_s):
+def _pothole(u, dt, max_s, lim):
     length = _lin(u[0], 0.2, 2.0)
     depth = _lin(u[1], 0.005, ROAD_MAX_HEIGHT_M)
     edge = _lin(u[3], 0.1, 0.45) * length
@@ -281,8 +293,10 @@ class Family:
 
     name: str
     dim: int
-    env: str  # "rig": bushing displacement, m; "quartercar": road height, m
-    build: Callable[[np.ndarray, float, float], tuple[np.ndarray, dict]]
+    target: str  # the TARGETS name: "rig" (bushing displacement, m), "quartercar" (road, m)
+    build: Callable[[np.ndarray, float, float, BushingScales], tuple[np.ndarray, dict]]
+    random: bool = True  # drawn by random search (not so the meta-family "any")
+    finish: Callable[[np.ndarray, float, float, BushingScales], np.ndarray] | None = None
 
     def _check(self, u) -> np.ndarray:
         u = np.asarray(u, dtype=np.float64).reshape(-1)
@@ -292,16 +306,29 @@ class Family:
             raise FamilyError(f"family {self.name!r}: parameters hold NaN or inf: {u}")
         return np.clip(u, 0.0, 1.0)
 
-    def profile(self, u, dt: float = PAPER_DT, max_s: float = MAX_PROFILE_S) -> np.ndarray:
-        """The (T,) profile for parameters ``u`` (clipped to [0, 1])."""
-        x, _ = self.build(self._check(u), dt, max_s)
-        if self.env == "rig":
-            return _finish(x, dt, max_s)
+    def profile(
+        self,
+        u,
+        dt: float = PAPER_DT,
+        max_s: float = MAX_PROFILE_S,
+        limits: BushingScales = MACHINE,
+    ) -> np.ndarray:
+        """The (T,) profile for parameters ``u`` (clipped to [0, 1]) within ``limits`` (the
+        bushing's stroke and velocity; default the papers' machine)."""
+        x, _ = self.build(self._check(u), dt, max_s, limits)
+        if self.finish is not None:
+            return self.finish(x, dt, max_s, limits)
         return np.asarray(x, dtype=np.float64)[: _n(max_s, dt)]
 
-    def describe(self, u, dt: float = PAPER_DT, max_s: float = MAX_PROFILE_S) -> dict:
+    def describe(
+        self,
+        u,
+        dt: float = PAPER_DT,
+        max_s: float = MAX_PROFILE_S,
+        limits: BushingScales = MACHINE,
+    ) -> dict:
         """The physical parameters ``u`` maps to (plain JSON values)."""
-        _, params = self.build(self._check(u), dt, max_s)
+        _, params = self.build(self._check(u), dt, max_s, limits)
         return {"family": self.name, **_plain(params)}
 
 
@@ -315,20 +342,18 @@ def _plain(v):
     return v
 
 
-FAMILIES: dict[str, Family] = {
-    **{name: Family(name, d, "rig", b) for name, (d, b) in _RIG_BUILDERS.items()},
-    "sequence": Family("sequence", SEQUENCE_SLOTS * _SLOT_DIM, "rig", _sequence),
-    "any": Family("any", _SLOT_DIM, "rig", _any),
-    "bump": Family("bump", 4, "quartercar", _bump),
-    "pothole": Family("pothole", 5, "quartercar", _pothole),
-}
-RIG_FAMILIES = tuple(n for n, f in FAMILIES.items() if f.env == "rig")
-ROAD_FAMILIES = tuple(n for n, f in FAMILIES.items() if f.env == "quartercar")
+FAMILIES: Registry[Family] = Registry("excitation family", FamilyError)
+for _name, (_d, _b) in _RIG_BUILDERS.items():
+    FAMILIES.add(_name, Family(_name, _d, "rig", _b, finish=_finish))
+FAMILIES.add(
+    "sequence", Family("sequence", SEQUENCE_SLOTS * _SLOT_DIM, "rig", _sequence, finish=_finish)
+)
+FAMILIES.add("any", Family("any", _SLOT_DIM, "rig", _any, random=False, finish=_finish))
+FAMILIES.add("bump", Family("bump", 4, "quartercar", _bump))
+FAMILIES.add("pothole", Family("pothole", 5, "quartercar", _pothole))
 
 
 def get_family(name: str) -> Family:
-    if name not in FAMILIES:
-        raise FamilyError(f"unknown excitation family {name!r}; known: {sorted(FAMILIES)}")
     return FAMILIES[name]
 
 

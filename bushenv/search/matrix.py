@@ -3,8 +3,9 @@
     bushenv campaign --models nn,hybrid,boucwen --axes axial,radial \\
         --searchers random,cma,ppo --seeds 0-9 --budget 256 --out runs/matrix [--ray]
 
-Each cell is one search run (``run_cell``): the model's default for the axis against the
-reference rubber bushing, one searcher, one seed, ``budget`` model evaluations. Cells are pure
+Each cell is one search run (``run_cell``): the model (a name's default for the axis, or a
+file) against ``--reference`` (default the rubber; a name, a file, or none), one searcher, one
+seed, ``budget`` model evaluations. Cells are pure
 functions of their description, so the local process pool and a Ray cluster give the same
 results for the same seeds (wall-clock fields aside: ``seconds``, ``seconds_to_failure``).
 
@@ -19,21 +20,30 @@ the divergence rate and the median evaluations to failure.
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import time
+from dataclasses import dataclass
 from itertools import product
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from bushenv.execution import get_backend
+from bushenv.models import AXES, MODELS, ModelError, check_axis, get_model, get_reference
+from bushenv.persist import write_json, write_text
+from bushenv.progress import Progress
+from bushenv.runlog import RunLog, run_cells
+from bushenv.scales import scales_of_reference
+from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.searchers import SEARCHERS, get_searcher
+from bushenv.search.targets import TARGETS
+
 EXAMPLE = (
     "bushenv campaign --models nn,hybrid --axes axial --searchers random,cma "
     "--seeds 0-3 --budget 128 --out runs/matrix"
 )
 WALL_CLOCK_FIELDS = ("seconds", "seconds_to_failure", "wall_s", "worker_backend")
-CELL_KEYS = ("model", "axis", "searcher", "seed", "budget", "env")
+CELL_KEYS = ("model", "axis", "searcher", "seed", "budget", "env", "reference")
 MAX_SEEDS = 100_000  # a typo like 0-1000000000 must not build a billion cells
 
 
@@ -83,9 +93,19 @@ def make_cells(
     seeds: list[int],
     budget: int,
     env: str = "rig",
+    reference: str | None = "rubber",
 ) -> list[dict[str, Any]]:
+    """One cell per model x axis x searcher x seed; ``reference`` None: judged without one."""
     return [
-        {"model": m, "axis": a, "searcher": s, "seed": int(seed), "budget": int(budget), "env": env}
+        {
+            "model": m,
+            "axis": a,
+            "searcher": s,
+            "seed": int(seed),
+            "budget": int(budget),
+            "env": env,
+            "reference": reference,
+        }
         for m, a, s, seed in product(models, axes, searchers, seeds)
     ]
 
@@ -95,15 +115,13 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     import torch
 
     torch.set_num_threads(1)
-    from bushenv.models import get_model
-    from bushenv.search.corpus import truth_reference
-    from bushenv.search.evaluate import BatchEvaluator
-    from bushenv.search.searchers import get_searcher
-
-    reference = truth_reference(cell["axis"])
-    model = get_model(cell["model"], axis=cell["axis"], dt=reference.dt)
+    spec, axis = cell.get("reference", "rubber"), cell["axis"]
+    model = get_model(cell["model"], axis=axis)
+    reference = None if spec is None else get_reference(spec, axis=axis, dt=model.dt)
+    scales = scales_of_reference(reference, builtin=spec == "rubber")
     t0 = time.perf_counter()
-    with BatchEvaluator(model, reference, env=cell["env"], threads=1, axis=cell["axis"]) as ev:
+    evaluator = BatchEvaluator(model, reference, cell["env"], 1, axis, scales=scales)
+    with evaluator as ev:
         result = get_searcher(cell["searcher"]).run(ev, cell["budget"], seed=cell["seed"])
     out = {**cell, **result.summary()}
     out["wall_s"] = time.perf_counter() - t0
@@ -120,77 +138,25 @@ def comparable(row: dict[str, Any]) -> dict[str, Any]:
 RESULT_KEYS = ("diverged", "evaluations", "evaluations_to_failure")
 
 
+def _log(path: Path, progress: Progress | None = None) -> RunLog:
+    say = progress.say if progress is not None else None
+    return RunLog(path, CELL_KEYS, RESULT_KEYS, error=MatrixError, say=say)
+
+
 def read_results(path: Path, require_results: bool = False) -> dict[str, dict[str, Any]]:
-    """Finished cells by key; drops a torn final line, refuses corruption elsewhere.
-
-    A line is a finished cell when it is a JSON object holding the cell's keys (``CELL_KEYS``)
-    and, with ``require_results`` (as ``run_matrix`` reads), the result fields
-    ``RESULT_KEYS``. Only the last line may be torn (a kill mid-write): it is dropped and cut
-    from the file, so the cell runs again on resume. A complete last line that lost only its
-    newline is kept and the newline restored, so the next append starts a line of its own.
-    """
-    done: dict[str, dict[str, Any]] = {}
-    if not path.exists():
-        return done
-    if not path.is_file():
-        raise MatrixError(f"{path}: not a regular file")
-    raw = path.read_bytes()
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise MatrixError(
-            f"{path}: not a results file (not UTF-8 text at byte {exc.start}); "
-            "move it away or pass another --out"
-        ) from None
-    lines = text.splitlines()
-    for i, line in enumerate(lines, start=1):
-        if not line.strip():
-            continue
-        row = _result_row(line, require_results)
-        if row is None:
-            if i == len(lines):
-                print(f"{path} line {i}: incomplete last line (interrupted write) dropped")
-                _truncate_last_line(path)
-                continue
-            raise MatrixError(f"{path} line {i}: corrupt result line; fix or remove it") from None
-        done[cell_key(row)] = row
-    if text and not text.endswith("\n") and path.read_bytes() == raw:
-        with path.open("a") as fh:
-            fh.write("\n")
-    return done
+    """Finished cells by key (``RunLog.read``): holding ``CELL_KEYS`` and, with
+    ``require_results``, ``RESULT_KEYS``; a torn last line is dropped, other corruption refused."""
+    log = _log(path)
+    if not require_results:
+        log.result_keys = ()
+    return log.read()
 
 
-def _result_row(line: str, require_results: bool) -> dict[str, Any] | None:
-    """The row a results line holds, or None when it is not a complete result."""
-    try:
-        row = json.loads(line)
-    except json.JSONDecodeError:
-        return None
-    needed = (*CELL_KEYS, *RESULT_KEYS) if require_results else CELL_KEYS
-    if not isinstance(row, dict) or any(k not in row for k in needed):
-        return None
-    return row
-
-
-def _truncate_last_line(path: Path) -> None:
-    text = path.read_text()
-    keep = text[: text.rstrip("\n").rfind("\n") + 1] if "\n" in text.rstrip("\n") else ""
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(keep)
-    os.replace(tmp, path)
-
-
-def _append(path: Path, row: dict[str, Any]) -> None:
-    with path.open("a") as fh:
-        fh.write(json.dumps(row, sort_keys=True, default=_plain) + "\n")
-        fh.flush()
-        os.fsync(fh.fileno())
-
-
-def _plain(o: Any) -> Any:
-    if isinstance(o, np.generic):
-        return o.item()
-    raise TypeError(type(o))
+def _describe(row: dict[str, Any]) -> str:
+    return (
+        f"{row['model']:8s} {row['axis']:6s} {row['searcher']:6s} seed {row['seed']}: "
+        f"{'DIVERGED' if row['diverged'] else 'bounded'} ({row['evaluations']} evals)"
+    )
 
 
 def run_matrix(
@@ -198,30 +164,12 @@ def run_matrix(
     out: Path,
     backend,
     resume: bool = False,
-    progress=print,
+    progress: Progress | None = None,
 ) -> list[dict[str, Any]]:
     """Run every cell not yet in ``out/cells.jsonl``; returns all rows in cell order."""
-    out.mkdir(parents=True, exist_ok=True)
-    results_path = out / "cells.jsonl"
-    done = read_results(results_path, require_results=True) if resume else {}
-    if not resume and results_path.exists():
-        raise MatrixError(f"{results_path} exists; pass --resume to continue or --out elsewhere")
-    todo = [c for c in cells if cell_key(c) not in done]
-    progress(
-        f"matrix: {len(cells)} cells, {len(cells) - len(todo)} already done, "
-        f"{len(todo)} to run on {backend.name} ({backend.workers} workers)"
-    )
-    t0 = time.perf_counter()
-    for n, (i, row) in enumerate(backend.imap_unordered(run_cell, todo), start=1):
-        row["worker_backend"] = backend.name
-        _append(results_path, row)
-        done[cell_key(todo[i])] = row
-        progress(
-            f"  [{n}/{len(todo)}] {row['model']:8s} {row['axis']:6s} {row['searcher']:6s} "
-            f"seed {row['seed']}: {'DIVERGED' if row['diverged'] else 'bounded'} "
-            f"({row['evaluations']} evals, {time.perf_counter() - t0:.0f} s)"
-        )
-    return [done[cell_key(c)] for c in cells]
+    progress = progress or Progress(quiet=True)
+    log = _log(Path(out) / "cells.jsonl", progress)
+    return run_cells(cells, run_cell, log, backend, resume, progress, _describe, "matrix")
 
 
 def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
@@ -244,9 +192,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def write_summary(out: Path, summary: dict[str, Any]) -> None:
-    tmp = out / "summary.json.tmp"
-    tmp.write_text(json.dumps(summary, indent=2))
-    os.replace(tmp, out / "summary.json")
+    write_json(out / "summary.json", summary, indent=2)
     searchers = sorted({s for per in summary.values() for s in per})
     lines = [
         "| model | " + " | ".join(searchers) + " |",
@@ -265,13 +211,12 @@ def write_summary(out: Path, summary: dict[str, Any]) -> None:
                 + (f", median {med:.0f} evals" if med is not None else "")
             )
         lines.append(f"| {model} | " + " | ".join(cells) + " |")
-    tmp = out / "summary.md.tmp"
-    tmp.write_text(
+    write_text(
+        out / "summary.md",
         "Divergence rate and median evaluations to failure, per model and searcher\n\n"
         + "\n".join(lines)
-        + "\n"
+        + "\n",
     )
-    os.replace(tmp, out / "summary.md")
     import matplotlib
 
     matplotlib.use("Agg")
@@ -305,76 +250,124 @@ def write_summary(out: Path, summary: dict[str, Any]) -> None:
     plt.close(fig)
 
 
+@dataclass
+class MatrixConfig:
+    """A campaign matrix; ``bushenv campaign`` translates its arguments into this."""
+
+    models: tuple[str, ...] = ("nn", "hybrid")
+    axes: tuple[str, ...] = ("axial",)
+    searchers: tuple[str, ...] = ("random", "cma")
+    seeds: tuple[int, ...] = (0, 1, 2, 3)
+    budget: int = 128
+    target: str = "rig"
+    reference: str | None = "rubber"  # a name or model file; None: judged without one
+    out: Path = Path("runs/matrix")
+    resume: bool = False
+
+    def checked(self) -> MatrixConfig:
+        """Every name known, every model resolvable now (a missing default file must stop the
+        matrix before it starts, not fail in a worker); raises ``MatrixError``."""
+        if self.budget <= 0:
+            raise MatrixError(
+                f"--budget must be a positive number of evaluations, got {self.budget}"
+            )
+        for what, names, registry in (
+            ("--models", self.models, MODELS),
+            ("--searchers", self.searchers, SEARCHERS),
+            ("--env", (self.target,), TARGETS),
+        ):
+            if not names:
+                raise MatrixError(f"{what} names nothing")
+            for n in names:
+                if n not in registry:
+                    raise MatrixError(registry.unknown_message(n))
+        if not self.axes:
+            raise MatrixError("--axes names nothing")
+        for a in self.axes:
+            if self.reference is not None:
+                try:
+                    get_reference(self.reference, axis=check_axis(a))
+                except ModelError as exc:
+                    raise MatrixError(f"--reference {self.reference!r} ({a}): {exc}") from None
+        for m, a in product(self.models, self.axes):
+            check_axis(a)
+            try:
+                get_model(m, axis=a)
+            except ModelError as exc:
+                raise MatrixError(f"model {m!r} ({a}): {exc}") from None
+        self.out = Path(self.out)
+        if self.out.exists() and not self.out.is_dir():
+            raise MatrixError(f"--out {self.out}: exists and is not a folder")
+        return self
+
+    def cells(self) -> list[dict[str, Any]]:
+        return make_cells(
+            list(self.models),
+            list(self.axes),
+            list(self.searchers),
+            list(self.seeds),
+            self.budget,
+            self.target,
+        )
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--models", default="nn,hybrid", help="comma list of model names")
-    p.add_argument("--axes", default="axial", help="comma list: axial, radial")
-    p.add_argument("--searchers", default="random,cma", help="comma list: random, cma, ppo, sac")
+    d = MatrixConfig()
+    p.add_argument("--models", default=",".join(d.models), help="comma list of model names")
+    p.add_argument("--axes", default=",".join(d.axes), help=f"comma list: {', '.join(AXES)}")
+    p.add_argument(
+        "--searchers",
+        default=",".join(d.searchers),
+        help=f"comma list: {', '.join(SEARCHERS.names())}",
+    )
     p.add_argument("--seeds", default="0-3", help="e.g. 0-9 or 1,4,7")
-    p.add_argument("--budget", type=int, default=128, help="model evaluations per cell (> 0)")
-    p.add_argument("--env", choices=("rig", "quartercar"), default="rig")
+    p.add_argument("--budget", type=int, default=d.budget, help="model evaluations per cell (> 0)")
+    p.add_argument("--env", choices=TARGETS.names(), default=d.target)
+    p.add_argument(
+        "--reference",
+        default=d.reference,
+        help="the bushing every cell is judged against: a registered name or a model file; "
+        "'none' judges with the criteria that need no reference",
+    )
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--resume", action="store_true", help="continue an interrupted matrix")
     p.add_argument("--workers", type=int, default=None, help="local worker processes")
     p.add_argument("--ray", action="store_true", help="run on Ray (a local instance)")
     p.add_argument("--ray-address", default=None, help="run on an existing Ray cluster")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+
+
+def _names(flag: str, text: str) -> tuple[str, ...]:
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    if not names:
+        raise MatrixError(f"{flag} {text!r} names nothing")
+    return names
 
 
 def run(args: argparse.Namespace) -> int:
-    from bushenv.cli import CliError
-    from bushenv.execution import BackendError, get_backend
-    from bushenv.models import AXES, model_names
-    from bushenv.search.searchers import SEARCHERS
-
-    if args.budget <= 0:
-        raise CliError(f"--budget must be a positive number of evaluations, got {args.budget}")
-    models = [m for m in args.models.split(",") if m]
-    known = set(model_names())
-    for m in models:
-        if m not in known:
-            raise CliError(f"unknown model {m!r}; known: {sorted(known)}")
-    axes = [a for a in args.axes.split(",") if a]
-    for a in axes:
-        if a not in AXES:
-            raise CliError(f"unknown axis {a!r}; known: {list(AXES)}")
-    searchers = [s for s in args.searchers.split(",") if s]
-    for s in searchers:
-        if s not in (*SEARCHERS, "ppo", "sac"):
-            raise CliError(f"unknown searcher {s!r}; known: {sorted(SEARCHERS) + ['ppo', 'sac']}")
-    for what, names in (("--models", models), ("--axes", axes), ("--searchers", searchers)):
-        if not names:
-            raise CliError(f"{what} {getattr(args, what[2:])!r} names nothing")
-    try:
-        seeds = parse_seeds(args.seeds)
-    except MatrixError as exc:
-        raise CliError(str(exc)) from None
-    # Resolve every model now: a missing default file must stop the matrix before it starts,
-    # not fail in a worker after the output folder exists.
-    from bushenv.models import ModelError, get_model
-
-    for m, a in product(models, axes):
-        try:
-            get_model(m, axis=a)
-        except ModelError as exc:
-            raise CliError(f"model {m!r} ({a}): {exc}") from None
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise CliError(f"--out {out}: exists and is not a folder")
-    cells = make_cells(models, axes, searchers, seeds, args.budget, args.env)
-    try:
-        backend = get_backend(
-            "ray" if (args.ray or args.ray_address) else "local",
-            workers=args.workers,
-            address=args.ray_address,
-        )
-    except BackendError as exc:
-        raise CliError(str(exc)) from None
+    config = MatrixConfig(
+        models=_names("--models", args.models),
+        axes=_names("--axes", args.axes),
+        searchers=_names("--searchers", args.searchers),
+        seeds=tuple(parse_seeds(args.seeds)),
+        budget=args.budget,
+        target=args.env,
+        reference=None if args.reference == "none" else args.reference,
+        out=Path(args.out),
+        resume=args.resume,
+    ).checked()
+    backend = get_backend(
+        "ray" if (args.ray or args.ray_address) else "local",
+        workers=args.workers,
+        address=args.ray_address,
+    )
+    progress = Progress(quiet=args.quiet)
     with backend:
-        try:
-            rows = run_matrix(cells, out, backend, resume=args.resume)
-        except MatrixError as exc:
-            raise CliError(str(exc)) from None
+        rows = run_matrix(
+            config.cells(), config.out, backend, resume=config.resume, progress=progress
+        )
     summary = summarise(rows)
-    write_summary(out, summary)
-    print((out / "summary.md").read_text())
-    print(f"wrote {out}/cells.jsonl, summary.json, summary.md, summary.png")
+    write_summary(config.out, summary)
+    print((config.out / "summary.md").read_text())
+    print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md, summary.png")
     return 0

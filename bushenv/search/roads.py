@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from bushenv.divergence import judge
+from bushenv.models import AXES, get_reference
 from bushenv.models.base import BushingModel
-from bushenv.search.divergence import judge
-
-AXES = ("radial", "axial")
+from bushenv.scales import MACHINE
 
 
 def quarter_car_responses(
@@ -30,6 +30,7 @@ def quarter_car_responses(
     lengths: np.ndarray,
     dt: float,
     axis: str,
+    scales=MACHINE,
 ):
     """(Verdict, x_model, f_model, f_ref, None) for (T, B) roads; see the module docstring."""
     from bushenv.rigs.quartercar import check_road
@@ -56,7 +57,7 @@ def quarter_car_responses(
     judged = np.maximum(1, np.minimum(lengths, limit_at))
     x, x_ref = rows[keys[0]], rows[keys[1]]
     fm, fr = rows[keys[2]], rows[keys[3]]
-    verdict = judge(x, fm, fr, dt, lengths=judged, x_ref=x_ref, hold_input=h)
+    verdict = judge(x, fm, fr, dt, lengths=judged, x_ref=x_ref, hold_input=h, scales=scales)
     return verdict, x, fm, fr, None
 
 
@@ -80,6 +81,4 @@ def make_cars(model, reference, n: int, dt: float, axis: str, episode_steps: int
 
 
 def _reference_for(axis: str, dt: float) -> BushingModel:
-    from bushenv.search.corpus import truth_reference
-
-    return truth_reference(axis, dt)
+    return get_reference("rubber", axis=axis, dt=dt)

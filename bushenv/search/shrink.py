@@ -35,9 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bushenv import excitation as ex
 from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.families import VMAX
+from bushenv.search.families import SPEED_MARGIN
 
 SCALES = (0.5, 0.7, 0.85, 0.95)
 MIN_CHUNK_S = 0.05
@@ -80,23 +79,23 @@ class ShrinkResult:
         }
 
 
-def _join(a: float, b: float, dt: float) -> np.ndarray:
+def _join(a: float, b: float, dt: float, vmax: float) -> np.ndarray:
     """Half-cosine move from a (excluded) to b (included) at half the velocity limit."""
     dist = abs(b - a)
     if dist < 1e-12:
         return np.zeros(0)
-    n = max(1, math.ceil(dist * math.pi / 2 / (0.5 * VMAX * dt)))
+    n = max(1, math.ceil(dist * math.pi / 2 / (0.5 * vmax * dt)))
     s = np.arange(1, n + 1) / n
     return a + (b - a) * 0.5 * (1.0 - np.cos(np.pi * s))
 
 
-def _candidates(x: np.ndarray, dt: float, rig: bool) -> list[np.ndarray]:
+def _candidates(x: np.ndarray, dt: float, finish, vmax: float) -> list[np.ndarray]:
     T = x.size
     out: list[np.ndarray] = []
     for k in range(1, 8):  # collapse the start: one move straight to where the profile is at a
         a = k * T // 8
         if 1 < a < T - 1:
-            out.append(np.concatenate([[0.0], _join(0.0, x[a], dt), x[a + 1 :]]))
+            out.append(np.concatenate([[0.0], _join(0.0, x[a], dt, vmax), x[a + 1 :]]))
             out.append(np.concatenate([x[:a], np.full(T - a, x[a - 1])]))  # hold from a on
     min_chunk = max(2, int(round(MIN_CHUNK_S / dt)))
     chunk = T // 2
@@ -105,7 +104,7 @@ def _candidates(x: np.ndarray, dt: float, rig: bool) -> list[np.ndarray]:
             b = min(T - 1, a + chunk)
             if b <= a:
                 continue
-            join = _join(x[a - 1], x[b], dt)
+            join = _join(x[a - 1], x[b], dt, vmax)
             out.append(np.concatenate([x[:a], join[:-1], x[b:]]))  # delete [a, b)
             n_join = join.size
             if b - a > n_join:  # flatten [a, b): hold, then move to x[b]
@@ -120,10 +119,54 @@ def _candidates(x: np.ndarray, dt: float, rig: bool) -> list[np.ndarray]:
             continue
         c = c.copy()
         c[0] = 0.0
-        if rig:
-            c = ex.clip_to_limits(c, dt)
-        fixed.append(c)
+        fixed.append(finish(c, dt))
     return fixed
+
+
+def _truncate(c: np.ndarray, r: dict, dt: float) -> np.ndarray:
+    """``c`` cut right after its first failure (nothing after it can make it simpler)."""
+    t = r.get("first_time_s")
+    if t is None:
+        return c
+    return c[: max(2, int(round(t / dt)) + 1)]
+
+
+def _default_rule(row: dict) -> Callable[[dict], bool]:
+    r0 = row["robustness"]
+    margin = MARGIN if r0 is None else min(MARGIN, abs(r0) / 2)
+
+    def still_fails(r: dict) -> bool:
+        rob = r["robustness"]
+        return bool(r["diverged"]) and (rob is None or rob < -margin)
+
+    return still_fails
+
+
+def _simplest_failing(x, evaluator, still_fails, room: int):
+    """One round: the simplest candidate simpler than ``x`` that still fails (None if none
+    does), its verdict row, and whether there was any candidate to try."""
+    lim, dt = evaluator.scales, evaluator.dt
+
+    def finish(c: np.ndarray, dt: float) -> np.ndarray:
+        return evaluator.target.finish(c, dt, lim)
+
+    cands = _candidates(x, dt, finish, lim.velocity_m_per_s * SPEED_MARGIN)
+    cands = [c for c in cands if complexity(c) < complexity(x)][:room]
+    if not cands:
+        return None, None, False
+    # a hold appended to each: a simplification may fail a little later than the original
+    # did (truncation cut right after its failure); the prefix is truncated again below
+    tail = int(round(TAIL_S / dt))
+    cands = [np.concatenate([c, np.full(tail, c[-1])]) for c in cands]
+    batch = evaluator.evaluate(cands)
+    best, best_row = None, None
+    for b, c in enumerate(cands):
+        r = batch.verdict.row(b)
+        if still_fails(r):
+            c = _truncate(c, r, dt)
+            if best is None or complexity(c) < complexity(best):
+                best, best_row = c, r
+    return best, best_row, True
 
 
 def shrink(
@@ -140,56 +183,26 @@ def shrink(
     last bit of rounding (e.g. the corpus's float32 storage). The input must fail; otherwise
     ValueError.
     """
-    rig = evaluator.env == "rig"
     dt = evaluator.dt
     x = np.asarray(profile, dtype=np.float64).copy()
     start_evals = evaluator.n_evaluations
     first = evaluator.evaluate([x])
     row = first.verdict.row(0)
-    if still_fails is None:
-        r0 = row["robustness"]
-        margin = MARGIN if r0 is None else min(MARGIN, abs(r0) / 2)
-
-        def still_fails(r: dict) -> bool:
-            rob = r["robustness"]
-            return bool(r["diverged"]) and (rob is None or rob < -margin)
-
+    still_fails = still_fails or _default_rule(row)
     if not still_fails(row):
         raise ValueError("shrink: the profile to shrink does not fail on this model")
     original = complexity(x)
-
-    def _truncate(c: np.ndarray, r: dict) -> np.ndarray:
-        t = r.get("first_time_s")
-        if t is None:
-            return c
-        n = int(round(t / dt)) + 1
-        return c[: max(2, n)]
-
-    x = _truncate(x, row)
+    x = _truncate(x, row, dt)
     row = evaluator.evaluate([x]).verdict.row(0)
     if not still_fails(row):  # cannot happen for a causal model; keep the original then
         x = np.asarray(profile, dtype=np.float64).copy()
         row = first.verdict.row(0)
     rounds = 0
     while evaluator.n_evaluations - start_evals < budget - 1:  # one kept for the final check
-        cands = _candidates(x, dt, rig)
         room = budget - 1 - (evaluator.n_evaluations - start_evals)
-        cands = [c for c in cands if complexity(c) < complexity(x)][:room]
-        if not cands:
+        best, best_row, tried = _simplest_failing(x, evaluator, still_fails, room)
+        if not tried:
             break
-        # a hold appended to each: a simplification may fail a little later than the original
-        # did (truncation cut right after its failure); the prefix is truncated again below
-        tail = int(round(TAIL_S / dt))
-        cands = [np.concatenate([c, np.full(tail, c[-1])]) for c in cands]
-        batch = evaluator.evaluate(cands)
-        best, best_row = None, None
-        for b, c in enumerate(cands):
-            r = batch.verdict.row(b)
-            if not still_fails(r):
-                continue
-            c = _truncate(c, r)
-            if best is None or complexity(c) < complexity(best):
-                best, best_row = c, r
         rounds += 1
         if best is None or complexity(best) >= complexity(x):
             break

@@ -3,19 +3,21 @@ import pytest
 
 from bushenv.diagnose.candidates import (
     EFFECTS,
-    Scales,
-    Signals,
-    dahl_states,
-    get_candidate,
-    maxwell_state,
-    shift_columns,
+    UnknownEffectError,
+    candidate_sets,
+    effect_names,
+    get_effect,
 )
+from bushenv.diagnose.effects.base import NULL, Scales, Signals
+from bushenv.diagnose.effects.delay import shift_columns
+from bushenv.diagnose.effects.friction import Friction, dahl_states
+from bushenv.diagnose.effects.relaxation import Relaxation, maxwell_state
 from bushenv.diagnose.fit import diagnose
 
 from .synthetic import record
 
 
-@pytest.mark.parametrize("effect", EFFECTS)
+@pytest.mark.parametrize("effect", list(EFFECTS))
 def test_each_candidate_recovers_its_own_effect_on_clean_synthetic_data(effect):
     train = record(1, effect, noise=0.002, duration_s=24.0)
     tests = [record(2, effect, noise=0.002, duration_s=24.0, name="t")]
@@ -70,10 +72,11 @@ def test_shift_columns_delays_by_whole_samples_exactly():
 
 
 def test_candidate_columns_have_one_weight_bound_each():
-    sig = Signals(1e-3 * np.sin(np.linspace(0, 20, 400)), 0.01)
-    scales = Scales(sigma_x=7e-4, duration_s=4.0, dt=0.01)
-    for name in EFFECTS:
-        cand = get_candidate(name)
+    x = 1e-3 * np.sin(np.linspace(0, 20, 400))
+    sig = Signals(x, 0.01)
+    scales = Scales.of([sig])
+    for name in effect_names():
+        cand = get_effect(name)
         for shape in cand.shapes(scales):
             cols = cand.columns(sig, shape, scales)
             assert cols.shape == (400, cand.columns_count(shape, scales))
@@ -81,9 +84,27 @@ def test_candidate_columns_have_one_weight_bound_each():
             assert np.all(np.isfinite(cols))
 
 
-def test_unknown_candidate_is_a_clear_error():
-    with pytest.raises(ValueError, match="unknown candidate effect 'creep'"):
-        get_candidate("creep")
+def test_unknown_candidate_is_a_clear_error_listing_the_registry():
+    with pytest.raises(UnknownEffectError, match="unknown candidate effect 'creep'; known: "):
+        get_effect("creep")
+    with pytest.raises(ValueError, match=", ".join(effect_names())):
+        get_effect("creep")
+
+
+def test_effects_compose_with_plus_and_refuse_a_duplicate():
+    combo = Relaxation() + Friction()
+    assert combo.name == "relaxation+friction"
+    assert combo.names == ("relaxation", "friction")
+    assert (NULL + Relaxation()).name == "relaxation"
+    with pytest.raises(ValueError, match="added twice"):
+        combo + Relaxation()
+
+
+def test_candidate_sets_are_every_single_and_every_pair_of_the_registry():
+    sets = candidate_sets()
+    n = len(EFFECTS)
+    assert len(sets) == n + n * (n - 1) // 2
+    assert [s.name for s in sets[:n]] == list(effect_names())
 
 
 def _fake_identify(monkeypatch, calls):
@@ -110,15 +131,20 @@ def test_other_baselines_come_from_the_identify_dispatcher_and_are_augmented(mon
     assert result["shrink"] > 0.6
 
 
-def test_other_baselines_refuse_a_test_at_another_rate(monkeypatch):
+def test_other_baselines_refuse_a_test_at_another_rate_and_the_cross_mode(monkeypatch):
     _fake_identify(monkeypatch, [])
     train = record(8, "none", dt=1 / 204.8, duration_s=10.0)
     test = record(9, "none", dt=1 / 512, duration_s=10.0, name="fast")
-    with pytest.raises(ValueError, match=r"TEST fast: sampled at 512 Hz but TRAIN at 204\.8 Hz"):
+    with pytest.raises(ValueError, match=r"fast: sampled at 512 Hz but TRAIN at 204\.8 Hz"):
         diagnose(train, [test], baseline="nn")
+    same = record(10, "none", duration_s=10.0, name="t")
+    with pytest.raises(ValueError, match="only the linear baseline"):
+        diagnose(train, [same], baseline="nn", cross=True)
 
 
 def test_a_test_equal_to_train_is_flagged_as_not_held_out():
     train = record(10, "none", duration_s=8.0)
     result = diagnose(train, [train], test_names=["same"])
-    assert result["notes"] == ["TEST same is the TRAIN record itself: its gap is not held out."]
+    assert result["notes"] == [
+        "TEST same is the TRAIN record rec10 itself: its gap is not held out."
+    ]

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from bushenv.cli import main
+from bushenv.diagnose.candidates import effect_names
 
 from .synthetic import record
 
@@ -35,9 +36,9 @@ def test_diagnose_command_writes_the_contract_files(case):
         report
     )
     assert [r["effect"] for r in report["ranking"]][0] == "friction"
-    assert sorted(r["effect"] for r in report["ranking"]) == sorted(
-        ["relaxation", "friction", "hardening", "thermal", "delay", "inertia"]
-    )
+    assert sorted(r["effect"] for r in report["ranking"]) == sorted(effect_names())
+    assert report["mode"] == "held_out"
+    assert 0 <= report["unexplained"]["unexplained_share"] <= 1
     for r in report["ranking"]:
         assert {"effect", "gap_before", "gap_after", "shrink"} <= set(r)
         assert r["shrink"] == pytest.approx(1 - r["gap_after"] / r["gap_before"])
@@ -52,6 +53,8 @@ def test_diagnose_command_writes_the_contract_files(case):
     for png in report["plots"]:
         assert (out / png).stat().st_size > 1000
         assert f"({png})" in md
+    for stem in ("random_a", "steps_b"):
+        assert f"forces_{stem}.png" in report["plots"] and f"loops_{stem}.png" in report["plots"]
 
 
 def test_none_writes_augmented_equal_to_baseline(tmp_path):

@@ -52,7 +52,7 @@ def bw_record():
 
 def test_quick_search_improves_and_is_reproducible(bw_record):
     x, f = bw_record
-    opts = dict(maxiter=4, popsize=4, fit_seconds=1.5, polish_maxfev=30, progress=False)
+    opts = dict(generations=4, population=4, fit_seconds=1.5, polish_evaluations=30, progress=False)
     a = fit_model("boucwen", x, f, DT, seed=5, **opts)
     b = fit_model("boucwen", x, f, DT, seed=5, **opts)
     assert np.array_equal(a.vector(), b.vector())

@@ -2,7 +2,6 @@ import numpy as np
 import pytest
 
 from bushenv.identify import IdentificationError, fit_model
-from bushenv.identify.linear import fit_linear
 
 DT = 1 / 204.8
 
@@ -12,7 +11,7 @@ def test_least_squares_recovers_k_and_c_exactly_on_linear_data():
     x = np.cumsum(rng.normal(size=2000)) * 1e-5
     v = np.gradient(x, DT)
     f = 3.7e5 * x + 2.1e3 * v
-    m = fit_linear(x, f, DT)
+    m = fit_model("linear", x, f, DT, progress=False)
     assert m.k_n_per_m == pytest.approx(3.7e5, rel=1e-10)
     assert m.c_ns_per_m == pytest.approx(2.1e3, rel=1e-10)
     np.testing.assert_allclose(m.simulate(x), f, rtol=1e-9, atol=1e-9)
@@ -28,13 +27,13 @@ def test_fit_model_dispatches_linear_and_uses_given_velocity():
 def test_bad_records_are_refused_naming_the_problem():
     x = np.zeros(100)
     with pytest.raises(IdentificationError, match="x is constant"):
-        fit_linear(x, x, DT)
+        fit_model("linear", x, x, DT)
     y = np.linspace(0, 1, 100)
     f = y.copy()
     f[17] = np.nan
     with pytest.raises(IdentificationError, match=r"f\[17\] is nan"):
-        fit_linear(y, f, DT)
+        fit_model("linear", y, f, DT)
     with pytest.raises(IdentificationError, match="equal length"):
-        fit_linear(y, f[:50], DT)
+        fit_model("linear", y, f[:50], DT)
     with pytest.raises(IdentificationError, match="no identification for model 'rubber'"):
         fit_model("rubber", y, y, DT)

@@ -6,7 +6,7 @@ import torch
 from standin import DT, standin_drive, standin_force
 
 from bushenv.identify import fit_model
-from bushenv.identify.neural import TorchNarx, difference_basis, torch_free_run
+from bushenv.identify.narx_torch import TorchNarx, difference_basis, torch_free_run
 from bushenv.metrics import rms_ratio
 from bushenv.models.hybrid import HybridBushing
 from bushenv.models.narx import NarxBushing
@@ -60,8 +60,8 @@ def test_numba_free_run_equals_torch_free_run_of_the_same_weights(kind, hidden, 
 def test_progress_lines_are_printed(record, capsys):
     x, f = record
     fit_model("nn", x, f, DT, seed=0, progress=True, progress_every_s=0.0, **QUICK)
-    out = capsys.readouterr().out
-    assert "teacher forcing done" in out and "best validation free-run RMS ratio" in out
+    err = capsys.readouterr().err
+    assert "teacher forcing done" in err and "best validation free-run RMS ratio" in err
 
 
 def test_unknown_training_option_is_refused(record):

@@ -3,7 +3,7 @@
 Each file in ``corpus/`` (written by ``bushenv attack --save``, format in
 ``bushenv/search/corpus.py`` and docs/search.md) is one test: the profile is run on every model
 the case names -- the shipped default files -- on the prescribed-motion batched path, or for
-QuarterCar roads through the batched quarter car, and judged by ``bushenv.search.divergence``.
+QuarterCar roads through the batched quarter car, and judged by ``bushenv.divergence``.
 A changed verdict fails with the case's name; if the model file changed since the case was
 recorded, the message says so (then either the new model fixed or broke something, or the
 case needs re-recording with ``bushenv attack --save --force``).

@@ -17,7 +17,8 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 from bushenv import excitation
 from bushenv.models import get_model
 from bushenv.models.linear import LinearBushing
-from bushenv.rigs.common import RigError, load_spec
+from bushenv.rigs.common import RigError
+from bushenv.rigs.specs import load_spec
 
 DT = 1.0 / 204.8
 MAX_STEP = excitation.MAX_VELOCITY_M_PER_S * DT
@@ -249,7 +250,7 @@ def test_reference_beyond_the_machine_force_truncates_without_a_verdict():
 
 
 def test_episode_truncates_after_episode_steps():
-    env = make(episode_steps=30)
+    env = make(max_episode_steps=30)
     out = run(env, np.zeros((100, 1), np.float32))
     assert len(out) == 31 and out[-1][3] and not out[-1][2]
 
@@ -296,7 +297,7 @@ def test_info_holds_plain_python_values():
 
 
 def test_memory_stays_flat_over_a_long_rollout():
-    env = make(model="linear", reference="rubber", episode_steps=10**9)
+    env = make(model="linear", reference="rubber", max_episode_steps=-1)
     env.reset(seed=0)
     a = np.array([0.3], np.float32)
     b = np.array([-0.3], np.float32)
@@ -314,7 +315,7 @@ def test_memory_stays_flat_over_a_long_rollout():
 
 @pytest.mark.slow
 def test_memory_stays_flat_over_a_million_steps():
-    env = make(model="linear", reference="rubber", episode_steps=10**9, render_mode="rgb_array")
+    env = make(model="linear", reference="rubber", max_episode_steps=-1, render_mode="rgb_array")
     env.reset(seed=0)
     a = np.array([0.3], np.float32)
     b = np.array([-0.3], np.float32)
@@ -391,3 +392,25 @@ def test_rgb_array_frame_shows_the_rig_and_changes_with_its_state():
     second = env.render()
     assert (first != second).any(axis=2).sum() > 500
     assert len(np.unique(second.reshape(-1, 3), axis=0)) > 5
+
+
+def test_force_termination_cannot_fire_where_the_single_env_skips_calling_it():
+    """BushRigEnv.step calls divergence.force_termination only when a force is not finite or
+    beyond the limit; within it, the function must decide "go on" (so skipping it is exact)."""
+    from bushenv.divergence import force_termination
+
+    limit = 25e3
+    rng = np.random.default_rng(0)
+    edges = np.array([0.0, -0.0, 5e-324, limit, -limit, np.nextafter(limit, 0), 1e-300])
+    f_m = np.concatenate([edges, rng.uniform(-limit, limit, 10_000), edges[::-1]])
+    f_r = np.concatenate([edges[::-1], rng.uniform(-limit, limit, 10_000), edges])
+    assert np.all(np.abs(f_m) <= limit) and np.all(np.abs(f_r) <= limit)
+    for flags in force_termination(f_m, f_r, limit):
+        assert not flags.any()
+    # and just beyond it, it does fire: the skip is no wider than the criteria
+    over = np.nextafter(limit, np.inf)
+    non_finite, model_over, reference_over = force_termination(
+        np.array([over, np.nan, 0.0]), np.array([0.0, 0.0, over]), limit
+    )
+    assert list(model_over) == [True, False, False] and list(non_finite) == [False, True, False]
+    assert list(reference_over) == [False, False, True]

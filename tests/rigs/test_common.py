@@ -1,4 +1,4 @@
-"""bushenv.rigs.common: action clean-up and refusal, reset options, numeric profiles."""
+"""bushenv.rigs.actions: action clean-up and refusal, reset options, numeric profiles."""
 
 from __future__ import annotations
 
@@ -8,13 +8,8 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from bushenv.rigs.common import (
-    RigError,
-    check_options,
-    numeric_profile,
-    unit_action,
-    unit_actions,
-)
+from bushenv.rigs.actions import check_options, numeric_profile, unit_action, unit_actions
+from bushenv.rigs.common import RigError
 
 
 # ----- unit_action ------------------------------------------------------------------------------

@@ -18,8 +18,8 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 from bushenv import excitation
 from bushenv.models import get_model
 from bushenv.models.linear import TABLE1, LinearBushing
+from bushenv.rigs.car import CarParameters
 from bushenv.rigs.common import RigError
-from bushenv.rigs.quartercar import CarParameters
 from bushenv.rigs.quartercar_batch import QuarterCarBatch
 
 DT = 1.0 / 204.8
@@ -93,7 +93,7 @@ def test_one_model_object_for_both_axes_is_refused():
 
 
 def test_spec_vehicle_is_a_plausible_passenger_car_corner():
-    from bushenv.rigs.common import load_spec
+    from bushenv.rigs.specs import load_spec
 
     p = CarParameters(load_spec("QuarterCar-v0")["kwargs"], resolve_models=False)
     wheel_rate = p.k_s * p.mount**2
@@ -448,14 +448,14 @@ def test_divergence_monitor_and_reward_hooks():
 
 
 def test_episode_truncates_after_episode_steps():
-    env = make(episode_steps=12)
+    env = make(max_episode_steps=12)
     env.reset(seed=0)
     flags = [env.step(np.zeros(1, np.float32))[3] for _ in range(12)]
     assert flags == [False] * 11 + [True]
 
 
 def test_memory_stays_flat_over_a_long_rollout():
-    env = make(episode_steps=10**9, render_mode="rgb_array")
+    env = make(max_episode_steps=-1, render_mode="rgb_array")
     env.reset(seed=0)
     acts = [np.array([v], np.float32) for v in (0.3, 0.3, -0.3, -0.3)]
     for i in range(300):
@@ -471,7 +471,7 @@ def test_memory_stays_flat_over_a_long_rollout():
 
 @pytest.mark.slow
 def test_memory_stays_flat_over_a_hundred_thousand_steps():
-    env = make(episode_steps=10**9)
+    env = make(max_episode_steps=-1)
     env.reset(seed=0)
     acts = [np.array([v], np.float32) for v in (0.3, 0.3, -0.3, -0.3)]
     tracemalloc.start()

@@ -14,8 +14,9 @@ import pytest
 from setuptools import find_namespace_packages
 
 import bushenv
-from bushenv.rigs.common import RigError, read_spec, spec_directory, spec_files
+from bushenv.rigs.common import RigError
 from bushenv.rigs.registration import register_all
+from bushenv.rigs.specs import read_spec, spec_directory, spec_files
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC_IDS = sorted(p.stem for p in (ROOT / "envs").glob("*.toml"))
@@ -25,11 +26,33 @@ def test_every_spec_file_is_registered_with_its_kwargs_on_import():
     assert "BushRig-v0" in SPEC_IDS
     for env_id in SPEC_IDS:
         spec = tomllib.loads((ROOT / "envs" / f"{env_id}.toml").read_text())
-        registered = gym.spec(env_id)
-        assert registered.entry_point == spec["entry_point"]
-        assert registered.kwargs == spec["kwargs"]
-        assert registered.vector_entry_point == spec.get("vector_entry_point")
+        for registered in (gym.spec(env_id), gym.spec(f"bushenv/{env_id}")):
+            assert registered.entry_point == spec["entry_point"]
+            assert registered.kwargs == spec["kwargs"]
+            assert registered.vector_entry_point == spec["vector_entry_point"]
+            assert registered.max_episode_steps == spec["max_episode_steps"] == 2048
+    assert gym.spec("bushenv/BushRig-v0").namespace == "bushenv"
     assert gym.spec("BushRig-v0").vector_entry_point == "bushenv.rigs.vector:BushRigVectorEnv"
+
+
+def test_the_namespaced_id_makes_in_a_fresh_process_from_another_folder(tmp_path):
+    """``gym.make("bushenv:bushenv/<id>")`` imports bushenv itself: no prior import needed."""
+    code = (
+        "import sys, gymnasium as gym\n"
+        "assert 'bushenv' not in sys.modules\n"
+        "for env_id in ('BushRig-v0', 'QuarterCar-v0'):\n"
+        "    env = gym.make(f'bushenv:bushenv/{env_id}')\n"
+        "    obs, info = env.reset(seed=0)\n"
+        "    print(env.spec.id, env.spec.max_episode_steps, obs.shape)\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split("\n")[:2] == [
+        "bushenv/BushRig-v0 2048 (12,)",
+        "bushenv/QuarterCar-v0 2048 (12,)",
+    ]
 
 
 def test_register_all_can_run_twice_and_returns_the_ids():
@@ -49,12 +72,31 @@ def test_the_specs_found_are_the_envs_folder_of_this_checkout():
 
 def test_a_spec_whose_name_differs_from_its_id_is_refused(tmp_path):
     bad = tmp_path / "Other-v0.toml"
-    bad.write_text('id = "BushRig-v0"\nentry_point = "x:y"\n[kwargs]\n')
+    bad.write_text('id = "BushRig-v0"\nentry_point = "x:y"\nmax_episode_steps = 9\n[kwargs]\n')
     with pytest.raises(RigError, match="does not match"):
         read_spec(bad)
     (tmp_path / "Broken-v0.toml").write_text("id = \n")
     with pytest.raises(RigError, match="not valid TOML"):
         read_spec(tmp_path / "Broken-v0.toml")
+
+
+@pytest.mark.parametrize(
+    ("top", "message"),
+    [
+        (
+            "max_episode_steps = 9\nmax_episode_step = 9",
+            r"unknown top-level key\(s\) \['max_episode_step'\]",
+        ),
+        ("max_episode_steps = 0", "max_episode_steps must be a positive integer, got 0"),
+        ("max_episode_steps = 2.5", "max_episode_steps must be a positive integer, got 2.5"),
+        ("", "lacks the required key 'max_episode_steps'"),
+    ],
+)
+def test_a_spec_with_an_unknown_key_or_a_bad_episode_length_is_refused(tmp_path, top, message):
+    bad = tmp_path / "Some-v0.toml"
+    bad.write_text(f'id = "Some-v0"\nentry_point = "x:y"\n{top}\n[kwargs]\n')
+    with pytest.raises(RigError, match=message):
+        read_spec(bad)
 
 
 def test_pyproject_lists_every_bushenv_subpackage():
@@ -83,7 +125,7 @@ def test_an_installed_package_finds_its_specs_through_importlib_resources(tmp_pa
     _install_like_a_wheel(site)
     code = (
         "import gymnasium as gym, bushenv\n"
-        "from bushenv.rigs.common import spec_files\n"
+        "from bushenv.rigs.specs import spec_files\n"
         "print(spec_files()[0])\n"
         f"print(sorted(k for k in gym.registry if k in {SPEC_IDS!r}))\n"
     )

@@ -58,7 +58,7 @@ def test_vector_columns_equal_single_envs_bit_for_bit(name, axis):
     actions = rng.uniform(-1.3, 1.3, size=(steps, n, 1)).astype(np.float32)
     actions[3, 0, 0] = np.nan
     actions[4, 1, 0] = np.inf
-    kw = dict(model=name, axis=axis, episode_steps=60)
+    kw = dict(model=name, axis=axis, max_episode_steps=60)
     venv = make_vec(n, **kw)
     venv.reset(seed=5)
     vec = [venv.step(a) for a in actions]
@@ -74,7 +74,7 @@ def test_vector_columns_equal_single_envs_bit_for_bit(name, axis):
 
 
 def test_vector_autoreset_is_next_step_and_restarts_from_rest():
-    env = make_vec(2, episode_steps=5)
+    env = make_vec(2, max_episode_steps=5)
     env.reset(seed=0)
     a = np.ones((2, 1), np.float32)
     for _ in range(4):
@@ -163,3 +163,33 @@ def test_vector_render_gives_a_frame_of_rig_zero():
     env.step(np.ones((2, 1), np.float32))
     (frame,) = env.render()
     assert frame.shape == (400, 600, 3)
+
+
+def test_same_step_autoreset_columns_equal_single_envs_reset_at_once():
+    """``autoreset_mode=SAME_STEP``: a finished column is reset in the step that ends it; its
+    last observation and info are kept in ``final_obs`` / ``final_info``."""
+    n, steps = 3, 90
+    rng = np.random.default_rng(4)
+    actions = rng.uniform(-1.3, 1.3, size=(steps, n, 1)).astype(np.float32)
+    kw = dict(model=ValueAfter(after=12, value=4e4), max_episode_steps=20)
+    venv = make_vec(n, autoreset_mode=gym.vector.AutoresetMode.SAME_STEP, **kw)
+    venv.reset(seed=0)
+    vec = [venv.step(a) for a in actions]
+    ends = 0
+    for j in range(n):
+        env = gym.make("BushRig-v0", **kw)
+        env.reset(seed=0)
+        for t in range(steps):
+            obs, r, term, trunc, info = env.step(actions[t, j])
+            v_obs, v_r, v_term, v_trunc, v_info = vec[t]
+            assert r == v_r[j] and term == v_term[j] and trunc == v_trunc[j], (j, t)
+            if term or trunc:
+                ends += 1
+                assert np.array_equal(v_info["final_obs"][j], obs) and v_info["_final_obs"][j]
+                assert all(v_info["final_info"][k][j] == info[k] for k in KEYS)
+                obs, info = env.reset()
+            else:
+                assert not v_info.get("_final_obs", np.zeros(n, bool))[j]
+            assert np.array_equal(obs, v_obs[j]), (j, t)
+            assert all(info[k] == v_info[k][j] for k in KEYS), (j, t)
+    assert ends == n * (steps // 13)  # each episode: the force beyond the limit at step 13

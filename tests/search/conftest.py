@@ -8,6 +8,8 @@ exactly the linear model, so every criterion's verdict on it is predictable.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -16,6 +18,14 @@ from bushenv.models.hybrid import HybridBushing
 from bushenv.models.linear import LinearBushing
 from bushenv.models.narx import NarxBushing
 from bushenv.reference.rubber import RubberBushing
+
+OLD_MODELS = Path(__file__).resolve().parents[1] / "regressions" / "models"
+
+
+def old_nn(axis: str) -> str:
+    """The NN shipped before certified training, kept with the corpus cases found on it: a
+    network with known energy failures, whatever the shipped models are today."""
+    return str(OLD_MODELS / f"{axis}_nn-6f15bf3.npz")
 
 
 class UnstableHoldBushing(BushingModel):

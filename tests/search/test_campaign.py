@@ -34,6 +34,8 @@ def _args(model_files, out, *extra):
         "40",
         "--threads",
         "2",
+        "--reference",
+        "rubber",  # the test models are models of the built-in rubber
         *extra,
     ]
 
@@ -99,3 +101,24 @@ def test_unknown_searchers_are_refused(tmp_path, model_files, capsys):
     args[args.index("random,cma")] = "random,dqn"
     assert main(args) == 2
     assert "unknown ['dqn']" in capsys.readouterr().err
+
+
+def test_a_model_file_without_a_reference_runs_only_the_criteria_that_need_none(
+    tmp_path, model_files, capsys
+):
+    bad, _ = model_files
+    out = tmp_path / "free"
+    args = ["attack", "--model", bad, "--budget", "32", "--searchers", "random", "--out", str(out)]
+    assert main([*args, "--no-plots", "--max-shrink", "1", "--shrink-budget", "20"]) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert report["reference"]["spec"] is None
+    run = report["criteria"]["run"]
+    assert "deviation" not in run and "static" not in run
+    assert {"non_finite", "force_bound", "self_sustained", "energy"} <= set(run)
+    assert "no reference" in report["criteria"]["why"]
+    # no rows of the built-in rubber's shipped models: they are models of another bushing
+    assert set(report["models"]) == {"bad_nn"}
+    text = capsys.readouterr().out
+    assert "reference: none" in text and "no hybrid row" in text
+    md = (out / "report.md").read_text()
+    assert "s->fail" in md and "wall-clock seconds" in md

@@ -109,3 +109,35 @@ def test_corrupt_case_files_are_refused_by_name(tmp_path, reference_axial, linea
     bad.write_text(json.dumps(d))
     with pytest.raises(CorpusError, match="expect\\['bad'\\] needs a boolean"):
         load_case(bad)
+
+
+def test_replay_command_says_which_cases_hold_and_fails_on_a_changed_verdict(tmp_path, capsys):
+    import json
+
+    from bushenv.cli import main
+    from bushenv.models.linear import LinearBushing
+    from bushenv.search.corpus import make_case, save_case
+
+    model = LinearBushing(k_n_per_m=380e3, c_ns_per_m=-4e3)  # negative damping: generates energy
+    path = model.save(tmp_path / "active.npz")
+    x = np.concatenate([np.sin(np.linspace(0, 20 * np.pi, 2000)) * 1e-3, np.zeros(300)])
+    case = make_case(
+        x,
+        env="rig",
+        axis="axial",
+        family="sine",
+        params=None,
+        found_by={"model": str(path)},
+        models={str(path): model},
+        reference=None,
+        reference_spec=None,
+    )
+    saved = save_case(case, tmp_path / "corpus")
+    assert main(["replay", str(tmp_path / "corpus"), "--quiet"]) == 0
+    assert "1 of 1 cases hold" in capsys.readouterr().out
+    data = json.loads(saved.read_text())
+    data["expect"][str(path)]["diverged"] = not data["expect"][str(path)]["diverged"]
+    saved.write_text(json.dumps(data))
+    assert main(["replay", str(saved), "--quiet"]) == 1
+    assert "was expected to" in capsys.readouterr().out
+    assert main(["replay", str(tmp_path / "nothing")]) == 2

@@ -9,14 +9,16 @@ from bushenv.search.families import (
     FAMILIES,
     MAX_PROFILE_S,
     MIN_HOLD_S,
-    RIG_FAMILIES,
-    ROAD_FAMILIES,
     ROAD_MAX_HEIGHT_M,
     ROAD_MAX_RATE_M_PER_S,
     FamilyError,
     get_family,
     pad_batch,
 )
+from bushenv.search.targets import TARGETS
+
+RIG_FAMILIES = TARGETS["rig"].family_names()
+ROAD_FAMILIES = TARGETS["quartercar"].family_names()
 
 unit = st.floats(0.0, 1.0)
 

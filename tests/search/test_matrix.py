@@ -5,6 +5,7 @@ import json
 import pytest
 
 from bushenv.execution import LocalBackend
+from bushenv.progress import Progress
 from bushenv.search.matrix import (
     MatrixError,
     comparable,
@@ -29,9 +30,9 @@ def test_parse_seeds_ranges_lists_and_errors():
 
 def test_local_pool_gives_the_same_rows_as_in_process(tmp_path):
     with LocalBackend(workers=1) as one:
-        serial = run_matrix(CELLS, tmp_path / "one", one, progress=lambda s: None)
+        serial = run_matrix(CELLS, tmp_path / "one", one, progress=Progress(quiet=True))
     with LocalBackend(workers=2) as two:
-        pooled = run_matrix(CELLS, tmp_path / "two", two, progress=lambda s: None)
+        pooled = run_matrix(CELLS, tmp_path / "two", two, progress=Progress(quiet=True))
     assert [comparable(r) for r in serial] == [comparable(r) for r in pooled]
     # the linear control is never flagged, whatever the searcher finds
     assert not any(r["diverged"] for r in serial)
@@ -43,15 +44,15 @@ def test_local_pool_gives_the_same_rows_as_in_process(tmp_path):
 def test_interrupted_matrix_resumes_and_drops_a_torn_line(tmp_path):
     out = tmp_path / "m"
     with LocalBackend(workers=1) as one:
-        run_matrix(CELLS[:2], out, one, progress=lambda s: None)
+        run_matrix(CELLS[:2], out, one, progress=Progress(quiet=True))
         path = out / "cells.jsonl"
         with path.open("a") as fh:
             fh.write('{"model": "linear", "axis": "ax')  # killed mid-write
         with pytest.raises(MatrixError, match="exists; pass --resume"):
-            run_matrix(CELLS, out, one, progress=lambda s: None)
+            run_matrix(CELLS, out, one, progress=Progress(quiet=True))
         msgs = []
-        rows = run_matrix(CELLS, out, one, resume=True, progress=msgs.append)
-    assert "2 already done, 2 to run" in msgs[0]
+        rows = run_matrix(CELLS, out, one, resume=True, progress=Progress(sink=msgs.append))
+    assert "interrupted write" in msgs[0] and "2 already done, 2 to run" in msgs[1]
     assert len(rows) == 4
     assert len(read_results(out / "cells.jsonl")) == 4
 
@@ -69,11 +70,26 @@ def test_ray_backend_gives_identical_results_to_local(tmp_path):
     from bushenv.execution import RayBackend
 
     with LocalBackend(workers=1) as one:
-        local = run_matrix(CELLS, tmp_path / "local", one, progress=lambda s: None)
+        local = run_matrix(CELLS, tmp_path / "local", one, progress=Progress(quiet=True))
     backend = RayBackend(num_cpus=2)
     try:
-        remote = run_matrix(CELLS, tmp_path / "ray", backend, progress=lambda s: None)
+        remote = run_matrix(CELLS, tmp_path / "ray", backend, progress=Progress(quiet=True))
     finally:
         backend.close()
     assert not ray.is_initialized()
     assert [comparable(r) for r in local] == [comparable(r) for r in remote]
+
+
+def test_cells_are_judged_against_the_reference_they_name(tmp_path):
+    from bushenv.models.linear import LinearBushing
+    from bushenv.search.matrix import make_cells, run_cell
+
+    ref = LinearBushing.preset("axial").save(tmp_path / "ref.npz")
+    free, own = (
+        run_cell(make_cells(["linear"], ["axial"], ["random"], [0], 16, reference=r)[0])
+        for r in (None, str(ref))
+    )
+    assert free["reference"] is None and own["reference"] == str(ref)
+    assert not free["diverged"] and not own["diverged"]
+    # the linear model judged against itself: the deviation it can reach is zero
+    assert own["worst_deviation"] == 0.0

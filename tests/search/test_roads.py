@@ -26,7 +26,7 @@ def test_linear_control_in_the_quarter_car_is_never_flagged_on_roads(axis):
         for f in ("bump", "pothole")
         for c in (0.0, 1.0)
     ]
-    ev = BatchEvaluator(LinearBushing.preset(axis), ref, env="quartercar", axis=axis)
+    ev = BatchEvaluator(LinearBushing.preset(axis), ref, target="quartercar", axis=axis)
     v = ev.evaluate(roads).verdict
     assert not v.diverged.any(), [v.row(b) for b in np.flatnonzero(v.diverged)][:2]
 
@@ -34,9 +34,9 @@ def test_linear_control_in_the_quarter_car_is_never_flagged_on_roads(axis):
 def test_quarter_car_batch_is_judged_per_road_and_threads_agree():
     ref = RubberBushing.preset("axial", measurement=False)
     roads = _roads(6, 2)
-    one = BatchEvaluator(bad_narx(), ref, env="quartercar", threads=1).evaluate(roads)
-    two = BatchEvaluator(bad_narx(), ref, env="quartercar", threads=2).evaluate(roads)
+    one = BatchEvaluator(bad_narx(), ref, target="quartercar", threads=1).evaluate(roads)
+    two = BatchEvaluator(bad_narx(), ref, target="quartercar", threads=2).evaluate(roads)
     assert np.array_equal(one.verdict.robustness, two.verdict.robustness)
-    alone = BatchEvaluator(bad_narx(), ref, env="quartercar").evaluate(roads[3:4])
+    alone = BatchEvaluator(bad_narx(), ref, target="quartercar").evaluate(roads[3:4])
     assert alone.verdict.robustness[0] == one.verdict.robustness[3]
-    assert one.road is not None and np.array_equal(one.profile(3), roads[3])
+    assert np.array_equal(one.profile(3), roads[3])

@@ -3,7 +3,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bushenv.search import stl
+from bushenv import stl
 
 signals = st.lists(st.floats(-10, 10), min_size=1, max_size=30).map(np.array)
 

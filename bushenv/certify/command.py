@@ -1,0 +1,188 @@
+"""``bushenv certify``: hold-stability and passivity certificates of a NARX model.
+
+Writes DIR/certificate.json and three plots (static force, spectral radius, Im K); prints a
+summary on stdout and progress on stderr.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from bushenv.certify.certificate import CertifyOptions, certify
+from bushenv.certify.network import CertifyError, narx_net
+from bushenv.certify.plots import passivity_plot, spectral_radius_plot, static_force_plot
+from bushenv.models import get_model, get_reference
+from bushenv.persist import write_json
+from bushenv.progress import Progress
+
+EXAMPLE = "bushenv certify hybrid --axis radial --reference rubber --out runs/certify-radial"
+DEFAULTS = CertifyOptions()
+
+
+def resolve_model(spec: str, axis: str, dt: float | None = None):
+    """A registered name or a model file -> the model to certify."""
+    return get_model(spec, axis=axis, dt=dt)
+
+
+def _mm_list(text: str) -> tuple[float, ...]:
+    try:
+        vals = tuple(float(v) * 1e-3 for v in text.split(",") if v.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated mm values, got {text!r}"
+        ) from None
+    if not vals:
+        raise argparse.ArgumentTypeError("expected at least one value")
+    return vals
+
+
+def _fmt_mm(vals: tuple[float, ...]) -> str:
+    return ",".join(f"{v * 1e3:g}" for v in vals)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from bushenv.models import AXES
+
+    parser.add_argument("model", metavar="MODEL", help="nn, hybrid or a NARX model file (.npz)")
+    parser.add_argument(
+        "--reference",
+        default="rubber",
+        help="registered name or model file the static force and Im K are compared with "
+        "(default: rubber)",
+    )
+    parser.add_argument("--axis", default="axial", choices=AXES, help="(default: axial)")
+    parser.add_argument(
+        "--holds",
+        type=int,
+        default=DEFAULTS.holds,
+        help=f"held displacements over the stroke, >= 3 (default: {DEFAULTS.holds})",
+    )
+    parser.add_argument(
+        "--stroke-mm",
+        type=float,
+        default=DEFAULTS.stroke_m * 1e3,
+        help=f"holds span -S..+S mm (default: {DEFAULTS.stroke_m * 1e3:g}, the machine's)",
+    )
+    parser.add_argument(
+        "--at-mm",
+        type=_mm_list,
+        default=(),
+        help="held displacements to certify besides the grid, mm, e.g. 0.53,4 (default: none)",
+    )
+    parser.add_argument(
+        "--hold-s",
+        type=float,
+        default=DEFAULTS.hold_s,
+        help=f"length of every simulated hold, s (default: {DEFAULTS.hold_s:g})",
+    )
+    parser.add_argument(
+        "--velocity",
+        default=DEFAULTS.velocity,
+        choices=("central", "backward"),
+        help="velocity the hybrid's damper sees in K: central (simulate, the machine) or "
+        "backward (the rigs) (default: central)",
+    )
+    parser.add_argument(
+        "--passivity-mm",
+        type=_mm_list,
+        default=DEFAULTS.passivity_holds_m,
+        help="holds about which K is computed, mm "
+        f"(default: {_fmt_mm(DEFAULTS.passivity_holds_m)})",
+    )
+    parser.add_argument(
+        "--sine-mm",
+        type=float,
+        default=DEFAULTS.reference_amplitude_m * 1e3,
+        help="amplitude of the sines that measure the reference's K, mm "
+        f"(default: {DEFAULTS.reference_amplitude_m * 1e3:g})",
+    )
+    parser.add_argument(
+        "--energy-mm",
+        type=_mm_list,
+        default=DEFAULTS.energy_amplitudes_m,
+        help="amplitudes of the sines judged for the energy criterion, mm "
+        f"(default: {_fmt_mm(DEFAULTS.energy_amplitudes_m)})",
+    )
+    parser.add_argument("--out", required=True, metavar="DIR", help="folder for the results")
+    parser.add_argument("--force", action="store_true", help="replace an existing certificate")
+    parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
+
+
+def _progress(quiet: bool):
+    """``report(stage, fraction_done)`` on the shared progress lines (stderr, time left)."""
+    progress = Progress(total=1.0, quiet=quiet, every_s=0.0)
+
+    def report(stage: str, fraction: float) -> None:
+        progress.update(fraction, stage)
+
+    return report
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.holds < 3:
+        raise CertifyError(f"--holds must be >= 3, got {args.holds}")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise CertifyError(f"--out {out}: exists and is not a folder")
+    target = out / "certificate.json"
+    if target.exists() and not args.force:
+        raise CertifyError(f"{target} exists; pass --force to replace it")
+    model = resolve_model(args.model, args.axis)
+    try:
+        narx_net(model)
+    except CertifyError as exc:
+        raise CertifyError(f"{args.model}: {exc}") from None
+    reference = get_reference(args.reference, axis=args.axis, dt=model.dt)
+    opts = CertifyOptions(
+        holds=args.holds,
+        extra_holds_m=args.at_mm,
+        stroke_m=args.stroke_mm * 1e-3,
+        hold_s=args.hold_s,
+        velocity=args.velocity,
+        passivity_holds_m=args.passivity_mm,
+        reference_amplitude_m=args.sine_mm * 1e-3,
+        energy_amplitudes_m=args.energy_mm,
+    )
+    report = _progress(args.quiet)
+    cert = certify(model, reference, opts, progress=report)
+    doc = cert.document
+    doc["model"]["source"] = str(args.model)
+    doc["model"]["axis"] = args.axis
+    doc["reference"] = {"source": str(args.reference), "class": type(reference).__name__}
+    report("plots", 0.99)
+    out.mkdir(parents=True, exist_ok=True)
+    name = f"{Path(args.model).name} ({args.axis})"
+    paths = [
+        static_force_plot(cert, out / "static_force.png", f"{name}: static force in a hold"),
+        spectral_radius_plot(cert, out / "spectral_radius.png", f"{name}: hold stability"),
+        passivity_plot(cert, out / "passivity.png", f"{name}: small-signal Im K"),
+    ]
+    write_json(target, doc)
+    _summary(doc, [target, *paths])
+    return 0
+
+
+def _mm_ranges(ranges: list[list[float]]) -> str:
+    return "[" + ", ".join(f"{a * 1e3:+.3g}..{b * 1e3:+.3g} mm" for a, b in ranges) + "]"
+
+
+def _hz_bands(bands: list[list[float]]) -> str:
+    return "[" + ", ".join(f"{a:.1f}-{b:.1f} Hz" for a, b in bands) + "]"
+
+
+def _summary(doc: dict, paths: list[Path]) -> None:
+    s = doc["summary"]
+    print(
+        f"holds: {s['holds']}, settling stably {s['holds_settling_stably']}, departing "
+        f"{s['departing_holds']}, oscillating {s['oscillating_holds']}, folds {s['folds']}; "
+        f"wrong sign {s['wrong_sign_holds']} {_mm_ranges(s['wrong_sign_ranges_m'])}, static "
+        f"force off {s['static_off_holds']} {_mm_ranges(s['static_off_ranges_m'])}"
+    )
+    print(
+        f"non-passive at rest: {_hz_bands(s['non_passive_bands_hz_at_rest'])}; "
+        f"hold certificate {'passes' if s['passes_holds'] else 'FAILS'}, passivity "
+        f"{'passes' if s['passes_passivity'] else 'FAILS'}"
+    )
+    for p in paths:
+        print(p)

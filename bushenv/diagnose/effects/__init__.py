@@ -1,0 +1,1 @@
+"""Candidate unmodelled effects, one module each; the registry is ``diagnose.candidates``."""

@@ -1,0 +1,111 @@
+"""Hardening: a nonlinear elastic backbone of any monotone shape, stiffening or softening."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from bushenv.diagnose.effects.base import Effect, Scales, Signals
+
+KNOTS = (0.25, 0.5, 0.8)  # fractions of the largest deflection
+GRID = 4001  # points of the tangent's integral table
+
+
+def _knots(scales: Scales) -> tuple[float, float, float]:
+    """Knots u1 < u2 < u3 (m): fractions KNOTS of the largest deflection on either side.
+
+    Fractions of the range, not quantiles: a held step would pile quantiles onto one level.
+    """
+    top = max([q[-1] for q in (scales.x_pos, scales.x_neg) if q] or [scales.sigma_x])
+    return tuple(f * max(top, 1e-12) for f in KNOTS)
+
+
+def tangent_shapes(s: np.ndarray, scales: Scales) -> np.ndarray:
+    """(len(s), 6) tangent-stiffness shapes at |x| = ``s`` (dimensionless), both sides alike.
+
+    Hats peaking at 0, u1 and u2; a shape rising from u2 to 1 at u3 that stays at 1 beyond;
+    and the growth (s/u3)^2, (s/u3)^4 (the tangent of a cubic and a quintic term). Beyond
+    the identification range the tangent keeps its last value or stiffens polynomially;
+    with weights >= 0 it stays >= 0.
+    """
+    u1, u2, u3 = _knots(scales)
+    r = s / u3
+    return np.stack(
+        [
+            np.interp(s, [0.0, u1], [1.0, 0.0]),
+            np.interp(s, [0.0, u1, u2], [0.0, 1.0, 0.0]),
+            np.interp(s, [u1, u2, u3], [0.0, 1.0, 0.0]),
+            np.interp(s, [u1, u2, u3], [0.0, 0.0, 1.0]),
+            r * r,
+            r**4,
+        ],
+        axis=1,
+    )
+
+
+def _integrated(mag: np.ndarray, scales: Scales) -> np.ndarray:
+    """int_0^|x| of each tangent shape, by a fine table (trapezoid) read by interpolation."""
+    top = max(float(mag.max()) if mag.size else 0.0, 1e-12)
+    s = np.linspace(0.0, top, GRID)
+    h = tangent_shapes(s, scales)
+    table = np.concatenate([np.zeros((1, h.shape[1])), np.cumsum((h[1:] + h[:-1]) / 2, axis=0)])
+    table *= s[1] - s[0]
+    return np.stack([np.interp(mag, s, table[:, j]) for j in range(h.shape[1])], axis=1)
+
+
+def _two_sided(scales: Scales) -> bool:
+    return bool(scales.x_pos) and bool(scales.x_neg)
+
+
+class Hardening(Effect):
+    """The elastic force as a monotone function of x, replacing the linear spring ``k x``.
+
+    Its tangent stiffness is a non-negative combination of shapes of ``|x|``: hats on knots
+    at 0, 25, 50 and 80 % of the identification records' largest deflection, constant
+    beyond the last knot, and a growth ``(x/x80)^2``, ``(x/x80)^4`` -- the same on both sides
+    (what tension teaches extrapolates to compression), plus, when the records load both
+    sides, a constant extra tangent on each side (tension and compression may differ). All
+    weights are tangent stiffnesses >= 0, so the backbone is monotone whatever the fit: a
+    falling tangent is a softening backbone, a rising one hardening.
+    """
+
+    name = "hardening"
+    form = (
+        "F(x) = int_0^x k_t(s) ds replacing k x; k_t(abs(x)) >= 0 piecewise linear on knots at "
+        "0, 25, 50, 80 % of the range + (x/x80)^2, (x/x80)^4, + a constant per side"
+    )
+    weights = "tangent stiffnesses >= 0 (N/m): monotone, softening or stiffening"
+    replaces_spring = True
+
+    def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        x = s.x
+        cols = np.sign(x)[:, None] * _integrated(np.abs(x), scales)
+        if _two_sided(scales):
+            cols = np.concatenate(
+                [cols, np.maximum(x, 0.0)[:, None], np.minimum(x, 0.0)[:, None]], axis=1
+            )
+        return cols
+
+    def columns_count(self, shape: Any, scales: Scales) -> int:
+        return 6 + 2 * _two_sided(scales)
+
+    def parameters(self, shape: Any, scales: Scales, w: np.ndarray) -> dict[str, Any]:
+        u1, u2, u3 = _knots(scales)
+        out: dict[str, Any] = {}
+        kinds = []
+        for i, (side, q) in enumerate((("positive", scales.x_pos), ("negative", scales.x_neg))):
+            if not q:
+                continue
+            pts = np.array([0.0, u1, u2, u3, q[-1], 1.5 * q[-1]])
+            k = tangent_shapes(pts, scales) @ w[:6]
+            if _two_sided(scales):
+                k = k + w[6 + i]
+            out[f"{side}_side"] = [
+                {"deflection_m": float(p), "tangent_stiffness_n_per_m": float(kk)}
+                for p, kk in zip(pts, k, strict=True)
+            ]
+            ratio = k[4] / k[0] if k[0] > 0 else np.inf
+            kinds.append("hardening" if ratio > 1.05 else "softening" if ratio < 0.95 else "linear")
+        out["kind"] = "+".join(dict.fromkeys(kinds)) if kinds else "linear"
+        return out

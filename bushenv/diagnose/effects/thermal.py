@@ -1,0 +1,63 @@
+"""Thermal: stiffness and damping lost as the specimen heats by its own dissipation."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+from bushenv.diagnose.effects.base import Effect, Scales, Signals
+
+TIME_CONSTANTS_S = (10.0, 30.0, 100.0, 300.0, np.inf)
+HEATING = ("viscous", "hysteretic")  # heat input ~ v^2 (a damper) or ~ |v| (friction)
+
+
+def heating_state(v: np.ndarray, dt: float, tau: float, heating: str, v_rms: float) -> np.ndarray:
+    """theta' = P - theta / tau from rest (tau = inf: cumulative), in m^2/s.
+
+    P = v^2 for viscous heating, |v| v_rms for hysteretic (friction-like) heating; v_rms of the
+    identification records keeps both in the same units.
+    """
+    p = v * v if heating == "viscous" else np.abs(v) * v_rms
+    if np.isinf(tau):
+        return np.cumsum(p) * dt
+    a = np.exp(-dt / tau)
+    return signal.lfilter([dt], [1.0, -a], p)
+
+
+class Thermal(Effect):
+    """``-theta (b_k x + b_c v)``: self-heating softens the spring and the damper.
+
+    theta integrates a heating power (viscous ``v^2`` or hysteretic ``|v|``) with a leak to
+    ambient of time constant ``tau_th``; each record starts cold. Both heating laws and five
+    time constants are tried.
+    """
+
+    name = "thermal"
+    form = "-theta (b_k x + b_c v), theta' = P - theta / tau_th, P = v^2 or abs(v) v_rms"
+    weights = "b_k, b_c >= 0"
+    shape_text = "tau_th in {10, 30, 100, 300, inf} s x heating {viscous, hysteretic}"
+
+    def shapes(self, scales: Scales) -> list:
+        return [(h, t) for h in HEATING for t in TIME_CONSTANTS_S]
+
+    def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        heating, tau = shape
+        theta = heating_state(s.v, s.dt, tau, heating, scales.v_rms)
+        return np.stack([-theta * s.x, -theta * s.v], axis=1)
+
+    def columns_count(self, shape: Any, scales: Scales) -> int:
+        return 2
+
+    def describe(self, shape: Any) -> str:
+        return f"thermal ({shape[0]} heating, tau_th={shape[1]:g} s)"
+
+    def parameters(self, shape: Any, scales: Scales, w: np.ndarray) -> dict[str, Any]:
+        return {
+            "heating": shape[0],
+            "time_constant_s": float(shape[1]),
+            "stiffness_loss_n_per_m_per_heat": float(w[0]),
+            "damping_loss_ns_per_m_per_heat": float(w[1]),
+            "heat_unit": "m^2/s (integral of v^2 or |v| v_rms)",
+        }

@@ -1,0 +1,235 @@
+"""Fit a candidate (a combination of effects) on some records and judge it on others.
+
+Weights by bounded linear least squares from the summed Gram products of ``design.py``;
+shape settings (heating laws and time constants, delays) by the fitting error
+over the product of the members' grids, a delay refined by a bounded 1-D search. ``Fold``s
+say which records fit and which are judged: one fold (TRAIN fits, TESTs judged), or one per
+record in the cross mode (all others fit, that one is judged).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import linalg
+from scipy.optimize import lsq_linear, minimize_scalar
+
+from bushenv.diagnose.design import DAMPER, SPRING, Block, ColumnStore, Prepared
+from bushenv.diagnose.effects.base import Combination
+from bushenv.diagnose.effects.delay import shift_columns
+
+
+@dataclass(frozen=True)
+class Fold:
+    """Records whose weights are fitted, and records judged with them."""
+
+    fit: tuple[Prepared, ...]
+    judged: tuple[Prepared, ...]
+
+
+@dataclass
+class Fit:
+    """A combination with chosen shapes and its fitted weights."""
+
+    combo: Combination
+    shapes: tuple
+    blocks: tuple[Block, ...]
+    theta: np.ndarray
+    mse: float  # on the records fitted
+    n: int  # samples fitted
+    force_ms: float  # mean square of the force fitted (for a relative fitting error)
+
+    @property
+    def delay_s(self) -> float:
+        return sum(m.delay_s(s) for m, s in zip(self.combo.members, self.shapes, strict=True))
+
+    @property
+    def n_extra(self) -> int:
+        """Weights beyond a spring and a damper, plus one per shape setting chosen."""
+        shaped = sum(1 for s in self.shapes if s is not None)
+        return int(self.theta.size) - 2 + shaped
+
+
+def bounded_lstsq(g: np.ndarray, b: np.ndarray, lower: np.ndarray, n: int) -> np.ndarray:
+    """min |A w - y| subject to w >= lower, from G = A^T A and b = A^T y.
+
+    Columns are scaled to unit RMS; a ridge of 1e-8 of the scaled diagonal steadies
+    near-collinear columns (a long Maxwell branch beside the spring) without biasing the fit.
+    """
+    p = g.shape[0]
+    if p == 0:
+        return np.zeros(0)
+    scale = np.sqrt(np.maximum(np.diag(g), 0.0) / max(n, 1))
+    scale[scale == 0] = 1.0
+    gs = g / np.outer(scale, scale) + 1e-8 * n * np.eye(p)
+    r = linalg.cholesky(gs, lower=False)
+    qy = linalg.solve_triangular(r, b / scale, trans="T")
+    lo = lower * scale
+    if np.all(np.isneginf(lo)):
+        w = linalg.solve_triangular(r, qy)
+    else:
+        w = lsq_linear(r, qy, bounds=(lo, np.full(p, np.inf)), method="bvls").x
+    return w / scale
+
+
+def blocks_of(store: ColumnStore, combo: Combination, shapes: tuple, linear_base: bool):
+    spring = DAMPER if (linear_base and combo.replaces_spring) else SPRING
+    blocks = [spring]
+    for m, s in zip(combo.members, shapes, strict=True):
+        if m.columns_count(s, store.scales) > 0:
+            blocks.append((m.name, s))
+    return tuple(blocks)
+
+
+def fit(
+    store: ColumnStore,
+    combo: Combination,
+    shapes: tuple,
+    records: tuple[Prepared, ...],
+    linear_base: bool,
+) -> Fit:
+    """Weights of ``combo`` at ``shapes`` by bounded least squares on ``records``."""
+    blocks = blocks_of(store, combo, shapes, linear_base)
+    delay = sum(m.delay_s(s) for m, s in zip(combo.members, shapes, strict=True))
+    g = sum(store.gram(p, blocks) for p in records)
+    b = np.zeros(g.shape[0])
+    yy = 0.0
+    for p in records:
+        bp, yp = store.rhs(p, blocks, delay)
+        b = b + bp
+        yy += yp
+    n = sum(p.n for p in records)
+    theta = bounded_lstsq(g, b, store.lower(blocks), n)
+    mse = max(float(yy - 2 * theta @ b + theta @ g @ theta) / n, 0.0)
+    force_ms = float(sum(np.sum(p.force**2) for p in records)) / n
+    return Fit(combo, tuple(shapes), blocks, theta, mse, n, force_ms)
+
+
+def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
+    """The fitted model's force on one record (N), (T,)."""
+    a = store.design(prep, f.blocks)
+    return shift_columns(prep.b0 + a @ f.theta, f.delay_s, prep.dt)
+
+
+def _product(grids: list[list]) -> list[tuple]:
+    out: list[tuple] = [()]
+    for g in grids:
+        out = [o + (s,) for o in out for s in g]
+    return out
+
+
+def best_shapes(
+    store: ColumnStore, combo: Combination, records: tuple[Prepared, ...], linear_base: bool
+) -> Fit:
+    """The shapes with the lowest fitting error over the product of the members' grids."""
+    grids = [m.shapes(store.scales) for m in combo.members]
+
+    def delay_of(shapes: tuple) -> float:
+        return sum(m.delay_s(s) for m, s in zip(combo.members, shapes, strict=True))
+
+    # by delay, so that the shifted force targets of one delay are used together
+    combos = sorted(_product(grids), key=delay_of)
+    best = min((fit(store, combo, c, records, linear_base) for c in combos), key=lambda f: f.mse)
+    for i, member in enumerate(combo.members):
+        if member.continuous_shape and len(grids[i]) >= 3:
+            best = _refine(store, combo, grids, i, best, records, linear_base)
+    return best
+
+
+def _refine(store, combo, grids, i: int, best: Fit, records, linear_base: bool) -> Fit:
+    """Refine shape ``i`` between its grid neighbours, then choose the others again."""
+    grid = grids[i]
+    k = grid.index(best.shapes[i])
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+
+    def mse(log_s: float) -> float:
+        combo_s = list(best.shapes)
+        combo_s[i] = float(np.exp(log_s))
+        return fit(store, combo, tuple(combo_s), records, linear_base).mse
+
+    res = minimize_scalar(
+        mse, bounds=(np.log(lo), np.log(hi)), method="bounded", options={"xatol": 0.01}
+    )
+    if res.fun >= best.mse:
+        return best
+    shapes = list(best.shapes)
+    shapes[i] = float(np.exp(res.x))
+    best = fit(store, combo, tuple(shapes), records, linear_base)
+    for j in range(len(grids)):
+        if j == i or len(grids[j]) < 2:
+            continue
+        for s in grids[j]:
+            trial_shapes = list(best.shapes)
+            trial_shapes[j] = s
+            trial = fit(store, combo, tuple(trial_shapes), records, linear_base)
+            if trial.mse < best.mse:
+                best = trial
+    return best
+
+
+@dataclass
+class Judged:
+    """A combination fitted fold by fold and judged on the held-out records."""
+
+    combo: Combination
+    fits: list[Fit]
+    predictions: dict[int, np.ndarray]  # record uid -> held-out prediction
+    sse: float
+    n: int
+
+    @property
+    def mse(self) -> float:
+        return self.sse / self.n
+
+    @property
+    def gap_train(self) -> float:
+        """RMS ratio of the fitting error (fitting records), averaged over folds."""
+        return float(np.mean([np.sqrt(f.mse / f.force_ms) for f in self.fits]))
+
+    @property
+    def n_extra(self) -> int:
+        return self.fits[0].n_extra
+
+
+def judge(store: ColumnStore, combo: Combination, folds: list[Fold], linear_base: bool) -> Judged:
+    """Fit ``combo`` on each fold's fitting records, predict its judged records."""
+    preds: dict[int, np.ndarray] = {}
+    fits = []
+    sse, n = 0.0, 0
+    for fold in folds:
+        f = best_shapes(store, combo, fold.fit, linear_base)
+        fits.append(f)
+        for p in fold.judged:
+            pred = predict(store, f, p)
+            preds[p.uid] = pred
+            sse += float(np.sum((p.force - pred) ** 2))
+            n += p.n
+    return Judged(combo, fits, preds, sse, n)
+
+
+def describe_shapes(f: Fit) -> list[str]:
+    return [m.describe(s) for m, s in zip(f.combo.members, f.shapes, strict=True)]
+
+
+def parameters(store: ColumnStore, f: Fit, linear_base: bool) -> dict[str, Any]:
+    """The fitted model in physical terms: spring, damper and each effect, SI units."""
+    out: dict[str, Any] = {}
+    i = 0
+    for block in f.blocks:
+        n = store.columns_count(block)
+        w = f.theta[i : i + n]
+        i += n
+        if block == SPRING:
+            pre = "" if linear_base else "delta_"
+            out[f"{pre}k_n_per_m"], out[f"{pre}c_ns_per_m"] = float(w[0]), float(w[1])
+        elif block == DAMPER:
+            out["c_ns_per_m"] = float(w[0])
+        else:
+            member = next(m for m in f.combo.members if m.name == block[0])
+            out[block[0]] = member.parameters(block[1], store.scales, w)
+    for m, s in zip(f.combo.members, f.shapes, strict=True):
+        if m.name not in out:
+            out[m.name] = m.parameters(s, store.scales, np.zeros(0))
+    return out

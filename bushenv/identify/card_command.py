@@ -1,0 +1,42 @@
+"""``bushenv card``: show a model's card and check it against its model file and records.
+
+Exit 0 when the model file and every given record match the card; 2 (one line naming the
+record or file) when one does not.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+EXAMPLE = "bushenv card my_nn.npz train.csv held.csv"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("card", metavar="MODEL.npz|CARD.json", help="a model file or its card")
+    p.add_argument(
+        "records", nargs="*", metavar="RECORD.csv", help="record files to check against the card"
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from bushenv.identify.card import load_card
+
+    card = load_card(args.card, records=args.records)
+    d = card.data
+    src = d["source"]
+    print(
+        f"{card.path}: model {d['model']} in {d['model_file']} (sha256 matches), "
+        f"{d['sample_rate_hz']:.6g} Hz, made by {src['kind']} with bushenv {d['bushenv_version']}"
+    )
+    for r in card.records:
+        m = r.get("metrics")
+        score = f"RMS ratio {100 * m['rms_ratio']:.2f} %" if m else ""
+        checked = (
+            " (checked)" if (r["file"] or r["name"]).endswith(tuple(card.checked_records)) else ""
+        )
+        print(
+            f"  {r['role']:9s} {r['file'] or r['name']}  {r['duration_s']:.1f} s  {score}{checked}"
+        )
+    if args.records:
+        print(f"{len(args.records)} record file(s) match the card")
+    return 0

@@ -1,0 +1,153 @@
+"""What identification trains on: one or several records, each its own history, at one rate.
+
+``training_set(records)`` checks the records where they enter (finite, same sample rate, long
+enough, not constant) and returns a ``TrainingSet``: per record the displacement x (m), force
+f (N) and velocity v (m/s, the central difference of x unless given), all (T_r,). Every method
+treats each record as starting from rest and never lets a sample's history reach into another
+record.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from bushenv.models.base import velocity_of
+
+MIN_SAMPLES = 10  # a record shorter than this identifies nothing
+RATE_RTOL = 1e-6  # two records whose sample times differ by less are at the same rate
+
+
+class IdentificationError(ValueError):
+    """Identification data or options are unusable; the message names the record or option."""
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One record's arrays, (T,) each: x m, f N, v m/s; ``label`` names it in messages."""
+
+    x: np.ndarray
+    f: np.ndarray
+    v: np.ndarray
+    label: str
+
+    def __len__(self) -> int:
+        return int(self.x.size)
+
+
+@dataclass(frozen=True)
+class TrainingSet:
+    """Records of one bushing axis sampled every ``dt`` s (``segments`` in the given order)."""
+
+    segments: tuple[Segment, ...]
+    dt: float
+
+    @property
+    def labels(self) -> list[str]:
+        return [s.label for s in self.segments]
+
+    def concatenated(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """x, f, v of every record end to end: for fits without memory (least squares)."""
+        return tuple(np.concatenate([getattr(s, k) for s in self.segments]) for k in "xfv")
+
+
+def check_record(x, f, dt: float, v=None, label: str = "record") -> Segment:
+    """Validate one (T,) displacement/force record; the velocity defaults to the central
+    difference of x. Raises ``IdentificationError`` naming ``label`` and the bad value."""
+    x = np.asarray(x, dtype=np.float64)
+    f = np.asarray(f, dtype=np.float64)
+    if x.ndim != 1 or f.shape != x.shape:
+        raise IdentificationError(
+            f"{label}: x and f must be 1-D of equal length, got shapes {x.shape} and {f.shape}"
+        )
+    if x.size < MIN_SAMPLES:
+        raise IdentificationError(
+            f"{label}: record too short: {x.size} samples (need at least {MIN_SAMPLES})"
+        )
+    if not (np.isfinite(dt) and dt > 0):
+        raise IdentificationError(f"dt must be a positive number of seconds, got {dt!r}")
+    for name, a in (("x", x), ("f", f)):
+        bad = np.flatnonzero(~np.isfinite(a))
+        if bad.size:
+            raise IdentificationError(
+                f"{label}: {name}[{bad[0]}] is {a[bad[0]]}: record holds NaN/inf"
+            )
+    if v is None:
+        v = velocity_of(x, dt)
+    else:
+        v = np.asarray(v, dtype=np.float64)
+        if v.shape != x.shape or not np.all(np.isfinite(v)):
+            raise IdentificationError(
+                f"{label}: v must be finite with shape {x.shape}, got {v.shape}"
+            )
+    if np.ptp(x) == 0:
+        raise IdentificationError(f"{label}: x is constant: nothing to identify")
+    return Segment(x, f, v, label)
+
+
+def record_label(record, index: int) -> str:
+    """How a record is named in messages: its file, its name, or its position."""
+    path = getattr(record, "path", None)
+    if path is not None:
+        return os.fspath(path)
+    return getattr(record, "name", "") or f"record {index + 1}"
+
+
+def rate_of(record, label: str) -> float:
+    """The record's sample time, s (``Record.dt``)."""
+    try:
+        return float(record.dt)
+    except ValueError as exc:
+        raise IdentificationError(f"{label}: {exc}") from None
+
+
+def check_same_rate(records: Sequence, what: str = "records") -> float:
+    """The common sample time of ``records``, s; refuses records at different rates, naming
+    both files and both rates."""
+    first_label, first_dt = "", 0.0
+    for i, rec in enumerate(records):
+        label = record_label(rec, i)
+        rdt = rate_of(rec, label)
+        if i == 0:
+            first_label, first_dt = label, rdt
+        elif abs(rdt - first_dt) > RATE_RTOL * first_dt:
+            raise IdentificationError(
+                f"{what} at different sample rates: {label} at {1 / rdt:.6g} Hz, "
+                f"{first_label} at {1 / first_dt:.6g} Hz; resample them to one rate "
+                "(bushenv.records.resample)"
+            )
+    if not first_label:
+        raise IdentificationError(f"no {what} given")
+    return first_dt
+
+
+def check_model_rate(record, dt: float, index: int = 0) -> None:
+    """Refuse a record at another rate than a model's ``dt``, naming both rates."""
+    label = record_label(record, index)
+    rdt = rate_of(record, label)
+    if abs(rdt - dt) > RATE_RTOL * dt:
+        raise IdentificationError(
+            f"{label} is sampled at {1 / rdt:.6g} Hz, the model at {1 / dt:.6g} Hz (the rate "
+            "of its training records); resample it (bushenv.records.resample)"
+        )
+
+
+def training_set(records: Sequence, velocities: Sequence | None = None) -> TrainingSet:
+    """Check ``records`` (objects with ``displacement``, ``force``, ``dt``: ``bushenv.records.
+    Record``) and return their arrays; ``velocities`` (one (T,) array or None per record)
+    replace the central-difference velocity."""
+    records = list(records)
+    if not records:
+        raise IdentificationError("no training records given")
+    dt = check_same_rate(records, what="training records")
+    velocities = list(velocities) if velocities is not None else [None] * len(records)
+    if len(velocities) != len(records):
+        raise IdentificationError(f"{len(velocities)} velocity arrays for {len(records)} records")
+    segments = tuple(
+        check_record(r.displacement, r.force, dt, v, record_label(r, i))
+        for i, (r, v) in enumerate(zip(records, velocities, strict=True))
+    )
+    return TrainingSet(segments, dt)

@@ -1,0 +1,182 @@
+"""What every searcher shares: the interface, the result and its book-keeping.
+
+Every searcher is ``searcher.run(evaluator, budget, seed) -> SearchResult``. The budget counts
+model evaluations (profiles simulated, ``BatchEvaluator.n_evaluations``), the same unit for
+every searcher; the result records how many evaluations and seconds it took to the first
+failure, the worst profile found (lowest STL robustness, see ``bushenv/divergence.py``) and
+every failing profile (up to ``MAX_KEPT_FAILURES``). Given the seed, a run is deterministic.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+MAX_KEPT_FAILURES = 512
+
+
+class SearchError(ValueError):
+    """Bad searcher name, budget or family."""
+
+
+@dataclass
+class Candidate:
+    """One evaluated profile: where it came from and what the verdict said."""
+
+    profile: np.ndarray  # (T,) rig displacement or road height, m
+    family: str
+    params: list[float] | None  # unit-cube coordinates (None for RL-made profiles)
+    robustness: float
+    diverged: bool
+    verdict: dict  # divergence.Verdict.row
+    evaluation: int  # 1-based index of the evaluation that produced it, within its search
+    seconds: float  # wall time since the search started when it was evaluated
+
+    def to_json(self) -> dict:
+        return {
+            "family": self.family,
+            "params": self.params,
+            "robustness": self.verdict["robustness"],
+            "diverged": self.diverged,
+            "verdict": self.verdict,
+            "evaluation": self.evaluation,
+            "seconds": self.seconds,
+            "n_samples": int(self.profile.size),
+        }
+
+
+@dataclass
+class SearchResult:
+    searcher: str
+    seed: int
+    budget: int
+    env: str
+    evaluations: int = 0
+    seconds: float = 0.0
+    first_failure: Candidate | None = None
+    worst: Candidate | None = None
+    failures: list[Candidate] = field(default_factory=list)
+    n_failures: int = 0
+    n_reference_unusable: int = 0  # profiles the reference itself could not run
+    history: list[tuple[int, float]] = field(default_factory=list)  # (evals, best robustness)
+
+    @property
+    def diverged(self) -> bool:
+        return self.first_failure is not None
+
+    def summary(self) -> dict:
+        ff = self.first_failure
+        w = self.worst
+        return {
+            "searcher": self.searcher,
+            "seed": self.seed,
+            "budget": self.budget,
+            "env": self.env,
+            "diverged": self.diverged,
+            "evaluations": self.evaluations,
+            "seconds": round(self.seconds, 3),
+            "evaluations_to_failure": ff.evaluation if ff else None,
+            "seconds_to_failure": round(ff.seconds, 3) if ff else None,
+            "n_failures": self.n_failures,
+            "worst_deviation": w.verdict["worst_deviation"] if w else None,
+            "worst_robustness": w.verdict["robustness"] if w else None,
+            "worst_family": w.family if w else None,
+            "worst_criterion": w.verdict["first_criterion"] if w else None,
+            "failing_families": sorted({c.family for c in self.failures}),
+            "reference_unusable": self.n_reference_unusable,
+        }
+
+
+class Recorder:
+    """Book-keeping shared by all searchers: counts, first failure, worst, kept failures."""
+
+    def __init__(self, result: SearchResult, evaluator) -> None:
+        self.result = result
+        self.evaluator = evaluator
+        self.t0 = time.perf_counter()
+        self.best = np.inf
+
+    def record(
+        self,
+        batch,
+        families: list[str],
+        params: list[list[float] | None],
+        limit: int | None = None,
+    ) -> None:
+        """Book the first ``limit`` (default: all) profiles of ``batch``."""
+        v = batch.verdict
+        res = self.result
+        now = time.perf_counter() - self.t0
+        n = len(families) if limit is None else min(len(families), int(limit))
+        unusable = v.reference_unusable
+        for b in range(n):
+            res.evaluations += 1
+            if unusable is not None and unusable[b]:
+                res.n_reference_unusable += 1
+            rob = float(v.robustness[b])
+            div = bool(v.diverged[b])
+            worse = res.worst is None or rob < res.worst.robustness
+            if not (div or worse):
+                continue
+            cand = Candidate(
+                profile=batch.profile(b),
+                family=families[b],
+                params=params[b],
+                robustness=rob,
+                diverged=div,
+                verdict=v.row(b),
+                evaluation=res.evaluations,
+                seconds=now,
+            )
+            if worse:
+                res.worst = cand
+            if div:
+                res.n_failures += 1
+                if res.first_failure is None:
+                    res.first_failure = cand
+                if len(res.failures) < MAX_KEPT_FAILURES:
+                    res.failures.append(cand)
+        self.best = min(self.best, float(np.min(v.robustness[:n])))
+        res.history.append((res.evaluations, self.best))
+        res.seconds = now
+
+
+ProgressFn = Callable[[str], None]
+
+
+def _check_budget(budget: int) -> int:
+    budget = int(budget)
+    if budget < 1:
+        raise SearchError(f"budget must be >= 1 model evaluation, got {budget}")
+    return budget
+
+
+class Searcher:
+    """Base: subclasses implement ``_search(evaluator, budget, rng, recorder)``."""
+
+    name = ""
+
+    def run(
+        self,
+        evaluator,
+        budget: int,
+        seed: int = 0,
+        progress: ProgressFn | None = None,
+    ) -> SearchResult:
+        budget = _check_budget(budget)
+        result = SearchResult(self.name, int(seed), budget, evaluator.target.name)
+        recorder = Recorder(result, evaluator)
+        rng = np.random.default_rng([int(seed), _stable_id(self.name)])
+        self._search(evaluator, budget, rng, recorder, seed, progress or (lambda s: None))
+        result.seconds = time.perf_counter() - recorder.t0
+        return result
+
+    def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
+        raise NotImplementedError
+
+
+def _stable_id(name: str) -> int:
+    return sum((i + 1) * ord(c) for i, c in enumerate(name))

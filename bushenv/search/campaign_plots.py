@@ -1,0 +1,132 @@
+"""A campaign's pictures: the worst profile of every search and every shrunk failure.
+
+Each row shows the profile over time, the model's force beside the reference's (the reference
+always blue, the model red, the moment of divergence a dashed line named in the legend), and
+the force-deflection loop of both. For an ``energy`` failure the loop panel states the net
+work each did over the profile (``W = int F dx``): a passive bushing's is positive; a model
+that gives back more than it took generates energy, which a bounded-looking force trace hides.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bushenv.divergence import cumulative_work
+from bushenv.persist import load_profiles
+from bushenv.search.corpus import load_case
+
+REF_COLOUR, MODEL_COLOUR, FAIL_COLOUR = "tab:blue", "tab:red", "tab:purple"
+
+
+def _row(axes, t, profile, x, fm, fr, verdict: dict, key: str, profile_label: str) -> None:
+    """One row of three panels for one profile judged on model ``key``."""
+    ax_p, ax_f, ax_l = axes
+    ax_p.plot(t, profile * 1e3, "k", lw=0.8)
+    ax_p.set_ylabel(profile_label)
+    if fr is not None:
+        ax_f.plot(t, fr, color=REF_COLOUR, lw=0.9, label="reference")
+        ax_l.plot(x * 1e3, fr, color=REF_COLOUR, lw=0.8, label="reference")
+    ax_f.plot(t, fm, color=MODEL_COLOUR, lw=0.8, label=key)
+    ax_f.set_ylabel("force [N]")
+    ax_l.plot(x * 1e3, fm, color=MODEL_COLOUR, lw=0.7, label=key)
+    ax_l.set_xlabel("bushing deflection [mm]")
+    ax_l.set_ylabel("force [N]")
+    t_fail = verdict.get("first_time_s")
+    if verdict.get("diverged") and t_fail is not None:
+        what = f"divergence: {verdict.get('first_criterion')} at {t_fail:.2f} s"
+        for a in (ax_p, ax_f):
+            a.axvline(t_fail, color=FAIL_COLOUR, ls="--", lw=0.9, label=what)
+    if verdict.get("first_criterion") == "energy" or "energy" in verdict.get("criteria", []):
+        w_m = float(cumulative_work(x[:, None], np.nan_to_num(fm)[:, None])[-1, 0])
+        ref = "" if fr is None else "reference "
+        if fr is not None:
+            w_r = float(cumulative_work(x[:, None], fr[:, None])[-1, 0])
+            ref = f"reference {w_r:+.3g} J, "
+        ax_l.set_title(f"net work over the profile: {ref}{key} {w_m:+.3g} J", fontsize=8)
+    ax_f.legend(fontsize=7, loc="upper right")
+    ax_l.legend(fontsize=7, loc="upper left")
+
+
+def _worst_rows(campaign, key: str) -> list[tuple[str, np.ndarray, dict]]:
+    rows = []
+    for name, summary in campaign.report["models"][key]["searchers"].items():
+        f = summary.get("profiles_file")
+        if f:
+            ps, ms = load_profiles(campaign.out / f)
+            worst = [(p, m) for p, m in zip(ps, ms, strict=True) if m.get("worst")]
+            if worst:
+                rows.append((name, *worst[0]))
+    return rows
+
+
+def _figure(plt, n_rows: int):
+    return plt.subplots(n_rows, 3, figsize=(15, 2.8 * n_rows), squeeze=False)
+
+
+def plot_worst(campaign, plt, plot_dir) -> list[str]:
+    """``plots/worst-<model>.png``: each search's worst profile on that model."""
+    dt, label = campaign.dt, campaign.target.profile_label
+    names = []
+    for key in campaign.models:
+        rows = _worst_rows(campaign, key)
+        if not rows:
+            continue
+        fig, axes = _figure(plt, len(rows))
+        with campaign.evaluator(key) as ev:
+            batch = ev.evaluate([p for _, p, _ in rows])
+        for r, (name, p, m) in enumerate(rows):
+            n, v = p.size, m["verdict"]
+            t = np.arange(n) * dt
+            fr = None if batch.f_ref is None else batch.f_ref[:n, r]
+            args = (batch.x[:n, r], batch.f_model[:n, r], fr)
+            _row(axes[r], t, p, *args, v, key, label)
+            state = "DIVERGES" if v["diverged"] else "bounded"
+            axes[r, 0].set_title(
+                f"{key} / {name}: worst {m['family']}, robustness {v['robustness']:.3g}, {state}",
+                fontsize=9,
+            )
+        for a in axes[-1, :2]:
+            a.set_xlabel("time [s]")
+        fig.tight_layout()
+        names.append(f"worst-{key}.png")
+        fig.savefig(plot_dir / names[-1], dpi=90)
+        plt.close(fig)
+    return names
+
+
+def plot_shrunk(campaign, plt, plot_dir) -> list[str]:
+    """``plots/shrunk-<i>.png``: each shrunk failure on every model of the campaign."""
+    dt, label = campaign.dt, campaign.target.profile_label
+    names = []
+    for i, entry in enumerate(campaign.report["shrunk"]):
+        case = load_case(campaign.out / entry["case_file"])
+        p = case.profile
+        t = np.arange(p.size) * dt
+        fig, axes = _figure(plt, len(campaign.models))
+        for r, key in enumerate(campaign.models):
+            with campaign.evaluator(key) as ev:
+                b = ev.evaluate([p])
+            row = b.verdict.row(0)
+            fr = None if b.f_ref is None else b.f_ref[:, 0]
+            _row(axes[r], t, p, b.x[:, 0], b.f_model[:, 0], fr, row, key, label)
+            state = "DIVERGES" if row["diverged"] else "bounded"
+            axes[r, 0].set_title(f"shrunk failure {case.name}: {key} {state}", fontsize=9)
+        for a in axes[-1, :2]:
+            a.set_xlabel("time [s]")
+        fig.tight_layout()
+        names.append(f"shrunk-{i}.png")
+        fig.savefig(plot_dir / names[-1], dpi=90)
+        plt.close(fig)
+    return names
+
+
+def plot_campaign(campaign) -> list[str]:
+    """Every plot of the campaign in ``DIR/plots``; returns their file names."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    plot_dir = campaign.out / "plots"
+    plot_dir.mkdir(parents=True, exist_ok=True)
+    return plot_worst(campaign, plt, plot_dir) + plot_shrunk(campaign, plt, plot_dir)

@@ -1,0 +1,215 @@
+"""A campaign's report: its layout, resuming it, and the table a person reads.
+
+``report.json`` (docs/search.md describes every field)::
+
+    {"format": "bushenv-attack-report", "version": 1, "arguments": {...}, "searchers": [...],
+     "reference": {"spec", "file_sha256", "params_sha256"} (spec null: judged without one),
+     "scales": {"stroke_m", "velocity_m_per_s", "force_floor_n", "force_limit_n", ...},
+     "criteria": {"run": [...], "why": "..."}, "notes": [...],
+     "models": {key: {"role", "spec", "class", "file", "sha256", "params_sha256",
+                      "searchers": {name: SearchResult.summary() + first_failure, worst,
+                                    profiles_file}}},
+     "recheck": {"profiles": n, key: {"diverged", "failures", ...}},
+     "shrunk": [...], "corpus": [...], "complete": bool, "seconds": float}
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from bushenv.models import file_hash, model_file, params_sha
+from bushenv.search.corpus import reference_identity
+
+REPORT_FORMAT = "bushenv-attack-report"
+REPORT_VERSION = 1
+
+
+class ReportError(ValueError):
+    """A report that cannot be resumed; the message says why and what to do."""
+
+
+def model_identity(spec: str, model, axis: str) -> dict[str, Any]:
+    """Which model a report row is: its spec, class, file and hashes."""
+    path = model_file(spec, axis)
+    if path is not None and not path.is_file():
+        path = None
+    return {
+        "spec": spec,
+        "class": type(model).__name__,
+        "file": str(path) if path else None,
+        "sha256": file_hash(path) if path else None,
+        "params_sha256": params_sha(model),
+    }
+
+
+def fresh_report(campaign) -> dict[str, Any]:
+    """The report of a campaign that has run nothing yet."""
+    c = campaign.config
+    return {
+        "format": REPORT_FORMAT,
+        "version": REPORT_VERSION,
+        "arguments": c.arguments(),
+        "searchers": list(c.searchers),
+        "reference": reference_identity(campaign.reference_spec, campaign.reference, c.axis),
+        "scales": campaign.scales.to_json(),
+        "criteria": campaign.criteria(),
+        "notes": list(campaign.notes),
+        "models": {
+            key: {
+                "role": campaign.roles[key],
+                **model_identity(campaign.specs[key], m, c.axis),
+                "searchers": {},
+            }
+            for key, m in campaign.models.items()
+        },
+        "recheck": {},
+        "shrunk": [],
+        "corpus": [],
+        "complete": False,
+        "seconds": 0.0,
+    }
+
+
+def resumed_report(path: Path, fresh: dict[str, Any]) -> dict[str, Any]:
+    """``fresh`` with what the interrupted run at ``path`` finished; refuses another campaign's
+    report, a corrupt one, or one whose model files changed since."""
+    try:
+        old = json.loads(path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ReportError(
+            f"{path}: corrupt or half-written report ({exc}); use --force to start again"
+        ) from None
+    if not isinstance(old, dict) or old.get("format") != REPORT_FORMAT:
+        raise ReportError(f"{path}: not a bushenv attack report")
+    if old.get("arguments") != fresh["arguments"] or old.get("searchers") != fresh["searchers"]:
+        raise ReportError(
+            f"{path} was made with other arguments ({old.get('arguments')}, searchers "
+            f"{old.get('searchers')}); use another --out or --force"
+        )
+    for key, entry in old.get("models", {}).items():
+        if key in fresh["models"]:
+            if entry.get("sha256") != fresh["models"][key]["sha256"]:
+                raise ReportError(
+                    f"{path}: model {key} changed since the interrupted run (sha256 differs); "
+                    "use --force"
+                )
+            fresh["models"][key]["searchers"] = entry.get("searchers", {})
+    for key in ("recheck", "shrunk", "corpus"):
+        fresh[key] = old.get(key, fresh[key])
+    fresh["seconds"] = old.get("seconds", 0.0)
+    return fresh
+
+
+def _verdicts(verdicts: dict[str, Any]) -> str:
+    return ", ".join(
+        f"{m}: {'DIVERGES' if x['diverged'] else 'bounded'}" for m, x in verdicts.items()
+    )
+
+
+def _search_row(key: str, role: str, name: str, s: dict[str, Any]) -> str:
+    ff = s.get("first_failure") or {}
+    fam = (
+        f"{ff.get('family')} ({ff.get('verdict', {}).get('first_criterion')})"
+        if s["diverged"]
+        else "-"
+    )
+    wd = s.get("worst_deviation")
+    stf = f"{s['seconds_to_failure']:.2f}" if s["diverged"] else "-"
+    wds = f"{wd:.3g}" if wd is not None else "-"
+    return (
+        f"{key:<10} {role:<8} {name:<11} {s['evaluations']:>6} "
+        f"{'YES' if s['diverged'] else 'no':>8} "
+        f"{s['evaluations_to_failure'] or '-':>11} "
+        f"{stf:>8} {wds:>9} {s['worst_robustness']:>10.3g} {fam}"
+    )
+
+
+COLUMNS = (
+    ("model", "the model's report key (a registered name or a model file's stem)"),
+    (
+        "role",
+        "target (under attack), hybrid (rechecked on its failures, then attacked), "
+        "control (must stay clean: a flagged control means the criteria are at fault)",
+    ),
+    ("searcher", "the search that produced the row (``SEARCHERS``)"),
+    ("evals", "model evaluations spent (profiles simulated; an RL episode is one)"),
+    ("diverged", "whether any profile made the model diverge"),
+    ("evals->fail", "evaluations until the first failing profile"),
+    ("s->fail", "wall-clock seconds until the first failing profile (this machine, this load)"),
+    (
+        "worst dev",
+        "largest |F_model - F_reference| over the worst profile, as a multiple of the "
+        "reference's peak force (dimensionless; 1.0 = an error as large as the whole force)",
+    ),
+    (
+        "robustness",
+        "STL robustness of the worst profile: the margin to the nearest criterion, "
+        "in units of that criterion's scale (negative = diverged)",
+    ),
+    (
+        "failing family (criterion)",
+        "the excitation family of the first failure and the "
+        "divergence criterion that fired (bushenv/divergence.py)",
+    ),
+)
+
+
+def format_table(report: dict[str, Any], target_key: str) -> str:
+    """The campaign as a plain-text table, the recheck and the shrunk failures."""
+    head = (
+        f"{'model':<10} {'role':<8} {'searcher':<11} {'evals':>6} {'diverged':>8} "
+        f"{'evals->fail':>11} {'s->fail':>8} {'worst dev':>9} {'robustness':>10} "
+        f"{'failing family (criterion)'}"
+    )
+    ref = report["reference"].get("spec")
+    lines = [
+        f"reference: {ref if ref is not None else 'none'}; criteria run: "
+        f"{', '.join(report['criteria']['run'])}",
+        *(f"note: {n}" for n in report.get("notes", [])),
+        "",
+        head,
+        "-" * len(head),
+    ]
+    for key, entry in report["models"].items():
+        for name, s in entry["searchers"].items():
+            lines.append(_search_row(key, entry["role"], name, s))
+    rc = report.get("recheck", {})
+    if rc:
+        lines += ["", f"recheck on the {rc.get('profiles', 0)} profiles that broke {target_key}:"]
+        lines += [
+            f"  {k:<10} diverged on {e['diverged']}" for k, e in rc.items() if k != "profiles"
+        ]
+    if report.get("shrunk"):
+        lines += ["", "shrunk failures (segments, samples, peak um) and verdicts:"]
+        for e in report["shrunk"]:
+            if e["shrink"] is None:
+                lines.append(f"  the papers' 4 mm step held 10 s: {_verdicts(e['verdicts'])}")
+                continue
+            fin = e["shrink"]["final"]
+            lines.append(
+                f"  {e['failed_model']}/{e['family']:<11} -> {fin['segments']} seg, "
+                f"{fin['samples']} samples, {fin['peak_um'] / 1e3:.2f} mm peak; "
+                f"{_verdicts(e['verdicts'])}"
+            )
+    return "\n".join(lines)
+
+
+def report_markdown(report: dict[str, Any], target_key: str, plots: list[str]) -> str:
+    """``report.md``: the table, what each column means with its unit, the scales, the plots."""
+    lines = ["# Adversarial campaign", "", "```", format_table(report, target_key), "```", ""]
+    lines += ["## The columns", "", "| column | meaning |", "|---|---|"]
+    lines += [f"| {name} | {text} |" for name, text in COLUMNS]
+    lines += ["", "## Criteria", "", report["criteria"]["why"], ""]
+    sc = report["scales"]
+    lines += [
+        "## Scales",
+        "",
+        f"stroke {sc['stroke_m'] * 1e3:.4g} mm, velocity {sc['velocity_m_per_s']:.4g} m/s, "
+        f"force floor {sc['force_floor_n']:.4g} N, force limit {sc['force_limit_n']:.4g} N "
+        f"({sc['source']})",
+        "",
+    ]
+    lines += [f"![{p}](plots/{p})\n" for p in plots]
+    return "\n".join(lines)

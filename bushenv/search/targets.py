@@ -1,0 +1,177 @@
+"""Targets: what the search needs from one environment, and ``TARGETS``, the one list of them.
+
+A target owns everything env-specific a search touches: its excitation families (``FAMILIES``
+entries name their target), the batched simulation that turns a batch of profiles into a
+verdict's inputs, the vector env RL agents act in, and how a profile is kept within the env's
+limits. Searchers, the evaluator, shrinking, campaigns and the corpus ask the target; none of
+them compares env names.
+
+| name       | profile                          | simulation                                       |
+|------------|----------------------------------|--------------------------------------------------|
+| rig        | bushing displacement, m          | the models' batched kernels on prescribed motion |
+| quartercar | road height under the wheel, m   | ``QuarterCarBatch``: the car, model vs twin      |
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bushenv import excitation as ex
+from bushenv.divergence import Verdict, judge
+from bushenv.models.base import BushingModel, velocity_of
+from bushenv.registry import Registry
+from bushenv.scales import MACHINE
+from bushenv.search.base import SearchError
+from bushenv.search.families import FAMILIES, Family
+from bushenv.search.roads import quarter_car_responses
+
+
+@dataclass
+class Responses:
+    """A batch simulated on a target: the verdict and what it was judged on, all (T, B)."""
+
+    verdict: Verdict
+    x: np.ndarray  # the model's bushing deflection, m
+    f_model: np.ndarray  # N
+    f_ref: np.ndarray  # N
+
+
+class Target:
+    """Base: the families and limits every target has; subclasses simulate and build RL envs."""
+
+    name = ""
+    env_id = ""
+    profile_label = ""  # what a profile is, with its plotting unit
+    cma_family = ""  # the family CMA-ES searches by default
+    default_searchers: tuple[str, ...] = ()
+    float32 = False  # NARX models may run in float32 on this target
+    paper_step = False  # the papers' 4 mm step applies (prescribed displacement)
+    reference_free = False  # can judge a model with no reference (criteria that need none)
+    judges_static = False  # holds are of the bushing itself (the static criterion applies)
+
+    def families(self) -> list[Family]:
+        return [f for f in FAMILIES.values() if f.target == self.name]
+
+    def family_names(self) -> tuple[str, ...]:
+        return tuple(f.name for f in self.families())
+
+    def random_families(self) -> tuple[str, ...]:
+        return tuple(f.name for f in self.families() if f.random)
+
+    def family(self, name: str) -> Family:
+        fam = FAMILIES[name]
+        if fam.target != self.name:
+            raise SearchError(
+                f"family {name!r} is for the {fam.target} target, not the {self.name}; "
+                f"known for the {self.name}: {', '.join(self.family_names())}"
+            )
+        return fam
+
+    def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
+        """``x`` kept within the env's limits (a shrinking move may step outside them)."""
+        return x
+
+    def responses(
+        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
+    ) -> Responses:
+        raise NotImplementedError
+
+    def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
+        raise NotImplementedError
+
+
+class RigTarget(Target):
+    """BushRig-v0: prescribed bushing displacement; model and reference see the same motion."""
+
+    name = "rig"
+    env_id = "BushRig-v0"
+    profile_label = "deflection [mm]"
+    cma_family = "any"
+    default_searchers = ("random", "cma", "certificate", "ppo", "sac")
+    float32 = True
+    paper_step = True
+    reference_free = True
+    judges_static = True
+
+    def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
+        return ex.clip_to_limits(x, dt, limits.stroke_m, limits.velocity_m_per_s)
+
+    def responses(
+        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
+    ) -> Responses:
+        """``reference`` is a ``ReferenceRuns`` (its forces are cached by profile)."""
+        if dtype == "float32":
+            fm = model.simulate(x, dtype="float32").astype(np.float64)
+        else:
+            fm = simulate_or_nan(model, x)
+        fr = reference.forces(x, lengths)
+        fs = reference.static_forces(x)
+        verdict = judge(x, fm, fr, dt, lengths=lengths, scales=scales, f_static=fs)
+        return Responses(verdict, x, fm, fr)
+
+    def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
+        from bushenv.search.rl_rig import rig_agent_env
+
+        return rig_agent_env(evaluator, n_envs, episode_steps, on_episodes, actions)
+
+
+class QuarterCarTarget(Target):
+    """QuarterCar-v0: road height under the wheel; the model's car beside a twin on the
+    reference, the verdict on the attacked axis (``roads.py``)."""
+
+    name = "quartercar"
+    env_id = "QuarterCar-v0"
+    profile_label = "road [mm]"
+    cma_family = "bump"
+    default_searchers = ("random", "cma")
+
+    def responses(
+        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
+    ) -> Responses:
+        verdict, xm, fm, fr, _ = quarter_car_responses(
+            model, reference.model, x, lengths, dt, axis, scales
+        )
+        return Responses(verdict, xm, fm, fr)
+
+    def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
+        from bushenv.search.rl_road import road_agent_env
+
+        return road_agent_env(evaluator, n_envs, episode_steps, on_episodes, actions)
+
+
+TARGETS: Registry[Target] = Registry("target", SearchError)
+TARGETS.add("rig", RigTarget())
+TARGETS.add("quartercar", QuarterCarTarget())
+
+
+def get_target(target: str | Target) -> Target:
+    return target if isinstance(target, Target) else TARGETS[target]
+
+
+def simulate_or_nan(model: BushingModel, x: np.ndarray) -> np.ndarray:
+    """``model.simulate(x)`` for (T, B) ``x``; a model that refuses (raises ValueError, e.g.
+    Bouc-Wen's step-size control) gives NaN from the sample it refused on, in the histories that
+    made it refuse -- a non-finite output, which ``judge`` calls a divergence."""
+    try:
+        return model.simulate(x)
+    except ValueError:
+        pass
+    out = np.empty_like(x)
+    for b in range(x.shape[1]):
+        col = np.ascontiguousarray(x[:, b])
+        try:
+            out[:, b] = model.simulate(col)
+            continue
+        except ValueError:
+            pass
+        v = velocity_of(col, model.dt)  # the velocity simulate would have used
+        model.reset(1)
+        out[:, b] = np.nan
+        for t in range(col.size):
+            try:
+                out[t, b] = model.step(col[t], v[t])
+            except ValueError:
+                break
+    return out

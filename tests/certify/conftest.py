@@ -1,0 +1,132 @@
+"""Hand-built NARX models with known hold behaviour for the certificate tests.
+
+``fold_nn``: one tanh unit fed back on itself, y_t = tanh(g sum_j w_j y_{t-j} + u),
+u = sum_i v_i xs_{t-i} with the weights w, v each summing to 1 and xs = x / 1 mm. In a hold
+its fixed points solve y = tanh(g y + u): for g > 1 three of them while |u| < u_f and one
+beyond, with folds at u = +-u_f, u_f = g y_f - artanh(y_f), y_f = sqrt(1 - 1/g) (where
+g sech^2 = 1). The force offset makes rest (F = 0) the output ``rest_y``: with rest_y < 0 the
+run starts on the lower branch, which vanishes at x = +u_f mm.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from bushenv.models.hybrid import HybridBushing
+from bushenv.models.narx import NarxBushing
+
+X_SCALE_M = 1e-3
+
+OLD_MODELS = Path(__file__).resolve().parents[1] / "regressions" / "models"
+
+
+def old_nn(axis: str) -> str:
+    """The NN shipped before certified training, kept with the corpus cases found on it: a
+    network with known energy failures, whatever the shipped models are today."""
+    return str(OLD_MODELS / f"{axis}_nn-6f15bf3.npz")
+
+
+def fold_u(g: float) -> float:
+    """The analytic fold of y = tanh(g y + u): u_f > 0 (folds at +-u_f)."""
+    yf = np.sqrt(1.0 - 1.0 / g)
+    return float(g * yf - np.arctanh(yf))
+
+
+def fold_roots(g: float, u: float) -> np.ndarray:
+    """Roots of y = tanh(g y + u) by a dense bracketed search (independent of bushenv)."""
+    y = np.linspace(-1.0, 1.0, 2_000_001)
+    f = np.tanh(g * y + u) - y
+    neg = f < 0
+    k = np.flatnonzero(neg[:-1] != neg[1:])
+    return y[k] - f[k] * (y[k + 1] - y[k]) / (f[k + 1] - f[k])
+
+
+def _fold_params(g, y_weights, x_weights, f_scale_n, rest_y):
+    wy = g * np.asarray(y_weights, dtype=float) / np.sum(y_weights)
+    wx = np.asarray(x_weights, dtype=float) / np.sum(x_weights)
+    return dict(
+        x_offset_m=0.0,
+        x_scale_m=X_SCALE_M,
+        f_offset_n=-rest_y * f_scale_n,
+        f_scale_n=f_scale_n,
+        w1=np.concatenate([wx, wy])[None, :],
+        b1=np.zeros(1),
+        w2=np.zeros((0, 1)),
+        b2=np.zeros(0),
+        w_out=np.ones(1),
+        b_out=0.0,
+        n_past_x=len(wx) - 1,
+        n_past_f=len(wy),
+    )
+
+
+def fold_nn(
+    g=2.0,
+    y_weights=(0.4, 0.3, 0.15, 0.1, 0.05),
+    x_weights=(0.3, 0.2, 0.2, 0.1, 0.1, 0.1),
+    f_scale_n=1000.0,
+    rest_y=-0.9,
+) -> NarxBushing:
+    return NarxBushing(**_fold_params(g, y_weights, x_weights, f_scale_n, rest_y))
+
+
+def fold_hybrid(k_n_per_m=2.0e5, c_ns_per_m=2.0e3, **kw) -> HybridBushing:
+    """The fold network as the residual of a hybrid (the issue's kind of hold departure)."""
+    p = _fold_params(
+        kw.get("g", 2.0),
+        kw.get("y_weights", (0.5, 0.2, 0.2, 0.1)),
+        kw.get("x_weights", (0.5, 0.3, 0.2)),
+        kw.get("f_scale_n", 300.0),
+        kw.get("rest_y", -0.9),
+    )
+    return HybridBushing(k_n_per_m=k_n_per_m, c_ns_per_m=c_ns_per_m, **p)
+
+
+def wrong_sign_hybrid(k_n_per_m=1.0e5, beta=1.0, f_scale_n=200.0, feedback=0.3) -> HybridBushing:
+    """F = k x + f_scale y, y = tanh(-beta xs + feedback * mean of past y): near x = 0 the
+    network's -f_scale beta x / 1 mm outweighs k x (200 N/mm against 100 N/mm by default)."""
+    n = 5
+    w1 = np.concatenate([np.full(n + 1, -beta / (n + 1)), np.full(n, feedback / n)])[None, :]
+    return HybridBushing(
+        k_n_per_m=k_n_per_m,
+        c_ns_per_m=1.0e3,
+        x_offset_m=0.0,
+        x_scale_m=X_SCALE_M,
+        f_offset_n=0.0,
+        f_scale_n=f_scale_n,
+        w1=w1,
+        b1=np.zeros(1),
+        w2=np.zeros((0, 1)),
+        b2=np.zeros(0),
+        w_out=np.ones(1),
+        b_out=0.0,
+    )
+
+
+def random_narx(rng: np.random.Generator, hidden=(6,), n_past_x=3, n_past_f=4, gain=1.5):
+    """A random network whose own-output feedback (``gain``) is strong enough to give several
+    fixed points at some holds; one or two hidden layers, any lags."""
+    n_in = 1 + n_past_x + n_past_f
+    w1 = rng.normal(0, 1, (hidden[0], n_in))
+    w1[:, 1 + n_past_x :] *= gain
+    if len(hidden) == 2:
+        w2 = rng.normal(0, 1.5, (hidden[1], hidden[0]))
+        b2 = rng.normal(0, 0.5, hidden[1])
+    else:
+        w2, b2 = np.zeros((0, hidden[0])), np.zeros(0)
+    return NarxBushing(
+        x_offset_m=0.0,
+        x_scale_m=2e-3,
+        f_offset_n=float(rng.normal(0, 50)),
+        f_scale_n=500.0,
+        w1=w1,
+        b1=rng.normal(0, 0.5, hidden[0]),
+        w2=w2,
+        b2=b2,
+        w_out=rng.normal(0, 1.0, hidden[-1]),
+        b_out=float(rng.normal(0, 0.2)),
+        n_past_x=n_past_x,
+        n_past_f=n_past_f,
+    )

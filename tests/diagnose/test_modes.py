@@ -1,0 +1,163 @@
+"""Cross mode, several TRAIN records, shift warnings, the unexplained share, plausibility
+limits, the noise margin on pairs and the monotone backbone."""
+
+import json
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from bushenv.cli import main
+from bushenv.diagnose import rule
+from bushenv.diagnose.fit import diagnose
+
+from .synthetic import C, K, Rec, motion, record
+from .test_report import write_csv
+
+DT = 1 / 204.8
+
+
+def slow_relaxation_force(x, tau_s=8.0, k_rel=0.6 * K):
+    v = np.gradient(x, DT)
+    a = np.exp(-DT / tau_s)
+    return K * x + C * v + k_rel * signal.lfilter([DT], [1.0, -a], v)
+
+
+def hold(level_m, hold_s=40.0):
+    n0, nr = int(1 / DT), int(0.1 / DT)
+    ramp = np.linspace(0, level_m, nr)
+    parts = [np.zeros(n0), ramp, np.full(int(hold_s / DT), level_m), ramp[::-1], np.zeros(n0)]
+    return np.concatenate(parts)
+
+
+def relaxation_records():
+    rng = np.random.default_rng(0)
+    xs = {"train": motion(1, 12.0, DT, steps=False), "hold_a": hold(3e-3), "hold_b": hold(-2.5e-3)}
+    out = []
+    for name, x in xs.items():
+        f = slow_relaxation_force(x)
+        out.append(
+            Rec(
+                np.arange(x.size) * DT, x, f + 0.003 * np.std(f) * rng.normal(size=x.size), DT, name
+            )
+        )
+    return out
+
+
+def test_cross_mode_names_a_slow_relaxation_that_only_the_holds_identify():
+    train, *tests = relaxation_records()
+    held = diagnose(train, tests)
+    cross = diagnose(train, tests, cross=True)
+    assert held["mode"] == "held_out" and cross["mode"] == "cross"
+    assert "leave one record out" in cross["mode_text"]
+    assert cross["effect"] == "relaxation" and cross["shrink"] > 0.9
+    assert cross["shrink"] > held["shrink"] + 0.2
+    assert cross["records"]["judged"] == ["train", "hold_a", "hold_b"]
+    assert [p["name"] for p in cross["predictions"]] == ["train", "hold_a", "hold_b"]
+    regimes = [w["regime"] for w in held["shift_warnings"]]
+    assert regimes.count("holds_after_step") == 2
+    assert any("holds after a step" in w["text"] for w in held["shift_warnings"])
+
+
+def test_several_train_files_and_cross_on_the_command_line(tmp_path):
+    recs = relaxation_records()
+    paths = [write_csv(tmp_path / f"{r.name}.csv", r) for r in recs]
+    extra = write_csv(tmp_path / "train2.csv", record(7, "relaxation", duration_s=8.0))
+    out = tmp_path / "out"
+    args = ["diagnose", str(paths[0]), str(paths[1]), str(paths[2]), "--train", str(extra)]
+    assert main(args + ["--cross", "--out", str(out), "--quiet"]) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert [t["name"] for t in report["records"]["train"]] == ["train", "train2"]
+    assert report["mode"] == "cross"
+    stems = sorted(p.stem for p in (out / "predictions").iterdir())
+    assert stems == ["hold_a", "hold_b", "train", "train2"]
+    assert "leave one record out" in (out / "report.md").read_text()
+
+
+def test_a_test_beyond_trains_amplitude_gets_a_shift_warning_naming_it():
+    train = record(11, "none", duration_s=10.0)
+    big = record(12, "none", duration_s=10.0, name="big")
+    big.displacement = 2.0 * big.displacement
+    big.force = 2.0 * big.force
+    result = diagnose(train, [big])
+    texts = [w["text"] for w in result["shift_warnings"] if w["regime"] == "amplitude_beyond"]
+    assert texts and "TEST big" in texts[0] and "beyond the identification records'" in texts[0]
+
+
+def test_a_gap_outside_the_candidates_is_reported_as_mostly_unexplained():
+    rng = np.random.default_rng(3)
+    recs = []
+    for seed, name in ((13, "train"), (14, "t")):
+        r = record(seed, "none", noise=0.002, duration_s=15.0, name=name)
+        drift = np.cumsum(rng.normal(size=r.force.size))  # a random walk of the force offset
+        r.force = r.force + 0.2 * np.std(r.force) * drift / np.std(drift)
+        recs.append(r)
+    result = diagnose(recs[0], recs[1:])
+    assert result["unexplained"]["mostly_outside_candidates"]
+    assert any("mostly outside the candidate set" in t for t in result["unexplained"]["text"])
+    assert result["unexplained"]["unexplained_share"] > 0.5
+
+
+def test_metres_scale_records_need_the_limit_raised_or_the_unit_stated(tmp_path, capsys):
+    t = np.arange(2000) * 0.02
+    x = 0.12 * np.abs(np.sin(2 * np.pi * t / 40.0))
+    f = 8.0 * x + 0.5 * np.gradient(x, 0.02)
+    for name in ("pull", "pull2"):
+        np.savetxt(tmp_path / f"{name}.csv", np.column_stack([t, x, f]), delimiter=",",
+                   header="time,displacement,force", comments="")  # fmt: skip
+    args = ["diagnose", str(tmp_path / "pull.csv"), str(tmp_path / "pull2.csv"), "--quiet"]
+    assert main(args + ["--out", str(tmp_path / "a")]) == 2
+    assert "--max-displacement" in capsys.readouterr().err
+    assert main(args + ["--out", str(tmp_path / "b"), "--max-displacement", "0.5"]) == 0
+    text = (tmp_path / "pull2.csv").read_text().replace("displacement", "displacement [m]", 1)
+    (tmp_path / "pull2.csv").write_text(text)
+    (tmp_path / "pull.csv").write_text(text)
+    assert main(args + ["--out", str(tmp_path / "c")]) == 0
+
+
+def test_a_pair_whose_second_effect_adds_less_than_the_noise_margin_is_not_named():
+    def row(name, members, gap, mse, p):
+        out = {"effect": name, "members": members, "gap_after": gap, "_mse": mse}
+        out.update(n_extra_parameters=p, shrink_vs_null=1 - gap / 0.2, gap_train=gap)
+        return out
+
+    singles = [
+        row("relaxation", ["relaxation"], 0.10, 1.0e-2, 12),
+        row("delay", ["delay"], 0.15, 2e-2, 1),
+    ]
+    pair = row("relaxation+delay", ["relaxation", "delay"], 0.07, 0.999e-2, 13)
+    rule.mark_passes(singles + [pair], mse_null=4e-2, n_fit=1000)
+    rule.mark_pairs(singles, [pair], n_fit=1000, gap_null=0.2)
+    assert pair["passes"] is False and pair["members_add"] is False
+    named, top_two = rule.named_and_top_two(singles, [pair])
+    assert named["effect"] == "relaxation" and top_two == ["relaxation", "delay"]
+    pair["_mse"] = 0.5e-2  # now delay adds far more than the margin
+    rule.mark_passes([pair], mse_null=4e-2, n_fit=1000)
+    rule.mark_pairs(singles, [pair], n_fit=1000, gap_null=0.2)
+    assert pair["passes"] is True
+    assert rule.named_and_top_two(singles, [pair])[0]["effect"] == "relaxation+delay"
+
+
+def test_a_softening_backbone_is_named_hardening_with_a_monotone_falling_tangent():
+    recs = []
+    for seed, name in ((15, "train"), (16, "t")):
+        x = motion(seed, 20.0, DT)
+        xs = 2e-3  # the motion peaks at 4 mm
+        f = K * xs * np.tanh(x / xs) + C * np.gradient(x, DT)
+        recs.append(
+            Rec(
+                np.arange(x.size) * DT,
+                x,
+                f * (1 + 0.002 * np.random.default_rng(seed).normal(size=x.size)),
+                DT,
+                name,
+            )
+        )
+    result = diagnose(recs[0], recs[1:])
+    assert result["effect"] == "hardening" and result["shrink"] > 0.8
+    back = result["parameters"]["hardening"]
+    assert back["kind"] == "softening"
+    for side in ("positive_side", "negative_side"):
+        k = [p["tangent_stiffness_n_per_m"] for p in back[side]]
+        assert min(k) >= 0 and k[0] > k[3]
+    assert back["positive_side"][0]["tangent_stiffness_n_per_m"] == pytest.approx(K, rel=0.15)

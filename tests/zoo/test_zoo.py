@@ -1,0 +1,58 @@
+"""The population study: rows per trained model, rates with intervals, resumable."""
+
+import json
+
+import pytest
+
+from bushenv.execution import LocalBackend
+from bushenv.progress import Progress
+from bushenv.runlog import RunLog, run_cells
+from bushenv.zoo.cell import run_cell
+from bushenv.zoo.command import CELL_KEYS, RESULT_KEYS, ZooConfig, ZooError
+from bushenv.zoo.summary import summarise, wilson
+
+QUICK = {"teacher_steps": 150}  # a small one-step-ahead training: seconds, not minutes
+
+
+def test_wilson_interval_matches_known_values():
+    lo, hi = wilson(0, 10)
+    assert lo == 0.0 and hi == pytest.approx(0.2775, abs=1e-4)
+    lo, hi = wilson(5, 10)
+    assert lo == pytest.approx(0.2366, abs=1e-4) and hi == pytest.approx(0.7634, abs=1e-4)
+
+
+def test_unknown_recipes_and_searchers_are_refused():
+    with pytest.raises(ZooError, match="--recipes: unknown"):
+        ZooConfig(recipes=("adam",)).checked()
+    with pytest.raises(ZooError, match="--searchers: unknown"):
+        ZooConfig(searchers=("dqn",)).checked()
+
+
+def test_a_small_population_trains_judges_summarises_and_resumes(tmp_path):
+    config = ZooConfig(
+        recipes=("teacher-forcing",),
+        models=("nn",),
+        axes=("axial",),
+        seeds=(0, 1),
+        searchers=("random", "certificate"),
+        budget=8,
+        out=tmp_path,
+        train_options=QUICK,
+    ).checked()
+    log = RunLog(tmp_path / "cells.jsonl", CELL_KEYS, RESULT_KEYS, ZooError)
+    with LocalBackend(workers=1) as backend:
+        cells = config.cells()
+        first = run_cells(cells[:1], run_cell, log, backend, False, Progress(quiet=True), str)
+        rows = run_cells(cells, run_cell, log, backend, True, Progress(quiet=True), str)
+    assert rows[0] == first[0]  # resumed: the finished cell is not trained again
+    assert (tmp_path / rows[1]["model_file"]).is_file()
+    for r in rows:
+        assert set(r["attacks"]) == {"random", "certificate"}
+        assert 0 < r["accuracy"]["rms_ratio_n1"] < 1
+        assert set(r["step"]) == {"+4mm", "-4mm"}
+        assert isinstance(r["certificate"]["passes_holds"], bool)
+    s = summarise(rows)["teacher-forcing/nn"]
+    assert s["cells"] == 2
+    lo, hi = s["diverged_any_searcher"]["ci95"]
+    assert 0.0 <= lo <= s["diverged_any_searcher"]["rate"] <= hi <= 1.0
+    assert json.loads(json.dumps(s)) == s
