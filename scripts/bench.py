@@ -508,6 +508,56 @@ def bench_campaign(fig: Figures, quick: bool) -> None:
     )
 
 
+def bench_attack_reference(fig: Figures, quick: bool) -> None:
+    """The judge's share of an attack: ``bushenv attack --model nn`` judged by the shipped
+    Bouc-Wen (``--reference boucwen``) against the same attack judged by the rubber (target at
+    most 2x), and the default ``bushenv attack`` (target under 45 s on the 2 cores). Whole
+    commands, report and plots included; --quick: budgets of 16 evaluations."""
+    print("\n== attack: Bouc-Wen reference against the rubber, and the default attack")
+    import contextlib
+    import io
+    import tempfile
+
+    from bushenv.cli import main
+
+    small = ["--budget", "16", "--rl-budget", "16", "--shrink-budget", "20"] if quick else []
+    seconds = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        runs = {
+            "rubber": ["--model", "nn", "--reference", "rubber"],
+            "boucwen": ["--model", "nn", "--reference", "boucwen"],
+            "default": [],
+        }
+        warm = ["attack", "--budget", "4", "--rl-budget", "4", "--searchers", "random,ppo,sac"]
+        for ref in ("rubber", "boucwen"):  # compiled kernels and imports loaded outside timing
+            with contextlib.redirect_stdout(io.StringIO()):
+                main([*warm, "--reference", ref, "--out", str(Path(tmp) / f"w{ref}"), "--quiet"])
+        for name, extra in runs.items():
+            argv = ["attack", *extra, *small, "--out", str(Path(tmp) / name), "--quiet"]
+            t0 = time.perf_counter()
+            with contextlib.redirect_stdout(io.StringIO()):  # the commands' own summaries
+                code = main(argv)
+            seconds[name] = time.perf_counter() - t0
+            if code not in (0, 1):  # 1: a failure was found, which is a result
+                raise RuntimeError(f"bushenv {' '.join(argv)} exited {code}")
+    fig.add(
+        "attack.reference_boucwen_over_rubber.time_ratio",
+        seconds["boucwen"] / seconds["rubber"],
+        "x",
+        target=2.0,
+        better="lower",
+        note=f"{seconds['boucwen']:.1f} s against {seconds['rubber']:.1f} s",
+    )
+    fig.add(
+        "attack.default.seconds",
+        seconds["default"],
+        "s",
+        target=None if quick else 45.0,
+        better="lower",
+        note="bushenv attack with no arguments" + (" (quick budgets)" if quick else ""),
+    )
+
+
 def bench_float32_verdicts(fig: Figures, quick: bool) -> None:
     """Does float32 change what a search concludes? Divergence verdicts on random profiles of
     the search's "any" family, NN in float32 and in float64 against the same reference."""
@@ -702,6 +752,7 @@ SECTIONS = {
     "paper": bench_paper_tasks,
     "fit": bench_fit_command,
     "campaign": bench_campaign,
+    "attack": bench_attack_reference,
     "float32": bench_float32_verdicts,
     "memory": bench_memory,
     "certify": bench_certify,

@@ -68,6 +68,8 @@ EXPECTED = [
     "campaign.random.threads2.evaluations_per_s",
     "campaign.nn.random.seconds_to_first_divergence",
     "campaign.nn.float32_verdict_changes",
+    "attack.reference_boucwen_over_rubber.time_ratio",
+    "attack.default.seconds",
     "memory.batch_B1024_T512.peak",
     "records.load_csv_20k_over_loadtxt",
     "diagnose.cross.4_records.seconds",
@@ -102,6 +104,7 @@ def test_quick_benchmark_produces_every_figure_with_units_and_targets(tmp_path):
             assert isinstance(r["met"], bool), name
     assert rows["free_run.nn.B1024.threads2"]["target"] == 50e6
     assert rows["free_run.boucwen.B1024.threads2"]["target"] == 10e6  # issue 18
+    assert rows["attack.reference_boucwen_over_rubber.time_ratio"]["target"] == 2.0
     # the comparisons are of the same computation: same network, same accuracy
     assert rows["compare.nn.torch_agreement"]["value"] < 1e-9
     for m in ("LSODA", "Radau"):
