@@ -164,10 +164,17 @@ def report_text(summary: dict[str, Any], seed: int, case_set: str) -> str:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--set", dest="case_set", default="reference", choices=list(SETS))
-    parser.add_argument("--cases", type=int, default=70, help="number of blind cases (default 70)")
-    parser.add_argument("--seed", type=int, default=0, help="validation seed (default 0)")
-    parser.add_argument("--start", type=int, default=0, help="first case index (default 0)")
+    parser.add_argument(
+        "--set",
+        dest="case_set",
+        default="reference",
+        choices=list(SETS),
+        help="reference: the forms the candidates assume; widened: other forms, strengths, "
+        "rates and noise (docs/diagnose.md)",
+    )
+    parser.add_argument("--cases", type=int, default=70, help="number of blind cases")
+    parser.add_argument("--seed", type=int, default=0, help="validation seed")
+    parser.add_argument("--start", type=int, default=0, help="first case index")
     parser.add_argument("--out", required=True, metavar="DIR", help="output folder")
     parser.add_argument("--force", action="store_true", help="write into an existing DIR")
     parser.add_argument("--quiet", action="store_true", help="no progress lines")

@@ -40,7 +40,10 @@ CERTIFY = CertifyOptions(holds=101, energy_amplitudes_m=(), passivity_holds_m=(0
 
 
 def cell_name(cell: dict[str, Any]) -> str:
-    return f"{cell['recipe']}-{cell['model']}-{cell['axis']}-s{cell['seed']}"
+    extra = "".join(
+        f"-{k}" for k, v in sorted(cell.get("train_options", {}).items()) if v and v != "off"
+    )
+    return f"{cell['recipe']}{extra}-{cell['model']}-{cell['axis']}-s{cell['seed']}"
 
 
 def records(axis: str, seed: int):

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from bushenv.execution import get_backend
+from bushenv.identify.narx_options import RECIPES
 from bushenv.models import AXES, check_axis
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
@@ -29,9 +30,8 @@ EXAMPLE = (
     "bushenv zoo --recipes teacher-forcing,free-run --models nn,hybrid --seeds 0-9 "
     "--axes axial,radial --out runs/zoo"
 )
-RECIPES = ("teacher-forcing", "free-run")
 NARX_MODELS = ("nn", "hybrid")  # the models with a recipe and a certificate
-CELL_KEYS = ("recipe", "model", "axis", "seed", "budget", "searchers")
+CELL_KEYS = ("recipe", "model", "axis", "seed", "budget", "searchers", "train_options")
 RESULT_KEYS = ("accuracy", "attacks", "step", "certificate")
 # Training time relative to teacher forcing, for the time left only (median of the 10-seed
 # run in docs/recipes.md: teacher forcing 11 s, free run 52-72 s per model on a loaded machine).
@@ -94,6 +94,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seeds", default="0-9", help="training and record seeds, e.g. 0-9 or 1,4")
     p.add_argument("--searchers", default=",".join(d.searchers), help="searchers per model")
     p.add_argument("--budget", type=int, default=d.budget, help="evaluations per search")
+    p.add_argument(
+        "--certified",
+        choices=("off", "on"),
+        default="off",
+        help="train every model with the certified-holds loss term (bushenv fit --certified on)",
+    )
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--resume", action="store_true", help="continue an interrupted study")
     p.add_argument("--workers", type=int, default=None, help="local worker processes")
@@ -115,8 +121,9 @@ def _describe(row: dict[str, Any]) -> str:
     )
 
 
-def run(args: argparse.Namespace) -> int:
-    config = ZooConfig(
+def config_from(args: argparse.Namespace) -> ZooConfig:
+    """The study the arguments describe (checked)."""
+    return ZooConfig(
         recipes=_names(args.recipes),
         models=_names(args.models),
         axes=_names(args.axes),
@@ -125,7 +132,12 @@ def run(args: argparse.Namespace) -> int:
         budget=args.budget,
         out=Path(args.out),
         resume=args.resume,
+        train_options={"certified": "on"} if args.certified == "on" else {},
     ).checked()
+
+
+def run(args: argparse.Namespace) -> int:
+    config = config_from(args)
     progress = Progress(quiet=args.quiet)
     log = RunLog(config.out / "cells.jsonl", CELL_KEYS, RESULT_KEYS, ZooError, progress.say)
     backend = get_backend(

@@ -35,10 +35,16 @@ def rate(k: int, n: int) -> dict[str, Any]:
     return {"failed": k, "of": n, "rate": k / n if n else None, "ci95": [lo, hi]}
 
 
+def recipe_label(row: dict) -> str:
+    """The recipe with the training options that change it (``free-run +certified``)."""
+    extra = [k for k, v in sorted(row.get("train_options", {}).items()) if v and v != "off"]
+    return " +".join([row["recipe"], *extra])
+
+
 def _groups(rows: list[dict]) -> dict[tuple[str, str], list[dict]]:
     out: dict[tuple[str, str], list[dict]] = defaultdict(list)
     for r in rows:
-        out[(r["recipe"], r["model"])].append(r)
+        out[(recipe_label(r), r["model"])].append(r)
     return dict(out)
 
 

@@ -56,3 +56,24 @@ def test_a_small_population_trains_judges_summarises_and_resumes(tmp_path):
     lo, hi = s["diverged_any_searcher"]["ci95"]
     assert 0.0 <= lo <= s["diverged_any_searcher"]["rate"] <= hi <= 1.0
     assert json.loads(json.dumps(s)) == s
+
+
+def test_certified_flag_reaches_the_training_the_file_names_and_the_summary_label():
+    import argparse
+
+    from bushenv.zoo.cell import cell_name
+    from bushenv.zoo.command import add_arguments, config_from
+    from bushenv.zoo.summary import recipe_label
+
+    p = argparse.ArgumentParser()
+    add_arguments(p)
+    args = p.parse_args(["--out", "x", "--certified", "on", "--seeds", "0"])
+    cell = config_from(args).cells()[0]
+    assert cell["train_options"] == {"certified": "on"}
+    assert "train_options" in CELL_KEYS  # a resumed study never mixes the two kinds of cell
+    plain = config_from(p.parse_args(["--out", "x", "--seeds", "0"])).cells()[0]
+    assert cell_name(cell) != cell_name(plain) and "-certified-" in cell_name(cell)
+    assert recipe_label(cell) == f"{cell['recipe']} +certified"
+    assert recipe_label(plain) == plain["recipe"]
+    with pytest.raises(SystemExit):
+        p.parse_args(["--out", "x", "--certified", "yes"])
