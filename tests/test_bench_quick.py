@@ -69,6 +69,7 @@ EXPECTED = [
     "campaign.nn.random.seconds_to_first_divergence",
     "campaign.nn.float32_verdict_changes",
     "attack.reference_boucwen_over_rubber.time_ratio",
+    "attack.reference_boucwen_over_rubber.nn_searches_ratio",
     "attack.default.seconds",
     "memory.batch_B1024_T512.peak",
     "records.load_csv_20k_over_loadtxt",

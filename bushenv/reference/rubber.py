@@ -215,6 +215,35 @@ def _check_names(names: Any, what: str) -> tuple[str, ...]:
     return names
 
 
+def _relaxation(relax_k_n_per_m: Any, relax_tau_s: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The Maxwell branches' stiffnesses and time constants, checked."""
+    rk = np.array(relax_k_n_per_m, dtype=np.float64).reshape(-1)
+    rt = np.array(relax_tau_s, dtype=np.float64).reshape(-1)
+    if rk.shape != rt.shape or rk.size > MAX_BRANCHES:
+        raise ModelError(
+            f"rubber: relax_k_n_per_m ({rk.size}) and relax_tau_s ({rt.size}) must have the "
+            f"same length, at most {MAX_BRANCHES}"
+        )
+    if not (np.all(np.isfinite(rk)) and np.all(rk >= 0)):
+        raise ModelError(f"rubber: relax_k_n_per_m must be finite and >= 0, got {rk}")
+    if not (np.all(np.isfinite(rt)) and np.all(rt > 0)):
+        raise ModelError(f"rubber: relax_tau_s must be finite and > 0, got {rt}")
+    return rk, rt
+
+
+def _check_laws(friction_law: str, hardening_law: str) -> None:
+    if friction_law not in FRICTION_LAWS or friction_law == "off":
+        raise ModelError(
+            f"rubber: unknown friction_law {friction_law!r}; known: "
+            f"{[k for k in FRICTION_LAWS if k != 'off']}"
+        )
+    if hardening_law not in HARDENING_LAWS or hardening_law == "off":
+        raise ModelError(
+            f"rubber: unknown hardening_law {hardening_law!r}; known: "
+            f"{[k for k in HARDENING_LAWS if k != 'off']}"
+        )
+
+
 class RubberBushing(BushingModel):
     """Reference rubber bushing; see the module docstring for the force law and parameters."""
 
@@ -268,19 +297,7 @@ class RubberBushing(BushingModel):
             raise ModelError(
                 f"rubber: need k_n_per_m > 0 and c_ns_per_m >= 0, got {k_n_per_m!r}, {c_ns_per_m!r}"
             )
-        rk = np.array(relax_k_n_per_m, dtype=np.float64).reshape(-1)
-        rt = np.array(relax_tau_s, dtype=np.float64).reshape(-1)
-        if rk.shape != rt.shape or rk.size > MAX_BRANCHES:
-            raise ModelError(
-                f"rubber: relax_k_n_per_m ({rk.size}) and relax_tau_s ({rt.size}) must have the "
-                f"same length, at most {MAX_BRANCHES}"
-            )
-        if not (np.all(np.isfinite(rk)) and np.all(rk >= 0)):
-            raise ModelError(f"rubber: relax_k_n_per_m must be finite and >= 0, got {rk}")
-        if not (np.all(np.isfinite(rt)) and np.all(rt > 0)):
-            raise ModelError(f"rubber: relax_tau_s must be finite and > 0, got {rt}")
-        self.relax_k_n_per_m = rk
-        self.relax_tau_s = rt
+        self.relax_k_n_per_m, self.relax_tau_s = _relaxation(relax_k_n_per_m, relax_tau_s)
         for name, value in (
             ("friction_fmax_n", friction_fmax_n),
             ("friction_x2_m", friction_x2_m),
@@ -297,39 +314,33 @@ class RubberBushing(BushingModel):
             if val < 0 and name != "fixture_mass_kg":
                 raise ModelError(f"rubber: {name} must be >= 0, got {value!r}")
             setattr(self, name, val)
-        if friction_law not in FRICTION_LAWS or friction_law == "off":
-            raise ModelError(
-                f"rubber: unknown friction_law {friction_law!r}; known: "
-                f"{[k for k in FRICTION_LAWS if k != 'off']}"
-            )
-        if hardening_law not in HARDENING_LAWS or hardening_law == "off":
-            raise ModelError(
-                f"rubber: unknown hardening_law {hardening_law!r}; known: "
-                f"{[k for k in HARDENING_LAWS if k != 'off']}"
-            )
+        _check_laws(friction_law, hardening_law)
         self.friction_law = str(friction_law)
         self.hardening_law = str(hardening_law)
         self.friction_elements = int(friction_elements)
         if not 1 <= self.friction_elements <= 64:
             raise ModelError(f"rubber: friction_elements must be 1..64, got {friction_elements!r}")
         self.seed = int(seed)
-        configured = tuple(e for e in EFFECTS if self._has_params(e))
-        if effects is None:
-            self.effects = configured
-        else:
-            wanted = _check_names(effects, "effects")
-            missing = [e for e in wanted if e not in configured]
-            if missing:
-                raise ModelError(
-                    f"rubber: effect(s) {missing} switched on but their parameters are zero: "
-                    + ", ".join(f"{e}: {EFFECT_PARAMS[e]}" for e in missing)
-                )
-            self.effects = tuple(e for e in EFFECTS if e in wanted)
+        self.effects = self._switched_on(effects)
         super().__init__(dt)
         self._build_kernel_args()
         self.reset(1)
 
     # ----- effects -----------------------------------------------------------------------
+    def _switched_on(self, effects: Any) -> tuple[str, ...]:
+        """The effects that run: every configured one, or those asked for (each configured)."""
+        configured = tuple(e for e in EFFECTS if self._has_params(e))
+        if effects is None:
+            return configured
+        wanted = _check_names(effects, "effects")
+        missing = [e for e in wanted if e not in configured]
+        if missing:
+            raise ModelError(
+                f"rubber: effect(s) {missing} switched on but their parameters are zero: "
+                + ", ".join(f"{e}: {EFFECT_PARAMS[e]}" for e in missing)
+            )
+        return tuple(e for e in EFFECTS if e in wanted)
+
     def _has_params(self, effect: str) -> bool:
         return bool(REFERENCE_EFFECTS[effect].configured(self))
 

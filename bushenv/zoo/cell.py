@@ -40,9 +40,7 @@ CERTIFY = CertifyOptions(holds=101, energy_amplitudes_m=(), passivity_holds_m=(0
 
 
 def cell_name(cell: dict[str, Any]) -> str:
-    extra = "".join(
-        f"-{k}" for k, v in sorted(cell.get("train_options", {}).items()) if v and v != "off"
-    )
+    extra = "".join(f"-{k}" for k, v in sorted(cell.get("train_options", {}).items()) if v == "on")
     return f"{cell['recipe']}{extra}-{cell['model']}-{cell['axis']}-s{cell['seed']}"
 
 

@@ -24,7 +24,7 @@ from bushenv.runlog import RunLog, run_cells
 from bushenv.search.matrix import parse_seeds
 from bushenv.search.searchers import SEARCHERS
 from bushenv.zoo.cell import run_cell
-from bushenv.zoo.summary import write
+from bushenv.zoo.summary import recipe_label, write
 
 EXAMPLE = (
     "bushenv zoo --recipes teacher-forcing,free-run --models nn,hybrid --seeds 0-9 "
@@ -116,7 +116,7 @@ def _describe(row: dict[str, Any]) -> str:
     acc = row["accuracy"]["rms_ratio_n1"]
     verdict = "DIVERGED" if row["diverged"] else "bounded"
     return (
-        f"{row['recipe']:15s} {row['model']:6s} {row['axis']:6s} seed {row['seed']}: "
+        f"{recipe_label(row):15s} {row['model']:6s} {row['axis']:6s} seed {row['seed']}: "
         f"RMS {100 * acc:.1f} %, {verdict} (trained in {row['train_s']:.0f} s)"
     )
 

@@ -36,8 +36,8 @@ def rate(k: int, n: int) -> dict[str, Any]:
 
 
 def recipe_label(row: dict) -> str:
-    """The recipe with the training options that change it (``free-run +certified``)."""
-    extra = [k for k, v in sorted(row.get("train_options", {}).items()) if v and v != "off"]
+    """The recipe with the training switches that are on (``free-run +certified``)."""
+    extra = [k for k, v in sorted(row.get("train_options", {}).items()) if v == "on"]
     return " +".join([row["recipe"], *extra])
 
 
