@@ -250,16 +250,23 @@ def inverse(tabs, target, off_d, l0_d, idl_d, im_d, off_u, idl_u, im_u):  # prag
         else:
             hi = mid
     k = int(off) + 2 * lo
-    p0 = tabs[k]
-    m0 = tabs[k + 1]
-    p1 = tabs[k + 2]
-    m1 = tabs[k + 3]
+    t, _, _ = hermite_solve(
+        tabs[k], tabs[k + 1], tabs[k + 2], tabs[k + 3], target, INVERSE_ITERATIONS, 0.0
+    )
+    return l0 + (lo + t) / idl
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def hermite_solve(p0, m0, p1, m1, target, iterations, tol):  # pragma: no cover - compiled
+    """t in [0, 1] where the cubic Hermite p0 + t (m0 + t (c2 + t c3)) (ends p0, p1, slopes
+    m0, m1 times the spacing) equals ``target``: Newton safeguarded by bisection, at most
+    ``iterations`` steps, stopping once a step moves t by less than ``tol``. Returns (t, c2, c3)."""
     c2 = 3.0 * (p1 - p0) - 2.0 * m0 - m1
     c3 = 2.0 * (p0 - p1) + m0 + m1
     t = (target - p0) / (p1 - p0) if p1 > p0 else 0.0
     a = 0.0
     b = 1.0
-    for _ in range(INVERSE_ITERATIONS):
+    for _ in range(iterations):
         f = p0 + t * (m0 + t * (c2 + t * c3)) - target
         if f > 0.0:
             b = t
@@ -267,5 +274,9 @@ def inverse(tabs, target, off_d, l0_d, idl_d, im_d, off_u, idl_u, im_u):  # prag
             a = t
         df = m0 + t * (2.0 * c2 + 3.0 * t * c3)
         tn = t - f / df if df > 0.0 else 0.5 * (a + b)
-        t = tn if a <= tn <= b else 0.5 * (a + b)
-    return l0 + (lo + t) / idl
+        tn = tn if a <= tn <= b else 0.5 * (a + b)
+        if abs(tn - t) < tol:
+            t = tn
+            break
+        t = tn
+    return t, c2, c3

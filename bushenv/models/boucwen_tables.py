@@ -35,6 +35,8 @@ import math
 import numba as nb
 import numpy as np
 
+from bushenv.models.boucwen_step import hermite_solve
+
 # Parameter rows of a parameter vector (16,), SI.
 BW_ORDER = (
     "c0",
@@ -225,23 +227,7 @@ def _solve_in(nodes, i0, i1, l0, dl, target, hint):  # pragma: no cover - compil
         lo -= 1
     p0, m0 = nodes[lo, 0], nodes[lo, 1]
     p1, m1 = nodes[lo + 1, 0], nodes[lo + 1, 1]
-    c2 = 3.0 * (p1 - p0) - 2.0 * m0 - m1
-    c3 = 2.0 * (p0 - p1) + m0 + m1
-    t = (target - p0) / (p1 - p0) if p1 > p0 else 0.0
-    a, b = 0.0, 1.0
-    for _ in range(8):
-        f = p0 + t * (m0 + t * (c2 + t * c3)) - target
-        if f > 0.0:
-            b = t
-        else:
-            a = t
-        df = m0 + t * (2.0 * c2 + 3.0 * t * c3)
-        tn = t - f / df if df > 0.0 else 0.5 * (a + b)
-        tn = tn if a <= tn <= b else 0.5 * (a + b)
-        if abs(tn - t) < 1e-15:
-            t = tn
-            break
-        t = tn
+    t, c2, c3 = hermite_solve(p0, m0, p1, m1, target, 8, 1e-15)
     return l0 + (lo - i0 + t) * dl, (m0 + t * (2.0 * c2 + 3.0 * t * c3)) / dl, lo
 
 
