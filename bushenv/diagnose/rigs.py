@@ -237,26 +237,29 @@ def diagnose_rig(
             f"the rig shows no gap (largest {100 * rig_gap:.3g} % < {100 * RIG_GAP_FLOOR:g} %): "
             f"none (the reference's record alone says {result['effect']})"
         )
-    force_channels = [c for c in channels if c["channel"].endswith("force_n")
-                      and c["channel"] != "tyre_force_n"]  # fmt: skip
     return {
         "env_id": env_id,
         "channel": top,
-        "force_channel": force_channels[0]["channel"] if force_channels else "force",
+        "force_channel": _force_channel(channels),
         "channels": channels,
         "axis": chosen_axis,
         "axis_reason": axis_reason,
         "rig_gap": rig_gap,
         "effect": effect,
         "bushing_effect": result["effect"],
-        "top_two": result["top_two"],
-        "ranking": result["ranking"],
-        "gap_before": result["gap_before"],
-        "gap_after": result["gap_after"],
+        **{k: result[k] for k in ("top_two", "ranking", "gap_before", "gap_after")},
         "shrink": shrink,
         "model": model_info,
         "bushing_diagnosis": result,
     }
+
+
+def _force_channel(channels: list[dict[str, Any]]) -> str:
+    """The bushing-force channel with the largest gap (channels come ranked by gap)."""
+    for c in channels:
+        if c["channel"].endswith("force_n") and c["channel"] != "tyre_force_n":
+            return c["channel"]
+    return "force"
 
 
 def _check_rig_args(env_id: str, axis: str, test_profiles, test_names) -> list[str]:
