@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import sys
 
+from bushenv.diagnose.candidates import EFFECTS
 from bushenv.models import MODELS
+from bushenv.reference.rubber import REFERENCE_EFFECTS
 from bushenv.search.families import FAMILIES
 from bushenv.search.searchers import SEARCHERS
 from bushenv.search.targets import TARGETS
@@ -52,6 +54,11 @@ def markdown() -> str:
         for name, t in TARGETS.items()
     ]
     families = [(f"`{name}`", f.target, str(f.dim)) for name, f in FAMILIES.items()]
+    effects = [(f"`{name}`", c.form, str(c.weights), _where(c)) for name, c in EFFECTS.items()]
+    reference = [
+        (f"`{name}`", e.kind, ", ".join(f"`{p}`" for p in e.params))
+        for name, e in REFERENCE_EFFECTS.items()
+    ]
     lines = [
         "# Registries",
         "",
@@ -74,6 +81,14 @@ def markdown() -> str:
         "## Excitation families (`bushenv/search/families.py: FAMILIES`)",
         "",
         *_table(("name", "target", "unit-cube dimension"), families),
+        "",
+        "## Diagnosis candidates (`bushenv/diagnose/candidates.py: EFFECTS`)",
+        "",
+        *_table(("name", "form added to the baseline", "weights", "class"), effects),
+        "",
+        "## Effects of the reference rubber (`bushenv/reference/rubber.py: REFERENCE_EFFECTS`)",
+        "",
+        *_table(("name", "acts on", "parameters"), reference),
         "",
     ]
     return "\n".join(lines)

@@ -17,19 +17,16 @@ from bushenv.diagnose.effects.friction import Friction
 from bushenv.diagnose.effects.inertia import Inertia
 from bushenv.diagnose.effects.relaxation import Relaxation
 from bushenv.diagnose.effects.thermal import Thermal
-
-EFFECTS: dict[str, type[Effect]] = {
-    "relaxation": Relaxation,
-    "friction": Friction,
-    "hardening": Hardening,
-    "thermal": Thermal,
-    "delay": Delay,
-    "inertia": Inertia,
-}
+from bushenv.registry import Registry
 
 
 class UnknownEffectError(ValueError):
     """An effect name that is not in the registry; the message lists the known names."""
+
+
+EFFECTS: Registry[type[Effect]] = Registry("candidate effect", UnknownEffectError)
+for _cls in (Relaxation, Friction, Hardening, Thermal, Delay, Inertia):
+    EFFECTS.add(_cls.name, _cls)
 
 
 def effect_names() -> tuple[str, ...]:
@@ -40,8 +37,7 @@ def register_effect(cls: type[Effect]) -> type[Effect]:
     """Add ``cls`` under ``cls.name`` (for extensions and tests; the built-ins are listed)."""
     if not cls.name:
         raise ValueError(f"{cls.__name__} has no name")
-    EFFECTS[cls.name] = cls
-    return cls
+    return EFFECTS.add(cls.name, cls)
 
 
 def get_effect(name: str) -> Effect:
