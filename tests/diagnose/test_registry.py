@@ -44,9 +44,9 @@ def hum_record(seed, name=""):
 
 
 @pytest.fixture
-def with_hum(monkeypatch):
-    monkeypatch.setitem(EFFECTS, "hum", Hum)
-    return Hum
+def with_hum():
+    with EFFECTS.temporarily("hum", Hum):
+        yield Hum
 
 
 def test_a_dummy_effect_added_at_run_time_is_tried_and_named(with_hum):
