@@ -77,3 +77,39 @@ def test_certified_flag_reaches_the_training_the_file_names_and_the_summary_labe
     assert recipe_label(plain) == plain["recipe"]
     with pytest.raises(SystemExit):
         p.parse_args(["--out", "x", "--certified", "yes"])
+
+
+def test_a_cell_run_on_ray_gives_the_local_result(tmp_path):
+    ray = pytest.importorskip("ray", reason="Ray not installed (pip install 'bushenv[ray]')")
+    from bushenv.execution import RayBackend
+
+    def cells(out):
+        config = ZooConfig(
+            recipes=("teacher-forcing",),
+            models=("nn",),
+            axes=("radial",),
+            seeds=(3,),
+            searchers=("random",),
+            budget=8,
+            out=out,
+            train_options=QUICK,
+        ).checked()
+        return config.cells()
+
+    def run(out, backend):
+        log = RunLog(out / "cells.jsonl", CELL_KEYS, RESULT_KEYS, ZooError)
+        return run_cells(cells(out), run_cell, log, backend, False, Progress(quiet=True), str)
+
+    def same(row):  # what a cell found, without where and how long
+        drop = {"out", "train_s", "judge_s", "worker_backend"}
+        return {k: v for k, v in row.items() if k not in drop}
+
+    with LocalBackend(workers=1) as one:
+        local = run(tmp_path / "local", one)
+    backend = RayBackend(num_cpus=1)
+    try:
+        remote = run(tmp_path / "ray", backend)
+    finally:
+        backend.close()
+    assert not ray.is_initialized()
+    assert [same(r) for r in remote] == [same(r) for r in local]
