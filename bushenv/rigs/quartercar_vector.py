@@ -74,12 +74,6 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
     ((4, 12), (4,))
     """
 
-    metadata = {
-        "render_modes": ["rgb_array"],
-        "render_fps": 204.8,
-        "autoreset_mode": AutoresetMode.NEXT_STEP,
-    }
-
     def __init__(
         self,
         num_envs: int = 1,
@@ -92,9 +86,7 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
         divergence_monitor=None,
         **spec_overrides: Any,
     ) -> None:
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise RigError(f"render_mode must be one of {self.metadata['render_modes']}")
-        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode)
+        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode)
         n = self.num_envs
         self.batch = QuarterCarBatch(n, with_reference=True, **spec_overrides)
         self.params = p = self.batch.params

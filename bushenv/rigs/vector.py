@@ -70,12 +70,6 @@ class BushRigVectorEnv(ArrayVectorEnv):
     ((3, 12), (3,), 2048)
     """
 
-    metadata = {
-        "render_modes": ["rgb_array"],
-        "render_fps": 204.8,
-        "autoreset_mode": AutoresetMode.NEXT_STEP,
-    }
-
     def __init__(
         self,
         num_envs: int = 1,
@@ -88,9 +82,7 @@ class BushRigVectorEnv(ArrayVectorEnv):
         divergence_monitor=None,
         **spec_overrides: Any,
     ) -> None:
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise RigError(f"render_mode must be one of {self.metadata['render_modes']}")
-        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode)
+        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode)
         n = self.num_envs
         p = RigParameters(spec_kwargs(ENV_ID, spec_overrides))
         self.params = p

@@ -45,7 +45,17 @@ class ArrayVectorEnv(VectorEnv):
     models of the columns ``mask`` back to rest) and ``_rest_info()`` (one column's info at
     rest, plain values)."""
 
-    def _setup(self, env_id, num_envs, max_episode_steps, episode_steps, autoreset_mode) -> None:
+    metadata = {
+        "render_modes": ["rgb_array"],
+        "render_fps": 204.8,  # the papers' rate; each env sets 1 / its dt
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+    }
+
+    def _setup(
+        self, env_id, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode=None
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise RigError(f"render_mode must be one of {self.metadata['render_modes']}")
         self.env_id = env_id
         self.num_envs = positive_int("num_envs", num_envs)
         if episode_steps is not None:  # the former name of max_episode_steps
