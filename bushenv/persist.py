@@ -46,6 +46,11 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
     return atomic_write(path, lambda fh: fh.write(data))
 
 
+def save_figure(fig: Any, path: str | os.PathLike, dpi: int = 110) -> Path:
+    """Write a matplotlib figure as PNG, atomically (a reader never sees half a picture)."""
+    return atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=dpi))
+
+
 def json_default(o: Any) -> Any:
     """JSON for the values bushenv's reports hold: numpy scalars and arrays, paths."""
     if isinstance(o, np.generic):

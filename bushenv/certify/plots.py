@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from bushenv.certify.certificate import Certificate
+from bushenv.persist import save_figure
 
 
 def _pyplot():
@@ -18,11 +19,12 @@ def _pyplot():
     return plt
 
 
-def _save(fig, path: Path) -> Path:
-    tmp = path.with_name(path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(path)
-    return path
+def _finish(fig, path: Path) -> Path:
+    """Lay out, write atomically, close."""
+    fig.tight_layout()
+    out = save_figure(fig, path)
+    _pyplot().close(fig)
+    return out
 
 
 def _folds(ax, cert: Certificate) -> None:
@@ -85,10 +87,7 @@ def static_force_plot(cert: Certificate, path: Path, title: str) -> Path:
     ax.set_title(title)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return _finish(fig, path)
 
 
 def spectral_radius_plot(cert: Certificate, path: Path, title: str) -> Path:
@@ -117,10 +116,7 @@ def spectral_radius_plot(cert: Certificate, path: Path, title: str) -> Path:
     ax.set_title(title)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return _finish(fig, path)
 
 
 def passivity_plot(cert: Certificate, path: Path, title: str) -> Path:
@@ -171,7 +167,4 @@ def passivity_plot(cert: Certificate, path: Path, title: str) -> Path:
     bx.set_ylabel("sine amplitude [mm]")
     bx.legend(fontsize=7, loc="upper left")
     bx.grid(alpha=0.3)
-    fig.tight_layout()
-    out = _save(fig, path)
-    plt.close(fig)
-    return out
+    return _finish(fig, path)

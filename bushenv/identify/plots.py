@@ -3,22 +3,19 @@ loops, measured beside model (matplotlib Agg; mm and N at the edges)."""
 
 from __future__ import annotations
 
-import io
 import re
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from bushenv.persist import atomic_write
+from bushenv.persist import save_figure
 
 LOOP_WINDOW_S = 2.0  # the zoomed loop panel: this long around the largest deflection
 
 
 def _save(fig: Any, path: Path) -> None:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    atomic_write(path, lambda fh: fh.write(buf.getvalue()))
+    save_figure(fig, path)
 
 
 def safe_name(text: str) -> str:
