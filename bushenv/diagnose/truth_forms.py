@@ -23,6 +23,8 @@ import numba as nb
 import numpy as np
 from scipy import signal
 
+from bushenv.diagnose.effects.friction import amplitude_envelope
+
 Params = dict[str, Any]
 
 
@@ -143,19 +145,9 @@ def _fric_jenkins(p: Params, x, v, a, dt) -> np.ndarray:
     return p["scale"] * _iwan(np.ascontiguousarray(x), 1.0 / xy, np.array([1.0]))
 
 
-@nb.njit(cache=True)
-def _envelope(x, decay):  # pragma: no cover - compiled
-    out = np.empty(x.size)
-    e = 0.0
-    for t in range(x.size):
-        e = max(abs(x[t]), e * decay)
-        out[t] = e
-    return out
-
-
 def _fric_payne(p: Params, x, v, a, dt) -> np.ndarray:
     """Amplitude softening: stiffness falls with the recent amplitude A (peak hold, decays)."""
-    env = _envelope(np.ascontiguousarray(x), float(np.exp(-dt / p["tau_a_s"])))
+    env = amplitude_envelope(np.ascontiguousarray(x), float(np.exp(-dt / p["tau_a_s"])))
     return -p["scale"] * x * env / (env + p["a_c_m"])
 
 

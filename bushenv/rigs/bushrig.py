@@ -22,6 +22,7 @@ from bushenv.rigs.common import (
     MODEL_ERRORS,
     ForceDeviationReward,
     RigError,
+    ask_monitor,
     call_reset,
     check_hook,
     force_observation,
@@ -373,7 +374,7 @@ class BushRigEnv(gym.Env):
             reason = f"|F_model| = {abs(f_m):.6g} N exceeds {p.force_limit:.6g} N"
         info = self._info(x, v, f_m, f_r, finite, model_over, ref_over, False, reason)
         if self.divergence_monitor is not None and not terminated:
-            terminated = self._ask_monitor(info)
+            terminated = ask_monitor(self.divergence_monitor, info)
         info["diverged"] = terminated
         if self._end is not None and self._t >= self._end:
             truncated = True
@@ -384,15 +385,6 @@ class BushRigEnv(gym.Env):
         if self.render_mode == "human":
             self.render()
         return obs.ravel().copy(), reward, terminated, truncated, info
-
-    def _ask_monitor(self, info: dict[str, Any]) -> bool:
-        """The divergence monitor's verdict, written into ``info``; True ends the episode."""
-        verdict = self.divergence_monitor(info)
-        if not verdict:
-            return False
-        info["monitor_verdict"] = True
-        info["divergence_reason"] = verdict if isinstance(verdict, str) else "divergence monitor"
-        return True
 
     def _info(self, x, v, f_m, f_r, finite, model_over, ref_over, monitor, reason):
         return {

@@ -180,6 +180,17 @@ def check_hook(name: str, hook: Callable | None) -> Callable | None:
     return hook
 
 
+def ask_monitor(monitor: Callable, info: dict[str, Any]) -> bool:
+    """A divergence monitor's verdict on one step's ``info``, written into it; True ends the
+    episode (a string verdict is the reason)."""
+    verdict = monitor(info)
+    if not verdict:
+        return False
+    info["monitor_verdict"] = True
+    info["divergence_reason"] = verdict if isinstance(verdict, str) else "divergence monitor"
+    return True
+
+
 def force_observation(f: float, limit: float) -> float:
     """F / limit clipped to [-1, 1]; NaN -> 0 (the episode ends on it anyway)."""
     r = f / limit

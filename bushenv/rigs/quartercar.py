@@ -27,7 +27,13 @@ from bushenv.rigs.car import (
     check_road,
     out_of_bounds,
 )
-from bushenv.rigs.common import ForceDeviationReward, RigError, call_reset, check_hook
+from bushenv.rigs.common import (
+    ForceDeviationReward,
+    RigError,
+    ask_monitor,
+    call_reset,
+    check_hook,
+)
 from bushenv.rigs.drawing import Canvas, Trace
 from bushenv.rigs.scenes import draw_quartercar
 from bushenv.rigs.specs import spec_kwargs
@@ -297,7 +303,7 @@ class QuarterCarEnv(gym.Env):
             why_m if terminated else "",
         )  # fmt: skip
         if self.divergence_monitor is not None and not (terminated or truncated):
-            terminated = self._ask_monitor(info)
+            terminated = ask_monitor(self.divergence_monitor, info)
         info["diverged"] = terminated
         if self._end is not None and self._t >= self._end:
             truncated = True
@@ -309,15 +315,6 @@ class QuarterCarEnv(gym.Env):
         if self.render_mode == "human":
             self.render()
         return self._obs.copy(), reward, terminated, truncated, info
-
-    def _ask_monitor(self, info: dict[str, Any]) -> bool:
-        """The divergence monitor's verdict, written into ``info``; True ends the episode."""
-        verdict = self.divergence_monitor(info)
-        if not verdict:
-            return False
-        info["monitor_verdict"] = True
-        info["divergence_reason"] = verdict if isinstance(verdict, str) else "divergence monitor"
-        return True
 
     def _observe(self, info: dict[str, Any]) -> None:
         o = self._obs
