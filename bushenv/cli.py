@@ -15,6 +15,8 @@ import signal
 import sys
 import threading
 
+from bushenv.errors import BadInput, ModelRaised
+
 COMMANDS = {
     # name: (module, one-line help)
     "reproduce": ("bushenv.reproduce", "identify every model and reproduce the papers' tables"),
@@ -32,7 +34,7 @@ COMMANDS = {
 }
 
 
-class CliError(Exception):
+class CliError(BadInput):
     """A user-facing problem: printed as one line, exit code 2."""
 
 
@@ -90,11 +92,13 @@ def _command_module(name: str):
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run one command; returns the exit code (0 ok, 2 bad input, 130 interrupted).
+    """Run one command; returns the exit code: 0 ok, 1 a bug (or the command's own "failed"
+    verdict: ``replay``, ``certify``), 2 bad input, 3 a model raised while it ran, 130/143
+    interrupted (``bushenv.errors`` says which error is which).
 
-    Every failure is one line on stderr: ``bushenv COMMAND: error: ...``. An unexpected
-    exception (a bug) is also one line, naming its type; set ``BUSHENV_DEBUG=1`` for the full
-    traceback.
+    Every failure is one line on stderr: ``bushenv COMMAND: error: ...`` for bad input,
+    ``bushenv COMMAND: model error: ...`` with the model's own message, and for an unexpected
+    exception (a bug) one line naming its type; ``BUSHENV_DEBUG=1`` shows the full traceback.
     """
     argv = list(sys.argv[1:] if argv is None else argv)
     only = argv[0] if argv and argv[0] in COMMANDS else None
@@ -116,13 +120,19 @@ def main(argv: list[str] | None = None) -> int:
         how = "terminated" if isinstance(exc, Terminated) else "interrupted"
         print(f"bushenv {args.command}: {how}; results written so far are kept", file=sys.stderr)
         return 143 if isinstance(exc, Terminated) else 130
-    except CliError as exc:
-        print(f"bushenv {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except (ValueError, OSError) as exc:
-        # Our loaders raise ValueError subclasses with file/line/value in the message.
+    except (BadInput, OSError) as exc:
+        # Our loaders raise BadInput subclasses with file/line/value in the message.
         print(f"bushenv {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except ModelRaised as exc:
+        if os.environ.get("BUSHENV_DEBUG"):
+            raise
+        print(
+            f"bushenv {args.command}: model error: {_one_line(exc)} (the model's own code "
+            "raised; this is not a divergence verdict)",
+            file=sys.stderr,
+        )
+        return 3
     except Exception as exc:
         if os.environ.get("BUSHENV_DEBUG"):
             raise

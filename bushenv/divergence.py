@@ -88,6 +88,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bushenv import stl
+from bushenv.errors import BadInput
 from bushenv.scales import MACHINE, BushingScales
 
 FORCE_PEAK_FACTOR = 5.0
@@ -107,7 +108,7 @@ CRITERIA = ("non_finite", "force_bound", "deviation", "self_sustained", "energy"
 NEEDS_REFERENCE = ("deviation", "static")  # judged only against a reference's force
 
 
-class DivergenceInputError(ValueError):
+class DivergenceInputError(BadInput):
     """Arrays of wrong shape or a displacement that is not finite."""
 
 

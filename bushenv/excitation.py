@@ -56,6 +56,8 @@ import math
 import numba as nb
 import numpy as np
 
+from bushenv.errors import BadInput
+
 # ----- machine limits (seed 002 Table 1) ---------------------------------------------------
 MAX_DYNAMIC_FORCE_N = 25.0e3
 MAX_STATIC_FORCE_N = 37.5e3
@@ -77,7 +79,7 @@ PAPER_BUMP_LENGTHS_M = (0.4, 0.7, 1.0)  # seed 001 §4, Fig. 19
 PAPER_VEHICLE_SPEED_M_PER_S = 30.0 / 3.6  # seed 000 §6: 30 km/h
 
 
-class ExcitationError(ValueError):
+class ExcitationError(BadInput):
     """An excitation argument is invalid; the message names the argument and the value."""
 
 

@@ -21,8 +21,10 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any
 
+from bushenv.errors import BadInput
 
-class BackendError(ValueError):
+
+class BackendError(BadInput):
     """A backend cannot start (Ray missing, cluster unreachable, bad worker count)."""
 
 

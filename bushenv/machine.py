@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from bushenv import excitation as ex
+from bushenv.errors import BadInput
 from bushenv.models.base import DT_TOLERANCE, PAPER_DT, BushingModel
 from bushenv.persist import write_json
 from bushenv.records import Record, RecordError, save_csv
@@ -59,7 +60,7 @@ STEP_PRE_S = 0.5
 PROGRAMMES = ("harmonic", "random", "step", "papers")
 
 
-class MachineError(ValueError):
+class MachineError(BadInput):
     """The machine cannot run this excitation or programme; the message says why."""
 
 

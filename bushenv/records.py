@@ -49,6 +49,8 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.errors import BadInput
+
 HEADER = ("time", "displacement", "force")
 HEADER_TEXT = ",".join(HEADER)
 STEP_RTOL = 0.01  # a step may differ from dt by 1 % of dt ...
@@ -85,7 +87,7 @@ _BINARY_MAGIC = (
 )
 
 
-class RecordError(ValueError):
+class RecordError(BadInput):
     """A record file or record array is invalid; the message names file, line and value."""
 
 

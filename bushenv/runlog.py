@@ -15,11 +15,12 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from bushenv.errors import BadInput
 from bushenv.persist import json_default, write_text
 from bushenv.progress import Progress
 
 
-class RunLogError(ValueError):
+class RunLogError(BadInput):
     """A results file that cannot be read or continued; the message names file and line."""
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from bushenv import excitation as ex
+from bushenv.errors import BadInput
 
 FORCE_FLOOR_N = 200.0  # the papers' bushing on the papers' machine (divergence.py says why)
 RIG_FORCE_LIMIT_N = 25.0e3  # seed 002 Table 1, max dynamic force of the MTS test machine
@@ -25,7 +26,7 @@ STATIC_HOLD_S = 2.0  # hold before reading a model's static force (rubber relaxe
 STATIC_PROBE_M = 1.0e-3
 
 
-class ScaleError(ValueError):
+class ScaleError(BadInput):
     """A scale that cannot be used (not positive, beyond the machine); names the value."""
 
 

@@ -31,8 +31,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.ndimage import maximum_filter1d, minimum_filter1d
 
+from bushenv.errors import BadInput
 
-class STLError(ValueError):
+
+class STLError(BadInput):
     """A malformed formula argument (window bounds, shapes)."""
 
 

@@ -17,6 +17,7 @@ import pytest
 
 from bushenv import cli
 from bushenv.cli import COMMANDS, main
+from bushenv.errors import BadInput, ModelRaised
 
 
 def run_cli(argv: list[str], capsys) -> tuple[int, str, str]:
@@ -159,7 +160,19 @@ def test_debug_variable_shows_the_traceback_of_an_unexpected_exception(fake_comm
     [
         (KeyboardInterrupt(), 130, "bushenv fake: interrupted; results written so far are kept"),
         (cli.Terminated(), 143, "bushenv fake: terminated; results written so far are kept"),
-        (ValueError("x.csv line 3: bad"), 2, "bushenv fake: error: x.csv line 3: bad"),
+        (BadInput("x.csv line 3: bad"), 2, "bushenv fake: error: x.csv line 3: bad"),
+        (
+            ValueError("operands could not be broadcast"),
+            1,
+            "bushenv fake: internal error: ValueError: operands could not be broadcast "
+            "(a bug: please report it; BUSHENV_DEBUG=1 shows the traceback)",
+        ),
+        (
+            ModelRaised("mine.npz", ValueError("operands could not be broadcast")),
+            3,
+            "bushenv fake: model error: mine.npz: ValueError: operands could not be broadcast "
+            "(the model's own code raised; this is not a divergence verdict)",
+        ),
         (
             FileNotFoundError(2, "No such file or directory", "/nope/a.csv"),
             2,
@@ -167,7 +180,15 @@ def test_debug_variable_shows_the_traceback_of_an_unexpected_exception(fake_comm
         ),
         (cli.CliError("--budget must be > 0"), 2, "bushenv fake: error: --budget must be > 0"),
     ],
-    ids=["ctrl-c", "sigterm", "value-error", "os-error", "cli-error"],
+    ids=[
+        "ctrl-c",
+        "sigterm",
+        "bad-input",
+        "plain-value-error",
+        "model-error",
+        "os-error",
+        "cli-error",
+    ],  # fmt: skip
 )
 def test_known_failures_map_to_one_line_and_an_exit_code(fake_command, capsys, exc, code, line):
     fake_command.to_raise = exc

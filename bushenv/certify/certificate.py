@@ -145,8 +145,8 @@ def _hold_entry(net, fp, gh, run, i, ref_n, bands) -> dict:
         "linger_force_n": run.linger_force_n,
         "oscillates": run.oscillates,
         "static_force_n": static,
-        "reference_static_force_n": ref,
-        "static_error_n": None if static is None else static - ref,
+        "reference_static_force_n": ref if np.isfinite(ref) else None,
+        "static_error_n": None if static is None or not np.isfinite(ref) else static - ref,
         "wrong_sign": bool(wrong),
         "static_off": bool(off),
         "ghosts": [
@@ -180,7 +180,11 @@ def _passivity(model, reference, net, opts: CertifyOptions) -> list[dict]:
     for i, x0 in enumerate(fp.x_m):
         idx = [p for p in fp.of_hold(i) if fp.stable[p]]
         k = dynamic_stiffness(net, fp.point_x_m[idx], fp.y[idx], freq, opts.velocity)
-        k_ref = sine_stiffness(reference, float(x0), ref_freq, opts.reference_amplitude_m)
+        k_ref = (
+            np.full(ref_freq.size, np.nan + 0j)
+            if reference is None
+            else sine_stiffness(reference, float(x0), ref_freq, opts.reference_amplitude_m)
+        )
         entries.append(
             {
                 "x_m": float(x0),
@@ -236,14 +240,15 @@ def certify(
     options: CertifyOptions | None = None,
     progress: Callable[[str, float], None] | None = None,
 ) -> Certificate:
-    """The certificate of ``model`` (nn or hybrid) against ``reference`` over the stroke.
+    """The certificate of ``model`` (nn or hybrid) against ``reference`` over the stroke;
+    ``reference`` None: the reference-free parts only (no static comparison, no reference K).
 
     ``progress(stage, fraction_done)`` is called before each stage.
     """
     opts = options or CertifyOptions()
     opts.check()
     net = narx_net(model)
-    if abs(reference.dt - net.dt_s) > 1e-9 * net.dt_s:
+    if reference is not None and abs(reference.dt - net.dt_s) > 1e-9 * net.dt_s:
         raise CertifyError(
             f"model runs at {1 / net.dt_s:.6g} Hz, reference at {1 / reference.dt:.6g} Hz; "
             "give a reference sampled at the model's rate"
@@ -267,7 +272,11 @@ def certify(
     bands = _reached_bands(net, fp, runs, opts.velocity)
     timing["free_runs_s"], done = time.perf_counter() - t, done + units["free runs"]
     t = stage("reference holds")
-    ref_static = reference_static_force(reference, x, opts.hold_s)
+    ref_static = (  # no reference: no static comparison (wrong sign, off band) is made
+        np.full(x.size, np.nan)
+        if reference is None
+        else reference_static_force(reference, x, opts.hold_s)
+    )
     timing["reference_holds_s"], done = time.perf_counter() - t, done + units["reference holds"]
     t = stage("passivity")
     pas = _passivity(model, reference, net, opts)

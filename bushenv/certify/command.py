@@ -1,7 +1,11 @@
 """``bushenv certify``: hold-stability and passivity certificates of a NARX model.
 
 Writes DIR/certificate.json and three plots (static force, spectral radius, Im K); prints a
-summary on stdout and progress on stderr.
+summary on stdout and progress on stderr. Exits as a test runner does: 0 when the certificate
+passes (holds and passivity), 1 when it fails, 2 on bad input. The reference and the stroke
+come from the one judging setup (``bushenv.judge``): the stroke is the model card's (1.5 x its
+records'), the papers' +-12.5 mm only for the shipped models, ``--stroke-mm`` on top; without a
+reference only the reference-free parts run, and the summary says what needs one.
 """
 
 from __future__ import annotations
@@ -12,7 +16,8 @@ from pathlib import Path
 from bushenv.certify.certificate import CertifyOptions, certify
 from bushenv.certify.network import CertifyError, narx_net
 from bushenv.certify.plots import passivity_plot, spectral_radius_plot, static_force_plot
-from bushenv.models import get_model, get_reference
+from bushenv.judge import ScaleFlags, build_judge
+from bushenv.models import MODELS, get_model
 from bushenv.persist import write_json
 from bushenv.progress import Progress
 
@@ -47,9 +52,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("model", metavar="MODEL", help="nn, hybrid or a NARX model file (.npz)")
     parser.add_argument(
         "--reference",
-        default="rubber",
-        help="registered name or model file the static force and Im K are compared with "
-        "(default: rubber)",
+        default=None,
+        help="registered name, model file or 'none': what the static force and Im K are "
+        "compared with (default: rubber for a registered model; none for a model file, then "
+        "the static comparison is not made)",
+    )
+    parser.add_argument(
+        "--trust-reference",
+        action="store_true",
+        help="certify against a reference that failed its vetting (marked in the certificate)",
     )
     parser.add_argument("--axis", default="axial", choices=AXES, help="(default: axial)")
     parser.add_argument(
@@ -61,8 +72,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--stroke-mm",
         type=float,
-        default=DEFAULTS.stroke_m * 1e3,
-        help=f"holds span -S..+S mm (default: {DEFAULTS.stroke_m * 1e3:g}, the machine's)",
+        default=None,
+        help="holds span -S..+S mm (default: the model card's stroke, 1.5 x its records'; "
+        f"{DEFAULTS.stroke_m * 1e3:g}, the machine's, for the shipped models)",
     )
     parser.add_argument(
         "--at-mm",
@@ -133,11 +145,25 @@ def run(args: argparse.Namespace) -> int:
         narx_net(model)
     except CertifyError as exc:
         raise CertifyError(f"{args.model}: {exc}") from None
-    reference = get_reference(args.reference, axis=args.axis, dt=model.dt)
+    judge = build_judge(
+        args.model,
+        args.reference,
+        axis=args.axis,
+        dt=model.dt,
+        flags=ScaleFlags(stroke_mm=args.stroke_mm),
+        trust_reference=args.trust_reference,
+        model_object=model,
+    )
+    reference = judge.reference
+    if args.stroke_mm is None and args.model not in MODELS and "card" not in judge.scales.source:
+        raise CertifyError(
+            f"{args.model}: no model card to take the stroke from (and the papers' +-12.5 mm "
+            "is the shipped models' only); give --stroke-mm S, the stroke the model is for"
+        )
     opts = CertifyOptions(
         holds=args.holds,
         extra_holds_m=args.at_mm,
-        stroke_m=args.stroke_mm * 1e-3,
+        stroke_m=judge.scales.stroke_m,
         hold_s=args.hold_s,
         velocity=args.velocity,
         passivity_holds_m=args.passivity_mm,
@@ -149,7 +175,11 @@ def run(args: argparse.Namespace) -> int:
     doc = cert.document
     doc["model"]["source"] = str(args.model)
     doc["model"]["axis"] = args.axis
-    doc["reference"] = {"source": str(args.reference), "class": type(reference).__name__}
+    doc["reference"] = {
+        "source": judge.reference_spec,
+        "class": None if reference is None else type(reference).__name__,
+    }
+    doc["judge"] = judge.describe()
     report("plots", 0.99)
     out.mkdir(parents=True, exist_ok=True)
     name = f"{Path(args.model).name} ({args.axis})"
@@ -159,8 +189,9 @@ def run(args: argparse.Namespace) -> int:
         passivity_plot(cert, out / "passivity.png", f"{name}: small-signal Im K"),
     ]
     write_json(target, doc)
-    _summary(doc, [target, *paths])
-    return 0
+    _summary(doc, [target, *paths], judge)
+    s = doc["summary"]
+    return 0 if s["passes_holds"] and s["passes_passivity"] else 1
 
 
 def _mm_ranges(ranges: list[list[float]]) -> str:
@@ -171,8 +202,18 @@ def _hz_bands(bands: list[list[float]]) -> str:
     return "[" + ", ".join(f"{a:.1f}-{b:.1f} Hz" for a, b in bands) + "]"
 
 
-def _summary(doc: dict, paths: list[Path]) -> None:
+def _summary(doc: dict, paths: list[Path], judge) -> None:
     s = doc["summary"]
+    print(
+        f"stroke +-{judge.scales.stroke_m * 1e3:.4g} mm ({judge.scales.source}); reference: "
+        f"{judge.reference_spec or 'none'}"
+        + ("" if judge.vetting is None else f", vetting {judge.vetting.summary()}")
+    )
+    if judge.reference is None:
+        print(
+            "no reference: the static comparison (wrong sign, static force off the reference's) "
+            "needs one and was not made; pass --reference NAME|FILE"
+        )
     print(
         f"holds: {s['holds']}, settling stably {s['holds_settling_stably']}, departing "
         f"{s['departing_holds']}, oscillating {s['oscillating_holds']}, folds {s['folds']}; "

@@ -30,16 +30,18 @@ def energy_fires(
     model, reference, freq_hz: np.ndarray, amplitudes_m: np.ndarray
 ) -> list[list[bool | None]]:
     """[amplitude][frequency]: does ``judge`` flag ``energy`` on that sine (None: not drivable).
-    ``model`` and ``reference`` are copied (their states are not touched)."""
+    ``model`` and ``reference`` are copied (their states are not touched); ``reference`` None:
+    judged without one (the model's own work must stay >= 0 at every return)."""
     freq_hz = np.asarray(freq_hz, dtype=np.float64)
     out: list[list[bool | None]] = []
-    m, r = model.copy(), reference.copy()
+    m, r = model.copy(), None if reference is None else reference.copy()
     for amp in np.asarray(amplitudes_m, dtype=np.float64):
         ok = 2.0 * np.pi * freq_hz * amp <= ex.MAX_VELOCITY_M_PER_S
         row: list[bool | None] = [None] * freq_hz.size
         if np.any(ok):
             x = sine_batch(freq_hz[ok], float(amp), model.dt)
-            verdict = judge(x, m.simulate(x), r.simulate(x), model.dt)
+            f_ref = None if r is None else r.simulate(x)  # None: the model's own work
+            verdict = judge(x, m.simulate(x), f_ref, model.dt)
             for k, fires in zip(np.flatnonzero(ok), verdict.flags["energy"], strict=True):
                 row[k] = bool(fires)
         out.append(row)

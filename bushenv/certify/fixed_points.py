@@ -20,7 +20,9 @@ declared empty, so each root ends in a monotone cell (found, then refined by bis
 machine precision) or in a cell left unresolved at the depth limit, which is narrower than
 ``2**-MAX_DEPTH`` of the initial cell and can only hold a (near-)double root: a hold sitting
 on a fold to within that width. Unresolved cells are counted per hold (``unresolved``) and
-their sign-changing ones still give a root, so nothing is dropped silently.
+each run of touching ones gives one root (phi vanishes there to machine precision; a tangent
+root need not change sign), so nothing is dropped silently: whether a hold placed exactly on a
+fold shows its double root no longer depends on how the platform rounds tanh.
 
 **Stability.** Linearised about y*, the held recurrence is dy_t = sum_j a_j dy_{t-j}
 (``network.lag_gradients``); the fixed point is asymptotically stable when the spectral
@@ -132,8 +134,12 @@ def _isolate(net: NarxNet, c: np.ndarray, n_cells: int):
             break
         if depth == MAX_DEPTH:
             unresolved.append(hold)
-            root = (pa == 0) | (pa * pb < 0)  # at least one root: keep it, flagged
-            found.append((hold[root], a[root], b[root], pa[root]))
+            # phi vanishes on such a cell to machine precision: a (near-)double root, kept
+            # whether or not phi changes sign across it (a tangent root at a fold does not,
+            # or does by rounding alone), one per run of adjacent cells; pa = 0 marks it exact
+            keep = _one_per_run(hold, a, b, np.abs(pa) + np.abs(pb))
+            sign_change = (pa == 0) | (pa * pb < 0)
+            found.append((hold[keep], a[keep], b[keep], np.where(sign_change, pa, 0.0)[keep]))
             break
         mid = 0.5 * (a + b)
         pm, dm = diagonal(net, c[hold], mid)
@@ -144,6 +150,24 @@ def _isolate(net: NarxNet, c: np.ndarray, n_cells: int):
     cat = [np.concatenate(parts) for parts in zip(*found, strict=True)]
     bad = np.concatenate(unresolved) if unresolved else np.zeros(0, dtype=np.int64)
     return (*cat, np.bincount(bad, minlength=c.shape[0]))
+
+
+def _one_per_run(hold: np.ndarray, a: np.ndarray, b: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Indices of one cell (the smallest ``size``) per run of touching cells of one hold."""
+    order = np.lexsort((a, hold))
+    keep, best = [], None
+    for k, i in enumerate(order):
+        j = order[k - 1] if k else None
+        touching = j is not None and hold[i] == hold[j] and a[i] <= b[j]
+        if not touching:
+            if best is not None:
+                keep.append(best)
+            best = i
+        elif size[i] < size[best]:
+            best = i
+    if best is not None:
+        keep.append(best)
+    return np.array(keep, dtype=np.int64)
 
 
 def _bisect(net: NarxNet, c: np.ndarray, a: np.ndarray, b: np.ndarray, pa: np.ndarray):

@@ -22,13 +22,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bushenv.errors import BadInput
 from bushenv.models.narx import NarxBushing
 
 # max |d^2 tanh(a) / da^2| = max |2 tanh(a) (1 - tanh(a)^2)|, reached at tanh(a) = 1/sqrt(3)
 TANH_CURVATURE = 4.0 / (3.0 * np.sqrt(3.0))
 
 
-class CertifyError(ValueError):
+class CertifyError(BadInput):
     """Bad input to a certificate (a model that is not a NARX network, a bad option)."""
 
 

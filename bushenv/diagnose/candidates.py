@@ -17,10 +17,11 @@ from bushenv.diagnose.effects.friction import Friction
 from bushenv.diagnose.effects.inertia import Inertia
 from bushenv.diagnose.effects.relaxation import Relaxation
 from bushenv.diagnose.effects.thermal import Thermal
+from bushenv.errors import BadInput
 from bushenv.registry import Registry
 
 
-class UnknownEffectError(ValueError):
+class UnknownEffectError(BadInput):
     """An effect name that is not in the registry; the message lists the known names."""
 
 

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.errors import BadInput
 from bushenv.metrics import all_metrics
 from bushenv.persist import plain, write_json, write_text
 
@@ -37,7 +38,7 @@ CARD_FORMAT = "bushenv-model-card"
 CARD_VERSION = 1
 
 
-class CardError(ValueError):
+class CardError(BadInput):
     """A model card is unreadable or does not match its model or records (names which)."""
 
 

@@ -15,13 +15,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bushenv.errors import BadInput
 from bushenv.models.base import velocity_of
 
 MIN_SAMPLES = 10  # a record shorter than this identifies nothing
 RATE_RTOL = 1e-6  # two records whose sample times differ by less are at the same rate
 
 
-class IdentificationError(ValueError):
+class IdentificationError(BadInput):
     """Identification data or options are unusable; the message names the record or option."""
 
 

@@ -23,6 +23,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from bushenv.errors import BadInput
 from bushenv.persist import atomic_write
 
 FORMAT_VERSION = 1
@@ -31,7 +32,7 @@ DT_TOLERANCE = 1e-9  # relative; two dt values closer than this are the same rat
 AXES = ("axial", "radial")  # the bushing directions of seed 000 Table 1
 
 
-class ModelError(ValueError):
+class ModelError(BadInput):
     """A model file or a model argument is wrong; the message names the file and the problem."""
 
 

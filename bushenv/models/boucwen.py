@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.errors import ModelRefused
 from bushenv.models.base import PAPER_DT, BushingModel, ModelError
 from bushenv.models.boucwen_kernels import BW_MAX_SUBSTEPS, BW_N_STATE, boucwen_kernel
 from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare
@@ -84,7 +85,11 @@ def n_mm_to_si(p: dict[str, float]) -> dict[str, float]:
 
 
 class BoucWenError(ModelError):
-    """The Bouc-Wen equations cannot be integrated (refused set, step limit, or a runaway)."""
+    """These Bouc-Wen parameters cannot be integrated (a refused set: bad input)."""
+
+
+class BoucWenRunaway(BoucWenError, ModelRefused):
+    """The integration refused to go on (step limit, or the solution ran away): a divergence."""
 
 
 class BoucWenBushing(BushingModel):
@@ -166,7 +171,7 @@ class BoucWenBushing(BushingModel):
             x, v, self.state, self._tabs, self._bc, self._tab_index, self.dt, BW_MAX_SUBSTEPS, out
         )
         if n_bad:
-            raise BoucWenError(
+            raise BoucWenRunaway(
                 f"boucwen: {n_bad} of {x.shape[1]} histories could not be integrated: more "
                 f"than {BW_MAX_SUBSTEPS} trial steps in one sample, or the solution ran away "
                 f"(z beyond its table, or not finite); parameters {self.params}"

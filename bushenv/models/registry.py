@@ -37,6 +37,11 @@ class ModelEntry:
         Trained defaults ship in the package; the name loads ``<axis>_<name>.npz``.
     reference_preset : dict
         Keyword arguments of ``preset`` when the model is a verdict's reference.
+    hybrid : str or None
+        The hybrid ``bushenv attack`` rechecks and attacks beside this model (default:
+        ``hybrid``): the papers' NN goes with the papers' hybrid.
+    also : tuple of str
+        Models rechecked on every profile that broke this one, in their own rows.
     """
 
     entry_point: str | type
@@ -45,6 +50,8 @@ class ModelEntry:
     options: Any = None
     shipped: bool = False
     reference_preset: dict[str, Any] = field(default_factory=dict)
+    hybrid: str | None = None
+    also: tuple[str, ...] = ()
 
     def model_class(self) -> type:
         ep = self.entry_point
@@ -84,6 +91,26 @@ MODELS.add(
         "linear backbone plus a bounded NARX residual network (seed 000 §3)",
         fit="bushenv.identify.neural:fit_hybrid",
         options="bushenv.identify.narx_options:NarxOptions",
+        shipped=True,
+    ),
+)
+MODELS.add(
+    "nn-paper",
+    ModelEntry(
+        "bushenv.models.narx:NarxBushing",
+        "the papers' pure NARX network as seed 000 made it: 5+5 lags, 9 tanh units, trained "
+        "one step ahead only (teacher forcing), no certified holds",
+        shipped=True,
+        hybrid="hybrid-paper",
+        also=("nn", "hybrid"),
+    ),
+)
+MODELS.add(
+    "hybrid-paper",
+    ModelEntry(
+        "bushenv.models.hybrid:HybridBushing",
+        "the papers' hybrid as seed 000 made it: linear backbone plus the same network, "
+        "teacher forcing, no certified holds",
         shipped=True,
     ),
 )

@@ -26,6 +26,7 @@ from bushenv.rigs.common import (
     call_reset,
     check_hook,
     force_observation,
+    model_error_text,
     model_label,
     per_axis,
     positive,
@@ -83,7 +84,13 @@ class RigParameters:
         self.reward_cap = positive("reward_cap", kwargs["reward_cap"])
         self.max_step = self.max_v * self.dt  # largest displacement change per step, m
         self.model = resolve_model(kwargs["model"], self.axis, self.dt)
-        self.reference = resolve_reference(kwargs["reference"], self.axis, self.dt)
+        self.reference = resolve_reference(
+            kwargs["reference"],
+            self.axis,
+            self.dt,
+            trust_reference=bool(kwargs.get("trust_reference", False)),
+        )
+        self.judge = self.reference.judge
         self.model_name = model_label(self.model, kwargs["model"])
         self.reference_name = model_label(self.reference, kwargs["reference"])
 
@@ -340,12 +347,15 @@ class BushRigEnv(gym.Env):
         self._x = x
         self._t += 1
 
-        reason = ""
+        reason = model_error = ""
         try:
             f_m = self.model.step(x, v)
         except MODEL_ERRORS as exc:  # a model refusing to go on (Bouc-Wen's guard), 1/0, ...
             f_m = math.nan
             reason = f"model raised {type(exc).__name__}: {exc}"
+        except Exception as exc:  # the model's own bug: ends the episode, not a divergence
+            f_m = math.nan
+            model_error = model_error_text(exc)
         f_r = self.reference.step(x, v)
 
         self._set_actuator_velocity(v, 0.0)
@@ -372,10 +382,14 @@ class BushRigEnv(gym.Env):
             reason = reason or "model force is not finite"
         elif model_over:
             reason = f"|F_model| = {abs(f_m):.6g} N exceeds {p.force_limit:.6g} N"
+        if model_error:
+            reason = ""
         info = self._info(x, v, f_m, f_r, finite, model_over, ref_over, False, reason)
         if self.divergence_monitor is not None and not terminated:
             terminated = ask_monitor(self.divergence_monitor, info)
-        info["diverged"] = terminated
+        info["diverged"] = terminated and not model_error
+        info["model_error"] = model_error
+        terminated = terminated or bool(model_error)
         if self._end is not None and self._t >= self._end:
             truncated = True
         reward = float(self.reward_fn(info))
@@ -402,6 +416,7 @@ class BushRigEnv(gym.Env):
             "diverged": False,  # set by step once the monitor has spoken
             "machine_limit": ref_over,
             "divergence_reason": reason,
+            "model_error": "",  # the model's own exception, when it raised (not a divergence)
         }
 
     # ----- drawing ---------------------------------------------------------------------------

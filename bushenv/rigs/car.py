@@ -23,6 +23,7 @@ from bushenv.rigs.actions import check_profile
 from bushenv.rigs.common import (
     MODEL_ERRORS,
     RigError,
+    model_error_text,
     model_label,
     positive,
     positive_int,
@@ -42,10 +43,18 @@ DAMPING_ANGLE_STEP = 0.005  # rad; see Car.update_damping
 BODIES = ("chassis", "unsprung", "road")
 
 
-def axis_models(spec: Any, dt: float, reference: bool) -> dict[str, BushingModel]:
+def axis_models(
+    spec: Any, dt: float, reference: bool, trust_reference: bool = False
+) -> dict[str, BushingModel]:
     """One model per bushing axis: a name or path (the same for both axes, each axis' own
-    preset or file), or a dict ``{"radial": ..., "axial": ...}`` of names, paths or objects."""
-    resolve = resolve_reference if reference else resolve_model
+    preset or file), or a dict ``{"radial": ..., "axial": ...}`` of names, paths or objects.
+    References go through the one judging setup (vetted, ``rigs.common.resolve_reference``)."""
+
+    def resolve(s: Any, axis: str, dt: float) -> BushingModel:
+        if reference:
+            return resolve_reference(s, axis, dt, trust_reference=trust_reference)
+        return resolve_model(s, axis, dt)
+
     if isinstance(spec, dict):
         missing = [a for a in AXES if a not in spec]
         if missing or set(spec) - set(AXES):
@@ -77,6 +86,9 @@ def check_road(profile: Any, max_height_m: float, max_step_m: float) -> np.ndarr
         "a change of {value:.6g} m exceeds max_road_step_m "
         + f"{max_step_m:.6g} m (the road starts at 0)",
     )
+
+
+MODEL_ERROR_PREFIX = "model error: "  # a sample whose model raised (not a divergence)
 
 
 class CarParameters:
@@ -126,7 +138,12 @@ class CarParameters:
         self.c_in = {a: TABLE1[a]["c_ns_per_m"] for a in AXES}
         if resolve_models:
             self.models = axis_models(kwargs["model"], self.dt, reference=False)
-            self.references = axis_models(kwargs["reference"], self.dt, reference=True)
+            self.references = axis_models(
+                kwargs["reference"],
+                self.dt,
+                reference=True,
+                trust_reference=bool(kwargs.get("trust_reference", False)),
+            )
             self.model_name = axis_label(self.models, kwargs["model"])
             self.reference_name = axis_label(self.references, kwargs["reference"])
 
@@ -311,6 +328,8 @@ class CarPair:
             forces = (models["radial"].step(xr, vr), models["axial"].step(xa, va))
         except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
             return motion, (math.nan, math.nan), f"model raised {type(exc).__name__}: {exc}"
+        except Exception as exc:  # the model's own bug: ends the episode, not a divergence
+            return motion, (math.nan, math.nan), MODEL_ERROR_PREFIX + model_error_text(exc)
         why = force_reason(*forces, self.p.force_limit)
         if not why:
             car.radial.hold(forces[0], xr, vr)

@@ -20,17 +20,23 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.models import MODELS, BushingModel, get_model, get_reference
+from bushenv.errors import DIVERGENCE_RAISES, BadInput
+from bushenv.models import MODELS, BushingModel, get_model
 
 
-class RigError(ValueError):
+class RigError(BadInput):
     """A rig argument, spec file or excitation is wrong; the message names it and the value."""
 
 
-# What a model's step may raise that ends its episode as a divergence instead of escaping the
-# env: a ValueError (ModelError: the model refusing to go on, e.g. Bouc-Wen's guard) or an
-# ArithmeticError (ZeroDivisionError, FloatingPointError under np.seterr, OverflowError).
-MODEL_ERRORS = (ValueError, ArithmeticError)
+# What a model's step may raise that ends its episode as a divergence: its own state ran away
+# (Bouc-Wen's guard) or 1/0, overflow (``bushenv.errors``). Anything else the model raises is a
+# model error: the episode ends with ``info["model_error"]``, never as a divergence.
+MODEL_ERRORS = DIVERGENCE_RAISES
+
+
+def model_error_text(exc: BaseException) -> str:
+    """One line for ``info["model_error"]``: the exception's type and the model's message."""
+    return f"{type(exc).__name__}: {' '.join(str(exc).split())}"
 
 
 def positive(name: str, value: Any) -> float:
@@ -67,12 +73,33 @@ def resolve_model(spec: Any, axis: str, dt: float) -> BushingModel:
     return model
 
 
-def resolve_reference(spec: Any, axis: str, dt: float) -> BushingModel:
-    """The reference bushing (``bushenv.models.get_reference``; ``"rubber"``: the calibrated
-    specimen without the load cell's delay, fixture inertia and noise)."""
-    model = get_reference(spec, axis=axis, dt=dt)
-    model.reset(1)
-    return model
+def resolve_reference(
+    spec: Any,
+    axis: str,
+    dt: float,
+    model: Any = None,
+    model_object: BushingModel | None = None,
+    trust_reference: bool = False,
+    target: str = "rig",
+) -> BushingModel:
+    """The reference bushing, through the one judging setup (``bushenv.judge``): vetted
+    before it judges (a ``JudgeError`` names what failed, unless ``trust_reference``). The
+    envs' own verdicts (not finite, beyond the machine's force) do not compare the model with
+    the reference, so they vet the reference alone (``model`` None: holds and its records, no
+    compatibility check); the attack, which compares, passes the model too.
+    ``"rubber"``: the calibrated specimen without the load cell's delay, inertia and noise."""
+    from bushenv.judge import build_judge
+
+    if spec is None or (isinstance(spec, str) and spec.strip().lower() == "none"):
+        raise RigError("reference: the rig runs a reference beside the model; give one")
+    judge = build_judge(
+        model, spec, axis=axis, dt=dt, target=target, trust_reference=trust_reference,
+        model_object=model_object,
+    )  # fmt: skip
+    reference = judge.reference
+    reference.reset(1)
+    reference.judge = judge  # what judged: recorded by the env (``judge`` in its params)
+    return reference
 
 
 def model_label(model: BushingModel, spec: Any) -> str:
@@ -105,7 +132,7 @@ def shared_state_rows(model: BushingModel, probe_steps: int = 24) -> np.ndarray:
     try:
         for t in range(probe_steps):
             probe.step(x[t], v[t])
-    except MODEL_ERRORS:
+    except Exception:  # a model that cannot take this probe: every row its own
         return mask
     st = probe.state
     if st.shape[0] == n:

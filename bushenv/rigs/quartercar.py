@@ -17,6 +17,7 @@ from gymnasium import spaces
 from bushenv.rigs.actions import check_options, unit_action
 from bushenv.rigs.car import (
     AXES,
+    MODEL_ERROR_PREFIX,
     Car,
     CarPair,
     CarParameters,
@@ -304,7 +305,12 @@ class QuarterCarEnv(gym.Env):
         )  # fmt: skip
         if self.divergence_monitor is not None and not (terminated or truncated):
             terminated = ask_monitor(self.divergence_monitor, info)
-        info["diverged"] = terminated
+        model_error = (
+            why_m[len(MODEL_ERROR_PREFIX) :] if why_m.startswith(MODEL_ERROR_PREFIX) else ""
+        )
+        info["diverged"] = terminated and not model_error
+        info["model_error"] = model_error
+        terminated = terminated or bool(model_error)
         if self._end is not None and self._t >= self._end:
             truncated = True
         reward = float(self.reward_fn(info))
@@ -357,6 +363,7 @@ class QuarterCarEnv(gym.Env):
             "diverged": False,
             "physical_limit": bool(why_r),
             "divergence_reason": reason,
+            "model_error": "",
         }
 
     # ----- drawing ---------------------------------------------------------------------------

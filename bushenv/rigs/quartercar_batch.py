@@ -25,6 +25,7 @@ from typing import Any
 import numba as nb
 import numpy as np
 
+from bushenv.errors import ModelRaised
 from bushenv.rigs.car import AXES, CarParameters, axis_models, check_road
 from bushenv.rigs.common import (
     MODEL_ERRORS,
@@ -253,6 +254,8 @@ class QuarterCarBatch:
                 except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
                     f = np.full(n, np.nan)
                     self.raised[group] = f"model raised {type(exc).__name__}: {exc}"
+                except Exception as exc:  # the model's own bug: an error, never a divergence
+                    raise ModelRaised(f"{group} ({axis})", exc) from exc
                 forces[row, cols] = f
                 forces[row + 2, cols] = x[cols]
                 held = f - (p.k_in[axis] * x[cols] + p.c_in[axis] * v[cols])

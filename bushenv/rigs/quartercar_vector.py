@@ -32,7 +32,7 @@ from bushenv.rigs.quartercar import ENV_ID, OBS_SIZE, QuarterCarEnv, observation
 from bushenv.rigs.quartercar_batch import TH, X_U, Y_C, Y_U, QuarterCarBatch
 from bushenv.rigs.vector_base import ArrayVectorEnv
 
-TEXT_KEYS = ("model_out_of_bounds", "reference_out_of_bounds", "divergence_reason")
+TEXT_KEYS = ("model_out_of_bounds", "reference_out_of_bounds", "divergence_reason", "model_error")
 FLAG_KEYS = ("monitor_verdict", "diverged", "physical_limit")
 # the batch's outputs that are the env's info under the same key
 BATCH_KEYS = (

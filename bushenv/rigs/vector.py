@@ -28,6 +28,7 @@ from bushenv.rigs.common import (
     call_reset,
     check_hook,
     force_observations,
+    model_error_text,
     reset_columns,
     shared_state_rows,
 )
@@ -50,6 +51,7 @@ REST_INFO = {
     "diverged": False,
     "machine_limit": False,
     "divergence_reason": "",
+    "model_error": "",
 }
 
 
@@ -131,18 +133,21 @@ class BushRigVectorEnv(ArrayVectorEnv):
         info = self._info(zeros, zeros, zeros, zeros, ~no, no, no, no.copy(), reasons)
         return self._obs.reshape(n, -1).copy(), info
 
-    def _model_forces(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, str]:
-        """The model's (N,) forces and, if its batched step raised, the reason. A raise refuses
-        the whole batch; the histories that caused it show non-finite forces in what the kernel
-        wrote (``last_force_n``); all columns are judged if none do."""
+    def _model_forces(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, str, str]:
+        """The model's (N,) forces, the reason if its batched step refused (a divergence), and
+        the model's own error if it raised otherwise (``common.MODEL_ERRORS``). A refusal
+        refuses the whole batch; the histories that caused it show non-finite forces in what
+        the kernel wrote (``last_force_n``); all columns are judged if none do."""
         n = self.num_envs
         try:
-            return np.array(self.model.step(x, v), dtype=np.float64), ""
+            return np.array(self.model.step(x, v), dtype=np.float64), "", ""
         except MODEL_ERRORS as exc:
             f_m = np.array(self.model.last_force_n, np.float64)
             if f_m.shape != (n,) or np.isfinite(f_m).all():
                 f_m = np.full(n, np.nan)
-            return f_m, f"model raised {type(exc).__name__}: {exc}"
+            return f_m, f"model raised {type(exc).__name__}: {exc}", ""
+        except Exception as exc:  # the model's own bug: ends every episode, not a divergence
+            return np.full(n, np.nan), "", model_error_text(exc)
 
     def step(self, actions):
         p, n = self.params, self.num_envs
@@ -155,7 +160,7 @@ class BushRigVectorEnv(ArrayVectorEnv):
         v = (x - x0) / p.dt
         self._x = x
         self._t += 1
-        f_m, raised = self._model_forces(x, v)
+        f_m, raised, model_error = self._model_forces(x, v)
         f_r = np.array(self.reference.step(x, v), dtype=np.float64)
 
         obs = self._obs
@@ -180,6 +185,11 @@ class BushRigVectorEnv(ArrayVectorEnv):
             reasons[verdict] = "divergence monitor"
             terminated = terminated | verdict
         info["diverged"] = terminated.copy()
+        if model_error:
+            info["diverged"][:] = False
+            reasons[:] = ""
+            info["model_error"] = np.full(n, model_error, dtype=object)
+            terminated = np.ones(n, dtype=bool)
         reward = np.asarray(self.reward_fn(info), dtype=np.float64).copy()
         return self._end_step(obs.reshape(n, -1).copy(), reward, terminated, truncated, info)
 
@@ -208,6 +218,7 @@ class BushRigVectorEnv(ArrayVectorEnv):
             "diverged": np.zeros(self.num_envs, dtype=bool),
             "machine_limit": ref_over.copy(),
             "divergence_reason": reasons,
+            "model_error": np.full(self.num_envs, "", dtype=object),
         }
         return self._masks(info)
 

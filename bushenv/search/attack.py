@@ -27,7 +27,12 @@ EXAMPLE = "bushenv attack --model nn --budget 256 --searchers random,cma,ppo,sac
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     d = CampaignConfig()
-    p.add_argument("--model", default=d.model, help="model under attack: name or .npz file")
+    p.add_argument(
+        "--model",
+        default=d.model,
+        help="model under attack: name or .npz file (default: nn-paper, the papers' NARX "
+        "network as seed 000 trained it; nn is the certified one)",
+    )
     p.add_argument("--budget", type=int, default=d.budget, help="model evaluations per search")
     p.add_argument("--rl-budget", type=int, default=d.rl_budget, help="cap on RL episodes")
     p.add_argument("--axis", default=d.axis, choices=AXES)
@@ -43,9 +48,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--reference",
         default=None,
-        help="the bushing the verdicts compare with: a registered name or a model file "
-        "(default: rubber for a registered --model; none for a model file: then only the "
-        "criteria that need no reference run)",
+        help="the bushing the verdicts compare with: a registered name, a model file or "
+        "'none' (default: rubber for a registered --model; none for a model file: then only "
+        "the criteria that need no reference run). It is vetted before it judges",
+    )
+    p.add_argument(
+        "--trust-reference",
+        action="store_true",
+        help="judge with a reference that failed its vetting; every verdict is then marked "
+        "as judged by an unvetted reference",
     )
     p.add_argument(
         "--hybrid",
@@ -118,6 +129,7 @@ def config_from(args: argparse.Namespace) -> CampaignConfig:
         force=args.force,
         plots=not args.no_plots,
         paper_step=args.paper_step,
+        trust_reference=args.trust_reference,
     )
 
 

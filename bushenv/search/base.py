@@ -15,10 +15,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from bushenv.errors import BadInput
+
 MAX_KEPT_FAILURES = 512
 
 
-class SearchError(ValueError):
+class SearchError(BadInput):
     """Bad searcher name, budget or family."""
 
 
@@ -62,6 +64,20 @@ class SearchResult:
     n_failures: int = 0
     n_reference_unusable: int = 0  # profiles the reference itself could not run
     history: list[tuple[int, float]] = field(default_factory=list)  # (evals, best robustness)
+    # per family: [profiles, smallest peak |x|, largest peak |x|, largest |dx/dt|] (m, m/s)
+    coverage: dict[str, list[float]] = field(default_factory=dict)
+
+    def coverage_json(self) -> dict[str, dict[str, float]]:
+        """What the search tried, per family: profiles, peak deflection range, fastest rate."""
+        return {
+            fam: {
+                "profiles": int(c[0]),
+                "peak_mm_min": round(c[1] * 1e3, 4),
+                "peak_mm_max": round(c[2] * 1e3, 4),
+                "max_rate_m_per_s": round(c[3], 4),
+            }
+            for fam, c in sorted(self.coverage.items())
+        }
 
     @property
     def diverged(self) -> bool:
@@ -87,6 +103,7 @@ class SearchResult:
             "worst_criterion": w.verdict["first_criterion"] if w else None,
             "failing_families": sorted({c.family for c in self.failures}),
             "reference_unusable": self.n_reference_unusable,
+            "coverage": self.coverage_json(),
         }
 
 
@@ -112,6 +129,7 @@ class Recorder:
         now = time.perf_counter() - self.t0
         n = len(families) if limit is None else min(len(families), int(limit))
         unusable = v.reference_unusable
+        self._cover(batch, families, n)
         for b in range(n):
             res.evaluations += 1
             if unusable is not None and unusable[b]:
@@ -142,6 +160,20 @@ class Recorder:
         self.best = min(self.best, float(np.min(v.robustness[:n])))
         res.history.append((res.evaluations, self.best))
         res.seconds = now
+
+    def _cover(self, batch, families: list[str], n: int) -> None:
+        """Add the first ``n`` profiles' peak deflection and rate to the coverage."""
+        x = batch.x[:, :n]
+        peak = np.max(np.abs(x), axis=0)
+        dt = float(getattr(self.evaluator, "dt", 1.0))
+        rate = np.max(np.abs(np.diff(x, axis=0)), axis=0) / dt if x.shape[0] > 1 else peak * 0
+        cov = self.result.coverage
+        for b in range(n):
+            c = cov.setdefault(families[b], [0, np.inf, 0.0, 0.0])
+            c[0] += 1
+            c[1] = min(c[1], float(peak[b]))
+            c[2] = max(c[2], float(peak[b]))
+            c[3] = max(c[3], float(rate[b]))
 
 
 ProgressFn = Callable[[str], None]

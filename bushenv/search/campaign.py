@@ -25,21 +25,20 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.divergence import CRITERIA, NEEDS_REFERENCE
+from bushenv.errors import BadInput
 from bushenv.execution import local_cores
-from bushenv.models import get_model, get_reference
+from bushenv.judge import ScaleFlags, build_judge
+from bushenv.models import get_model
 from bushenv.persist import load_profiles, save_profiles, write_json, write_text
 from bushenv.progress import Progress
 from bushenv.scales import stiffness_mismatch
+from bushenv.search.campaign_holds import NAME as HOLD_STAGE
+from bushenv.search.campaign_holds import CertificateHolds, listed_holds
 from bushenv.search.campaign_models import (
     FITTED_CONTROL,
-    builtin_reference,
-    campaign_scales,
     card_displacements,
     fitted_linear,
-    reference_spec,
     roles,
-    static_trusted,
 )
 from bushenv.search.campaign_report import fresh_report, report_markdown, resumed_report
 from bushenv.search.corpus import DEFAULT_CORPUS
@@ -50,7 +49,7 @@ from bushenv.search.targets import TARGETS, Target
 MAX_SAVED_FAILURES = 256  # profiles per search written to failures/*.npz for the recheck
 
 
-class CampaignError(ValueError):
+class CampaignError(BadInput):
     """Bad campaign settings or an existing report without resume/force."""
 
 
@@ -58,7 +57,7 @@ class CampaignError(ValueError):
 class CampaignConfig:
     """Everything a campaign is told; ``bushenv attack`` translates its arguments into this."""
 
-    model: str = "nn"  # name or model file under attack
+    model: str = "nn-paper"  # name or model file under attack (default: the papers' NN)
     budget: int = 256  # model evaluations per search
     rl_budget: int = 256  # cap on episodes for RL searchers
     axis: str = "axial"
@@ -66,7 +65,7 @@ class CampaignConfig:
     searchers: tuple[str, ...] | None = None  # default: the target's
     seed: int = 0
     out: Path = Path("runs/attack")
-    reference: str | None = None  # name or file; None: "rubber" for a registered model, else none
+    reference: str | None = None  # name, file or "none"; None: rubber for a registered model
     hybrid: str | None = None  # rechecked and attacked; None: the shipped one for the rubber
     control: str | None = None  # must stay clean; None: see ``Campaign.controls``
     stroke_mm: float | None = None  # the bushing's limits, beyond what the reference gives
@@ -82,6 +81,7 @@ class CampaignConfig:
     force: bool = False
     plots: bool = True
     paper_step: bool = False  # also the papers' 4 mm step held 10 s
+    trust_reference: bool = False  # judge with a reference that failed its vetting
 
     def checked(self) -> CampaignConfig:
         """The config with its searchers resolved; raises ``CampaignError`` on bad values."""
@@ -113,6 +113,7 @@ class CampaignConfig:
             "control": self.control,
             "max_shrink": self.max_shrink,
             "shrink_budget": self.shrink_budget,
+            "trust_reference": self.trust_reference,
         }
 
 
@@ -139,21 +140,37 @@ class Campaign:
             raise CampaignError(
                 f"{self.report_path} exists; pass --resume to continue it or --force to start again"
             )
-        self.reference_spec = reference_spec(c)
         self.dt = get_model(c.model, axis=c.axis).dt
-        self.reference = (
-            None
-            if self.reference_spec is None
-            else get_reference(self.reference_spec, axis=c.axis, dt=self.dt)
+        self.judge = build_judge(
+            c.model,
+            c.reference,
+            axis=c.axis,
+            dt=self.dt,
+            target=self.target,
+            flags=ScaleFlags(c.stroke_mm, c.max_velocity_m_per_s, c.force_floor_n, c.force_scale_n),
+            trust_reference=c.trust_reference,
+            model_object=get_model(c.model, axis=c.axis),
         )
-        self.scales = campaign_scales(c, self.reference, builtin_reference(c))
-        self.static = self.reference is not None and static_trusted(c)
+        self.reference_spec = self.judge.reference_spec
+        self.reference = self.judge.reference
+        self.scales = self.judge.scales
+        self.static = self.judge.static
         self.notes: list[str] = []
-        if self.reference is not None and not self.static:
+        if self.judge.vetting is not None:
+            self.progress.say(f"reference {self.reference_spec}: vetted")
+            for line in self.judge.vetting.lines():
+                self.progress.say(f"  {line}")
+        if self.reference is not None and not self.static and self.target.judges_static:
             self.notes.append(
                 "static not judged: the reference's model card shows no quasi-static content "
                 "in its training records (no hold of 1 s, under 1 % of the displacement power "
                 "at or below 1 Hz), so its held force is an extrapolation"
+            )
+        if self.judge.trusted_by_flag:
+            self.notes.append(
+                f"UNVETTED REFERENCE: {self.reference_spec} failed its vetting "
+                f"({self.judge.vetting.summary()}); --trust-reference judged with it anyway, "
+                "so every verdict below may be the reference's fault"
             )
         self._models()
         fresh = fresh_report(self)
@@ -174,7 +191,7 @@ class Campaign:
         self.roles: dict[str, str] = {}
         self.specs: dict[str, str] = {}
         keys = {}
-        for role, spec in roles(c, self.notes):
+        for role, spec in roles(c, self.judge, self.notes):
             key = label(spec)
             keys[role] = key
             if key in self.models:  # e.g. --model hybrid: the hybrid step is the target step
@@ -222,7 +239,8 @@ class Campaign:
         """Work ahead in evaluation-equivalents (an RL episode costs ``cost`` evaluations)."""
         per_model = sum(self.budget_of(s) * SEARCHERS[s].cost for s in self.config.searchers)
         shrinks = (self.config.max_shrink + 2) * self.config.shrink_budget
-        return len(self.models) * per_model + shrinks
+        searched = [k for k in self.models if self.roles[k] != "also"]
+        return len(searched) * per_model + shrinks
 
     # ----- searching ---------------------------------------------------------------------------
     def search(self, key: str) -> None:
@@ -235,8 +253,37 @@ class Campaign:
             done[name] = self._search_one(key, name)
             self.save()
 
-    def _search_one(self, key: str, name: str) -> dict[str, Any]:
-        budget, cost = self.budget_of(name), SEARCHERS[name].cost
+    def hold_stage(self) -> None:
+        """Simulate every hold the target's certificate lists as failing (``campaign_holds``)."""
+        done = self.report["models"][self.target_key]["searchers"]
+        if HOLD_STAGE in done:
+            self.progress.say(f"[{self.target_key}] {HOLD_STAGE}: done earlier (resumed)")
+            return
+        model = self.models[self.target_key]
+        holds = listed_holds(model, self.reference, self.scales.stroke_m)
+        if holds is None:
+            self.report["hold_stage"] = {"run": False, "why": "not a NARX network (no certificate)"}
+            return
+        stage = CertificateHolds(holds)
+        if not holds:
+            self.report["hold_stage"] = {"run": True, "listed": 0, "confirmed": 0, "holds": []}
+            self.progress.say(f"[{self.target_key}] {HOLD_STAGE}: the certificate lists none")
+            return
+        done[HOLD_STAGE] = self._search_one(self.target_key, HOLD_STAGE, stage, len(holds))
+        self.report["hold_stage"] = {
+            "run": True,
+            "listed": len(holds),
+            "confirmed": sum(v["confirmed"] for v in stage.verdicts),
+            "holds": stage.verdicts,
+        }
+        self.save()
+
+    def _search_one(
+        self, key: str, name: str, searcher: Any = None, budget: int | None = None
+    ) -> dict[str, Any]:
+        budget = self.budget_of(name) if budget is None else budget
+        cost = SEARCHERS[name].cost if searcher is None else 1.0
+        searcher = searcher or get_searcher(name)
         self.progress.say(f"[{key}] {name}: budget {budget} evaluations ...")
         start = self.progress.done
         with self.evaluator(key) as ev:
@@ -244,11 +291,16 @@ class Campaign:
             def report(msg: str) -> None:
                 self.progress.update(start + cost * ev.n_evaluations, f"[{key}]   {msg}")
 
-            res = get_searcher(name).run(ev, budget, seed=self.config.seed, progress=report)
+            res = searcher.run(ev, max(1, budget), seed=self.config.seed, progress=report)
         self.progress.done = start + cost * budget
         summary = res.summary()
         if res.first_failure is not None:
             summary["first_failure"] = res.first_failure.to_json()
+            summary["first_failure"]["reference_in_envelope"] = self.judge.in_envelope(
+                res.first_failure.profile, self.dt
+            )
+        outside = [self.judge.in_envelope(c.profile, self.dt) is False for c in res.failures]
+        summary["failures_reference_outside_envelope"] = int(sum(outside))
         if res.worst is not None:
             summary["worst"] = res.worst.to_json()
         kept = res.failures[:MAX_SAVED_FAILURES]
@@ -338,9 +390,10 @@ class Campaign:
             f"-> {self.out}"
         )
         self.search(self.target_key)
+        self.hold_stage()
         self.recheck()
         for key in self.models:
-            if key != self.target_key:
+            if self.roles[key] in ("hybrid", "control"):  # "also": rechecked only
                 self.search(key)
         shrink_and_save(self)
         plots = plot_campaign(self) if c.plots else []
@@ -350,23 +403,11 @@ class Campaign:
         return self.report
 
     def criteria(self) -> dict[str, Any]:
-        """Which criteria the verdicts used, and why some did not run."""
-        if self.reference is None:
-            why = (
-                f"no reference: {self.config.model} is a model file and no --reference was "
-                f"given, so only the criteria that need none ran ({', '.join(NEEDS_REFERENCE)} "
-                "compare with a reference's force); pass --reference NAME|FILE for all"
-            )
-            run = [c for c in CRITERIA if c not in NEEDS_REFERENCE]
-        else:
-            run, why = list(CRITERIA), f"all, against the reference {self.reference_spec!r}"
-        if not self.target.judges_static and "static" in run:
-            run.remove("static")
-            why += f"; static is judged on the rig only (the {self.target.name} has no hold)"
-        elif "static" in run and not self.static:
-            run.remove("static")
-            why += "; static not judged: the reference's records show no static behaviour"
-        return {"run": run, "why": why}
+        """Which criteria the verdicts used, and why some did not run (the judge's)."""
+        why = self.judge.why
+        if self.reference is not None:
+            why = f"{why} {self.reference_spec!r}"
+        return {"run": list(self.judge.criteria), "why": why}
 
     def control_flagged(self) -> bool:
         control = self.report["models"].get(self.control_key, {}).get("searchers", {})

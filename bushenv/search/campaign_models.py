@@ -10,35 +10,32 @@ given). Rows of another bushing's models would say nothing about this one.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.identify.linear import least_squares_kc
+from bushenv.judge import card_of
 from bushenv.models import MODELS
 from bushenv.models.base import velocity_of
 from bushenv.models.linear import LinearBushing
-from bushenv.scales import (
-    BushingScales,
-    scales_of_card,
-    scales_of_reference,
-    static_identified,
-)
+from bushenv.scales import BushingScales
 
 FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
 CONTROL_RECORD_S = 40.0  # the papers' identification record length (seed 000 §4.1)
 
 
-def roles(config, notes: list[str]) -> list[tuple[str, str]]:
-    """(role, spec) for the target, the hybrid (when there is one) and the control."""
-    builtin = builtin_reference(config)
+def roles(config, judge, notes: list[str]) -> list[tuple[str, str]]:
+    """(role, spec) for the target, the hybrid (when there is one), the control and, for a
+    target whose registry entry names them, the models rechecked beside it (``also``)."""
+    builtin = judge.builtin
+    entry = MODELS.get(config.model) if config.model in MODELS else None
     out = [("target", config.model)]
     if config.hybrid is not None:
         out.append(("hybrid", config.hybrid))
     elif builtin:
-        out.append(("hybrid", "hybrid"))
+        out.append(("hybrid", (entry and entry.hybrid) or "hybrid"))
     else:
         notes.append(
             "no hybrid row: the shipped hybrid is a model of the built-in rubber, not of this "
@@ -48,7 +45,7 @@ def roles(config, notes: list[str]) -> list[tuple[str, str]]:
         out.append(("control", config.control))
     elif builtin:
         out.append(("control", "linear"))
-    elif config.reference is not None:
+    elif judge.reference is not None:
         notes.append(
             "control: a linear model fitted by least squares to the reference's response to "
             "the records of its model card (without a card: a "
@@ -60,67 +57,15 @@ def roles(config, notes: list[str]) -> list[tuple[str, str]]:
             "no control row: without a reference there is no bushing to fit a linear control "
             "to (give --reference, or --control FILE)"
         )
+    if builtin and entry is not None:
+        out += [("also", name) for name in entry.also]
     return out
-
-
-def builtin_reference(config) -> bool:
-    """The campaign judges against the built-in rubber: asked for, or by default for a
-    registered model (the shipped models are models of it)."""
-    if config.reference is None:
-        return config.model in MODELS
-    return config.reference == "rubber"
-
-
-def reference_spec(config) -> str | None:
-    """The reference the campaign is judged against: as given; by default the rubber for a
-    registered model; None (judged without one) for a model file."""
-    if config.reference is None:
-        return "rubber" if config.model in MODELS else None
-    return config.reference
-
-
-def static_trusted(config) -> bool:
-    """Whether the reference's static force may judge (``scales.static_identified``)."""
-    card = _card_of(reference_spec(config))
-    return card is None or static_identified(card)
-
-
-def campaign_scales(config, reference, builtin: bool) -> BushingScales:
-    """The reference's scales (``bushenv.scales``), its model card's records' range when it
-    is a file with a card beside it, and the flags' values on top of both."""
-    scales = scales_of_reference(reference, builtin)
-    # the reference's card; with no reference, the card of the model under attack: its records
-    # are the only word on the bushing's range
-    card = _card_of(reference_spec(config) if reference is not None else config.model)
-    if card is not None:
-        scales = scales_of_card(scales, card)
-    flags = {
-        "stroke_m": None if config.stroke_mm is None else config.stroke_mm * 1e-3,
-        "velocity_m_per_s": config.max_velocity_m_per_s,
-        "force_floor_n": config.force_floor_n,
-        "force_scale_n": config.force_scale_n,
-    }
-    given = {k: v for k, v in flags.items() if v is not None}
-    if not given:
-        return scales
-    return replace(scales, **given, source=scales.source + f"; flags: {sorted(given)}")
-
-
-def _card_of(spec: str | None) -> dict | None:
-    """The model card beside a reference file (checked against the file), or None."""
-    if spec is None or spec in MODELS or not Path(spec).is_file():
-        return None
-    from bushenv.identify.card import card_paths, load_card
-
-    if not card_paths(spec)[0].is_file():
-        return None
-    return load_card(spec).data
 
 
 def card_displacements(spec: str | None) -> list[np.ndarray] | None:
     """The displacement of the training records a reference file's card names, when they are
     all still there (checked against the card's hashes), else None."""
-    card = _card_of(spec)
+    card = card_of(spec)
     if card is None:
         return None
     paths = [r.get("file") for r in card["records"] if r.get("role") == "train"]

@@ -19,6 +19,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from bushenv.errors import BadInput
 from bushenv.models import file_hash, model_file, params_sha
 from bushenv.search.corpus import reference_identity
 
@@ -26,7 +27,7 @@ REPORT_FORMAT = "bushenv-attack-report"
 REPORT_VERSION = 1
 
 
-class ReportError(ValueError):
+class ReportError(BadInput):
     """A report that cannot be resumed; the message says why and what to do."""
 
 
@@ -54,6 +55,7 @@ def fresh_report(campaign) -> dict[str, Any]:
         "searchers": list(c.searchers),
         "reference": reference_identity(campaign.reference_spec, campaign.reference, c.axis),
         "scales": campaign.scales.to_json(),
+        "judge": campaign.judge.describe(),
         "criteria": campaign.criteria(),
         "notes": list(campaign.notes),
         "models": {
@@ -119,7 +121,7 @@ def _search_row(key: str, role: str, name: str, s: dict[str, Any]) -> str:
     stf = f"{s['seconds_to_failure']:.2f}" if s["diverged"] else "-"
     wds = f"{wd:.3g}" if wd is not None else "-"
     return (
-        f"{key:<10} {role:<8} {name:<11} {s['evaluations']:>6} "
+        f"{key:<12} {role:<8} {name:<11} {s['evaluations']:>6} "
         f"{'YES' if s['diverged'] else 'no':>8} "
         f"{s['evaluations_to_failure'] or '-':>11} "
         f"{stf:>8} {wds:>9} {s['worst_robustness']:>10.3g} {fam}"
@@ -159,7 +161,7 @@ COLUMNS = (
 def format_table(report: dict[str, Any], target_key: str) -> str:
     """The campaign as a plain-text table, the recheck and the shrunk failures."""
     head = (
-        f"{'model':<10} {'role':<8} {'searcher':<11} {'evals':>6} {'diverged':>8} "
+        f"{'model':<12} {'role':<8} {'searcher':<11} {'evals':>6} {'diverged':>8} "
         f"{'evals->fail':>11} {'s->fail':>8} {'worst dev':>9} {'robustness':>10} "
         f"{'failing family (criterion)'}"
     )
@@ -167,6 +169,7 @@ def format_table(report: dict[str, Any], target_key: str) -> str:
     lines = [
         f"reference: {ref if ref is not None else 'none'}; criteria run: "
         f"{', '.join(report['criteria']['run'])}",
+        *_judge_lines(report.get("judge")),
         *(f"note: {n}" for n in report.get("notes", [])),
         "",
         head,
@@ -175,11 +178,16 @@ def format_table(report: dict[str, Any], target_key: str) -> str:
     for key, entry in report["models"].items():
         for name, s in entry["searchers"].items():
             lines.append(_search_row(key, entry["role"], name, s))
+    lines += _hold_stage_lines(report.get("hold_stage"))
+    lines += _coverage_lines(report, target_key)
     rc = report.get("recheck", {})
     if rc:
         lines += ["", f"recheck on the {rc.get('profiles', 0)} profiles that broke {target_key}:"]
+        roles = {k: e.get("role", "") for k, e in report["models"].items()}
         lines += [
-            f"  {k:<10} diverged on {e['diverged']}" for k, e in rc.items() if k != "profiles"
+            f"  {k:<12} {roles.get(k, ''):<8} diverged on {e['diverged']}"
+            for k, e in rc.items()
+            if k != "profiles"
         ]
     if report.get("shrunk"):
         lines += ["", "shrunk failures (segments, samples, peak um) and verdicts:"]
@@ -194,6 +202,67 @@ def format_table(report: dict[str, Any], target_key: str) -> str:
                 f"{_verdicts(e['verdicts'])}"
             )
     return "\n".join(lines)
+
+
+def _judge_lines(judge: dict | None) -> list[str]:
+    """Who judged: the reference's vetting (or why there is none) and its envelope."""
+    if not judge:
+        return []
+    if judge["reference"] is None:
+        return ["judge: no reference (only the criteria that need none)"]
+    vet = judge.get("vetting")
+    if vet is None:
+        return [f"judge: reference {judge['reference']} NOT VETTED"]
+    state = "passed" if vet["passed"] else "FAILED (--trust-reference: verdicts UNVETTED)"
+    env = judge.get("envelope") or {}
+    lines = [f"judge: reference {judge['reference']} vetted, {state}"]
+    mark = {True: "ok", False: "FAILED", None: "undecided"}
+    lines += [f"  {c['check']}: {mark[c['passed']]} ({c['detail']})" for c in vet["checks"]]
+    if env:
+        lines.append(
+            f"  envelope: |x| <= {env['max_abs_displacement_m'] * 1e3:.4g} mm, |dx/dt| <= "
+            f"{env['max_abs_velocity_m_per_s']:.4g} m/s ({env['source']})"
+        )
+    return lines
+
+
+def _hold_stage_lines(stage: dict | None) -> list[str]:
+    if not stage:
+        return []
+    if not stage.get("run"):
+        return ["", f"certificate holds: not run ({stage.get('why')})"]
+    head = (
+        f"certificate holds: {stage['listed']} listed as oscillating, departing or wrong-sign, "
+        f"{stage['confirmed']} confirmed by the judge, {stage['listed'] - stage['confirmed']} "
+        "refuted"
+    )
+    shown = [h for h in stage["holds"] if h["confirmed"]][:6]
+    return ["", head] + [
+        f"  {h['x_mm']:+.3g} mm ({', '.join(h['listed_as'])}): confirmed ({h['criterion']})"
+        for h in shown
+    ]
+
+
+def _coverage_lines(report: dict[str, Any], target_key: str) -> list[str]:
+    """What the searches against the target tried: the scope of a "no divergence"."""
+    entry = report["models"].get(target_key, {})
+    fams: dict[str, list[float]] = {}
+    for s in entry.get("searchers", {}).values():
+        for fam, c in (s.get("coverage") or {}).items():
+            f = fams.setdefault(fam, [0, float("inf"), 0.0, 0.0])
+            f[0] += c["profiles"]
+            f[1] = min(f[1], c["peak_mm_min"])
+            f[2] = max(f[2], c["peak_mm_max"])
+            f[3] = max(f[3], c["max_rate_m_per_s"])
+    if not fams:
+        return []
+    seed = report.get("arguments", {}).get("seed")
+    lines = ["", f"covered on {target_key} (seed {seed}): family, profiles, peak mm, max m/s"]
+    lines += [
+        f"  {fam:<12} {int(c[0]):>5}  {c[1]:.3g}-{c[2]:.3g} mm  {c[3]:.3g} m/s"
+        for fam, c in sorted(fams.items())
+    ]
+    return lines
 
 
 def report_markdown(report: dict[str, Any], target_key: str, plots: list[str]) -> str:

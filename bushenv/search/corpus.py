@@ -47,6 +47,7 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.errors import BadInput
 from bushenv.models import (
     MODELS,
     BushingModel,
@@ -68,7 +69,7 @@ ENCODING = "f32-diff-zlib-b64"
 DEFAULT_CORPUS = Path("tests") / "regressions" / "corpus"
 
 
-class CorpusError(ValueError):
+class CorpusError(BadInput):
     """A corrupt or mismatching case file; the message names the file."""
 
 

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bushenv import excitation as ex
+from bushenv.errors import BadInput
 from bushenv.models.base import PAPER_DT
 from bushenv.registry import Registry
 from bushenv.scales import MACHINE, BushingScales
@@ -56,7 +57,7 @@ ROAD_MAX_HEIGHT_M = 0.15  # QuarterCar-v0's max_road_height_m: kerbs, potholes, 
 ROAD_MAX_RATE_M_PER_S = 0.95 * 0.05 * 204.8
 
 
-class FamilyError(ValueError):
+class FamilyError(BadInput):
     """Bad family name or parameter vector."""
 
 

@@ -28,12 +28,13 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.errors import BadInput
 from bushenv.execution import get_backend
-from bushenv.models import AXES, MODELS, ModelError, check_axis, get_model, get_reference
+from bushenv.judge import build_judge
+from bushenv.models import AXES, MODELS, ModelError, check_axis, get_model
 from bushenv.persist import write_json, write_text
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
-from bushenv.scales import scales_of_reference
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import SEARCHERS, get_searcher
 from bushenv.search.targets import TARGETS
@@ -47,7 +48,7 @@ CELL_KEYS = ("model", "axis", "searcher", "seed", "budget", "env", "reference")
 MAX_SEEDS = 100_000  # a typo like 0-1000000000 must not build a billion cells
 
 
-class MatrixError(ValueError):
+class MatrixError(BadInput):
     """Bad matrix arguments or a corrupt results file."""
 
 
@@ -93,9 +94,9 @@ def make_cells(
     seeds: list[int],
     budget: int,
     env: str = "rig",
-    reference: str | None = "rubber",
+    reference: str = "rubber",
 ) -> list[dict[str, Any]]:
-    """One cell per model x axis x searcher x seed; ``reference`` None: judged without one."""
+    """One cell per model x axis x searcher x seed; ``reference`` "none": judged without one."""
     return [
         {
             "model": m,
@@ -115,15 +116,24 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     import torch
 
     torch.set_num_threads(1)
-    spec, axis = cell.get("reference", "rubber"), cell["axis"]
+    axis = cell["axis"]
     model = get_model(cell["model"], axis=axis)
-    reference = None if spec is None else get_reference(spec, axis=axis, dt=model.dt)
-    scales = scales_of_reference(reference, builtin=spec == "rubber")
+    judge = build_judge(
+        cell["model"],
+        cell.get("reference", "rubber"),
+        axis=axis,
+        dt=model.dt,
+        target=cell["env"],
+        trust_reference=bool(cell.get("trust_reference", False)),
+        model_object=model,
+    )
     t0 = time.perf_counter()
-    evaluator = BatchEvaluator(model, reference, cell["env"], 1, axis, scales=scales)
+    evaluator = BatchEvaluator(
+        model, judge.reference, cell["env"], 1, axis, scales=judge.scales, static=judge.static
+    )
     with evaluator as ev:
         result = get_searcher(cell["searcher"]).run(ev, cell["budget"], seed=cell["seed"])
-    out = {**cell, **result.summary()}
+    out = {**cell, **result.summary(), "judge": judge.describe()}
     out["wall_s"] = time.perf_counter() - t0
     return out
 
@@ -260,7 +270,7 @@ class MatrixConfig:
     seeds: tuple[int, ...] = (0, 1, 2, 3)
     budget: int = 128
     target: str = "rig"
-    reference: str | None = "rubber"  # a name or model file; None: judged without one
+    reference: str = "rubber"  # a name, a model file, or "none": judged without one
     out: Path = Path("runs/matrix")
     resume: bool = False
 
@@ -283,18 +293,17 @@ class MatrixConfig:
                     raise MatrixError(registry.unknown_message(n))
         if not self.axes:
             raise MatrixError("--axes names nothing")
-        for a in self.axes:
-            if self.reference is not None:
-                try:
-                    get_reference(self.reference, axis=check_axis(a))
-                except ModelError as exc:
-                    raise MatrixError(f"--reference {self.reference!r} ({a}): {exc}") from None
         for m, a in product(self.models, self.axes):
             check_axis(a)
             try:
-                get_model(m, axis=a)
+                model = get_model(m, axis=a)
             except ModelError as exc:
                 raise MatrixError(f"model {m!r} ({a}): {exc}") from None
+            try:  # the judge every cell of this model and axis gets, vetted before any runs
+                build_judge(m, self.reference, axis=a, dt=model.dt, target=self.target,
+                            model_object=model)  # fmt: skip
+            except ModelError as exc:
+                raise MatrixError(f"--reference {self.reference!r} ({a}): {exc}") from None
         self.out = Path(self.out)
         if self.out.exists() and not self.out.is_dir():
             raise MatrixError(f"--out {self.out}: exists and is not a folder")
@@ -308,6 +317,7 @@ class MatrixConfig:
             list(self.seeds),
             self.budget,
             self.target,
+            self.reference,
         )
 
 
@@ -352,7 +362,7 @@ def run(args: argparse.Namespace) -> int:
         seeds=tuple(parse_seeds(args.seeds)),
         budget=args.budget,
         target=args.env,
-        reference=None if args.reference == "none" else args.reference,
+        reference=args.reference,
         out=Path(args.out),
         resume=args.resume,
     ).checked()

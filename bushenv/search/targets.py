@@ -20,6 +20,7 @@ import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.divergence import Verdict, judge
+from bushenv.errors import DIVERGENCE_RAISES, ModelRaised
 from bushenv.models.base import BushingModel, velocity_of
 from bushenv.registry import Registry
 from bushenv.scales import MACHINE
@@ -151,27 +152,35 @@ def get_target(target: str | Target) -> Target:
 
 
 def simulate_or_nan(model: BushingModel, x: np.ndarray) -> np.ndarray:
-    """``model.simulate(x)`` for (T, B) ``x``; a model that refuses (raises ValueError, e.g.
-    Bouc-Wen's step-size control) gives NaN from the sample it refused on, in the histories that
-    made it refuse -- a non-finite output, which ``judge`` calls a divergence."""
+    """``model.simulate(x)`` for (T, B) ``x``; a model that refuses (``ModelRefused``, e.g.
+    Bouc-Wen's step-size control, or an ``ArithmeticError``) gives NaN from the sample it
+    refused on, in the histories that made it refuse -- a non-finite output, which ``judge``
+    calls a divergence. Anything else it raises is its own bug: ``ModelRaised``, never a
+    verdict."""
     try:
         return model.simulate(x)
-    except ValueError:
+    except DIVERGENCE_RAISES:
         pass
+    except Exception as exc:
+        raise ModelRaised(model.name, exc) from exc
     out = np.empty_like(x)
     for b in range(x.shape[1]):
         col = np.ascontiguousarray(x[:, b])
         try:
             out[:, b] = model.simulate(col)
             continue
-        except ValueError:
+        except DIVERGENCE_RAISES:
             pass
+        except Exception as exc:
+            raise ModelRaised(model.name, exc) from exc
         v = velocity_of(col, model.dt)  # the velocity simulate would have used
         model.reset(1)
         out[:, b] = np.nan
         for t in range(col.size):
             try:
                 out[t, b] = model.step(col[t], v[t])
-            except ValueError:
+            except DIVERGENCE_RAISES:
                 break
+            except Exception as exc:
+                raise ModelRaised(model.name, exc) from exc
     return out

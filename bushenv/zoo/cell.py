@@ -27,8 +27,8 @@ from bushenv import excitation as ex
 from bushenv import metrics
 from bushenv.certify import CertifyOptions, certify
 from bushenv.identify import fit_model
+from bushenv.judge import build_judge
 from bushenv.machine import random_test
-from bushenv.models import get_reference
 from bushenv.reference.rubber import RubberBushing
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import get_searcher
@@ -75,12 +75,14 @@ def _certificate(model, reference) -> dict[str, Any]:
     return {k: s[k] for k in keep}
 
 
-def _steps(model, reference) -> dict[str, Any]:
+def _steps(model, judge) -> dict[str, Any]:
     """The papers' step both ways: verdict, departure time, held force beside the reference's."""
     dt = model.dt
     out = {}
     profiles = [ex.step_hold(s * STEP_M, STEP_HOLD_S, dt, pre_s=1.0) for s in (1, -1)]
-    with BatchEvaluator(model, reference, "rig") as ev:
+    with BatchEvaluator(
+        model, judge.reference, "rig", scales=judge.scales, static=judge.static
+    ) as ev:
         batch = ev.evaluate(profiles)
     departure = batch.verdict.criterion_first_s["self_sustained"]
     for b, name in enumerate(("+4mm", "-4mm")):
@@ -98,8 +100,10 @@ def _steps(model, reference) -> dict[str, Any]:
     return out
 
 
-def _attack(model, reference, searcher: str, budget: int, seed: int) -> dict[str, Any]:
-    with BatchEvaluator(model, reference, "rig") as ev:
+def _attack(model, judge, searcher: str, budget: int, seed: int) -> dict[str, Any]:
+    with BatchEvaluator(
+        model, judge.reference, "rig", scales=judge.scales, static=judge.static
+    ) as ev:
         res = get_searcher(searcher).run(ev, budget, seed=seed)
     ff = res.first_failure
     return {
@@ -134,7 +138,8 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     )
     train_s = time.perf_counter() - t0
     path = model.save(Path(cell["out"]) / "models" / f"{cell_name(cell)}.npz")
-    reference = get_reference("rubber", axis=axis, dt=model.dt)
+    judge = build_judge(model, "rubber", axis=axis, dt=model.dt, model_object=model)
+    reference = judge.reference
     t1 = time.perf_counter()
     row = {
         **cell,
@@ -142,9 +147,9 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
         "train_s": train_s,
         "accuracy": _accuracy(model, seen, beyond),
         "certificate": _certificate(model, reference),
-        "step": _steps(model, reference),
+        "step": _steps(model, judge),
         "attacks": {
-            s: _attack(model, reference, s, int(cell["budget"]), seed)
+            s: _attack(model, judge, s, int(cell["budget"]), seed)
             for s in cell["searchers"].split(",")
         },
     }

@@ -16,6 +16,7 @@ from itertools import product
 from pathlib import Path
 from typing import Any
 
+from bushenv.errors import BadInput
 from bushenv.execution import get_backend
 from bushenv.identify.narx_options import RECIPES
 from bushenv.models import AXES, check_axis
@@ -38,7 +39,7 @@ RESULT_KEYS = ("accuracy", "attacks", "step", "certificate")
 RECIPE_EFFORT = {"teacher-forcing": 1.0, "free-run": 6.0}
 
 
-class ZooError(ValueError):
+class ZooError(BadInput):
     """Bad population-study settings or results file; the message says which."""
 
 

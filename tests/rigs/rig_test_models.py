@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bushenv.models import PAPER_DT, BushingModel, ModelError, default_model_path
+from bushenv.errors import ModelRefused
+from bushenv.models import PAPER_DT, BushingModel, default_model_path
 
 ALL_MODELS = ("linear", "nn", "hybrid", "boucwen", "rubber")
 TRAINED = ("nn", "hybrid", "boucwen")
@@ -53,10 +54,36 @@ class RaisesAfter(NanAfter):
     def _advance(self, x, v, out):
         super()._advance(x, v, out)
         if not np.isfinite(out).all():
-            raise ModelError("test double gave up")
+            raise ModelRefused("test double gave up")  # its own state ran away: a divergence
 
     def copy(self):
         return RaisesAfter(self.after, self.k, self.dt)
+
+
+class Buggy(BushingModel):
+    """A model whose force has a bug after ``after`` steps (a numpy shape error): an error of
+    the model's own, never a divergence."""
+
+    name = "buggy_test_double"
+    param_names = ()
+
+    def __init__(self, after: int = 3, dt: float = PAPER_DT) -> None:
+        self.after = int(after)
+        super().__init__(dt)
+
+    @property
+    def n_state(self) -> int:
+        return 1
+
+    def _advance(self, x, v, out):
+        for t in range(x.shape[0]):
+            self.state[0] += 1
+            if self.state[0, 0] > self.after:
+                np.ones(3) + np.ones(4)  # ValueError: operands could not be broadcast together
+            out[t] = 1e5 * x[t]
+
+    def copy(self):
+        return Buggy(self.after, self.dt)
 
 
 class DiffKV(BushingModel):

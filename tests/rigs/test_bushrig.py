@@ -11,7 +11,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from rig_test_models import ALL_MODELS, RaisesAfter, ValueAfter, model_or_skip
+from rig_test_models import ALL_MODELS, Buggy, RaisesAfter, ValueAfter, model_or_skip
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 from bushenv import excitation
@@ -231,6 +231,16 @@ def test_model_raising_an_error_terminates_instead_of_crashing():
     info = out[-1][4]
     assert out[-1][2] and info["diverged"]
     assert "test double gave up" in info["divergence_reason"]
+
+
+def test_a_model_bug_ends_the_episode_as_a_model_error_not_a_divergence():
+    env = make(model=Buggy(after=3))
+    out = run(env, np.full((20, 1), 0.1, np.float32))
+    terminated, info = out[-1][2], out[-1][4]
+    assert terminated and not info["diverged"]
+    assert "ValueError" in info["model_error"] and "broadcast" in info["model_error"]
+    assert info["divergence_reason"] == ""
+    assert all(step[4]["model_error"] == "" for step in out[:-1])
 
 
 def test_model_beyond_the_machine_force_terminates_as_divergence():

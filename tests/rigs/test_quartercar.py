@@ -11,7 +11,15 @@ import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from rig_test_models import ALL_MODELS, DiffKV, NanAfter, RaisesAfter, ValueAfter, model_or_skip
+from rig_test_models import (
+    ALL_MODELS,
+    Buggy,
+    DiffKV,
+    NanAfter,
+    RaisesAfter,
+    ValueAfter,
+    model_or_skip,
+)
 from scipy import signal
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
@@ -405,6 +413,15 @@ def test_model_raising_an_arithmetic_error_terminates_with_its_name(error):
     _, _, term, trunc, info = outs[3]
     assert term and not trunc and info["diverged"]
     assert info["divergence_reason"] == f"model raised {type(error).__name__}: {error}"
+
+
+def test_a_model_bug_ends_the_episode_as_a_model_error_not_a_divergence():
+    env = make(model={"radial": Buggy(after=3), "axial": "linear"})
+    env.reset(seed=0)
+    outs = [env.step(np.array([0.01], np.float32)) for _ in range(4)]
+    assert not any(o[2] for o in outs[:3]) and all(o[4]["model_error"] == "" for o in outs[:3])
+    _, _, term, _, info = outs[3]
+    assert term and not info["diverged"] and "broadcast" in info["model_error"]
 
 
 def test_bad_actions_options_and_roads_are_refused_naming_them():

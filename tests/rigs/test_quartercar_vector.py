@@ -163,7 +163,7 @@ def test_a_model_raising_ends_every_column_naming_the_error():
     venv.reset(seed=0)
     for _ in range(4):
         *_, term, _, info = venv.step(np.full((2, 1), 0.5, np.float32))
-    assert term.all() and list(info["divergence_reason"]) == ["model raised ModelError: test "
+    assert term.all() and list(info["divergence_reason"]) == ["model raised ModelRefused: test "
                                                                "double gave up"] * 2  # fmt: skip
 
 

@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from bushenv.errors import ModelRefused
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.families import get_family
 from bushenv.search.searchers import CMASearch, RandomSearch, SearchError, get_searcher
@@ -76,7 +77,7 @@ class _Refusing(UnstableHoldBushing):
     def _advance(self, x, v, out):
         for t in range(x.shape[0]):
             if np.any(np.abs(x[t]) > 10e-3):
-                raise ValueError("refused")
+                raise ModelRefused("refused")
             super()._advance(x[t : t + 1], v[t : t + 1], out[t : t + 1])
 
 

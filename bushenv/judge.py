@@ -1,0 +1,265 @@
+"""The one judging setup: which reference judges, at which scales, by which criteria.
+
+Every command and env that makes a verdict (``attack``, ``campaign``, ``replay``, ``certify``,
+``zoo``, ``measure``, ``BushRig-v0``, ``QuarterCar-v0``) builds its judge here, so the same
+inputs give the same judge everywhere:
+
+- **reference**: as given (a registered name, a model file or a model object); not given: the
+  built-in ``rubber`` when the model under test is a registered name (the shipped models are
+  models of it), none for a model file; ``"none"``: judged without one, by the criteria that
+  need no reference -- the same meaning in every command.
+- **scales** (``bushenv.scales``): the reference's static stiffness sets the force floor, its
+  model card's records the stroke and velocity (without a reference: the model's card), flags
+  on top.
+- **criteria**: all of ``divergence.CRITERIA`` against a reference; without one, those that
+  need none; ``static`` only where the target has holds and the reference's card shows static
+  behaviour (``scales.static_identified``).
+- **vetting** (``bushenv.vetting``): the reference is checked before it judges. A reference
+  that fails is refused (``JudgeError``, exit 2) unless ``trust_reference``; then every verdict
+  is marked as judged by an unvetted reference.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from bushenv.divergence import CRITERIA, NEEDS_REFERENCE
+from bushenv.errors import BadInput
+from bushenv.models import MODELS, BushingModel, get_reference
+from bushenv.scales import BushingScales, scales_of_card, scales_of_reference, static_identified
+
+NO_REFERENCE = "none"  # the spelling of "judged without a reference" in every command
+BUILTIN_REFERENCE = "rubber"
+
+
+class JudgeError(BadInput):
+    """A judge that cannot be built: the reference failed its vetting, or cannot be loaded."""
+
+
+@dataclass(frozen=True)
+class ScaleFlags:
+    """The bushing's limits given on the command line (None: from the reference or card)."""
+
+    stroke_mm: float | None = None
+    max_velocity_m_per_s: float | None = None
+    force_floor_n: float | None = None
+    force_scale_n: float | None = None
+
+    def given(self) -> dict[str, float]:
+        values = {
+            "stroke_m": None if self.stroke_mm is None else self.stroke_mm * 1e-3,
+            "velocity_m_per_s": self.max_velocity_m_per_s,
+            "force_floor_n": self.force_floor_n,
+            "force_scale_n": self.force_scale_n,
+        }
+        return {k: v for k, v in values.items() if v is not None}
+
+
+@dataclass(frozen=True)
+class Judge:
+    """What judges a verdict; ``describe()`` is what reports and corpus cases record."""
+
+    reference_spec: str | None
+    builtin: bool
+    scales: BushingScales
+    static: bool
+    criteria: tuple[str, ...]
+    why: str
+    vetting: Any = None  # bushenv.vetting.Vetting, or None (no reference, or not vetted)
+    trusted_by_flag: bool = False
+    # where the reference is known to hold: its card's training records' largest |x| and
+    # |dx/dt| (m, m/s), else the scales' stroke and velocity; and where that comes from
+    envelope: tuple[float, float, str] | None = None
+    reference: BushingModel | None = field(default=None, compare=False, repr=False)
+
+    def in_envelope(self, profile, dt: float) -> bool | None:
+        """Whether ``profile`` (deflection, m) stays where the reference is known to hold;
+        None without a reference."""
+        if self.reference is None or self.envelope is None:
+            return None
+        import numpy as np
+
+        x = np.asarray(profile, dtype=np.float64)
+        x_max, v_max, _ = self.envelope
+        rate = float(np.max(np.abs(np.diff(x)))) / dt if x.size > 1 else 0.0
+        return bool(np.max(np.abs(x)) <= x_max * (1 + 1e-9) and rate <= v_max * (1 + 1e-9))
+
+    @property
+    def unvetted(self) -> bool:
+        """A reference judges that did not pass its vetting (or was not vetted)."""
+        return self.reference is not None and (self.vetting is None or not self.vetting.passed)
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "reference": self.reference_spec,
+            "builtin_reference": self.builtin,
+            "scales": self.scales.to_json(),
+            "static": self.static,
+            "criteria": list(self.criteria),
+            "why": self.why,
+            "vetting": None if self.vetting is None else self.vetting.describe(),
+            "trusted_by_flag": self.trusted_by_flag,
+            "unvetted": self.unvetted,
+            "envelope": None
+            if self.envelope is None
+            else {
+                "max_abs_displacement_m": self.envelope[0],
+                "max_abs_velocity_m_per_s": self.envelope[1],
+                "source": self.envelope[2],
+            },
+        }
+
+
+def is_file_spec(spec: Any) -> bool:
+    return isinstance(spec, str | os.PathLike) and str(spec) not in MODELS
+
+
+def reference_spec_for(model: Any, reference: Any) -> Any:
+    """The reference a verdict on ``model`` is judged against (see the module doc)."""
+    if reference is None:
+        registered = isinstance(model, str) and model in MODELS
+        return BUILTIN_REFERENCE if registered else None
+    if isinstance(reference, str) and reference.strip().lower() == NO_REFERENCE:
+        return None
+    return reference
+
+
+def card_of(spec: Any) -> dict | None:
+    """The model card beside a model file (checked against the file), or None."""
+    if not is_file_spec(spec) or not Path(spec).is_file():
+        return None
+    from bushenv.identify.card import card_paths, load_card
+
+    if not card_paths(spec)[0].is_file():
+        return None
+    return load_card(spec).data
+
+
+def judging_scales(
+    reference: BushingModel | None,
+    builtin: bool,
+    card: dict | None,
+    flags: ScaleFlags = ScaleFlags(),
+) -> BushingScales:
+    """The reference's scales, its card's records' range, and the flags on top of both."""
+    scales = scales_of_reference(reference, builtin)
+    if card is not None:
+        scales = scales_of_card(scales, card)
+    given = flags.given()
+    if not given:
+        return scales
+    return replace(scales, **given, source=scales.source + f"; flags: {sorted(given)}")
+
+
+def criteria_of(
+    reference: BushingModel | None, static: bool, target: Any
+) -> tuple[tuple[str, ...], str]:
+    """The criteria a verdict runs, and why some do not."""
+    if reference is None:
+        run = [c for c in CRITERIA if c not in NEEDS_REFERENCE]
+        why = (
+            "no reference: only the criteria that need none ran "
+            f"({', '.join(NEEDS_REFERENCE)} compare with a reference's force); pass "
+            "--reference NAME|FILE for all"
+        )
+    else:
+        run, why = list(CRITERIA), "all, against the reference"
+    if "static" in run and not getattr(target, "judges_static", True):
+        run.remove("static")
+        why += f"; static is judged on the rig only (the {target.name} has no hold)"
+    elif "static" in run and not static:
+        run.remove("static")
+        why += (
+            "; static not judged: the reference's model card shows no quasi-static content in "
+            "its training records (no hold of 1 s, under 1 % of the displacement power at or "
+            "below 1 Hz), so its held force is an extrapolation"
+        )
+    return tuple(run), why
+
+
+def build_judge(
+    model: Any,
+    reference: Any = None,
+    *,
+    axis: str,
+    dt: float,
+    target: Any = "rig",
+    flags: ScaleFlags = ScaleFlags(),
+    trust_reference: bool = False,
+    vet: bool = True,
+    model_object: BushingModel | None = None,
+) -> Judge:
+    """The judge of verdicts on ``model`` (a name, file or object) against ``reference``.
+
+    ``model_object`` is the resolved model under test (its responses enter the compatibility
+    check of the vetting). Raises ``JudgeError`` when the reference fails its vetting and
+    ``trust_reference`` is not set."""
+    from bushenv.search.targets import get_target
+
+    tgt = get_target(target)
+    spec = reference_spec_for(model, reference)
+    if spec is None and not tgt.reference_free:
+        raise JudgeError(
+            f"the {tgt.name} target needs a reference (its twin runs on it); pass "
+            "--reference NAME|FILE"
+        )
+    ref = None if spec is None else get_reference(spec, axis=axis, dt=dt)
+    builtin = isinstance(spec, str) and spec == BUILTIN_REFERENCE
+    ref_card = card_of(spec) if ref is not None else None
+    card = ref_card if ref is not None else card_of(model)
+    scales = judging_scales(ref, builtin, card, flags)
+    static = ref is not None and (ref_card is None or static_identified(ref_card))
+    criteria, why = criteria_of(ref, static, tgt)
+    label = _label(spec)
+    vetting = None
+    if ref is not None and vet:
+        from bushenv.vetting import vet_reference
+
+        vetting = vet_reference(
+            ref, label, scales, card=ref_card, card_file=spec, model=model_object,
+            model_card=card_of(model), model_file=model,
+        )  # fmt: skip
+        if not vetting.passed and not trust_reference:
+            raise JudgeError(
+                f"the reference {label} failed its vetting: {vetting.summary()}; a verdict "
+                "against it could be the reference's fault. Pass a reference of this bushing "
+                "that passes, or --trust-reference to judge with it anyway (every verdict is "
+                "then marked as judged by an unvetted reference)"
+            )
+    return Judge(
+        reference_spec=None if spec is None else _recorded(spec),
+        builtin=builtin,
+        scales=scales,
+        static=static and "static" in criteria,
+        criteria=criteria,
+        why=why,
+        vetting=vetting,
+        trusted_by_flag=bool(trust_reference and vetting is not None and not vetting.passed),
+        envelope=None if ref is None else envelope_of(ref_card, scales),
+        reference=ref,
+    )
+
+
+def envelope_of(card: dict | None, scales: BushingScales) -> tuple[float, float, str]:
+    """The reference's envelope (see ``Judge.envelope``)."""
+    train = [r for r in (card or {}).get("records", []) if r.get("role") == "train"]
+    if train and all("max_abs_displacement_m" in r for r in train):
+        return (
+            max(r["max_abs_displacement_m"] for r in train),
+            max(r["max_abs_velocity_m_per_s"] for r in train),
+            "the reference's card's training records",
+        )
+    return scales.stroke_m, scales.velocity_m_per_s, "the judged stroke and velocity"
+
+
+def _label(spec: Any) -> str:
+    if isinstance(spec, BushingModel):
+        return f"<{spec.name} object>"
+    return str(spec)
+
+
+def _recorded(spec: Any) -> str:
+    return _label(spec) if isinstance(spec, BushingModel) else os.fspath(spec)
