@@ -29,7 +29,13 @@ from typing import Any
 from bushenv.divergence import CRITERIA, NEEDS_REFERENCE
 from bushenv.errors import BadInput
 from bushenv.models import MODELS, BushingModel, get_reference
-from bushenv.scales import BushingScales, scales_of_card, scales_of_reference, static_identified
+from bushenv.scales import (
+    BushingScales,
+    ScaleError,
+    scales_of_card,
+    scales_of_reference,
+    static_identified,
+)
 
 NO_REFERENCE = "none"  # the spelling of "judged without a reference" in every command
 BUILTIN_REFERENCE = "rubber"
@@ -210,7 +216,13 @@ def build_judge(
     builtin = isinstance(spec, str) and spec == BUILTIN_REFERENCE
     ref_card = card_of(spec) if ref is not None else None
     card = ref_card if ref is not None else card_of(model)
-    scales = judging_scales(ref, builtin, card, flags)
+    try:
+        scales = judging_scales(ref, builtin, card, flags)
+    except ScaleError as exc:  # e.g. a reference that pulls: no floor from its stiffness
+        raise JudgeError(
+            f"the reference {_label(spec)} cannot judge: {exc}; a bushing pushes back "
+            "(positive static stiffness)"
+        ) from None
     static = ref is not None and (ref_card is None or static_identified(ref_card))
     criteria, why = criteria_of(ref, static, tgt)
     label = _label(spec)

@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from bushenv.errors import BadInput
+from bushenv.errors import BadInput, BushenvError, ModelRaised
 from bushenv.persist import atomic_write
 
 FORMAT_VERSION = 1
@@ -95,7 +95,7 @@ class BushingModel:
                 )
             self._x1[0, 0] = x
             self._v1[0, 0] = v
-            self._advance(self._x1, self._v1, self._f1)
+            self._guarded(self._x1, self._v1, self._f1)
             return float(self._f1[0, 0])
         x = np.asarray(x, dtype=np.float64)
         if x.shape != (self.batch_size,):
@@ -104,8 +104,19 @@ class BushingModel:
             )
         self._x1[0] = x
         self._v1[0] = v
-        self._advance(self._x1, self._v1, self._f1)
+        self._guarded(self._x1, self._v1, self._f1)
         return self._f1[0].copy()
+
+    def _guarded(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """``_advance``, with anything the model's own code raises that is not a bushenv error
+        (``ModelRefused``: a divergence; ``BadInput``) nor arithmetic turned into
+        ``ModelRaised``: the model's bug, reported with its message, never a verdict."""
+        try:
+            self._advance(x, v, out)
+        except (BushenvError, ArithmeticError):
+            raise
+        except Exception as exc:
+            raise ModelRaised(self.name, exc) from exc
 
     @property
     def last_force_n(self) -> np.ndarray:
@@ -124,7 +135,7 @@ class BushingModel:
         x2, v2, one_d = self._profiles(x, v)
         self.reset(x2.shape[1])
         out = np.empty_like(x2)
-        self._advance(x2, v2, out)
+        self._guarded(x2, v2, out)
         return out[:, 0] if one_d else out
 
     def _profiles(self, x, v, dtype=np.float64) -> tuple[np.ndarray, np.ndarray, bool]:
