@@ -216,13 +216,12 @@ def build_judge(
     builtin = isinstance(spec, str) and spec == BUILTIN_REFERENCE
     ref_card = card_of(spec) if ref is not None else None
     card = ref_card if ref is not None else card_of(model)
+    scale_problem = None
     try:
         scales = judging_scales(ref, builtin, card, flags)
-    except ScaleError as exc:  # e.g. a reference that pulls: no floor from its stiffness
-        raise JudgeError(
-            f"the reference {_label(spec)} cannot judge: {exc}; a bushing pushes back "
-            "(positive static stiffness)"
-        ) from None
+    except ScaleError as exc:  # a reference that pulls or is not finite sets no floor
+        scale_problem = f"{exc}; a bushing pushes back (a positive, finite static stiffness)"
+        scales = judging_scales(None, builtin, card, flags)
     static = ref is not None and (ref_card is None or static_identified(ref_card))
     criteria, why = criteria_of(ref, static, tgt)
     label = _label(spec)
@@ -234,6 +233,11 @@ def build_judge(
             ref, label, scales, card=ref_card, card_file=spec, model=model_object,
             model_card=card_of(model), model_file=model,
         )  # fmt: skip
+        if scale_problem is not None:
+            from bushenv.vetting import Check, Vetting
+
+            vetting = Vetting(vetting.reference, (Check("scales", False, scale_problem),
+                                                  *vetting.checks))  # fmt: skip
         if not vetting.passed and not trust_reference:
             raise JudgeError(
                 f"the reference {label} failed its vetting: {vetting.summary()}; a verdict "
@@ -269,7 +273,7 @@ def envelope_of(card: dict | None, scales: BushingScales) -> tuple[float, float,
 
 def _label(spec: Any) -> str:
     if isinstance(spec, BushingModel):
-        return f"<{spec.name} object>"
+        return f"<{spec.name or type(spec).__name__} object>"
     return str(spec)
 
 

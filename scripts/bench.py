@@ -1,8 +1,9 @@
 """bushenv benchmark: every speed and memory figure, measured side by side in ONE run.
 
-    python scripts/bench.py                      # full run, writes docs/benchmarks.md
+    python scripts/bench.py --write-docs         # full run, writes docs/benchmarks.md
     python scripts/bench.py --quick              # CI: small sizes, checks each figure is produced
     python scripts/bench.py --json bench.json    # every figure: name, value, unit, target, met
+    (nothing in the checkout is written unless asked: --write-docs, or --markdown FILE)
 
 Figures: batched free-run throughput of each model at B = 1, 64, 1024; single-step latency;
 the comparisons a user would make (scripts/bench_compare.py: the Bouc-Wen free run beside
@@ -810,7 +811,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--quick", action="store_true", help="small sizes; checks figures exist")
     p.add_argument("--json", type=Path, help="write every figure to this JSON file")
     p.add_argument("--only", help="comma list of sections: " + ",".join(SECTIONS))
-    p.add_argument("--markdown", type=Path, default=None, help="table file (default docs/)")
+    p.add_argument("--markdown", type=Path, default=None, help="write the table to this file")
+    p.add_argument(
+        "--write-docs", action="store_true", help="write the table to docs/benchmarks.md"
+    )
     args = p.parse_args(argv)
     import torch
 
@@ -832,7 +836,7 @@ def main(argv: list[str] | None = None) -> int:
     md = args.markdown or (
         ROOT / "docs" / ("benchmarks-quick.md" if args.quick else "benchmarks.md")
     )
-    if not args.quick or args.markdown:
+    if args.markdown or args.write_docs:  # never a side effect of --json or a plain run
         write_markdown(fig, md, args.quick)
         print(f"\nwrote {md}")
     if failed:

@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 import bushenv  # noqa: F401  (registers the envs)
+from bushenv.judge import JudgeError
 from bushenv.models import ModelError
 from bushenv.models.base import PAPER_DT, BushingModel
 from bushenv.models.linear import LinearBushing
@@ -159,7 +160,10 @@ def test_bushrig_stepping_on_after_a_nan_verdict_never_raises():
 
 
 def test_bushrig_reference_returning_nan_truncates_without_blaming_the_model():
-    env = rig(model="linear", reference=BadAfter(after=3))
+    # such a reference fails its vetting (its holds are not finite): refused by default
+    with pytest.raises(JudgeError, match="cannot judge|failed its vetting"):
+        rig(model="linear", reference=BadAfter(after=3))
+    env = rig(model="linear", reference=BadAfter(after=3), trust_reference=True)
     env.reset(seed=0)
     _, _, term, trunc, info = push(env, 4)[3]
     assert trunc and not term

@@ -115,6 +115,7 @@ def test_quick_benchmark_produces_every_figure_with_units_and_targets(tmp_path):
 
 def test_quick_certify_benchmark_produces_its_figures(tmp_path):
     out = tmp_path / "bench.json"
+    docs = {p: p.read_bytes() for p in (ROOT / "docs").glob("benchmarks*.md")}
     proc = subprocess.run(
         [
             sys.executable,
@@ -136,3 +137,5 @@ def test_quick_certify_benchmark_produces_its_figures(tmp_path):
             r = rows[f"certify.{name}.{axis}.holds20"]
             assert r["unit"] == "s" and r["target"] == 1.0 and isinstance(r["met"], bool)
             assert math.isfinite(rows[f"certify.{name}.{axis}.analysis_holds20"]["value"])
+    # --json writes the JSON only: the checkout's docs are written only when asked
+    assert {p: p.read_bytes() for p in (ROOT / "docs").glob("benchmarks*.md")} == docs

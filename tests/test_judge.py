@@ -178,7 +178,7 @@ def test_a_stiffer_reference_without_records_draws_a_warning_not_a_refusal(regis
 
 def test_a_reference_that_pulls_is_refused_for_its_wrong_sign(registered):
     model = get_model("nn", axis="axial")
-    with pytest.raises(JudgeError, match=r"pulling cannot judge: .* static stiffness is -3"):
+    with pytest.raises(JudgeError, match=r"pulling failed its vetting: scales: .* static stiffness is -3"):
         build_judge("nn", "pulling", axis="axial", dt=model.dt, model_object=model)
 
 

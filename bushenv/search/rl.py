@@ -76,6 +76,7 @@ class RLSearch(Searcher):
         import torch
         from stable_baselines3 import PPO, SAC
         from stable_baselines3.common.callbacks import BaseCallback
+        from stable_baselines3.common.logger import Logger
 
         torch.set_num_threads(1)
         episode_steps = int(round(self.episode_s / evaluator.dt))
@@ -130,6 +131,9 @@ class RLSearch(Searcher):
                 policy_kwargs=policy_kwargs,
                 verbose=0,
             )
+        # SB3's default logger makes an empty SB3-<date> folder in the temp folder on every
+        # learn(); a logger with no outputs writes nothing
+        agent.set_logger(Logger(folder=None, output_formats=[]))
         total = (budget // n_envs + 2) * episode_steps * n_envs
         try:
             agent.learn(total_timesteps=total, callback=StopAtBudget())
