@@ -301,13 +301,13 @@ def save_case(case: Case, directory: str | os.PathLike, force: bool = False) -> 
         return None
     d = case.to_json()
     for spec, entry in case.expect.items():
-        file = _kept(case, spec, entry.get("file"), entry.get("sha256"), directory)
-        if file is not None:
-            d["expect"][spec] = {**entry, "file": file}
+        kept = _kept(case, spec, entry.get("file"), entry.get("sha256"), directory)
+        if kept is not None:
+            d["expect"][spec] = {**entry, "sha256": kept[1], "file": kept[0]}
     ref = case.reference or {}
-    file = _kept(case, ref.get("spec"), ref.get("file"), ref.get("file_sha256"), directory)
-    if file is not None:
-        d["reference"] = {**ref, "file": file}
+    kept = _kept(case, ref.get("spec"), ref.get("file"), ref.get("file_sha256"), directory)
+    if kept is not None:
+        d["reference"] = {**ref, "file_sha256": kept[1], "file": kept[0]}
     write_json(path, d)
     case.path, case.expect, case.reference = path, d["expect"], d["reference"]
     return path
@@ -315,8 +315,9 @@ def save_case(case: Case, directory: str | os.PathLike, force: bool = False) -> 
 
 def _kept(
     case: Case, spec: str | None, file: dict | None, sha: str | None, directory: Path
-) -> dict | None:
-    """The ``file`` entry of a model file kept in ``directory`` (None: not a model file)."""
+) -> tuple[dict, str] | None:
+    """The ``file`` entry of a model file kept in ``directory`` and its sha256 (None: not a
+    model file)."""
     if not is_model_file(spec):
         return None
     if file or case.path is not None:
@@ -336,7 +337,7 @@ def _kept(
             f"case {case.name}: {source} changed since its verdict was recorded (sha256 "
             f"{sha[:12]} -> {now[:12]}); judge the case again"
         )
-    return keep(source, directory, now)
+    return keep(source, directory, now), now
 
 
 def load_case(path: str | os.PathLike) -> Case:

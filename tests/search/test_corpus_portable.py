@@ -97,6 +97,15 @@ def test_model_files_are_kept_by_content_hash_with_their_cards(tmp_path, monkeyp
     assert file_hash(tmp_path / "corp" / ref["file"]["kept"]) == ref["file_sha256"]
 
 
+def test_a_file_recorded_without_its_hash_gets_it_when_kept(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    case = _case(tmp_path / "mine")
+    case.expect["mine/soft.npz"]["sha256"] = None  # as a caller passing no shas leaves it
+    path = save_case(case, tmp_path / "corp")
+    entry = json.loads(path.read_text())["expect"]["mine/soft.npz"]
+    assert entry["sha256"] == file_hash(tmp_path / "mine" / "soft.npz")
+
+
 def test_a_moved_corpus_replays_its_kept_copies_and_says_so(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     path = save_case(_case(tmp_path / "mine"), tmp_path / "corp")
