@@ -16,6 +16,11 @@ The format (one record per file):
 - Time strictly increases with a uniform step, at any rate: the step dt is read from the time
   column (the median step). Every step must be within ``STEP_RTOL`` (1 %) of dt plus
   ``STEP_ATOL_S`` (1e-9 s). At least two samples.
+- A time column under a plain ``time`` header must sample at ``PLAUSIBLE_RATE_HZ`` (10 Hz to
+  100 kHz: a dynamic test; a time column in milliseconds reads 1000 times slower). A record
+  outside it states its time unit in the header: ``time [ms]``, ``time [us]``, or ``time [s]``
+  for a slow creep record that really is in seconds (``save_csv`` writes ``time [s]`` then).
+- No units row under the header: the units go into the header (``displacement [mm]``).
 - Plausibility: ``max |displacement| <= MAX_PLAUSIBLE_DISPLACEMENT_M`` (0.1 m, eight times the
   test machine's stroke; larger values are almost always millimetres) and
   ``max |force| <= MAX_PLAUSIBLE_FORCE_N`` (1 MN, forty times the machine's 25 kN). These are
@@ -57,10 +62,13 @@ STEP_RTOL = 0.01  # a step may differ from dt by 1 % of dt ...
 STEP_ATOL_S = 1e-9  # ... plus 1 ns (printed times lose digits)
 MAX_PLAUSIBLE_DISPLACEMENT_M = 0.1
 MAX_PLAUSIBLE_FORCE_N = 1.0e6
+# Sample rates of a dynamic bushing test under a plain "time" header; outside, the unit is
+# almost always wrong (ms read as s) and must be stated in the header.
+PLAUSIBLE_RATE_HZ = (10.0, 100e3)
 MAX_RECORD_BYTES = 256 * 2**20
 # units a header may state per column, and their factor to SI
 UNITS = {
-    "time": {"s": 1.0, "ms": 1e-3},
+    "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6},
     "displacement": {"m": 1.0, "mm": 1e-3, "um": 1e-6},
     "force": {"N": 1.0, "kN": 1e3},
 }
@@ -243,6 +251,67 @@ def _check_columns(
             raise RecordError(
                 f"{where(i)}: {key} {float(a[i])!r} {unit} exceeds {limit:g} {unit}; {hint}"
             )
+
+
+def _check_rate(t: np.ndarray, label: str, where) -> None:
+    """Refuse a plain ``time`` column whose sample rate no dynamic test has (``where(1)``
+    names the second sample); the message says which unit the column looks like."""
+    step = float(np.median(np.diff(t)))
+    rate = 1.0 / step
+    low, high = PLAUSIBLE_RATE_HZ
+    if _is_plausible_rate(t):
+        return
+    looks = [
+        (name, unit)
+        for name, unit in (("milliseconds", "ms"), ("microseconds", "us"))
+        if low <= rate / UNITS["time"][unit] <= high
+    ]
+    if rate < low and looks:
+        name, unit = looks[0]
+        fix = (
+            f"the time column looks like {name} ({rate / UNITS['time'][unit]:.6g} Hz if it "
+            f"is): write its unit in the header, 'time [{unit}]'"
+        )
+    elif rate < low:
+        fix = "if the time column is not in seconds, write its unit in the header ('time [ms]')"
+    else:
+        fix = "check the time column: no bushing test machine samples this fast"
+    raise RecordError(
+        f"{where(1)}: time step {step!r} s is {rate:.6g} Hz sampling, implausible for a dynamic "
+        f"test ({low:g} Hz to {high / 1e3:g} kHz); {fix}, or 'time [s]' if it really is "
+        "seconds"
+    )
+
+
+def _is_plausible_rate(t: np.ndarray) -> bool:
+    """Within ``PLAUSIBLE_RATE_HZ``, give or take the time step's own 1 % tolerance."""
+    rate = 1.0 / float(np.median(np.diff(t)))
+    low, high = PLAUSIBLE_RATE_HZ
+    return low * (1 - STEP_RTOL) <= rate <= high * (1 + STEP_RTOL)
+
+
+def _units_row_problem(row: list[str], header: list[str]) -> str | None:
+    """What to say when the first data row holds units (``s,mm,kN``), else None."""
+    units = [re.sub(r"^[\[(]\s*|\s*[\])]$", "", s.strip()) for s in row]
+    for text in units:
+        try:
+            float(text)
+            return None  # a number: not a units row
+        except ValueError:
+            pass
+    known = {u.lower() for table in UNITS.values() for u in table} | {"sec", "µm", "μm", "kn"}
+    if not any(u.lower() in known for u in units):
+        return None
+    shown = ",".join(s.strip() for s in row)
+    names, factors, _ = header_units(header)
+    if factors:
+        return f"'{shown}' looks like a row of units; the header already states them: delete it"
+    suggestion = ",".join(f"{n.strip()} [{u}]" for n, u in zip(names, units, strict=False))
+    listed = "; ".join(f"{n} {', '.join(table)}" for n, table in UNITS.items())
+    return (
+        f"'{shown}' looks like a row of units under the header; put each unit in the header "
+        f"instead, '{suggestion}', and delete this row (units: {listed})"
+    )
 
 
 def header_units(fields: list[str]) -> tuple[list[str], dict[str, float], str | None]:
@@ -438,6 +507,7 @@ def _load_plain(
         max_displacement_m=max_displacement_m,
         max_force_n=max_force_n,
     )
+    _check_rate(record.time, str(path), where)
     return record
 
 
@@ -482,6 +552,8 @@ def _load_line_by_line(
         max_displacement_m=np.inf if "displacement" in factors else max_displacement_m,
         max_force_n=np.inf if "force" in factors else max_force_n,
     )
+    if "time" not in factors:  # a stated unit is taken as stated
+        _check_rate(record.time, str(path), lambda i: f"{path} line {int(line_of[i])}")
     return record
 
 
@@ -522,6 +594,10 @@ def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> dict[str, float]:
                 f"{path} line {line}: {len(row)} value(s) {','.join(row)!r}, expected 3 "
                 f"({HEADER_TEXT})"
             )
+        if not t:
+            units_row = _units_row_problem(row, header)
+            if units_row:
+                raise RecordError(f"{path} line {line}: {units_row}")
         for key, column, text in zip(HEADER, columns, row, strict=True):
             try:
                 value = float(text)
@@ -549,8 +625,10 @@ def save_csv(record: Record, path: str | os.PathLike, overwrite: bool = False) -
     """Validate ``record`` and write it to ``path`` atomically; returns the path.
 
     Refuses (``RecordError``) a record ``load_csv`` would refuse, and an existing ``path``
-    unless ``overwrite=True``. The data go to a temporary file in the same folder first, so a
-    crash never leaves a half-written record under the final name.
+    unless ``overwrite=True``. A record sampled outside ``PLAUSIBLE_RATE_HZ`` gets the header
+    ``time [s],displacement,force``, so that it reads back as it was written. The data go
+    to a temporary file in the same folder first, so a crash never leaves a half-written
+    record under the final name.
     """
     path = Path(path)
     record.validate()
@@ -560,7 +638,8 @@ def save_csv(record: Record, path: str | os.PathLike, overwrite: bool = False) -
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp")
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(HEADER_TEXT + "\n")
+            plain = _is_plausible_rate(record.time)
+            fh.write((HEADER_TEXT if plain else "time [s],displacement,force") + "\n")
             # tolist() gives Python floats, whose repr is the shortest exact round-trip text.
             rows = zip(
                 record.time.tolist(),

@@ -59,7 +59,8 @@ def test_non_csv_file_is_refused_saying_what_it_looks_like(tmp_path, data, messa
     [
         pytest.param(
             GOOD.replace("\n0.0,", "\ns,m,N\n0.0,", 1),
-            r"rec\.csv line 2: time 's' is not a number",
+            r"rec\.csv line 2: 's,m,N' looks like a row of units under the header; put each "
+            r"unit in the header instead, 'time \[s\],displacement \[m\],force \[N\]'",
             id="units-row",
         ),
         pytest.param(

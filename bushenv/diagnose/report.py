@@ -33,6 +33,7 @@ from bushenv.diagnose.candidates import effect_names
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import baseline_names, diagnose
 from bushenv.diagnose.plots import make_plots
+from bushenv.record_rates import add_resample_option, one_rate
 
 EXAMPLE = (
     "bushenv diagnose train.csv test_random.csv test_steps.csv --out diag/ "
@@ -90,6 +91,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write into an existing DIR (replaces only the report's own files)",
     )
     parser.add_argument("--seed", type=int, default=0, help="seed for baseline identification")
+    add_resample_option(parser, keep=True)
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 
@@ -136,6 +138,7 @@ def run(args: argparse.Namespace) -> int:
         )
     trains = _load(train_paths, args, progress)
     tests = _load(list(args.tests), args, progress)
+    trains, tests = one_rate([trains, tests], args.resample, "diagnose")
     result = diagnose(
         trains,
         tests,

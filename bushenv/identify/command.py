@@ -16,6 +16,7 @@ from typing import Any
 
 from bushenv.identify import fittable_models, options_class
 from bushenv.identify.options import describe, flag_of, option_fields
+from bushenv.record_rates import add_resample_option, one_rate
 
 EXAMPLE = "bushenv fit train1.csv train2.csv --model hybrid --validate held.csv --out my_hybrid.npz"
 DEST = "option_"  # argparse dest prefix of the model options
@@ -69,6 +70,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--force", action="store_true", help="replace an existing model file and its card"
     )
     p.add_argument("--no-plots", action="store_true", help="write no figures")
+    add_resample_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     groups: dict[tuple[str, ...], Any] = {}
     for name, owners in model_options().items():
@@ -132,6 +134,7 @@ def run(args: argparse.Namespace) -> int:
     given = chosen_options(args)
     train = [load_csv(p) for p in args.train]
     held = [load_csv(p) for p in args.validate or []]
+    train, held = one_rate([train, held], args.resample, "fit")
     dt = check_same_rate(train, what="training records")
     for i, rec in enumerate(held):
         check_model_rate(rec, dt, i)

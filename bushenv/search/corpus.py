@@ -14,14 +14,15 @@ A case file (``tests/regressions/corpus/<name>.json``) holds:
 | family, params| the excitation family and its physical parameters (or the agent's name)     |
 | found_by      | searcher, seed, model name and the sha256 of the model file it was found on |
 | expect        | per model spec: ``diverged`` (bool), the ``criterion`` it fired (or null),  |
-|               | ``sha256`` of the model file the verdict was recorded with. A spec is a     |
-|               | registered name (its shipped file) or a model file; a relative file path is |
-|               | relative to the case's own folder (``../models/old.npz``), so a case keeps  |
-|               | replaying a model that is no longer shipped                                 |
+|               | ``sha256`` of the model file the verdict was recorded with, and for a model |
+|               | file ``file``: where it was and the copy kept with the case               |
+|               | (``corpus_files.py``). A spec is a registered name (its shipped file) or a  |
+|               | model file; in cases without ``file`` a relative path is relative to the    |
+|               | case's own folder (``../models/old.npz``)                                   |
 | reference     | ``spec``: the reference the verdicts were judged against (a registered name |
 |               | or a model file; null: judged without one, by the criteria that need none), |
-|               | ``file_sha256`` and ``params_sha256``; replay refuses when it is missing    |
-|               | (cases before this field name the built-in ``rubber``)                     |
+|               | ``file_sha256``, ``params_sha256`` and, for a file, ``file`` as above;      |
+|               | replay refuses when it is gone (cases before this field: ``rubber``)        |
 | scales        | the bushing's scales the verdicts used (``bushenv/scales.py``; default the  |
 |               | papers' machine)                                                            |
 | shrink        | what shrinking did (segments / samples / peak before and after)            |
@@ -49,7 +50,6 @@ import numpy as np
 
 from bushenv.errors import BadInput
 from bushenv.models import (
-    MODELS,
     BushingModel,
     file_hash,
     get_model,
@@ -60,6 +60,7 @@ from bushenv.models import (
 from bushenv.models.base import PAPER_DT
 from bushenv.persist import write_json
 from bushenv.scales import MACHINE, BushingScales
+from bushenv.search.corpus_files import KeptFileError, is_model_file, keep, locate
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.targets import TARGETS
 
@@ -127,15 +128,22 @@ def reference_identity(spec: str | None, reference: BushingModel | None, axis: s
     }
 
 
-def case_reference(case: Case) -> BushingModel | None:
-    """The reference a case was judged against, resolved today; refuses (``CorpusError``) when
-    it is gone. Cases written before references were explicit name the built-in rubber."""
+def case_reference(case: Case, notes: list[str] | None = None) -> BushingModel | None:
+    """The reference a case was judged against, resolved today (a file: where it was, else the
+    copy kept with the case); refuses (``CorpusError``) when it is gone. Cases written before
+    references were explicit name the built-in rubber."""
     ref = case.reference
     spec = ref.get("spec", ref.get("name", "rubber")) if ref else "rubber"
     if spec is None:
         return None
     try:
-        return get_reference(spec, axis=case.axis, dt=case.dt)
+        path, note = locate(spec, ref.get("file"), ref.get("file_sha256"), _folder(case))
+    except KeptFileError as exc:
+        raise CorpusError(f"case {case.name}: its reference {exc}") from None
+    if note and notes is not None:
+        notes.append(note)
+    try:
+        return get_reference(spec if path is None else str(path), axis=case.axis, dt=case.dt)
     except ValueError as exc:
         raise CorpusError(
             f"case {case.name}: its reference {spec!r} cannot be loaded ({exc}); restore the "
@@ -190,14 +198,22 @@ def _default_resolver(name: str, axis: str, dt: float) -> BushingModel:
     return get_model(name, axis=axis, dt=dt)
 
 
-def model_spec(case: Case, spec: str) -> str:
-    """The model an ``expect`` key names: a registered name (or any other name a resolver
-    knows) as it is; a relative file path (``.npz``, or a path with a folder) taken relative to
-    the case's folder (absolute paths and cases not read from a file: as given)."""
-    is_path = spec.endswith(".npz") or "/" in spec or os.sep in spec
-    if spec in MODELS or not is_path or case.path is None or Path(spec).is_absolute():
-        return spec
-    return str(case.path.parent / spec)
+def _folder(case: Case) -> Path | None:
+    return None if case.path is None else case.path.parent
+
+
+def model_spec(case: Case, spec: str, notes: list[str] | None = None) -> str:
+    """The model an ``expect`` key names, to resolve today: a registered name (or any other
+    name a resolver knows) as it is; a model file where it was recorded, else the copy kept
+    with the case (``corpus_files.locate``; a note for the replay is added to ``notes``)."""
+    entry = case.expect.get(spec, {})
+    try:
+        path, note = locate(spec, entry.get("file"), entry.get("sha256"), _folder(case))
+    except KeptFileError as exc:
+        raise CorpusError(f"case {case.name}: a model it names cannot be loaded: {exc}") from None
+    if note and notes is not None:
+        notes.append(note)
+    return spec if path is None else str(path)
 
 
 def judge_profile(
@@ -274,13 +290,55 @@ def _slug(text: str) -> str:
 
 
 def save_case(case: Case, directory: str | os.PathLike, force: bool = False) -> Path | None:
-    """Write ``case`` atomically as ``directory/<name>.json``; None if it exists (unless force)."""
-    path = Path(directory) / f"{case.name}.json"
+    """Write ``case`` atomically as ``directory/<name>.json``; None if it exists (unless force).
+
+    Every model file the case names (and a reference file) is kept in ``directory/models/``
+    (``corpus_files.py``), so the case replays from any working folder and after ``directory``
+    moves. A case made in memory names its files relative to the working folder (as
+    ``bushenv attack`` was given them) or, failing that, relative to ``directory``."""
+    directory = Path(directory)
+    path = directory / f"{case.name}.json"
     if path.exists() and not force:
         return None
-    write_json(path, case.to_json())
-    case.path = path
+    d = case.to_json()
+    for spec, entry in case.expect.items():
+        kept = _kept(case, spec, entry.get("file"), entry.get("sha256"), directory)
+        if kept is not None:
+            d["expect"][spec] = {**entry, "sha256": kept[1], "file": kept[0]}
+    ref = case.reference or {}
+    kept = _kept(case, ref.get("spec"), ref.get("file"), ref.get("file_sha256"), directory)
+    if kept is not None:
+        d["reference"] = {**ref, "file_sha256": kept[1], "file": kept[0]}
+    write_json(path, d)
+    case.path, case.expect, case.reference = path, d["expect"], d["reference"]
     return path
+
+
+def _kept(
+    case: Case, spec: str | None, file: dict | None, sha: str | None, directory: Path
+) -> tuple[dict, str] | None:
+    """The ``file`` entry of a model file kept in ``directory`` and its sha256 (None: not a
+    model file)."""
+    if not is_model_file(spec):
+        return None
+    if file or case.path is not None:
+        try:
+            source, _ = locate(spec, file, sha, _folder(case))
+        except KeptFileError as exc:
+            raise CorpusError(f"case {case.name}: {exc}") from None
+    else:
+        given = Path(spec)
+        # lexically: ``directory`` may not exist yet, and ``..`` inside it would not resolve
+        source = given if given.is_file() else Path(os.path.normpath(directory / given))
+    if source is None or not source.is_file():
+        return None  # a name only a resolver knows; replay resolves it as before
+    now = file_hash(source)
+    if sha and now != sha:
+        raise CorpusError(
+            f"case {case.name}: {source} changed since its verdict was recorded (sha256 "
+            f"{sha[:12]} -> {now[:12]}); judge the case again"
+        )
+    return keep(source, directory, now), now
 
 
 def load_case(path: str | os.PathLike) -> Case:
@@ -353,16 +411,18 @@ def replay(
     case: Case,
     resolve: Resolver | None = None,
     sha_of: Callable[[str, str], str | None] | None = None,
+    notes: list[str] | None = None,
 ) -> list[Replay]:
     """Run the case on every model it names, today's files; one ``Replay`` per model.
 
     ``resolve(name, axis, dt)`` gives the model (default: ``get_model``); ``sha_of(name,
-    axis)`` the sha256 of its file today (default: the shipped file, ``model_sha``).
+    axis)`` the sha256 of its file today (default: the shipped file, ``model_sha``). Where a
+    kept copy stood in for a moved file, a line is added to ``notes``.
     """
     resolve = resolve or _default_resolver
     sha_of = sha_of or model_sha
-    reference = case_reference(case)
-    specs = {name: model_spec(case, name) for name in case.expect}
+    reference = case_reference(case, notes)
+    specs = {name: model_spec(case, name, notes) for name in case.expect}
     try:
         models = {name: resolve(spec, case.axis, case.dt) for name, spec in specs.items()}
     except ValueError as exc:
@@ -387,15 +447,24 @@ def check(
     case: Case,
     resolve: Resolver | None = None,
     sha_of: Callable[[str, str], str | None] | None = None,
+    notes: list[str] | None = None,
 ) -> list[str]:
-    """Messages for every changed verdict (empty when the case still holds)."""
+    """Messages for every changed verdict (empty when the case still holds); ``notes`` gets
+    the kept copies replayed and the model files that changed with their verdicts holding."""
     problems = []
-    results = replay(case, resolve, sha_of)
+    results = replay(case, resolve, sha_of, notes)
     reference = case_reference(case)
     ref_now = None if reference is None else params_sha(reference)
     ref_changed = case.reference.get("params_sha256") not in (None, ref_now)
     for r in results:
+        changed = bool(r.sha_recorded and r.sha_now and r.sha_recorded != r.sha_now)
         if r.ok:
+            if changed and notes is not None:
+                notes.append(
+                    f"case {case.name}: the {r.model} model file changed since the case was "
+                    f"recorded (sha256 {r.sha_recorded[:12]} -> {r.sha_now[:12]}); its "
+                    "verdict holds"
+                )
             continue
         want = "diverge" if r.expected else "stay bounded"
         got = (
@@ -404,7 +473,7 @@ def check(
             else f"stayed bounded (robustness {r.row['robustness']})"
         )
         msg = f"case {case.name}: {r.model} was expected to {want} but {got}"
-        if r.sha_recorded and r.sha_now and r.sha_recorded != r.sha_now:
+        if changed:
             msg += (
                 f"; the {r.model} model file changed since the case was recorded "
                 f"(sha256 {r.sha_recorded[:12]} -> {r.sha_now[:12]})"

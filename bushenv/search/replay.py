@@ -4,8 +4,11 @@
 
 Each case (``corpus.py``) is judged on the models it names against the reference it records,
 at its scales; a verdict that differs from the recorded one is printed with the case's name
-and whether the model file or the reference changed since. Exit 0 when every case holds, 1
-when some verdict changed, 2 when a case cannot be read or its reference is gone.
+and whether the model file or the reference changed since. A model file that is no longer
+where the case was recorded is replayed from the copy kept with the corpus (its sha256
+checked), and a ``note:`` line says so; so does a model file that changed while its verdict
+held. Exit 0 when every case holds, 1 when some verdict changed, 2 when a case cannot be read
+or a model or reference it names is gone.
 """
 
 from __future__ import annotations
@@ -43,11 +46,17 @@ def run(args: argparse.Namespace) -> int:
     files = _cases(args.paths)
     progress = Progress(total=len(files), quiet=args.quiet, every_s=0.0)
     changed = 0
+    said: set[str] = set()
     for k, path in enumerate(files, start=1):
-        problems = check(load_case(path))
+        notes: list[str] = []
+        problems = check(load_case(path), notes=notes)
         changed += bool(problems)
         for msg in problems:
             print(msg)
+        for note in notes:
+            if note not in said:  # one kept model stands in for many cases: say it once
+                said.add(note)
+                print(f"note: {note}")
         progress.update(k, f"{path.name}: {'CHANGED' if problems else 'holds'}")
     print(f"{len(files) - changed} of {len(files)} cases hold their recorded verdicts")
     return 1 if changed else 0

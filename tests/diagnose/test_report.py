@@ -110,7 +110,8 @@ def test_too_short_and_constant_records_are_refused(tmp_path, capsys):
     flat.write_text(
         "time,displacement,force\n" + "".join(f"{i * 0.01},0.001,{i}\n" for i in range(200))
     )
-    code = main(["diagnose", str(flat), str(good), "--out", str(tmp_path / "o3"), "--quiet"])
+    args = ["diagnose", str(flat), str(good), "--out", str(tmp_path / "o3"), "--quiet"]
+    code = main(args + ["--resample", "keep"])  # flat.csv is at 100 Hz, good.csv is not
     assert code == 2
     assert "displacement is constant" in capsys.readouterr().err
 

@@ -153,9 +153,9 @@ def bad_inputs(records, tmp_path):
     slow = save_csv(resample(load_csv(records["b"]), 0.01), tmp_path / "slow.csv")
     short = write_record(tmp_path / "short.csv", 0.25, 3)
     return [
-        ([a, str(slow)], "slow.csv at 100 Hz, "),
+        ([a, str(slow)], "slow.csv line 3: sampled at 100 Hz (time step 0.01 s), "),
         ([a, str(slow)], "train_a.csv at 204.8 Hz"),
-        ([a, "--validate", str(slow)], "slow.csv is sampled at 100 Hz, the model at 204.8 Hz"),
+        ([a, "--validate", str(slow)], "slow.csv line 3: sampled at 100 Hz (time step 0.01"),
         ([a, "--validate"], "--validate needs at least one held-out record file"),
         ([a, "--generations", "3"], "--generations is not an option of model nn"),
         ([str(short)], "short.csv: record too short for the lags"),

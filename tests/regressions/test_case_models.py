@@ -60,10 +60,16 @@ def _registered_linear_only(spec, axis, dt):
     return get_model(spec, axis=axis, dt=dt)
 
 
-def test_a_missing_model_file_is_refused_naming_the_case(tmp_path):
+def test_a_missing_model_file_is_replayed_from_its_kept_copy_and_refused_when_that_is_gone(
+    tmp_path,
+):
     path = _saved_case(tmp_path)
     (tmp_path / "models" / "stiff.npz").unlink()
     case = load_case(path)
+    notes = []
+    assert check(case, notes=notes) == []
+    assert any("replayed the copy kept with the corpus" in n for n in notes)
+    (path.parent / case.expect["../models/stiff.npz"]["file"]["kept"]).unlink()
     with pytest.raises(CorpusError, match=f"case {case.name}: a model it names cannot be loaded"):
         check(case)
 

@@ -137,7 +137,9 @@ def test_a_case_replays_against_its_own_reference_and_refuses_when_it_is_gone(tm
     assert stored["reference"]["spec"] == str(ref_path) and stored["reference"]["file_sha256"]
     assert check(load_case(path)) == []
     ref_path.unlink()
-    with pytest.raises(CorpusError, match="its reference .* cannot be loaded"):
+    assert check(load_case(path)) == []  # the copy kept with the corpus stands in
+    (path.parent / stored["reference"]["file"]["kept"]).unlink()
+    with pytest.raises(CorpusError, match="its reference .* neither at .* nor kept"):
         check(load_case(path))
 
 
