@@ -178,7 +178,8 @@ def test_a_stiffer_reference_without_records_draws_a_warning_not_a_refusal(regis
 
 def test_a_reference_that_pulls_is_refused_for_its_wrong_sign(registered):
     model = get_model("nn", axis="axial")
-    with pytest.raises(JudgeError, match=r"pulling failed its vetting: scales: .* static stiffness is -3"):
+    msg = r"pulling failed its vetting: scales: .* static stiffness is -3"
+    with pytest.raises(JudgeError, match=msg):
         build_judge("nn", "pulling", axis="axial", dt=model.dt, model_object=model)
 
 
@@ -232,3 +233,15 @@ def test_every_hold_the_certificate_lists_is_confirmed_or_refuted_by_the_attack(
     assert holds["n_failures"] == len(confirmed)
     # and they are among the failures the hybrid and the control are rechecked on
     assert report["recheck"]["profiles"] >= len(confirmed)
+
+
+def test_every_saved_case_records_the_judge_of_its_report(tmp_path):
+    out, corpus = tmp_path / "a", tmp_path / "corp"
+    argv = ["attack", "--model", "nn-paper", "--searchers", "random", "--budget", "8"]
+    argv += ["--max-shrink", "1", "--shrink-budget", "20", "--no-plots", "--quiet", "--save"]
+    assert main([*argv, "--corpus", str(corpus), "--out", str(out)]) == 0
+    report = json.loads((out / "report.json").read_text())
+    cases = sorted(corpus.glob("*.json"))
+    assert cases
+    for path in cases:
+        assert json.loads(path.read_text())["judge"] == report["judge"]

@@ -60,7 +60,6 @@ def _case(campaign, profile, family, params, found_by, **extra) -> Case:
     """``profile`` judged on every model of the campaign, as a corpus case."""
     c = campaign.config
     shas = {k: model_sha(campaign.specs[k], c.axis) for k in campaign.models}
-    c = campaign.config
     return make_case(
         profile,
         env=c.target,
@@ -73,6 +72,7 @@ def _case(campaign, profile, family, params, found_by, **extra) -> Case:
         reference_spec=campaign.reference_spec,
         scales=campaign.scales,
         static=campaign.static,
+        judge=campaign.judge.describe(),
         shas={campaign.specs[k]: shas[k] for k in campaign.models},
         **extra,
     )
@@ -142,7 +142,7 @@ def _shrunk_case(campaign, key: str, profile, meta: dict, seen: list) -> dict | 
 def paper_step_case(campaign) -> dict[str, Any]:
     """The papers' own case: a 4 mm step held 10 s, NN said to diverge after 7.3 s."""
     c = campaign.config
-    x = ex.step_hold(4e-3, 10.0, campaign.reference.dt, pre_s=0.5)
+    x = ex.step_hold(4e-3, 10.0, campaign.dt, pre_s=0.5)
     found_by = {
         "searcher": "paper (seed 000 §5.2)",
         "seed": None,

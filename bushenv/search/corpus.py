@@ -168,6 +168,7 @@ class Case:
     notes: str = ""
     scales: BushingScales = MACHINE
     static: bool = True  # the static criterion judged (the reference's static is trusted)
+    judge: dict[str, Any] | None = None  # the judge that made it (``Judge.describe``), if known
     path: Path | None = field(default=None, compare=False)
 
     def to_json(self) -> dict[str, Any]:
@@ -186,6 +187,7 @@ class Case:
             "reference": self.reference,
             "scales": self.scales.to_json(),
             "static": self.static,
+            "judge": self.judge,
             "shrink": self.shrink,
             "notes": self.notes,
         }
@@ -249,6 +251,7 @@ def make_case(
     shas: dict[str, str | None] | None = None,
     shrink: dict[str, Any] | None = None,
     notes: str = "",
+    judge: dict[str, Any] | None = None,
 ) -> Case:
     """A case whose ``expect`` holds what each model does on the decoded profile now, against
     ``reference`` (given by ``reference_spec``; None: judged without one) at ``scales``."""
@@ -281,6 +284,7 @@ def make_case(
         notes=notes,
         scales=scales,
         static=static,
+        judge=judge,
     )
 
 
@@ -374,6 +378,7 @@ def load_case(path: str | os.PathLike) -> Case:
         reference=d.get("reference", {}),
         scales=_scales(d.get("scales"), path),
         static=bool(d.get("static", True)),
+        judge=d.get("judge"),
         shrink=d.get("shrink"),
         notes=d.get("notes", ""),
         path=path,

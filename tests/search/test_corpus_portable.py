@@ -173,12 +173,6 @@ def test_a_case_saved_without_a_reference_replays_with_the_reference_free_criter
     assert "1 of 1 cases hold" in capsys.readouterr().out
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="bushenv/search/campaign_cases.py paper_step_case takes the sample time from "
-    "campaign.reference, None without a reference (AttributeError); fix: campaign.dt",
-)
 def test_the_papers_step_without_a_reference_is_kept_and_replays(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     shutil.copy(OLD_MODELS / "axial_nn-6f15bf3.npz", "my_nn.npz")
