@@ -5,7 +5,9 @@ PROVENANCE.md there). As a user would, it runs the ``bushenv`` commands one afte
 
 1. ``bushenv fit`` linear, nn and hybrid on the estimation record, judged on both test records;
 2. ``bushenv attack`` the fitted NN against the fitted hybrid as the reference, keeping what it
-   finds in a corpus; and the same attack with no reference (the physical criteria only);
+   finds in a corpus (the hybrid is vetted first; refused, the attack is run again with
+   ``--trust-reference`` and its verdicts marked unvetted); and the same attack with no
+   reference (the physical criteria only);
 3. ``bushenv replay`` the corpus;
 4. ``bushenv diagnose`` the linear model's gap on the test records.
 
@@ -17,6 +19,8 @@ Every figure of the page is in ``OUT/summary.json`` (and the commands' own outpu
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import json
 import sys
 import time
@@ -36,6 +40,18 @@ def step(name: str, argv: list[str], expect=(0,)) -> float:
     return time.perf_counter() - t0
 
 
+def refused(argv: list[str]) -> str | None:
+    """The one-line refusal of ``bushenv argv`` (exit 2), or None when it ran (exit 0)."""
+    err = io.StringIO()
+    print(f"\n$ bushenv {' '.join(argv)}", file=sys.stderr, flush=True)
+    with contextlib.redirect_stderr(err):
+        code = bushenv(argv)
+    sys.stderr.write(err.getvalue())
+    if code not in (0, 2):
+        raise SystemExit(f"bushenv exited {code}")
+    return err.getvalue().strip().splitlines()[-1] if code == 2 else None
+
+
 def run(data: Path, out: Path) -> dict:
     train = str(data / "train_multisine.csv")
     tests = [str(data / "test_multisine.csv"), str(data / "test_sinesweep.csv")]
@@ -48,8 +64,12 @@ def run(data: Path, out: Path) -> dict:
         )
         card = json.loads(path.with_suffix(".card.json").read_text())
         summary["fit"][m] = {Path(r["file"]).stem: r.get("metrics") for r in card["records"]}
+    vetting = ["attack", "--model", str(out / "nn.npz"), "--reference", str(out / "hybrid.npz")]
+    vetting += ["--out", str(out / "attack_vetting"), "--force", "--quiet"]
+    summary["hybrid_as_judge_refused"] = refused(vetting)
+    trust = [] if summary["hybrid_as_judge_refused"] is None else ["--trust-reference"]
     for name, extra in (
-        ("hybrid_reference", ["--reference", str(out / "hybrid.npz")]),
+        ("hybrid_reference", ["--reference", str(out / "hybrid.npz"), *trust]),
         ("no_reference", []),
     ):
         where = out / f"attack_{name}"
@@ -59,6 +79,7 @@ def run(data: Path, out: Path) -> dict:
         report = json.loads((where / "report.json").read_text())
         summary["attack"][name] = {
             "criteria": report["criteria"],
+            "judge": report["judge"],
             "notes": report["notes"],
             "scales": report["scales"],
             "rows": {
