@@ -140,7 +140,7 @@ class FmuBushing(BushingModel):
         self._slaves = [self._instance(i) for i in range(self.batch_size)]
 
     def _free(self) -> None:
-        for s in self._slaves:
+        for s in getattr(self, "_slaves", ()):
             try:
                 s.terminate()
                 s.freeInstance()

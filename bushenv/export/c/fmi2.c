@@ -9,22 +9,32 @@
 typedef struct {
     Core core;
     fmi2CallbackFunctions cb;
-    fmi2String name;
+    char name[128]; /* a copy: the importer's string need not outlive fmi2Instantiate */
     int logging_on;
     int initialised;
 } Instance;
 
+/* The logger's message is a printf format: importers that do not format it (a Python
+   callback) would show "%s", so the text itself is passed, its '%' doubled. */
+static void send2(Instance *m, fmi2Status status, const char *category, const char *message) {
+    char text[1024];
+    size_t j = 0;
+    for (size_t i = 0; message[i] && j + 2 < sizeof text; i++) {
+        if (message[i] == '%') text[j++] = '%';
+        text[j++] = message[i];
+    }
+    text[j] = 0;
+    m->cb.logger(m->cb.componentEnvironment, m->name, status, category, text);
+}
+
 static void log_fmi2(void *env, int warning, const char *message) {
     Instance *m = (Instance *)env;
     if (!warning && !m->logging_on) return;
-    m->cb.logger(m->cb.componentEnvironment, m->name, warning ? fmi2Warning : fmi2OK,
-                 warning ? "logStatusWarning" : "logAll", "%s", message);
+    send2(m, warning ? fmi2Warning : fmi2OK, warning ? "logStatusWarning" : "logAll", message);
 }
 
 static fmi2Status fail2(Instance *m, const char *message) {
-    if (m && m->cb.logger)
-        m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError", "%s",
-                     message);
+    if (m && m->cb.logger) send2(m, fmi2Error, "logStatusError", message);
     return fmi2Error;
 }
 
@@ -55,7 +65,7 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
     Instance *m = (Instance *)calloc(1, sizeof(Instance));
     if (!m) return NULL;
     m->cb = *cb;
-    m->name = name;
+    snprintf(m->name, sizeof m->name, "%s", name ? name : "");
     m->logging_on = logging_on;
     core_reset(&m->core, 0.0);
     m->core.log = log_fmi2;

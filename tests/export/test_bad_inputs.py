@@ -1,0 +1,102 @@
+"""Bad input to ``bushenv export`` and to the FMU loader: one line, exit 2, naming the fix."""
+
+import os
+import shutil
+import zipfile
+
+import pytest
+
+from bushenv.cli import main
+from bushenv.models import ModelError, get_model
+
+pytest.importorskip("fmpy")
+
+
+def _error(capsys) -> str:
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    return err
+
+
+def test_an_unknown_model_kind_is_refused_naming_the_known_ones(tmp_path, capsys):
+    assert main(["export", "spring", "--out", str(tmp_path / "a.fmu")]) == 2
+    assert "unknown model 'spring'" in _error(capsys)
+    assert main(["export", "rubber", "--out", str(tmp_path / "a.fmu")]) == 2
+    assert "exportable kinds: linear, nn, hybrid, boucwen" in _error(capsys)
+    assert not (tmp_path / "a.fmu").exists()
+
+
+def test_no_c_compiler_names_the_one_looked_for_and_how_to_install(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("CC", "no-such-cc")
+    assert main(["export", "linear", "--out", str(tmp_path / "a.fmu")]) == 2
+    err = _error(capsys)
+    assert "$CC='no-such-cc'" in err and "apt-get install gcc" in err
+    monkeypatch.delenv("CC")
+    monkeypatch.setenv("PATH", str(tmp_path))  # neither cc nor gcc
+    assert main(["export", "linear", "--out", str(tmp_path / "a.fmu")]) == 2
+    assert "'cc' and 'gcc' on PATH" in _error(capsys)
+
+
+def test_a_read_only_output_folder_is_refused(tmp_path, capsys):
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    folder.chmod(0o555)
+    # root writes into a 0o555 folder anyway; /proc refuses new files to everyone
+    target = folder if os.geteuid() != 0 else "/proc"
+    try:
+        assert main(["export", "linear", "--out", f"{target}/a.fmu"]) == 2
+    finally:
+        folder.chmod(0o755)
+    err = _error(capsys)
+    assert "a.fmu" in err and ("not writable" in err or "read-only" in err)
+
+
+def test_an_output_name_without_fmu_or_in_a_missing_folder_is_refused(tmp_path, capsys):
+    assert main(["export", "linear", "--out", str(tmp_path / "a.zip")]) == 2
+    assert "must end in .fmu" in _error(capsys)
+    assert main(["export", "linear", "--out", str(tmp_path / "no" / "a.fmu")]) == 2
+    assert "does not exist" in _error(capsys)
+
+
+def test_a_damaged_fmu_is_refused_as_a_model(tmp_path, fmu):
+    text = tmp_path / "text.fmu"
+    text.write_text("not a zip")
+    with pytest.raises(ModelError, match="damaged FMU: not a zip archive"):
+        get_model(str(text))
+    cut = tmp_path / "cut.fmu"
+    cut.write_bytes(fmu("linear", "2.0").read_bytes()[:400])
+    with pytest.raises(ModelError, match="damaged FMU"):
+        get_model(str(cut))
+    bad_xml = tmp_path / "bad.fmu"
+    with zipfile.ZipFile(fmu("linear", "2.0")) as src, zipfile.ZipFile(bad_xml, "w") as dst:
+        for item in src.namelist():
+            data = src.read(item)
+            dst.writestr(item, data[:100] if item == "modelDescription.xml" else data)
+    with pytest.raises(ModelError, match="modelDescription.xml cannot be read"):
+        get_model(str(bad_xml))
+
+
+def test_an_fmu_lacking_co_simulation_or_a_force_output_is_refused_naming_it(tmp_path, fmu):
+    def edited(name, old, new):
+        out = tmp_path / name
+        with zipfile.ZipFile(fmu("nn", "2.0")) as src, zipfile.ZipFile(out, "w") as dst:
+            for item in src.namelist():
+                data = src.read(item)
+                if item == "modelDescription.xml":
+                    data = data.decode().replace(old, new).encode()
+                dst.writestr(item, data)
+        return out
+
+    with pytest.raises(ModelError, match="lacks co-simulation"):
+        get_model(str(edited("me.fmu", "CoSimulation", "ModelExchange")))
+    with pytest.raises(ModelError, match="lacks a Real output 'force'"):
+        get_model(str(edited("noout.fmu", 'causality="output"', 'causality="local"')))
+    with pytest.raises(ModelError, match="lacks a Real input 'deflection'"):
+        get_model(str(edited("noin.fmu", 'causality="input"', 'causality="local"')))
+
+
+def test_the_cli_refuses_a_damaged_fmu_as_a_model_in_one_line(tmp_path, capsys):
+    bad = tmp_path / "bad.fmu"
+    shutil.copyfile(__file__, bad)
+    assert main(["certify", str(bad), "--out", str(tmp_path / "c")]) == 2
+    assert "damaged FMU" in _error(capsys)
