@@ -133,3 +133,20 @@ def test_shipped_nn_round_trip_loads_the_fmu_as_a_model_with_the_same_forces(fmu
     assert np.max(np.abs(both[:, 1] - get_model("nn").simulate(0.5 * x))) <= EXACT * np.max(
         np.abs(ref)
     )
+
+
+@pytest.mark.parametrize("model_name", ("nn", "hybrid"))
+def test_fmi2_input_derivatives_give_the_force_on_time_even_read_before_the_next_input(
+    fmu, model_name
+):
+    """A master that sets the inputs' slopes (canInterpolateInputs): the FMU extrapolates the
+    input along them, so the force read right after doStep is the model's at that time."""
+    from bushenv.export.fmpy_master import derivatives_then_step
+
+    dt = PAPER_DT
+    x = inputs()["random n=1"][:400]
+    v = np.gradient(x, dt)
+    t = np.arange(len(x)) * dt
+    got = derivatives_then_step(fmu(model_name, "2.0"), t, x, v)
+    ref = _reference(model_name, x, v)
+    assert np.max(np.abs(got - ref[1:])) <= EXACT * np.max(np.abs(ref))
