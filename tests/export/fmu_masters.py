@@ -1,6 +1,5 @@
 """What the export tests share: bushenv excitations and the set-then-read master."""
 
-
 from bushenv import excitation as ex
 from bushenv.export.fmpy_master import set_then_read  # noqa: F401  (re-exported)
 from bushenv.models import PAPER_DT
