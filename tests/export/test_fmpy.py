@@ -173,3 +173,26 @@ def test_fmpy_rebuilds_the_binary_from_the_sources_inside_with_the_same_forces(f
                     zf.write(p, p.relative_to(folder).as_posix())
         got = get_model(str(rebuilt)).simulate(x)
         assert np.max(np.abs(got - ref)) <= EXACT * np.max(np.abs(ref))
+
+
+def test_simulate_fmu_runs_the_papers_programme_as_bushenv_does(fmu):
+    """Every record of the papers' programme through FMPy (hybrid, FMI 3.0), one step late."""
+    from fmpy import simulate_fmu
+
+    from bushenv.machine import papers_programme
+
+    model = get_model("hybrid")
+    for item in papers_programme(PAPER_DT):
+        x = item.x
+        v = np.gradient(x, PAPER_DT)
+        t = np.arange(len(x)) * PAPER_DT
+        res = simulate_fmu(
+            str(fmu("hybrid", "3.0")),
+            stop_time=t[-1],
+            output_interval=PAPER_DT,
+            input=_signal("hybrid", t, x, v),
+            output=["force"],
+        )
+        ref = model.simulate(x, v)
+        err = np.max(np.abs(res["force"][1:] - ref[:-1])) / np.max(np.abs(ref))
+        assert err <= EXACT, item.name
