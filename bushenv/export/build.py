@@ -36,8 +36,14 @@ from bushenv.persist import atomic_write
 CFLAGS = ("-shared", "-fPIC", "-O2", "-std=c99", "-ffp-contract=off", "-fvisibility=hidden")
 HEADERS = ("core.h", "variables.h")
 FMI_HEADERS = {
-    "2.0": ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h", "fmi2_stubs.h"),
-    "3.0": ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h", "fmi3_stubs.h"),
+    "2.0": ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h", "fmi2_me.h"),
+    "3.0": (
+        "fmi3Functions.h",
+        "fmi3FunctionTypes.h",
+        "fmi3PlatformTypes.h",
+        "fmi3_me.h",
+        "fmi3_stubs.h",
+    ),
 }
 INSTALL_HINT = (
     "install one (Debian/Ubuntu: apt-get install gcc; Fedora: dnf install gcc; macOS: "
@@ -173,11 +179,10 @@ def export_fmu(
     with tempfile.TemporaryDirectory(prefix="bushenv-fmu-") as tmp:
         binary = compile_library(sources, main, compiler, Path(tmp))
     tool = f"bushenv {__version__}"
-    files = {
-        "modelDescription.xml": model_description(
-            fmi_version, model.name, token, has_v, facts, model.dt, tool
-        ).encode()
-    }
+    description = model_description(
+        fmi_version, model.name, token, has_v, facts, model.dt, tool, ode=model.name == "boucwen"
+    )
+    files = {"modelDescription.xml": description.encode()}
     files[f"binaries/{folders[fmi_version]}/{MODEL_IDENTIFIER}.so"] = binary
     for name, data in sources.items():
         files[f"sources/{name}"] = data

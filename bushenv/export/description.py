@@ -30,10 +30,20 @@ class Variable:
     description: str
     unit: str | None = None
     start: str | None = None
+    derivative_of: int | None = None  # vr of the state this is the derivative of
 
 
-def variables(has_velocity: bool, facts: Facts, dt: float) -> list[Variable]:
+STATES = ("y", "w", "z1", "z2")  # seed 002 eqs. 1-4, model exchange (value references 10-13)
+# where eqs. 1-2 switch (sgn d sgn z): relative velocities d1, d2 and z1, z2 (references 18-21)
+INDICATORS = ("d1", "d2", "z1", "z2")
+UNIT_OF = {"d1": "m/s", "d2": "m/s", "z1": "m", "z2": "m"}
+
+
+def variables(has_velocity: bool, facts: Facts, dt: float, ode: bool = False) -> list[Variable]:
+    """The FMU's variables; ``ode``: the model is an ODE (model exchange too): the force is
+    continuous and the states and their derivatives are listed."""
     env = facts.envelope
+    changes = "continuous" if ode else "discrete"
     out = [
         Variable(
             "deflection",
@@ -56,7 +66,7 @@ def variables(has_velocity: bool, facts: Facts, dt: float) -> list[Variable]:
             3,
             "Real",
             "output",
-            "discrete",
+            changes,
             "bushing force of the latest model sample",
             "N",
         ),
@@ -73,7 +83,7 @@ def variables(has_velocity: bool, facts: Facts, dt: float) -> list[Variable]:
             5,
             "Real",
             "output",
-            "discrete",
+            changes,
             "time the input has spent outside the validity envelope",
             "s",
         ),
@@ -108,6 +118,47 @@ def variables(has_velocity: bool, facts: Facts, dt: float) -> list[Variable]:
             lit(dt),
         ),
     ]
+    if ode:
+        for i, name in enumerate(STATES):
+            unit = "m"
+            out.append(
+                Variable(
+                    f"state.{name}",
+                    10 + i,
+                    "Real",
+                    "local",
+                    "continuous",
+                    f"seed 002 eqs. 1-4: {name}",
+                    unit,
+                    "0.0",
+                )
+            )
+        for i, name in enumerate(STATES):
+            out.append(
+                Variable(
+                    f"der(state.{name})",
+                    14 + i,
+                    "Real",
+                    "local",
+                    "continuous",
+                    f"d{name}/dt",
+                    "m/s",
+                    None,
+                    10 + i,
+                )
+            )
+        for i, name in enumerate(INDICATORS):
+            out.append(
+                Variable(
+                    f"event.{name}",
+                    18 + i,
+                    "Real",
+                    "local",
+                    "continuous",
+                    f"event indicator: {name} changes sign",
+                    UNIT_OF[name],
+                )
+            )
     for i, (name, value) in enumerate(facts.lines):
         out.append(
             Variable(
@@ -144,16 +195,23 @@ def _log_categories() -> list[str]:
     ]
 
 
-def _card_xml(facts: Facts) -> str:
-    items = "".join(f"<Fact name={quoteattr(n)}>{escape(v)}</Fact>" for n, v in facts.lines)
+def _card_xml(lines: list[tuple[str, str]]) -> str:
+    items = "".join(f"<Fact name={quoteattr(n)}>{escape(v)}</Fact>" for n, v in lines)
     return f"<Card>{items}</Card>"
 
 
 def model_description(
-    version: str, kind: str, token: str, has_velocity: bool, facts: Facts, dt: float, tool: str
+    version: str,
+    kind: str,
+    token: str,
+    has_velocity: bool,
+    facts: Facts,
+    dt: float,
+    tool: str,
+    ode: bool = False,
 ) -> str:
-    """modelDescription.xml for FMI ``version`` (co-simulation)."""
-    vs = variables(has_velocity, facts, dt)
+    """modelDescription.xml for FMI ``version``: co-simulation, and model exchange if ``ode``."""
+    vs = variables(has_velocity, facts, dt, ode)
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
     head = _attr(
         fmiVersion=version,
@@ -163,41 +221,81 @@ def model_description(
         generationDateAndTime=now,
         variableNamingConvention="structured",
     )
-    inputs = " ".join(str(v.vr) for v in vs if v.causality == "input")
-    outs = [v for v in vs if v.causality == "output"]
-    if version == "2.0":
-        idx = {v.vr: i + 1 for i, v in enumerate(vs)}
-        in_idx = " ".join(str(idx[v.vr]) for v in vs if v.causality == "input")
-        lines = [
-            '<?xml version="1.0" encoding="UTF-8"?>',
-            f'<fmiModelDescription{head} guid="{token}" numberOfEventIndicators="0">',
-            f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}"'
-            ' canHandleVariableCommunicationStepSize="true" canInterpolateInputs="true"'
-            ' maxOutputDerivativeOrder="0">',
-            '    <SourceFiles><File name="fmi2.c"/></SourceFiles>',
-            "  </CoSimulation>",
-            *_units(),
-            *_log_categories(),
-            f'  <DefaultExperiment startTime="0.0" stepSize="{lit(dt)}"/>',
-            f'  <VendorAnnotations><Tool name="bushenv">{_card_xml(facts)}</Tool>'
-            "</VendorAnnotations>",
-            "  <ModelVariables>",
+    make = _fmi2 if version == "2.0" else _fmi3
+    return (
+        "\n".join(['<?xml version="1.0" encoding="UTF-8"?>', *make(vs, head, token, dt, ode)])
+        + "\n"
+    )
+
+
+def _fmi2(vs: list[Variable], head: str, token: str, dt: float, ode: bool) -> list[str]:
+    idx = {v.vr: i + 1 for i, v in enumerate(vs)}
+    # outputs of an ODE model depend on the states too: no list (= on every known)
+    deps = (
+        ""
+        if ode
+        else _attr(dependencies=" ".join(str(idx[v.vr]) for v in vs if v.causality == "input"))
+    )
+    src = '<SourceFiles><File name="fmi2.c"/></SourceFiles>'
+    n_ind = len(INDICATORS) if ode else 0
+    lines = [f'<fmiModelDescription{head} guid="{token}" numberOfEventIndicators="{n_ind}">']
+    if ode:
+        lines.append(f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}">{src}</ModelExchange>')
+    lines += [
+        f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}"'
+        ' canHandleVariableCommunicationStepSize="true" canInterpolateInputs="true"'
+        f' maxOutputDerivativeOrder="0">{src}</CoSimulation>',
+        *_units(),
+        *_log_categories(),
+        f'  <DefaultExperiment startTime="0.0" stepSize="{lit(dt)}"/>',
+        f'  <VendorAnnotations><Tool name="bushenv">{_card_xml(facts_of_lines(vs))}</Tool>'
+        "</VendorAnnotations>",
+        "  <ModelVariables>",
+    ]
+    for v in vs:
+        exact = v.variability == "constant" or (v.start is not None and v.causality == "local")
+        attrs = _attr(
+            name=v.name,
+            valueReference=v.vr,
+            description=v.description,
+            causality=v.causality,
+            variability=v.variability,
+            initial="exact" if exact else None,
+        )
+        der = idx[v.derivative_of] if v.derivative_of is not None else None
+        lines.append(
+            f"    <ScalarVariable{attrs}>"
+            f"<{v.kind}{_attr(unit=v.unit, start=v.start, derivative=der)}/>"
+            "</ScalarVariable>"
+        )
+    outs = [idx[v.vr] for v in vs if v.causality == "output"]
+    ders = [idx[v.vr] for v in vs if v.derivative_of is not None]
+    lines += ["  </ModelVariables>", "  <ModelStructure>", "    <Outputs>"]
+    lines += [f'      <Unknown index="{i}"{deps}/>' for i in outs]
+    lines += ["    </Outputs>"]
+    if ders:
+        lines += [
+            "    <Derivatives>",
+            *[f'      <Unknown index="{i}"/>' for i in ders],
+            "    </Derivatives>",
         ]
-        for v in vs:
-            initial = "exact" if v.variability == "constant" else None
-            lines.append(
-                f"    <ScalarVariable{_attr(name=v.name, valueReference=v.vr, description=v.description, causality=v.causality, variability=v.variability, initial=initial)}>"  # noqa: E501
-                f"<{v.kind}{_attr(unit=v.unit, start=v.start)}/></ScalarVariable>"
-            )
-        lines += ["  </ModelVariables>", "  <ModelStructure>", "    <Outputs>"]
-        lines += [f'      <Unknown index="{idx[v.vr]}" dependencies="{in_idx}"/>' for v in outs]
-        lines += ["    </Outputs>", "    <InitialUnknowns>"]
-        lines += [f'      <Unknown index="{idx[v.vr]}" dependencies="{in_idx}"/>' for v in outs]
-        lines += ["    </InitialUnknowns>", "  </ModelStructure>", "</fmiModelDescription>"]
-        return "\n".join(lines) + "\n"
-    lines = [
-        '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<fmiModelDescription{head} instantiationToken="{token}">',
+    lines += ["    <InitialUnknowns>"]
+    lines += [f'      <Unknown index="{i}"{deps}/>' for i in sorted(outs + ders)]
+    lines += ["    </InitialUnknowns>", "  </ModelStructure>", "</fmiModelDescription>"]
+    return lines
+
+
+def _fmi3(vs: list[Variable], head: str, token: str, dt: float, ode: bool) -> list[str]:
+    deps = (
+        "" if ode else _attr(dependencies=" ".join(str(v.vr) for v in vs if v.causality == "input"))
+    )
+    lines = [f'<fmiModelDescription{head} instantiationToken="{token}">']
+    if ode:
+        lines.append(
+            f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}"'
+            ' needsCompletedIntegratorStep="true"/>'
+        )
+    lines += [
         f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}"'
         ' canHandleVariableCommunicationStepSize="true" hasEventMode="false"'
         f' fixedInternalStepSize="{lit(dt)}" providesIntermediateUpdate="false"/>',
@@ -210,30 +308,40 @@ def model_description(
     ]
     for v in vs:
         tag = {"Real": "Float64", "Boolean": "Boolean", "String": "String"}[v.kind]
+        exact = v.variability != "constant" and v.start is not None and v.causality == "local"
         attrs = _attr(
             name=v.name,
             valueReference=v.vr,
             description=v.description,
             causality=v.causality,
             variability=v.variability,
+            initial="exact" if exact else None,
             unit=v.unit,
+            derivative=v.derivative_of,
         )
         if v.kind == "String" and v.start is not None:
             lines.append(f"    <{tag}{attrs}><Start value={quoteattr(v.start)}/></{tag}>")
         else:
             lines.append(f"    <{tag}{attrs}{_attr(start=v.start)}/>")
+    outs = [v.vr for v in vs if v.causality == "output"]
+    ders = [v.vr for v in vs if v.derivative_of is not None]
     lines += ["  </ModelVariables>", "  <ModelStructure>"]
-    lines += [f'    <Output valueReference="{v.vr}" dependencies="{inputs}"/>' for v in outs]
-    lines += [
-        f'    <InitialUnknown valueReference="{v.vr}" dependencies="{inputs}"/>' for v in outs
-    ]
+    lines += [f'    <Output valueReference="{vr}"{deps}/>' for vr in outs]
+    lines += [f'    <ContinuousStateDerivative valueReference="{vr}"/>' for vr in ders]
+    lines += [f'    <InitialUnknown valueReference="{vr}"{deps}/>' for vr in outs + ders]
+    lines += [f'    <EventIndicator valueReference="{v.vr}"/>' for v in vs if v.vr in range(18, 22)]
     lines += [
         "  </ModelStructure>",
-        f'  <Annotations><Annotation type="org.bushenv.card">{_card_xml(facts)}</Annotation>'
-        "</Annotations>",
+        '  <Annotations><Annotation type="org.bushenv.card">'
+        f"{_card_xml(facts_of_lines(vs))}</Annotation></Annotations>",
         "</fmiModelDescription>",
     ]
-    return "\n".join(lines) + "\n"
+    return lines
+
+
+def facts_of_lines(vs: list[Variable]) -> list[tuple[str, str]]:
+    """The card's facts back from their string constants (the annotation repeats them)."""
+    return [(v.name.removeprefix("card."), v.start or "") for v in vs if v.kind == "String"]
 
 
 def build_description() -> str:

@@ -84,3 +84,72 @@ def derivatives_then_step(path, t_comm, x_comm, v_comm) -> np.ndarray:
             s.doStep(currentCommunicationPoint=float(t_comm[j]), communicationStepSize=h)
             out[j] = s.getReal([vr["force"]])[0]
         return out
+
+
+def model_exchange_rk4(path, t, x, v, substeps: int = 64) -> np.ndarray:
+    """Model exchange through FMPy's FMU classes with a fixed-step RK4 of our own: per sample,
+    ``substeps`` steps with the inputs linear within the sample (as ``boucwen_reference``),
+    the FMU giving the derivatives. Returns the force at each sample (inputs set, then read)."""
+    from ctypes import c_double
+
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Model
+    from fmpy.fmi3 import FMU3Model
+
+    md = read_model_description(str(path))
+    vr = {var.name: var.valueReference for var in md.modelVariables}
+    three = md.fmiVersion.startswith("3")
+    with tempfile.TemporaryDirectory(prefix="bushenv-fmu-") as folder:
+        m = (FMU3Model if three else FMU2Model)(
+            guid=md.guid,
+            unzipDirectory=extract(str(path), folder),
+            modelIdentifier=md.modelExchange.modelIdentifier,
+            instanceName="bushenv",
+        )
+        m.instantiate()
+        if three:
+            m.enterInitializationMode(startTime=float(t[0]))
+        else:
+            m.setupExperiment(startTime=float(t[0]))
+            m.enterInitializationMode()
+        m.exitInitializationMode()
+        if not three:
+            m.newDiscreteStates()
+        m.enterContinuousTimeMode()
+        setf = m.setFloat64 if three else m.setReal
+        getf = m.getFloat64 if three else m.getReal
+        deriv = m.getContinuousStateDerivatives if three else m.getDerivatives
+        q, dq = (c_double * 4)(), (c_double * 4)()
+        m.getContinuousStates(q, 4)
+
+        def rhs(tt, xx, uu, state):
+            m.setTime(tt)
+            setf([vr["deflection"], vr["velocity"]], [xx, uu])
+            m.setContinuousStates((c_double * 4)(*state), 4)
+            deriv(dq, 4)
+            return np.array(dq[:])
+
+        out = np.empty(len(t))
+        y = np.array(q[:])
+        x0 = u0 = 0.0
+        dt = t[1] - t[0]
+        h = dt / substeps
+        for k in range(len(t)):
+            for i in range(substeps):  # from rest before t[0], as the reference
+                a, mid, e = i / substeps, (i + 0.5) / substeps, (i + 1.0) / substeps
+                ta = t[k] - dt + a * dt
+                k1 = rhs(ta, x0 + a * (x[k] - x0), u0 + a * (v[k] - u0), y)
+                xm, um = x0 + mid * (x[k] - x0), u0 + mid * (v[k] - u0)
+                k2 = rhs(ta + h / 2, xm, um, y + h / 2 * k1)
+                k3 = rhs(ta + h / 2, xm, um, y + h / 2 * k2)
+                k4 = rhs(ta + h, x0 + e * (x[k] - x0), u0 + e * (v[k] - u0), y + h * k3)
+                y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            m.setTime(float(t[k]))
+            setf([vr["deflection"], vr["velocity"]], [float(x[k]), float(v[k])])
+            m.setContinuousStates((c_double * 4)(*y), 4)
+            out[k] = getf([vr["force"]])[0]
+            m.completedIntegratorStep()
+            x0, u0 = float(x[k]), float(v[k])
+        m.terminate()
+        m.freeInstance()
+        return out

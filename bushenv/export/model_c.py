@@ -56,6 +56,14 @@ def model_source(model: BushingModel, substeps: int = BOUCWEN_SUBSTEPS) -> str:
         body = _boucwen(model, substeps)
     else:
         body = _narx(model)
+    if kind != "boucwen":  # a recurrence, not an ODE: co-simulation only
+        body += [
+            "#define MODEL_HAS_RHS 0",
+            "static void model_rhs(double x, double u, const double *q, double *dq)"
+            " { (void)x; (void)u; (void)q; (void)dq; }",
+            "static double model_force(const double *q, double x, double u)"
+            " { (void)q; (void)x; (void)u; return 0.0; }",
+        ]
     return "\n".join(head + body) + "\n"
 
 
@@ -156,6 +164,7 @@ def _boucwen(m, substeps: int) -> list[str]:
     p = {k: lit(getattr(m, k)) for k in m.param_names}
     return [
         "#define MODEL_N_STATE 6",
+        "#define MODEL_HAS_RHS 1 /* an ODE: model exchange too (y, w, z1, z2) */",
         f"#define MODEL_SUBSTEPS {int(substeps)}",
         "static double sgn_prod(double d, double z) {",
         "    if (d == 0.0 || z == 0.0) return 0.0;",
@@ -173,6 +182,11 @@ def _boucwen(m, substeps: int) -> list[str]:
         f" * pow(fabs(z1), {p['n1']}));",
         f"    dq[3] = d2 * ({p['A2']} - ({p['gamma2']} + {p['beta2']} * sgn_prod(d2, z2))"
         f" * pow(fabs(z2), {p['n2']}));",
+        "}",
+        "static double model_force(const double *q, double x1, double u1) { /* eq. 5 */",
+        f"    double dw = ({p['c2']} * u1 + {p['k2']} * (x1 - q[1]) + {p['a2']} * q[3])"
+        f" / ({p['c0']} + {p['c2']});",
+        f"    return {p['k0']} * q[0] + {p['c0']} * dw;",
         "}",
         "static void model_reset(double *s) { for (int i = 0; i < 6; i++) s[i] = 0.0; }",
         "static double model_step(double *s, double x1, double u1) {",
@@ -193,8 +207,6 @@ def _boucwen(m, substeps: int) -> list[str]:
         "    }",
         "    for (int j = 0; j < 4; j++) s[j] = q[j];",
         "    s[4] = x1; s[5] = u1;",
-        f"    double dw = ({p['c2']} * u1 + {p['k2']} * (x1 - q[1]) + {p['a2']} * q[3])"
-        f" / ({p['c0']} + {p['c2']});",
-        f"    return {p['k0']} * q[0] + {p['c0']} * dw;",
+        "    return model_force(q, x1, u1);",
         "}",
     ]

@@ -36,6 +36,10 @@ typedef struct {
     double dx_now, dv_now;      /* input derivatives set by the master (FMI 2) */
     int fresh;                  /* the input at t_now is known: set, or along a derivative */
     int has_derivative;         /* the master sets input derivatives (FMI 2) */
+    /* model exchange (ODE models): the importer integrates q = (y, w, z1, z2) */
+    int me;
+    double q[4], t_last_step, me_time_outside;
+    int me_outside;
     core_log_fn log;
     void *log_env;
     char message[512];
@@ -51,6 +55,10 @@ static void core_reset(Core *c, double t0) {
     c->x_now = c->v_now = c->x_known = c->v_known = c->dx_now = c->dv_now = 0.0;
     c->fresh = 1;
     c->has_derivative = 0;
+    for (int i = 0; i < 4; i++) c->q[i] = 0.0;
+    c->t_last_step = t0;
+    c->me_time_outside = 0.0;
+    c->me_outside = 0;
 }
 
 static int core_in_flagged(double x) {
@@ -168,4 +176,21 @@ static void core_set_derivative(Core *c, int which, double value) {
     if (which == 0) c->dx_now = value;
     else c->dv_now = value;
     c->has_derivative = 1;
+}
+
+/* Model exchange: after each completed integrator step, the time since the last one counts as
+   outside when the input now is (velocity: the velocity input, there being no samples). */
+static void core_me_completed(Core *c) {
+    const char *why = core_outside_why(c->x_now, fabs(c->v_now));
+    if (why) c->me_time_outside += c->t_now - c->t_last_step;
+    if (why && !c->me_outside && c->log) {
+        snprintf(c->message, sizeof c->message,
+                 "t = %.6g s: input leaves the bushing's validity envelope: %s "
+                 "(x = %.6g m, v = %.6g m/s, stroke %.6g m, velocity limit %.6g m/s; %s)",
+                 c->t_now, why, c->x_now, c->v_now, ENV_STROKE_M, ENV_VELOCITY_M_PER_S,
+                 ENV_SOURCE);
+        c->log(c->log_env, 1, c->message);
+    }
+    c->me_outside = why != NULL;
+    c->t_last_step = c->t_now;
 }

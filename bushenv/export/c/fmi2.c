@@ -1,10 +1,10 @@
-/* FMI 2.0 co-simulation interface of a bushenv bushing FMU (model.h generated, core.h shared). */
+/* FMI 2.0 interface of a bushenv bushing FMU (model.h generated, core.h shared): co-simulation,
+   and model exchange for ODE models (fmi2_me.h). */
 #include <stdlib.h>
 #include "fmi2Functions.h"
 #include "model.h"
 #include "core.h"
 #include "variables.h"
-#include "fmi2_stubs.h"
 
 typedef struct {
     Core core;
@@ -52,7 +52,7 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
                               fmi2Boolean visible, fmi2Boolean logging_on) {
     (void)resources; (void)visible;
     if (!cb || !cb->logger) return NULL;
-    if (type != fmi2CoSimulation) {
+    if (type != fmi2CoSimulation && !(type == fmi2ModelExchange && MODEL_HAS_RHS)) {
         cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError",
                    "this FMU supports co-simulation only");
         return NULL;
@@ -68,6 +68,7 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
     snprintf(m->name, sizeof m->name, "%s", name ? name : "");
     m->logging_on = logging_on;
     core_reset(&m->core, 0.0);
+    m->core.me = type == fmi2ModelExchange;
     m->core.log = log_fmi2;
     m->core.log_env = m;
     return m;
@@ -80,9 +81,11 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, fmi2Rea
     (void)tol_defined; (void)tol; (void)stop_defined; (void)stop;
     Instance *m = (Instance *)c;
     double x = m->core.x_now, v = m->core.v_now;
+    int me = m->core.me;
     core_reset(&m->core, start);
     m->core.x_now = x;
     m->core.v_now = v;
+    m->core.me = me;
     return fmi2OK;
 }
 
@@ -94,7 +97,9 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }
 fmi2Status fmi2Reset(fmi2Component c) {
     Instance *m = (Instance *)c;
+    int me = m->core.me;
     core_reset(&m->core, 0.0);
+    m->core.me = me;
     m->initialised = 0;
     return fmi2OK;
 }
@@ -252,3 +257,5 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind k, fmi2Stri
     (void)k; (void)v;
     return fail2((Instance *)c, "fmi2GetStringStatus: not provided");
 }
+
+#include "fmi2_me.h"

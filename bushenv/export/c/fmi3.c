@@ -1,12 +1,11 @@
-/* FMI 3.0 co-simulation interface of a bushenv bushing FMU (model.h generated, core.h shared).
-   Functions of the other interface types and of types this FMU has none of are in
-   fmi3_stubs.h: they report an error. */
+/* FMI 3.0 interface of a bushenv bushing FMU (model.h generated, core.h shared): co-simulation,
+   and model exchange for ODE models (fmi3_me.h). Functions of scheduled execution and of types
+   this FMU has none of are in fmi3_stubs.h: they report an error. */
 #include <stdlib.h>
 #include "fmi3Functions.h"
 #include "model.h"
 #include "core.h"
 #include "variables.h"
-#include "fmi3_stubs.h"
 
 typedef struct {
     Core core;
@@ -35,13 +34,9 @@ fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean on, size_t n, const f
     return fmi3OK;
 }
 
-fmi3Instance fmi3InstantiateCoSimulation(
-    fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible,
-    fmi3Boolean logging_on, fmi3Boolean event_mode_used, fmi3Boolean early_return_allowed,
-    const fmi3ValueReference required[], size_t n_required, fmi3InstanceEnvironment env,
-    fmi3LogMessageCallback log_message, fmi3IntermediateUpdateCallback intermediate) {
-    (void)name; (void)resources; (void)visible; (void)event_mode_used;
-    (void)early_return_allowed; (void)required; (void)n_required; (void)intermediate;
+static Instance *new_instance(fmi3String token, fmi3Boolean logging_on,
+                              fmi3InstanceEnvironment env, fmi3LogMessageCallback log_message,
+                              int me) {
     if (!token || strcmp(token, FMU_TOKEN) != 0) {
         if (log_message)
             log_message(env, fmi3Error, "logStatusError",
@@ -54,9 +49,20 @@ fmi3Instance fmi3InstantiateCoSimulation(
     m->log_message = log_message;
     m->logging_on = logging_on;
     core_reset(&m->core, 0.0);
+    m->core.me = me;
     m->core.log = log_fmi3;
     m->core.log_env = m;
     return m;
+}
+
+fmi3Instance fmi3InstantiateCoSimulation(
+    fmi3String name, fmi3String token, fmi3String resources, fmi3Boolean visible,
+    fmi3Boolean logging_on, fmi3Boolean event_mode_used, fmi3Boolean early_return_allowed,
+    const fmi3ValueReference required[], size_t n_required, fmi3InstanceEnvironment env,
+    fmi3LogMessageCallback log_message, fmi3IntermediateUpdateCallback intermediate) {
+    (void)name; (void)resources; (void)visible; (void)event_mode_used;
+    (void)early_return_allowed; (void)required; (void)n_required; (void)intermediate;
+    return new_instance(token, logging_on, env, log_message, 0);
 }
 
 void fmi3FreeInstance(fmi3Instance c) { free(c); }
@@ -67,9 +73,11 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean tol_defined, 
     (void)tol_defined; (void)tol; (void)stop_defined; (void)stop;
     Instance *m = (Instance *)c;
     double x = m->core.x_now, v = m->core.v_now;
+    int me = m->core.me;
     core_reset(&m->core, start);
     m->core.x_now = x;
     m->core.v_now = v;
+    m->core.me = me;
     return fmi3OK;
 }
 
@@ -78,7 +86,10 @@ fmi3Status fmi3EnterEventMode(fmi3Instance c) { (void)c; return fmi3OK; }
 fmi3Status fmi3EnterStepMode(fmi3Instance c) { (void)c; return fmi3OK; }
 fmi3Status fmi3Terminate(fmi3Instance c) { (void)c; return fmi3OK; }
 fmi3Status fmi3Reset(fmi3Instance c) {
-    core_reset(&((Instance *)c)->core, 0.0);
+    Instance *m = (Instance *)c;
+    int me = m->core.me;
+    core_reset(&m->core, 0.0);
+    m->core.me = me;
     return fmi3OK;
 }
 
@@ -196,3 +207,6 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 t, fmi3Float64 h, fmi3Boolean 
     *last = t + h;
     return fmi3OK;
 }
+
+#include "fmi3_me.h"
+#include "fmi3_stubs.h"

@@ -1,9 +1,6 @@
-/* FMI 3.0 functions this co-simulation FMU does not provide: each reports an error (an
-   importer binds every function of the standard when it loads the binary). */
-fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken, fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn, fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
-    (void)instanceName; (void)instantiationToken; (void)resourcePath; (void)visible; (void)loggingOn; (void)instanceEnvironment; (void)logMessage;
-    return NULL;
-}
+/* FMI 3.0 functions this FMU does not provide (scheduled execution, clocks, integer and
+   binary types, FMU state, directional derivatives): each reports an error (an importer
+   binds every function of the standard when it loads the binary). */
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken, fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn, fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage, fmi3ClockUpdateCallback clockUpdate, fmi3LockPreemptionCallback lockPreemption, fmi3UnlockPreemptionCallback unlockPreemption) {
     (void)instanceName; (void)instantiationToken; (void)resourcePath; (void)visible; (void)loggingOn; (void)instanceEnvironment; (void)logMessage; (void)clockUpdate; (void)lockPreemption; (void)unlockPreemption;
     return NULL;
@@ -158,46 +155,6 @@ fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference 
 }
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance) {
     (void)instance;
-    return fmi3Error;
-}
-fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
-    (void)instance;
-    return fmi3Error;
-}
-fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean* enterEventMode, fmi3Boolean* terminateSimulation) {
-    (void)instance; (void)noSetFMUStatePriorToCurrentPoint; (void)enterEventMode; (void)terminateSimulation;
-    return fmi3Error;
-}
-fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
-    (void)instance; (void)time;
-    return fmi3Error;
-}
-fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[], size_t nContinuousStates) {
-    (void)instance; (void)continuousStates; (void)nContinuousStates;
-    return fmi3Error;
-}
-fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[], size_t nContinuousStates) {
-    (void)instance; (void)derivatives; (void)nContinuousStates;
-    return fmi3Error;
-}
-fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t nEventIndicators) {
-    (void)instance; (void)eventIndicators; (void)nEventIndicators;
-    return fmi3Error;
-}
-fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t nContinuousStates) {
-    (void)instance; (void)continuousStates; (void)nContinuousStates;
-    return fmi3Error;
-}
-fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nContinuousStates) {
-    (void)instance; (void)nominals; (void)nContinuousStates;
-    return fmi3Error;
-}
-fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t* nEventIndicators) {
-    (void)instance; (void)nEventIndicators;
-    return fmi3Error;
-}
-fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t* nContinuousStates) {
-    (void)instance; (void)nContinuousStates;
     return fmi3Error;
 }
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference, fmi3Float64 activationTime) {
