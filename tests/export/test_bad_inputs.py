@@ -100,3 +100,40 @@ def test_the_cli_refuses_a_damaged_fmu_as_a_model_in_one_line(tmp_path, capsys):
     shutil.copyfile(__file__, bad)
     assert main(["certify", str(bad), "--out", str(tmp_path / "c")]) == 2
     assert "damaged FMU" in _error(capsys)
+
+
+def test_an_fmu_without_a_sample_time_needs_dt(tmp_path, fmu):
+    out = tmp_path / "nodt.fmu"
+    with zipfile.ZipFile(fmu("nn", "3.0")) as src, zipfile.ZipFile(out, "w") as dst:
+        for item in src.namelist():
+            data = src.read(item)
+            if item == "modelDescription.xml":
+                text = data.decode()
+                start = text.index("  <DefaultExperiment")
+                data = (text[:start] + text[text.index("\n", start) + 1 :]).encode()
+            dst.writestr(item, data)
+    with pytest.raises(ModelError, match="states no sample time"):
+        get_model(str(out))
+    assert get_model(str(out), dt=1 / 204.8).dt == 1 / 204.8
+
+
+def test_a_card_that_no_longer_matches_its_model_stops_the_export(tmp_path, capsys):
+    from bushenv.identify.card import new_card, write_card
+
+    model = get_model("linear")
+    path = model.save(tmp_path / "lin.npz")
+    write_card(new_card(model, path, {"kind": "fit", "seed": 0, "wall_time_s": 0.0}), path)
+    type(model)(k_n_per_m=1.0, c_ns_per_m=1.0).save(path)  # replaced after the card
+    assert main(["export", str(path), "--out", str(tmp_path / "a.fmu")]) == 2
+    assert "does not match the card" in _error(capsys)
+    assert not (tmp_path / "a.fmu").exists()
+
+
+def test_export_command_writes_the_fmu_and_names_it(tmp_path, capsys):
+    out = tmp_path / "lin.fmu"
+    assert main(["export", "linear", "--fmi", "3.0", "--out", str(out), "--stroke-mm", "3"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.strip() == str(out)
+    assert "envelope |x| <= 3 mm" in captured.err
+    assert main(["export", "linear", "--out", str(out), "--stroke-mm", "-1"]) == 2
+    assert "--stroke-mm must be positive" in _error(capsys)

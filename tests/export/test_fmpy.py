@@ -211,3 +211,12 @@ def test_boucwen_model_exchange_derivatives_integrate_to_the_converged_run(fmu, 
     p = get_model("boucwen", axis="radial").vector()[:, None]
     ref = converged(p, x[:, None], v[:, None])[:, 0]
     assert np.max(np.abs(got - ref)) <= BOUCWEN_VS_CONVERGED * np.max(np.abs(ref))
+
+
+def test_an_fmu_stands_as_the_reference_too(fmu):
+    from bushenv.models import get_reference
+
+    ref = get_reference(str(fmu("linear", "2.0")))
+    x = inputs()["sines"]
+    want = get_model("linear").simulate(x)
+    assert np.max(np.abs(ref.simulate(x) - want)) <= EXACT * np.max(np.abs(want))
