@@ -75,7 +75,7 @@ def facts_of(
     lines.append(("model_sha256", model_sha256 or "none (a preset, not a file)"))
     env = Envelope()
     if card_path is not None:
-        env, card_lines = _from_card(card_path)
+        env, card_lines = _from_card(card_path, model_sha256)
         lines += card_lines
     else:
         lines.append(("card", "none: no MODEL.card.json beside the model file"))
@@ -110,12 +110,17 @@ def facts_of(
     return Facts(env, tuple(lines))
 
 
-def _from_card(card_path: Path) -> tuple[Envelope, list[tuple[str, str]]]:
+def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, list]:
     try:
         card = load_card(card_path, check_model=True)
     except CardError as exc:
         raise ModelError(str(exc)) from None
     data = card.data
+    if model_sha256 is not None and data.get("model_sha256") != model_sha256:
+        raise ModelError(
+            f"{card_path}: this card describes {data.get('model_file')}, not the model being "
+            "exported (sha256 differs); pass that model's own card"
+        )
     lines = [
         ("card", f"{card_path.name}, made by {data['source'].get('kind')} on {data.get('created')}")
     ]

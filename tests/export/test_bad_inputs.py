@@ -137,3 +137,15 @@ def test_export_command_writes_the_fmu_and_names_it(tmp_path, capsys):
     assert "envelope |x| <= 3 mm" in captured.err
     assert main(["export", "linear", "--out", str(out), "--stroke-mm", "-1"]) == 2
     assert "--stroke-mm must be positive" in _error(capsys)
+
+
+def test_the_card_of_another_model_is_refused(tmp_path, capsys):
+    from bushenv.identify.card import new_card, write_card
+
+    model = get_model("linear")
+    path = model.save(tmp_path / "lin.npz")
+    write_card(new_card(model, path, {"kind": "fit", "seed": 0, "wall_time_s": 0.0}), path)
+    other = type(model)(k_n_per_m=1.0, c_ns_per_m=1.0).save(tmp_path / "other.npz")
+    card = tmp_path / "lin.card.json"
+    assert main(["export", str(other), "--card", str(card), "--out", str(tmp_path / "a.fmu")]) == 2
+    assert "describes lin.npz, not the model being exported" in _error(capsys)
