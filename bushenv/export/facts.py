@@ -124,7 +124,7 @@ def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, lis
     lines = [
         ("card", f"{card_path.name}, made by {data['source'].get('kind')} on {data.get('created')}")
     ]
-    for r in card.records:
+    for i, r in enumerate(card.records):
         digest = r.get("sha256") or r.get("data_sha256")
         m = r.get("metrics") or {}
         errors = ""
@@ -135,8 +135,9 @@ def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, lis
                 f"max_error_n={m.get('max_error', float('nan')):.4g}, "
                 f"nrmse={m.get('nrmse', float('nan')):.4g}"
             )
-        name = r.get("file") or r.get("name")
-        lines.append((f"record.{r['role']}.{Path(str(name)).name}", f"sha256={digest}{errors}"))
+        name = Path(str(r.get("file") or r.get("name"))).name
+        # numbered: a record's name is no variable name (spaces, quotes, a role's hyphen)
+        lines.append((f"record_{i + 1}", f"{r['role']} {name}: sha256={digest}{errors}"))
     train = [r for r in card.records if r["role"] == "train" and "max_abs_displacement_m" in r]
     if not train:
         return Envelope(source=f"the papers' test machine ({card_path.name} has no ranges)"), lines

@@ -23,7 +23,8 @@ def carded(tmp_path_factory):
     model = get_model("linear")
     path = model.save(folder / "lin.npz")
     x = ex.sine(2.0, 2e-3, 2.0, PAPER_DT)
-    train = Record.from_arrays(x, model.simulate(x), PAPER_DT, name="train")
+    # a name with quotes, markup and non-ASCII: escaped in the XML and in the C
+    train = Record.from_arrays(x, model.simulate(x), PAPER_DT, name='train "1" & <a> \u00fc')
     held = Record.from_arrays(0.5 * x, model.simulate(0.5 * x), PAPER_DT, name="held")
     card = new_card(model, path, {"kind": "fit", "seed": 0, "wall_time_s": 0.0})
     card["records"] = [record_entry(train, "train", model), record_entry(held, "held-out", model)]
@@ -41,7 +42,10 @@ def carded(tmp_path_factory):
 
 
 def test_card_facts_are_in_the_model_description(carded):
+    from fmpy.validation import validate_fmu
+
     done, card = carded
+    assert validate_fmu(str(done.path)) == []
     with zipfile.ZipFile(done.path) as zf:
         xml = zf.read("modelDescription.xml").decode()
         assert (
@@ -50,7 +54,14 @@ def test_card_facts_are_in_the_model_description(carded):
     assert card["model_sha256"] in xml
     for r in card["records"]:
         assert r["data_sha256"] in xml
-    assert "record.held-out.held" in xml and "rms_ratio=" in xml
+    assert 'name="card.record_2"' in xml and "held-out held: sha256=" in xml and "rms_ratio=" in xml
+    from bushenv.export.fmpy_master import opened
+
+    with opened(done.path) as (s, vr, _):
+        got = s.getString([vr["card.record_1"]])[0]
+    assert got.startswith(
+        'train train "1" & <a> \u00fc: sha256=' + card["records"][0]["data_sha256"]
+    )
     assert "passes_holds=False, passes_passivity=True" in xml
 
 
