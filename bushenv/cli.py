@@ -31,6 +31,7 @@ COMMANDS = {
     "card": ("bushenv.identify.card_command", "show a model card; check its model and records"),
     "certify": ("bushenv.certify.command", "hold-stability and passivity certificates of a NARX"),
     "zoo": ("bushenv.zoo.command", "population study: how often NARX models fail, by recipe"),
+    "export": ("bushenv.export.command", "a model as an FMU (FMI 2.0 / 3.0, compiled C)"),
 }
 
 

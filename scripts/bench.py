@@ -13,7 +13,8 @@ and its numpy-vectorised form); the papers' verification task (6.44 s at 204.8 H
 identification times, with the identified models' accuracy on an unseen n = 1 record (the
 papers' protocol) and on an n = 1.5 record (extrapolation), beside the sensor-noise floor;
 a campaign's evaluations/s and time to the first NN divergence; peak memory of a 10^6-step
-rollout and of a B = 1024 batch; reading a 500k-row record file beside np.loadtxt. This
+rollout and of a B = 1024 batch; reading a 500k-row record file beside np.loadtxt; the exported
+NN FMU's step through FMPy and in C beside bushenv's step (scripts/bench_fmu.py). This
 machine is shared and noisy: compare ratios measured in the same run, not absolute figures
 across runs.
 """
@@ -35,6 +36,7 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_compare  # noqa: E402  (the scipy and torch comparisons, beside this file)
+import bench_fmu  # noqa: E402  (the exported FMU's step, beside this file)
 
 MODELS = ("linear", "nn", "hybrid", "boucwen", "rubber")
 
@@ -776,6 +778,7 @@ SECTIONS = {
     "certify": bench_certify,
     "records": bench_records,
     "diagnose": bench_diagnose,
+    "fmu": bench_fmu.bench_fmu,
 }
 
 

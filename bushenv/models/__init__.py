@@ -58,7 +58,8 @@ def get_model(
     ----------
     spec : str, path or BushingModel
         A name in ``MODELS`` (shipped defaults load their file for ``axis``; others build their
-        ``preset``), a ``.npz`` model file, or a model object.
+        ``preset``), a ``.npz`` model file, an ``.fmu`` (co-simulation, through FMPy), or a
+        model object.
     axis : {"axial", "radial"}
     dt : float, optional
         Required sample time, s; a model at another rate is refused, naming both rates.
@@ -89,6 +90,10 @@ def get_model(
                 )
             return load_model(path, dt=dt)
         return entry.model_class().preset(axis=axis, dt=dt or PAPER_DT, **(preset or {}))
+    if text.endswith(".fmu"):  # an FMU through FMPy (bushenv.export.fmu_model)
+        from bushenv.export.fmu_model import load_fmu
+
+        return load_fmu(text, dt=dt)
     if text.endswith(".npz") or Path(text).exists():
         return load_model(text, dt=dt)
     raise ModelError(f"{MODELS.unknown_message(text)} or a .npz model file")

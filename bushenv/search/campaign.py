@@ -119,7 +119,7 @@ class CampaignConfig:
 
 def label(spec: str) -> str:
     """The key a model goes by in the report: a name, or a model file's stem."""
-    return Path(spec).stem if spec.endswith(".npz") else spec
+    return Path(spec).stem if spec.endswith((".npz", ".fmu")) else spec
 
 
 class Campaign:

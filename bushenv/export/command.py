@@ -1,0 +1,80 @@
+"""``bushenv export``: a bushing model as an FMU (FMI 2.0 / 3.0 co-simulation, compiled C)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from bushenv.export.build import export_fmu
+from bushenv.export.description import FMI_VERSIONS
+from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE
+
+EXAMPLE = "bushenv export nn --fmi 3.0 --out bushing.fmu"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from bushenv.models import AXES
+
+    parser.add_argument(
+        "model", metavar="MODEL", help=f"{', '.join(EXPORTABLE)} or a model file (.npz)"
+    )
+    parser.add_argument("--fmi", default="2.0", choices=FMI_VERSIONS, help="FMI version")
+    parser.add_argument("--out", required=True, help="the FMU to write (.fmu)")
+    parser.add_argument("--axis", default="axial", choices=AXES, help="shipped model's axis")
+    parser.add_argument(
+        "--card",
+        default=None,
+        help="model card (default: MODEL.card.json beside a model file, if there is one)",
+    )
+    parser.add_argument(
+        "--certificate", default=None, help="certificate.json of bushenv certify (default: none)"
+    )
+    parser.add_argument(
+        "--stroke-mm",
+        type=float,
+        default=None,
+        help="envelope stroke instead of the card's (default: the card's, else 12.5)",
+    )
+    parser.add_argument(
+        "--velocity-m-per-s",
+        type=float,
+        default=None,
+        help="envelope velocity instead of the card's (default: the card's, else 1.257)",
+    )
+    parser.add_argument(
+        "--substeps",
+        type=int,
+        default=BOUCWEN_SUBSTEPS,
+        help="Bouc-Wen: RK4 sub-steps per sample in the C",
+    )
+    parser.add_argument("--quiet", action="store_true", help="print nothing on stderr")
+
+
+def run(args: argparse.Namespace) -> int:
+    from bushenv.cli import CliError
+
+    for name in ("stroke_mm", "velocity_m_per_s"):
+        value = getattr(args, name)
+        if value is not None and not value > 0:
+            raise CliError(f"--{name.replace('_', '-')} must be positive, got {value}")
+    done = export_fmu(
+        args.model,
+        args.out,
+        args.fmi,
+        axis=args.axis,
+        card=args.card,
+        certificate=args.certificate,
+        stroke_m=args.stroke_mm * 1e-3 if args.stroke_mm is not None else None,
+        velocity_m_per_s=args.velocity_m_per_s,
+        substeps=args.substeps,
+    )
+    env = done.facts.envelope
+    print(done.path)
+    if not args.quiet:
+        print(
+            f"FMI {done.fmi_version} co-simulation FMU of the {done.model!r} model, compiled with "
+            f"{done.compiler}; envelope |x| <= {env.stroke_m * 1e3:.4g} mm, |v| <= "
+            f"{env.velocity_m_per_s:.4g} m/s ({env.source})",
+            file=sys.stderr,
+        )
+    return 0

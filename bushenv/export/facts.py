@@ -1,0 +1,146 @@
+"""What an exported FMU carries besides the model: its validity envelope and the card's facts.
+
+The envelope is the stroke and velocity the model was fitted on: the largest |x| and |dx/dt| of
+its card's training records (as ``identify.card.record_entry`` measures them), else the papers'
+test machine (12.5 mm, 1.257 m/s), else flags; plus the displacement ranges its certificate
+(``bushenv certify``) flags: wrong-sign and static-off holds. The facts are one line each
+(model file hash, each record's hash, held-out errors, certificate verdicts), written into
+modelDescription.xml as string constants and as an annotation.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from bushenv import excitation as ex
+from bushenv.identify.card import CardError, card_paths, load_card
+from bushenv.models import BushingModel, ModelError, model_file
+
+
+@dataclass(frozen=True)
+class Envelope:
+    """Where the exported model may be driven; ``flagged_m``: [lo, hi] ranges of x, m."""
+
+    stroke_m: float = ex.MAX_DISPLACEMENT_M
+    velocity_m_per_s: float = ex.MAX_VELOCITY_M_PER_S
+    flagged_m: tuple[tuple[float, float], ...] = ()
+    source: str = "the papers' test machine (no model card)"
+
+
+@dataclass(frozen=True)
+class Facts:
+    """The envelope and the (name, one-line value) facts of one export."""
+
+    envelope: Envelope
+    lines: tuple[tuple[str, str], ...] = field(default_factory=tuple)
+
+
+def find_card(spec: str | os.PathLike | BushingModel, axis: str) -> Path | None:
+    """The card beside the model's file, if there is one."""
+    path = model_file(spec, axis)
+    if path is None:
+        return None
+    json_path = card_paths(path)[0]
+    return json_path if json_path.is_file() else None
+
+
+def read_certificate(path: str | os.PathLike) -> dict:
+    """A ``certificate.json`` written by ``bushenv certify`` (its summary is what we use)."""
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ModelError(f"{p}: no such certificate file") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ModelError(f"{p}: not a certificate (unreadable JSON: {exc})") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("summary"), dict):
+        raise ModelError(f"{p}: not a certificate written by bushenv certify (no summary)")
+    return doc
+
+
+def facts_of(
+    model: BushingModel,
+    model_sha256: str | None,
+    card_path: Path | None = None,
+    certificate_path: Path | None = None,
+    stroke_m: float | None = None,
+    velocity_m_per_s: float | None = None,
+) -> Facts:
+    """The envelope and facts of ``model`` from its card and certificate (either optional);
+    ``stroke_m`` and ``velocity_m_per_s`` override the card's."""
+    lines = [("model", model.name), ("sample_rate_hz", f"{1 / model.dt:.10g}")]
+    lines.append(("model_sha256", model_sha256 or "none (a preset, not a file)"))
+    env = Envelope()
+    if card_path is not None:
+        env, card_lines = _from_card(card_path, model_sha256)
+        lines += card_lines
+    else:
+        lines.append(("card", "none: no MODEL.card.json beside the model file"))
+    flagged: list[tuple[float, float]] = []
+    if certificate_path is not None:
+        summary = read_certificate(certificate_path)["summary"]
+        for key in ("wrong_sign_ranges_m", "static_off_ranges_m"):
+            flagged += [(float(lo), float(hi)) for lo, hi in summary.get(key, [])]
+        verdicts = ", ".join(
+            f"{k}={summary[k]}" for k in ("passes_holds", "passes_passivity") if k in summary
+        )
+        lines.append(("certificate", f"{Path(certificate_path).name}: {verdicts}"))
+        lines.append(("certificate_flagged_ranges_m", json.dumps(flagged)))
+    else:
+        lines.append(("certificate", "none"))
+    source = env.source
+    if stroke_m is not None or velocity_m_per_s is not None:
+        source += "; overridden by --stroke-mm / --velocity-m-per-s"
+    env = Envelope(
+        stroke_m if stroke_m is not None else env.stroke_m,
+        velocity_m_per_s if velocity_m_per_s is not None else env.velocity_m_per_s,
+        tuple(flagged),
+        source,
+    )
+    lines.append(
+        (
+            "envelope",
+            f"|x| <= {env.stroke_m:.6g} m, |v| <= {env.velocity_m_per_s:.6g}"
+            f" m/s, flagged x ranges {list(env.flagged_m)} ({env.source})",
+        )
+    )
+    return Facts(env, tuple(lines))
+
+
+def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, list]:
+    try:
+        card = load_card(card_path, check_model=True)
+    except CardError as exc:
+        raise ModelError(str(exc)) from None
+    data = card.data
+    if model_sha256 is not None and data.get("model_sha256") != model_sha256:
+        raise ModelError(
+            f"{card_path}: this card describes {data.get('model_file')}, not the model being "
+            "exported (sha256 differs); pass that model's own card"
+        )
+    lines = [
+        ("card", f"{card_path.name}, made by {data['source'].get('kind')} on {data.get('created')}")
+    ]
+    for i, r in enumerate(card.records):
+        digest = r.get("sha256") or r.get("data_sha256")
+        m = r.get("metrics") or {}
+        errors = ""
+        if m:
+            errors = (
+                f"; rms_ratio={m.get('rms_ratio', float('nan')):.4g}, "
+                f"esr={m.get('esr', float('nan')):.4g}, "
+                f"max_error_n={m.get('max_error', float('nan')):.4g}, "
+                f"nrmse={m.get('nrmse', float('nan')):.4g}"
+            )
+        name = Path(str(r.get("file") or r.get("name"))).name
+        # numbered: a record's name is no variable name (spaces, quotes, a role's hyphen)
+        lines.append((f"record_{i + 1}", f"{r['role']} {name}: sha256={digest}{errors}"))
+    train = [r for r in card.records if r["role"] == "train" and "max_abs_displacement_m" in r]
+    if not train:
+        return Envelope(source=f"the papers' test machine ({card_path.name} has no ranges)"), lines
+    stroke = max(r["max_abs_displacement_m"] for r in train)
+    speed = max(r["max_abs_velocity_m_per_s"] for r in train)
+    return Envelope(stroke, speed, (), f"the training records of {card_path.name}"), lines
