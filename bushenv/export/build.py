@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+from bushenv.errors import BadInput
 from bushenv.export.description import (
     FMI_VERSIONS,
     MODEL_IDENTIFIER,
@@ -51,7 +52,7 @@ INSTALL_HINT = (
 )
 
 
-class ExportError(ValueError):
+class ExportError(BadInput):
     """The model cannot be exported as asked; the message names what and how to fix it."""
 
 

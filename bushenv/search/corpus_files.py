@@ -24,12 +24,13 @@ import os
 import shutil
 from pathlib import Path
 
+from bushenv.errors import BadInput
 from bushenv.models import MODELS, file_hash
 
 KEPT_DIR = "models"
 
 
-class KeptFileError(ValueError):
+class KeptFileError(BadInput):
     """A model a case names is neither where it was nor kept with the case (or was altered)."""
 
 
