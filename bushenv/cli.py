@@ -19,19 +19,19 @@ from bushenv.errors import BadInput, ModelRaised
 
 COMMANDS = {
     # name: (module, one-line help)
-    "reproduce": ("bushenv.reproduce", "identify every model and reproduce the papers' tables"),
-    "attack": ("bushenv.search.attack", "adversarial campaign: excitations that break a model"),
-    "campaign": ("bushenv.search.matrix", "campaign matrix: models x axes x searchers x seeds"),
-    "replay": ("bushenv.search.replay", "replay a regression corpus; name every changed verdict"),
+    "reproduce": ("bushenv.commands.reproduce", "identify every model; the papers' tables beside"),
+    "attack": ("bushenv.commands.attack", "adversarial campaign: excitations that break a model"),
+    "campaign": ("bushenv.commands.campaign", "campaign matrix: models x axes x searchers x seeds"),
+    "replay": ("bushenv.commands.replay", "replay a regression corpus; name every changed verdict"),
     "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
-    "measure": ("bushenv.machine", "run a test programme on a model and write CSV records"),
+    "measure": ("bushenv.commands.measure", "run a test programme on a model; write CSV records"),
     "fit": ("bushenv.identify.command", "identify a model from measured records, with a card"),
     "import-nn": ("bushenv.identify.import_command", "a torch NARX network to a model file"),
     "card": ("bushenv.identify.card_command", "show a model card; check its model and records"),
-    "certify": ("bushenv.certify.command", "hold-stability and passivity certificates of a NARX"),
+    "certify": ("bushenv.commands.certify", "hold-stability and passivity certificates of a NARX"),
     "zoo": ("bushenv.zoo.command", "population study: how often NARX models fail, by recipe"),
-    "export": ("bushenv.export.command", "a model as an FMU (FMI 2.0 / 3.0, compiled C)"),
+    "export": ("bushenv.commands.export", "a model as an FMU (FMI 2.0 / 3.0, compiled C)"),
 }
 
 

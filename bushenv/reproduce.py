@@ -32,7 +32,6 @@ Ratios are fractions (0.051 = 5.1 %); forces in N; times in s.
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 from typing import Any
@@ -44,7 +43,6 @@ from bushenv.models import AXES, MODELS, get_model
 from bushenv.persist import json_text, write_text
 from bushenv.progress import Progress
 
-EXAMPLE = "bushenv reproduce --out runs/reproduce"
 # Identification time relative to the linear least squares, for the time-left estimate only.
 EFFORT = {"linear": 1.0, "nn": 12.0, "hybrid": 15.0, "boucwen": 45.0}
 
@@ -75,26 +73,6 @@ PAPER = {
     "step": {"nn_departure_s": 7.3, "hybrid": "bounded"},
 }
 VERIFICATION_RECORD_S = 6.44  # seed 002 §5: the verification data is 6.44 s long
-
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", required=True, help="output folder (refused if it holds a report)")
-    p.add_argument("--axes", default="axial,radial", help="comma list of axes")
-    p.add_argument("--seed", type=int, default=0, help="seed for records and training")
-    p.add_argument("--identification-s", type=float, default=40.0, help="n = 1 record length, s")
-    p.add_argument(
-        "--verification-s",
-        type=float,
-        default=20.0,
-        help="length of each unseen record (n = 1 and n = 1.5), s",
-    )
-    p.add_argument(
-        "--shipped",
-        action="store_true",
-        help="use the trained models shipped in the package instead of identifying anew",
-    )
-    p.add_argument("--force", action="store_true", help="overwrite an existing report in --out")
-    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
 
 
 def _records(axis: str, seed: int, ident_s: float, verif_s: float):
@@ -151,32 +129,6 @@ def _step_verdicts(axis: str, models: dict[str, Any], dt: float) -> dict[str, An
         verdict = judge(x[:, None], f[:, None], f_ref[:, None], dt).row(0)
         out[name] = {"force": f, "verdict": verdict}
     return out
-
-
-def run(args: argparse.Namespace) -> int:
-    from bushenv.cli import CliError
-
-    out = Path(args.out)
-    if (out / "report.json").exists() and not args.force:
-        raise CliError(f"{out}/report.json exists; pass --force to overwrite it")
-    if args.seed < 0:
-        raise CliError(f"--seed must be >= 0, got {args.seed}")
-    for name in ("identification_s", "verification_s"):
-        if not getattr(args, name) >= 6.44:
-            flag = "--" + name.replace("_", "-")
-            raise CliError(f"{flag} must be at least 6.44 s, got {getattr(args, name)}")
-    axes = [a.strip() for a in args.axes.split(",") if a.strip()]
-    for a in axes:
-        if a not in AXES:
-            raise CliError(f"unknown axis {a!r}; choose from {list(AXES)}")
-    out.mkdir(parents=True, exist_ok=True)
-    progress = Progress(quiet=args.quiet)
-    report = reproduce(
-        out, axes, args.seed, args.identification_s, args.verification_s, args.shipped, progress
-    )
-    print(format_tables(report))
-    print(f"\nwrote {out / 'report.json'}, {out / 'report.md'} and plots")
-    return 0
 
 
 def reproduce(

@@ -19,7 +19,6 @@ the divergence rate and the median evaluations to failure.
 
 from __future__ import annotations
 
-import argparse
 import time
 from dataclasses import dataclass
 from itertools import product
@@ -29,9 +28,8 @@ from typing import Any
 import numpy as np
 
 from bushenv.errors import BadInput
-from bushenv.execution import get_backend
 from bushenv.judge import build_judge
-from bushenv.models import AXES, MODELS, ModelError, check_axis, get_model
+from bushenv.models import MODELS, ModelError, check_axis, get_model
 from bushenv.persist import write_json, write_text
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
@@ -39,10 +37,6 @@ from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import SEARCHERS, get_searcher
 from bushenv.search.targets import TARGETS
 
-EXAMPLE = (
-    "bushenv campaign --models nn,hybrid --axes axial --searchers random,cma "
-    "--seeds 0-3 --budget 128 --out runs/matrix"
-)
 WALL_CLOCK_FIELDS = ("seconds", "seconds_to_failure", "wall_s", "worker_backend")
 CELL_KEYS = ("model", "axis", "searcher", "seed", "budget", "env", "reference")
 MAX_SEEDS = 100_000  # a typo like 0-1000000000 must not build a billion cells
@@ -319,65 +313,3 @@ class MatrixConfig:
             self.target,
             self.reference,
         )
-
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    d = MatrixConfig()
-    p.add_argument("--models", default=",".join(d.models), help="comma list of model names")
-    p.add_argument("--axes", default=",".join(d.axes), help=f"comma list: {', '.join(AXES)}")
-    p.add_argument(
-        "--searchers",
-        default=",".join(d.searchers),
-        help=f"comma list: {', '.join(SEARCHERS.names())}",
-    )
-    p.add_argument("--seeds", default="0-3", help="e.g. 0-9 or 1,4,7")
-    p.add_argument("--budget", type=int, default=d.budget, help="model evaluations per cell (> 0)")
-    p.add_argument("--env", choices=TARGETS.names(), default=d.target)
-    p.add_argument(
-        "--reference",
-        default=d.reference,
-        help="the bushing every cell is judged against: a registered name or a model file; "
-        "'none' judges with the criteria that need no reference",
-    )
-    p.add_argument("--out", required=True, help="output folder")
-    p.add_argument("--resume", action="store_true", help="continue an interrupted matrix")
-    p.add_argument("--workers", type=int, default=None, help="local worker processes")
-    p.add_argument("--ray", action="store_true", help="run on Ray (a local instance)")
-    p.add_argument("--ray-address", default=None, help="run on an existing Ray cluster")
-    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
-
-
-def _names(flag: str, text: str) -> tuple[str, ...]:
-    names = tuple(n.strip() for n in text.split(",") if n.strip())
-    if not names:
-        raise MatrixError(f"{flag} {text!r} names nothing")
-    return names
-
-
-def run(args: argparse.Namespace) -> int:
-    config = MatrixConfig(
-        models=_names("--models", args.models),
-        axes=_names("--axes", args.axes),
-        searchers=_names("--searchers", args.searchers),
-        seeds=tuple(parse_seeds(args.seeds)),
-        budget=args.budget,
-        target=args.env,
-        reference=args.reference,
-        out=Path(args.out),
-        resume=args.resume,
-    ).checked()
-    backend = get_backend(
-        "ray" if (args.ray or args.ray_address) else "local",
-        workers=args.workers,
-        address=args.ray_address,
-    )
-    progress = Progress(quiet=args.quiet)
-    with backend:
-        rows = run_matrix(
-            config.cells(), config.out, backend, resume=config.resume, progress=progress
-        )
-    summary = summarise(rows)
-    write_summary(config.out, summary)
-    print((config.out / "summary.md").read_text())
-    print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md, summary.png")
-    return 0
