@@ -24,16 +24,25 @@ def _umask() -> int:
     return mask
 
 
-def atomic_write(path: str | os.PathLike, write: Callable[[IO[bytes]], None]) -> Path:
-    """Create or replace ``path`` with what ``write(binary_file)`` writes, atomically."""
+def atomic_write(
+    path: str | os.PathLike, write: Callable[[IO[bytes]], None], replace: bool = True
+) -> Path:
+    """Create or replace ``path`` with what ``write(binary_file)`` writes, atomically.
+
+    ``replace=False``: never replace an existing file, not even one that appeared while
+    writing (``FileExistsError``; the data are linked in, not renamed over)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)
         os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
+        if replace:
+            os.replace(tmp, path)
+        else:
+            os.link(tmp, path)
+            Path(tmp).unlink()
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

@@ -46,7 +46,6 @@ import difflib
 import io
 import os
 import re
-import tempfile
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -55,6 +54,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.errors import BadInput
+from bushenv.persist import atomic_write
 
 HEADER = ("time", "displacement", "force")
 HEADER_TEXT = ",".join(HEADER)
@@ -634,33 +634,19 @@ def save_csv(record: Record, path: str | os.PathLike, overwrite: bool = False) -
     record.validate()
     if path.exists() and not overwrite:
         raise RecordError(f"{path} already exists; refusing to overwrite it (pass overwrite=True)")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp")
+    plain = _is_plausible_rate(record.time)
+    head = (HEADER_TEXT if plain else "time [s],displacement,force") + "\n"
+    # tolist() gives Python floats, whose repr is the shortest exact round-trip text.
+    rows = zip(
+        record.time.tolist(), record.displacement.tolist(), record.force.tolist(), strict=True
+    )
+    text = head + "".join(f"{a!r},{b!r},{c!r}\n" for a, b, c in rows)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            plain = _is_plausible_rate(record.time)
-            fh.write((HEADER_TEXT if plain else "time [s],displacement,force") + "\n")
-            # tolist() gives Python floats, whose repr is the shortest exact round-trip text.
-            rows = zip(
-                record.time.tolist(),
-                record.displacement.tolist(),
-                record.force.tolist(),
-                strict=True,
-            )
-            fh.writelines(f"{a!r},{b!r},{c!r}\n" for a, b, c in rows)
-        if overwrite:
-            os.replace(tmp, path)
-        else:
-            try:
-                os.link(tmp, path)  # fails if path appeared meanwhile: never replace silently
-            except FileExistsError:
-                raise RecordError(
-                    f"{path} already exists; refusing to overwrite it (pass overwrite=True)"
-                ) from None
-            Path(tmp).unlink()
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        atomic_write(path, lambda fh: fh.write(text.encode("utf-8")), replace=overwrite)
+    except FileExistsError:  # appeared while writing: never replaced silently
+        raise RecordError(
+            f"{path} already exists; refusing to overwrite it (pass overwrite=True)"
+        ) from None
     return path
 
 

@@ -44,6 +44,7 @@ from types import ModuleType
 from typing import NamedTuple
 
 from bushenv.models.fastmath import TANH_REDUCTION, TANH_SATURATION, TANH_SQUARINGS, TANH_TAYLOR
+from bushenv.persist import atomic_write
 
 DTYPES = ("float64", "float32")
 # tanh(a) = (e - 1) / (e + 1), e = (e^(a * reduction))^(2^squarings) = e^(2a), the inner
@@ -243,16 +244,8 @@ def _write_module(folder: Path, name: str, source: str) -> Path:
     path = folder / f"{name}.py"
     if path.is_file() and path.read_text() == source:
         return path  # untouched: numba's on-disk cache (keyed by the file's mtime) stays valid
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{name}", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(source)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)  # atomic: a concurrent reader sees the old or the new whole file
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    # atomic: a concurrent reader sees the old or the new whole file
+    return atomic_write(path, lambda fh: fh.write(source.encode("utf-8")))
 
 
 def _place_module(name: str, source: str) -> Path:

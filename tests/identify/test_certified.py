@@ -122,11 +122,8 @@ def test_gradients_are_finite_and_equal_finite_differences_of_the_fixed_points(p
     assert analytic == pytest.approx(numeric, rel=1e-5, abs=1e-7)
 
 
-def test_gradient_stays_finite_at_a_fold(problems):
-    # one unit fed back on itself through five lags: y = tanh(2 y + u), u = xs / 2, folds at
-    # cosh(2 y + u) = sqrt(2), u = +-(acosh(sqrt 2) - sqrt 2); held exactly there, phi' = 0
-    # at the double root and the gradient is clipped, not infinite
-    p = problems["nn"]
+def _fold_net():
+    """One unit fed back on itself through five lags: y = tanh(2 y + u), u = xs / 2."""
     net = _net(0, (1,))
     with torch.no_grad():
         for q in net.parameters():
@@ -134,6 +131,15 @@ def test_gradient_stays_finite_at_a_fold(problems):
         net.w1[0, 6:] = 2.0 / 5
         net.w1[0, 0] = 0.5
         net.w_out.fill_(1.0)
+    return net
+
+
+def test_gradient_stays_finite_at_a_fold(problems):
+    # one unit fed back on itself through five lags: y = tanh(2 y + u), u = xs / 2, folds at
+    # cosh(2 y + u) = sqrt(2), u = +-(acosh(sqrt 2) - sqrt 2); held exactly there, phi' = 0
+    # at the double root and the gradient is clipped, not infinite
+    p = problems["nn"]
+    net = _fold_net()
     # "exactly there" in floating point is a few ulps either side of the true fold, and one
     # side has no double root at all (it has vanished): whether the computed hold lands inside
     # was up to how the platform rounds arccosh and sqrt. Held 1e-12 inside, it always is.
@@ -153,13 +159,7 @@ def test_a_hold_just_inside_a_fold_finds_its_near_double_root(problems, inside):
     # between the fold and the hold, a stable and an unstable fixed point lie within
     # sqrt(inside) of each other, both with spectral radius within ~sqrt(inside) of 1
     p = problems["nn"]
-    net = _net(0, (1,))
-    with torch.no_grad():
-        for q in net.parameters():
-            q.zero_()
-        net.w1[0, 6:] = 2.0 / 5
-        net.w1[0, 0] = 0.5
-        net.w_out.fill_(1.0)
+    net = _fold_net()
     u = (np.arccosh(np.sqrt(2.0)) - np.sqrt(2.0)) * (1.0 - inside)
     x = p.x_off + p.x_sc * 2.0 * np.array([u, -u])
     out = CertifiedHolds(weight=1.0).penalties(net, p, x)
