@@ -126,21 +126,20 @@ class Campaign:
     """State of one campaign; every step updates ``self.report`` and writes it atomically."""
 
     def __init__(self, config: CampaignConfig, progress: Progress | None = None) -> None:
-        self.config = config.checked()
+        """Resolves everything once, here: the judge (vetted), the models and their roles.
+        Refuses an existing report unless ``resume`` or ``force``."""
+        c = self.config = config.checked()
         self.progress = progress or Progress(quiet=True)
-        self.out = self.config.out
+        self.out = c.out
         self.report_path = self.out / "report.json"
         self.t0 = time.perf_counter()
-        self.target: Target = TARGETS[self.config.target]
-
-    # ----- set-up ------------------------------------------------------------------------------
-    def prepare(self) -> None:
-        c = self.config
+        self.target: Target = TARGETS[c.target]
         if self.report_path.exists() and not (c.resume or c.force):
             raise CampaignError(
                 f"{self.report_path} exists; pass --resume to continue it or --force to start again"
             )
-        self.dt = get_model(c.model, axis=c.axis).dt
+        target_model = get_model(c.model, axis=c.axis)
+        self.dt = target_model.dt
         self.judge = build_judge(
             c.model,
             c.reference,
@@ -149,32 +148,48 @@ class Campaign:
             target=self.target,
             flags=ScaleFlags(c.stroke_mm, c.max_velocity_m_per_s, c.force_floor_n, c.force_scale_n),
             trust_reference=c.trust_reference,
-            model_object=get_model(c.model, axis=c.axis),
+            model_object=target_model,
         )
         self.reference_spec = self.judge.reference_spec
         self.reference = self.judge.reference
         self.scales = self.judge.scales
         self.static = self.judge.static
-        self.notes: list[str] = []
+        self.notes: list[str] = self._judge_notes()
+        self.models: dict[str, Any] = {}
+        self.roles: dict[str, str] = {}
+        self.specs: dict[str, str] = {}
+        keys = self._models()
+        self.target_key: str = keys["target"]
+        self.hybrid_key: str | None = keys.get("hybrid")
+        self.control_key: str | None = keys.get("control")
+        self.report: dict[str, Any] = {}
+        self.seconds_before = 0.0
+
+    def _judge_notes(self) -> list[str]:
+        notes = []
         if self.judge.vetting is not None:
             self.progress.say(f"reference {self.reference_spec}: vetted")
             for line in self.judge.vetting.lines():
                 self.progress.say(f"  {line}")
         if self.reference is not None and not self.static and self.target.judges_static:
-            self.notes.append(
+            notes.append(
                 "static not judged: the reference's model card shows no quasi-static content "
                 "in its training records (no hold of 1 s, under 1 % of the displacement power "
                 "at or below 1 Hz), so its held force is an extrapolation"
             )
         if self.judge.trusted_by_flag:
-            self.notes.append(
+            notes.append(
                 f"UNVETTED REFERENCE: {self.reference_spec} failed its vetting "
                 f"({self.judge.vetting.summary()}); --trust-reference judged with it anyway, "
                 "so every verdict below may be the reference's fault"
             )
-        self._models()
+        return notes
+
+    # ----- set-up ------------------------------------------------------------------------------
+    def prepare(self) -> None:
+        """The report: fresh, or what an interrupted run finished (``resume``); written."""
         fresh = fresh_report(self)
-        if c.resume and self.report_path.exists():
+        if self.config.resume and self.report_path.exists():
             fresh = resumed_report(self.report_path, fresh)
             self.progress.say(f"resuming {self.report_path}")
         self.report = fresh
@@ -184,14 +199,12 @@ class Campaign:
             self.progress.say(f"note: {note}")
         self.save()
 
-    def _models(self) -> None:
-        """The target, the hybrid and the control, each with its role (see ``roles``)."""
-        c = self.config
-        self.models: dict[str, Any] = {}
-        self.roles: dict[str, str] = {}
-        self.specs: dict[str, str] = {}
+    def _models(self) -> dict[str, str]:
+        """The target, the hybrid, the control and the models rechecked beside them, each
+        with its role (see ``roles``), into ``models``, ``roles`` and ``specs``; the key of
+        each role."""
         keys = {}
-        for role, spec in roles(c, self.judge, self.notes):
+        for role, spec in roles(self.config, self.judge, self.notes):
             key = label(spec)
             keys[role] = key
             if key in self.models:  # e.g. --model hybrid: the hybrid step is the target step
@@ -202,9 +215,7 @@ class Campaign:
                 warning = stiffness_mismatch(self.models[key], self.reference)
                 if warning:
                     self.notes.append(f"{key}: {warning}")
-        self.target_key = keys["target"]
-        self.hybrid_key = keys.get("hybrid")
-        self.control_key = keys.get("control")
+        return keys
 
     def _resolve(self, spec: str):
         """The model ``spec`` names, and the spec to record (a fitted control's saved file)."""
