@@ -6,11 +6,11 @@ cd "$(dirname "$0")/.."
 venv="$(mktemp -d)/venv"
 python3 -m venv "$venv"
 "$venv/bin/pip" install -q torch==2.13.0
-"$venv/bin/pip" install -q ".[test,ray]"
+"$venv/bin/pip" install -q ".[test,ray,fmi]"
 {
   echo "# Every dependency's version as tested (Python 3.11, x86_64, CPU). Used as pip constraints by the"
   echo "# README's commands and .ci/run. Refresh: bash scripts/lock.sh (docs/contributing.md)."
   "$venv/bin/pip" freeze --exclude bushenv | sed 's/^torch==\([0-9.]*\)+cpu/torch==\1/'
 } > constraints.txt
 rm -rf "$(dirname "$venv")"
-echo "constraints.txt refreshed; now: pip install -c constraints.txt '.[test,ray]' && pytest -m 'not slow' -q" >&2
+echo "constraints.txt refreshed; now: pip install -c constraints.txt '.[test,ray,fmi]' && pytest -m 'not slow' -q" >&2
