@@ -150,7 +150,10 @@ def _meta_case(linear_file, **changes):
         ({"version": 2}, "format version 2, this bushenv reads version 1"),
         ({"version": "1"}, "format version '1'"),
         ({"format": "other"}, r"not a bushenv model file \(format tag missing\)"),
-        ({"model": "lstm"}, r"unknown model 'lstm'; known names: linear, nn, hybrid, boucwen"),
+        (
+            {"model": "lstm"},
+            r"unknown model 'lstm'; known names: linear, nn, hybrid, nn-paper, hybrid-paper, boucwen",
+        ),
         ({"model": ["linear"]}, r"unknown model \['linear'\]"),
         ({"dt": "fast"}, r"invalid dt 'fast' in the header"),
         ({"dt": -0.1}, r"invalid dt -0\.1"),

@@ -42,6 +42,10 @@ class ModelEntry:
         ``hybrid``): the papers' NN goes with the papers' hybrid.
     also : tuple of str
         Models rechecked on every profile that broke this one, in their own rows.
+    kind : str or None
+        For a preset of another model's class (``nn-paper`` is an ``nn`` network trained
+        another way): the registered name of that class, which its files carry. None: the
+        entry's own name.
     """
 
     entry_point: str | type
@@ -52,6 +56,7 @@ class ModelEntry:
     reference_preset: dict[str, Any] = field(default_factory=dict)
     hybrid: str | None = None
     also: tuple[str, ...] = ()
+    kind: str | None = None
 
     def model_class(self) -> type:
         ep = self.entry_point
@@ -103,6 +108,7 @@ MODELS.add(
         shipped=True,
         hybrid="hybrid-paper",
         also=("nn", "hybrid"),
+        kind="nn",
     ),
 )
 MODELS.add(
@@ -112,6 +118,7 @@ MODELS.add(
         "the papers' hybrid as seed 000 made it: linear backbone plus the same network, "
         "teacher forcing, no certified holds",
         shipped=True,
+        kind="hybrid",
     ),
 )
 MODELS.add(
