@@ -152,7 +152,8 @@ def _meta_case(linear_file, **changes):
         ({"format": "other"}, r"not a bushenv model file \(format tag missing\)"),
         (
             {"model": "lstm"},
-            r"unknown model 'lstm'; known names: linear, nn, hybrid, nn-paper, hybrid-paper, boucwen",
+            r"unknown model 'lstm'; known names: "
+            r"linear, nn, hybrid, nn-paper, hybrid-paper, boucwen",
         ),
         ({"model": ["linear"]}, r"unknown model \['linear'\]"),
         ({"dt": "fast"}, r"invalid dt 'fast' in the header"),
