@@ -222,7 +222,7 @@ def compatibility_check(
         return _judged("compatibility", errors, "the model's card's records", RECORD_LIMIT)
     if model is None:
         return Check("compatibility", None, "no model under test to compare with")
-    from bushenv.search.campaign_models import fitted_linear
+    from bushenv.identify.linear import fitted_linear
 
     try:
         k_ref = fitted_linear(reference, scales).k_n_per_m

@@ -14,16 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from bushenv import excitation as ex
-from bushenv.identify.linear import least_squares_kc
+from bushenv.identify.linear import CONTROL_RECORD_S, fitted_linear  # noqa: F401 (re-export)
 from bushenv.judge import card_of
 from bushenv.models import MODELS
-from bushenv.models.base import velocity_of
-from bushenv.models.linear import LinearBushing
-from bushenv.scales import BushingScales
 
 FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
-CONTROL_RECORD_S = 40.0  # the papers' identification record length (seed 000 §4.1)
 
 
 def roles(config, judge, notes: list[str]) -> list[tuple[str, str]]:
@@ -76,28 +71,3 @@ def card_displacements(spec: str | None) -> list[np.ndarray] | None:
 
     load_card(spec, records=paths)  # CardError naming a record that changed since
     return [load_csv(p).displacement for p in paths]
-
-
-def fitted_linear(
-    source, scales: BushingScales, displacements: list | None = None, seed: int = 0
-) -> LinearBushing:
-    """Least-squares Kelvin-Voigt fit of ``source``'s response, from rest, to
-    ``displacements`` (the records the reference was identified on, so the control sees the
-    same band), else to an n = 1 random record scaled to the bushing's stroke (the papers'
-    n = 1 peak is 2 mm of a 12.5 mm stroke)."""
-    dt = source.dt
-    if not displacements:
-        x = ex.random_rpc(1.0, CONTROL_RECORD_S, dt, seed)
-        x = x * (scales.stroke_m / ex.MAX_DISPLACEMENT_M)
-        speed = np.max(np.abs(np.diff(x))) / dt
-        if speed > scales.velocity_m_per_s:
-            x = x * (scales.velocity_m_per_s / speed)
-        displacements = [x]
-    xs, vs, fs = [], [], []
-    for x in displacements:
-        v = velocity_of(np.asarray(x, dtype=np.float64), dt)
-        xs.append(x)
-        vs.append(v)
-        fs.append(source.copy().simulate(x, v))
-    k, c = least_squares_kc(np.concatenate(xs), np.concatenate(fs), np.concatenate(vs))
-    return LinearBushing(k_n_per_m=k, c_ns_per_m=c, dt=dt)
