@@ -41,6 +41,19 @@ NO_REFERENCE = "none"  # the spelling of "judged without a reference" in every c
 BUILTIN_REFERENCE = "rubber"
 
 
+@dataclass(frozen=True)
+class Where:
+    """What the judge needs of where verdicts are made (a search ``Target`` has the same
+    three attributes and may be passed instead)."""
+
+    name: str
+    reference_free: bool = True  # may judge with no reference (criteria that need none)
+    judges_static: bool = True  # holds are of the bushing itself (``static`` applies)
+
+
+RIG = Where("rig")  # prescribed displacement: the test rig, certify, the population study
+
+
 class JudgeError(BadInput):
     """A judge that cannot be built: the reference failed its vetting, or cannot be loaded."""
 
@@ -192,7 +205,7 @@ def build_judge(
     *,
     axis: str,
     dt: float,
-    target: Any = "rig",
+    target: Any = RIG,
     flags: ScaleFlags = ScaleFlags(),
     trust_reference: bool = False,
     vet: bool = True,
@@ -200,12 +213,11 @@ def build_judge(
 ) -> Judge:
     """The judge of verdicts on ``model`` (a name, file or object) against ``reference``.
 
+    ``target``: where the verdicts are made (``Where``, or a search ``Target``).
     ``model_object`` is the resolved model under test (its responses enter the compatibility
     check of the vetting). Raises ``JudgeError`` when the reference fails its vetting and
     ``trust_reference`` is not set."""
-    from bushenv.search.targets import get_target
-
-    tgt = get_target(target)
+    tgt = target  # a ``Where`` or a search ``Target``
     spec = reference_spec_for(model, reference)
     if spec is None and not tgt.reference_free:
         raise JudgeError(

@@ -17,6 +17,7 @@ import numpy as np
 import pymunk
 
 from bushenv.divergence import force_termination
+from bushenv.judge import Where
 from bushenv.models import BushingModel
 from bushenv.models.linear import TABLE1
 from bushenv.rigs.actions import check_profile
@@ -43,6 +44,9 @@ DAMPING_ANGLE_STEP = 0.005  # rad; see Car.update_damping
 BODIES = ("chassis", "unsprung", "road")
 
 
+CAR = Where("QuarterCar-v0", reference_free=False, judges_static=False)  # for the judge
+
+
 def axis_models(
     spec: Any, dt: float, reference: bool, trust_reference: bool = False
 ) -> dict[str, BushingModel]:
@@ -52,7 +56,7 @@ def axis_models(
 
     def resolve(s: Any, axis: str, dt: float) -> BushingModel:
         if reference:
-            return resolve_reference(s, axis, dt, trust_reference=trust_reference)
+            return resolve_reference(s, axis, dt, trust_reference=trust_reference, where=CAR)
         return resolve_model(s, axis, dt)
 
     if isinstance(spec, dict):

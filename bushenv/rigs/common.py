@@ -80,7 +80,7 @@ def resolve_reference(
     model: Any = None,
     model_object: BushingModel | None = None,
     trust_reference: bool = False,
-    target: str = "rig",
+    where: Any = None,
 ) -> BushingModel:
     """The reference bushing, through the one judging setup (``bushenv.judge``): vetted
     before it judges (a ``JudgeError`` names what failed, unless ``trust_reference``). The
@@ -88,12 +88,15 @@ def resolve_reference(
     the reference, so they vet the reference alone (``model`` None: holds and its records, no
     compatibility check); the attack, which compares, passes the model too.
     ``"rubber"``: the calibrated specimen without the load cell's delay, inertia and noise."""
-    from bushenv.judge import build_judge
+    from bushenv.judge import Where, build_judge
+
+    where = where or Where("BushRig-v0", reference_free=False)
 
     if spec is None or (isinstance(spec, str) and spec.strip().lower() == "none"):
         raise RigError("reference: the rig runs a reference beside the model; give one")
     judge = build_judge(
-        model, spec, axis=axis, dt=dt, target=target, trust_reference=trust_reference,
+        model, spec, axis=axis, dt=dt, target=where,
+        trust_reference=trust_reference,
         model_object=model_object,
     )  # fmt: skip
     reference = judge.reference

@@ -117,7 +117,7 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
         cell.get("reference", "rubber"),
         axis=axis,
         dt=model.dt,
-        target=cell["env"],
+        target=TARGETS[cell["env"]],
         trust_reference=bool(cell.get("trust_reference", False)),
         model_object=model,
     )
@@ -294,7 +294,7 @@ class MatrixConfig:
             except ModelError as exc:
                 raise MatrixError(f"model {m!r} ({a}): {exc}") from None
             try:  # the judge every cell of this model and axis gets, vetted before any runs
-                build_judge(m, self.reference, axis=a, dt=model.dt, target=self.target,
+                build_judge(m, self.reference, axis=a, dt=model.dt, target=TARGETS[self.target],
                             model_object=model)  # fmt: skip
             except ModelError as exc:
                 raise MatrixError(f"--reference {self.reference!r} ({a}): {exc}") from None
