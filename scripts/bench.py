@@ -287,9 +287,9 @@ QUICK_FIT_OPTIONS = {
         "teacher_steps": 100,
         "window_lengths": (20, 100),
         "iters_per_length": (10, 10),
-        "time_budget_s": 10.0,
+        "time_limit_s": 10.0,
     },
-    "boucwen": {"generations": 2, "population": 4, "polish_evaluations": 20, "time_budget_s": 10.0},
+    "boucwen": {"generations": 2, "population": 4, "polish_evaluations": 20, "time_limit_s": 10.0},
 }
 
 

@@ -109,6 +109,8 @@ def fit(
     t0 = time.perf_counter()
     fitted = fit_function(data, opts, seed=seed, progress=progress, **extra)
     seconds = time.perf_counter() - t0
+    # a method that chooses options itself (the NARX network's size) says which it used
+    opts = (getattr(fitted, "training", None) or {}).pop("options_used", None) or opts
     return FitResult(fitted, model, opts, records, data, int(seed), seconds)
 
 

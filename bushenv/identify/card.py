@@ -7,7 +7,10 @@
 - ``source``: how it was made (``"fit"`` with ``seed``, ``wall_time_s``, ``options`` -- every
   option with its value --, ``training`` summary; or ``"torch-import"`` with the torch file and
   the stated scaling);
-- ``records``: each source record with ``role`` ("train" or "held-out"), ``file``, ``sha256``
+- ``parameters``: the physical parameters of a physical model, by name, with their units
+  (linear and the hybrid's backbone: k and c; Bouc-Wen: its sixteen); null for the NN;
+- ``records``: each source record with ``role`` ("train" or "held-out"), ``file`` (relative
+  to the card's folder; cards before that hold absolute paths, read the same), ``sha256``
   (of the file's bytes, or null for records made in memory), ``data_sha256`` (of the time,
   displacement and force values as float64), ``samples``, ``sample_rate_hz``, ``duration_s``,
   and ``metrics`` of the model's free run from rest on it (``bushenv.metrics.all_metrics``:
@@ -64,13 +67,19 @@ def data_sha256(record: Any) -> str:
     return h.hexdigest()
 
 
-def record_entry(record: Any, role: str, model: Any | None = None) -> dict[str, Any]:
-    """A card's description of ``record`` (and the model's metrics on it, if given)."""
+def record_entry(
+    record: Any, role: str, model: Any | None = None, card_dir: str | os.PathLike | None = None
+) -> dict[str, Any]:
+    """A card's description of ``record`` (and the model's metrics on it, if given); its file
+    relative to ``card_dir`` when given, so a card moved with its records still finds them."""
     path = getattr(record, "path", None)
+    file = None
+    if path is not None:
+        file = os.path.relpath(path, card_dir) if card_dir is not None else os.fspath(path)
     entry = {
         "role": role,
         "name": getattr(record, "name", "") or (Path(path).stem if path else ""),
-        "file": os.fspath(path) if path is not None else None,
+        "file": file,
         "sha256": sha256_file(path) if path is not None else None,
         "data_sha256": data_sha256(record),
         "samples": len(record.force),
@@ -135,9 +144,33 @@ def new_card(model: Any, model_path: str | os.PathLike, source: dict[str, Any]) 
         "dt_s": model.dt,
         "sample_rate_hz": 1.0 / model.dt,
         "source": source,
+        "parameters": physical_parameters(model),
         "records": [],
         "plots": [],
     }
+
+
+# Units of the physical parameters a card lists (Bouc-Wen: seed 002 eqs 1-5).
+PARAMETER_UNITS = {
+    "k_n_per_m": "N/m",
+    "c_ns_per_m": "N s/m",
+    **{k: "N s/m" for k in ("c0", "c1", "c2")},
+    **{k: "N/m" for k in ("k0", "k1", "k2", "a1", "a2")},
+    **{k: "m^-n" for k in ("beta1", "beta2", "gamma1", "gamma2")},
+    **{k: "-" for k in ("A1", "A2", "n1", "n2")},
+}
+
+
+def physical_parameters(model: Any) -> dict[str, dict[str, Any]] | None:
+    """{name: {"value", "unit"}} of a physical model (linear or the hybrid's backbone: k, c;
+    Bouc-Wen: its sixteen, seed 002 order), None for a network alone."""
+    if model.name == "boucwen":
+        names = model.param_names
+    elif hasattr(model, "k_n_per_m") and hasattr(model, "c_ns_per_m"):
+        names = ("k_n_per_m", "c_ns_per_m")
+    else:
+        return None
+    return {n: {"value": float(getattr(model, n)), "unit": PARAMETER_UNITS[n]} for n in names}
 
 
 def write_card(card: dict[str, Any], model_path: str | os.PathLike) -> tuple[Path, Path]:
@@ -165,9 +198,19 @@ def card_markdown(card: dict[str, Any]) -> str:
     if src["kind"] == "fit":
         lines.append(f"- seed {src['seed']}, wall time {src['wall_time_s']:.1f} s")
         if src.get("stopped"):
-            lines.append(f"- training ended: {src['stopped']}")
+            early = "**stopped early** by the time limit: " if src.get("time_limited") else ""
+            lines.append(f"- training ended: {early}{src['stopped']}")
+        if src.get("budget_used"):
+            used = ", ".join(f"{k} {v}" for k, v in src["budget_used"].items())
+            lines.append(f"- budget used: {used}")
+        if src.get("choice"):
+            lines.append(f"- network chosen on validation: {src['choice']['summary']}")
     else:
         lines.append(f"- torch file `{src['torch_file']}`, sha256 `{src['torch_sha256']}`")
+    if card.get("parameters"):
+        lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---:|---|"]
+        params = card["parameters"].items()
+        lines += [f"| {k} | {p['value']:.6g} | {p['unit']} |" for k, p in params]
     lines += _records_table(card["records"])
     lines += ["", "## Options", "", "| option | value |", "|---|---|"]
     for k, v in src.get("options", {}).items():
@@ -222,6 +265,14 @@ class ModelCard:
     @property
     def records(self) -> list[dict[str, Any]]:
         return self.data["records"]
+
+    def record_path(self, entry: dict[str, Any]) -> Path | None:
+        """Where a card record's file is: relative paths from the card's folder (absolute
+        ones, as older cards hold, as they are); None for a record made in memory."""
+        if not entry.get("file"):
+            return None
+        p = Path(entry["file"])
+        return p if p.is_absolute() else self.path.parent / p
 
     def held_out(self) -> list[dict[str, Any]]:
         return [r for r in self.records if r["role"] == "held-out"]
@@ -323,11 +374,15 @@ def save_fit(
         "wall_time_s": result.seconds,
         "options": as_dict(result.options),
         "stopped": training.get("stopped"),
+        "time_limited": bool(training.get("time_limited", False)),
+        "budget_used": training.get("budget_used"),
+        "choice": training.get("choice"),
         "training": {k: training[k] for k in _TRAINING_SUMMARY if k in training},
     }
     card = new_card(model, model_path, source)
-    card["records"] = [record_entry(r, "train", model) for r in result.records]
-    card["records"] += [record_entry(r, "held-out", model) for r in held_out]
+    here = model_path.parent
+    card["records"] = [record_entry(r, "train", model, here) for r in result.records]
+    card["records"] += [record_entry(r, "held-out", model, here) for r in held_out]
     card["plots"] = figures
     write_card(card, model_path)
     return card

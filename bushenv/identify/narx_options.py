@@ -15,6 +15,9 @@ RECIPES = ("free-run", "teacher-forcing")
 INPUT_BASES = ("auto", "lags", "differences")
 EARLY_STOPS = ("training", "stage")
 SWITCH = ("off", "on")
+CHOOSE_HIDDEN = (9, 18)
+CHOOSE_LAGS = (5, 10)
+SET_BY_CHOICE = ("hidden", "n_past_x", "n_past_f")  # giving one of these turns the choice off
 
 
 @dataclass(frozen=True)
@@ -27,11 +30,27 @@ class NarxOptions:
         "teacher-forcing: one step ahead only (the papers' recipe, seed 000 §4.2)",
         choices=RECIPES,
     )
-    hidden: tuple[int, ...] = option(
-        HIDDEN, "tanh units per hidden layer, one or two layers (seed 001: 10,9)"
+    choose: str = option(
+        "on",
+        "on: hidden units and lags chosen on the validation parts among --choose-hidden x "
+        "--choose-lags, each trained with --choose-share of the iterations, the best then in "
+        "full; off: --hidden, --n-past-x, --n-past-f as given (giving one of them turns it off)",
+        choices=SWITCH,
     )
-    n_past_x: int = option(N_PAST_X, "past displacements fed to the net (besides the current)")
-    n_past_f: int = option(N_PAST_F, "past own forces fed to the net")
+    choose_hidden: tuple[int, ...] = option(CHOOSE_HIDDEN, "tanh units of the candidates")
+    choose_lags: tuple[int, ...] = option(
+        CHOOSE_LAGS, "lags of the candidates (n-past-x = n-past-f), samples"
+    )
+    choose_share: float = option(
+        0.25, "share of the iteration counts each candidate trains with before the choice"
+    )
+    hidden: tuple[int, ...] = option(
+        HIDDEN, "tanh units per hidden layer, one or two layers (seed 001: 10,9); --choose off"
+    )
+    n_past_x: int = option(
+        N_PAST_X, "past displacements fed to the net (besides the current); --choose off"
+    )
+    n_past_f: int = option(N_PAST_F, "past own forces fed to the net; --choose off")
     val_fraction: float = option(0.2, "last part of each record kept for validation")
     teacher_steps: int = option(2000, "full-batch Adam steps one step ahead")
     teacher_lr: float = option(1e-2, "learning rate one step ahead (cosine decay to 0)")
@@ -87,8 +106,19 @@ class NarxOptions:
         choices=EARLY_STOPS,
     )
     threads: int = option(1, "torch threads")
-    time_budget_s: float = option(120.0, "wall-time cap, s (a safety stop, reported)")
+    time_limit_s: float = option(
+        0.0,
+        "wall-time limit, s; 0: none. Iteration counts decide when training ends, so a seed "
+        "reproduces the weights; a limit that stops it early is reported and on the card",
+    )
     progress_every_s: float = option(3.0, "seconds between progress lines")
+
+    @staticmethod
+    def implied(given: dict) -> dict:
+        """Options as given, with ``choose="off"`` when a size or lag is given without it."""
+        if "choose" not in given and any(k in given for k in SET_BY_CHOICE):
+            return {**given, "choose": "off"}
+        return given
 
     def basis(self) -> str:
         """The input basis training uses ("auto" resolved by the recipe)."""
@@ -110,6 +140,18 @@ class NarxOptions:
             raise IdentificationError(
                 f"hidden must be one or two positive sizes, got {self.hidden}"
             )
+        if not (self.choose_hidden and self.choose_lags and min(self.choose_hidden) >= 1):
+            raise IdentificationError(
+                f"choose_hidden and choose_lags need at least one positive value each, got "
+                f"{self.choose_hidden} and {self.choose_lags}"
+            )
+        if min(self.choose_lags) < 1 or not 0.0 < self.choose_share <= 1.0:
+            raise IdentificationError(
+                f"choose_lags must be >= 1 and choose_share in (0, 1], got {self.choose_lags} "
+                f"and {self.choose_share}"
+            )
+        if self.time_limit_s < 0:
+            raise IdentificationError(f"time_limit_s must be >= 0, got {self.time_limit_s}")
         for name in ("n_past_x", "n_past_f", "eval_every", "patience", "batch_windows"):
             if getattr(self, name) < 1:
                 raise IdentificationError(f"{name} must be >= 1, got {getattr(self, name)}")

@@ -21,8 +21,9 @@ Torch trains; it never runs per step in use: the result is exported to the numpy
 
 Why step 5's free run: a net trained one step ahead on measured past forces, then run on its
 own, can self-oscillate on data like its training data (DESIGN-NOTES). Iteration counts, not
-the clock, decide when to stop, so a seed reproduces the weights; ``time_budget_s`` is only a
-safety cap (reported if hit). docs/fit.md explains each option and what the recipes give.
+the clock, decide when to stop, so a seed reproduces the weights; ``time_limit_s`` (off by
+default) is an explicit wall-time limit, reported and logged (``time_limited``, ``budget_used``)
+when it stops the training early. docs/fit.md explains each option and what the recipes give.
 
 Extra loss terms plug in through ``loss_terms`` (objects with ``name``, ``stages`` and
 ``__call__(net, problem) -> tensor``, added to the data loss of the stages they name);
@@ -44,6 +45,7 @@ from typing import ClassVar, Protocol
 import torch
 
 from bushenv.identify.data import IdentificationError, TrainingSet
+from bushenv.identify.narx_choice import choose_and_train
 from bushenv.identify.narx_data import NarxProblem, narx_problem
 from bushenv.identify.narx_options import NarxOptions
 from bushenv.identify.narx_torch import TorchNarx
@@ -126,24 +128,31 @@ def fit_narx(
 ) -> NarxBushing:
     """Identify a "nn" (NarxBushing) or "hybrid" (HybridBushing) model from ``data``.
 
-    The returned model carries a ``training`` dict (losses, validation RMS ratios, times, the
-    options) as an attribute; it is not saved in the model file.
+    With ``options.choose == "on"`` the network's size and lags are first chosen on the
+    validation parts (``narx_choice.py``). The returned model carries a ``training`` dict
+    (losses, validation RMS ratios, times, the choice, ``options_used``: the options of the
+    network returned) as an attribute; it is not saved in the model file.
     """
     if kind not in ("nn", "hybrid"):
         raise IdentificationError(f"fit_narx: kind must be 'nn' or 'hybrid', got {kind!r}")
     opt = options
-    problem = narx_problem(kind, data, opt.n_past_x, opt.n_past_f, opt.val_fraction)
-    stages = _stages(problem, opt)
+    terms = [*loss_terms_of(opt), *loss_terms]
     old_threads = torch.get_num_threads()
     torch.set_num_threads(max(1, int(opt.threads)))
-    torch.manual_seed(seed)
     try:
-        trainer = Trainer(problem, opt, [*loss_terms_of(opt), *loss_terms], seed, progress, stages)
-        training = trainer.run()
+        if opt.choose == "on":
+            trainer, opt, choice = choose_and_train(kind, data, opt, seed, progress, terms, _stages)
+        else:
+            problem = narx_problem(kind, data, opt.n_past_x, opt.n_past_f, opt.val_fraction)
+            torch.manual_seed(seed)
+            trainer = Trainer(problem, opt, terms, seed, progress, _stages(problem, opt))
+            trainer.run()
+            choice = None
     finally:
         torch.set_num_threads(old_threads)
-    model = export(trainer.net, problem)
-    model.training = training
+    model = export(trainer.net, trainer.problem)
+    model.training = trainer.log
+    model.training.update(choice=choice, options_used=opt)
     return model
 
 
