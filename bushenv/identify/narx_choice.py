@@ -1,7 +1,7 @@
 """The NARX network's size and lags chosen on the validation parts of the user's own records.
 
-With ``choose="on"`` (the default) every candidate -- each pair of ``choose_hidden`` (tanh
-units, one layer) and ``choose_lags`` (n_past_x = n_past_f) -- first trains with
+With ``choose="on"`` (the NN's default) every candidate of ``choose_networks`` (tanh units of
+one layer x lags, n_past_x = n_past_f) first trains with
 ``choose_share`` of the iteration counts (teacher steps and every window stage), on the same
 training parts and seed as the full training; it is scored by its best free-run RMS ratio on
 the validation parts (the last ``val_fraction`` of each record, never trained on). The
@@ -44,13 +44,12 @@ class Candidate:
 def candidates(kind: str, data: TrainingSet, opt: NarxOptions) -> list[Candidate]:
     """Every grid point the records are long enough for (refused only if none is)."""
     out, refused = [], []
-    for hidden in opt.choose_hidden:
-        for lag in opt.choose_lags:
-            o = replace(opt, hidden=(hidden,), n_past_x=lag, n_past_f=lag, choose="off")
-            try:
-                out.append(Candidate(o, narx_problem(kind, data, lag, lag, opt.val_fraction)))
-            except IdentificationError as exc:
-                refused.append(exc)
+    for hidden, lag in opt.networks():
+        o = replace(opt, hidden=(hidden,), n_past_x=lag, n_past_f=lag, choose="off")
+        try:
+            out.append(Candidate(o, narx_problem(kind, data, lag, lag, opt.val_fraction)))
+        except IdentificationError as exc:
+            refused.append(exc)
     if not out:
         raise refused[0]
     return out

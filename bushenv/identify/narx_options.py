@@ -15,8 +15,7 @@ RECIPES = ("free-run", "teacher-forcing")
 INPUT_BASES = ("auto", "lags", "differences")
 EARLY_STOPS = ("training", "stage")
 SWITCH = ("off", "on")
-CHOOSE_HIDDEN = (9, 18)
-CHOOSE_LAGS = (5, 10)
+CHOOSE_NETWORKS = ("9x5", "18x5", "9x10")  # units x lags; docs/fit.md: why these
 SET_BY_CHOICE = ("hidden", "n_past_x", "n_past_f")  # giving one of these turns the choice off
 
 
@@ -32,17 +31,16 @@ class NarxOptions:
     )
     choose: str = option(
         "on",
-        "on: hidden units and lags chosen on the validation parts among --choose-hidden x "
-        "--choose-lags, each trained with --choose-share of the iterations, the best then in "
-        "full; off: --hidden, --n-past-x, --n-past-f as given (giving one of them turns it off)",
+        "on: the network (units and lags) chosen on the validation parts among "
+        "--choose-networks, each trained with --choose-share of the iterations, the best then "
+        "in full; off: --hidden, --n-past-x, --n-past-f as given (giving one turns it off)",
         choices=SWITCH,
     )
-    choose_hidden: tuple[int, ...] = option(CHOOSE_HIDDEN, "tanh units of the candidates")
-    choose_lags: tuple[int, ...] = option(
-        CHOOSE_LAGS, "lags of the candidates (n-past-x = n-past-f), samples"
+    choose_networks: tuple[str, ...] = option(
+        CHOOSE_NETWORKS, "candidate networks, UNITSxLAGS (one tanh layer; n-past-x = n-past-f)"
     )
     choose_share: float = option(
-        0.25, "share of the iteration counts each candidate trains with before the choice"
+        0.2, "share of the iteration counts each candidate trains with before the choice"
     )
     hidden: tuple[int, ...] = option(
         HIDDEN, "tanh units per hidden layer, one or two layers (seed 001: 10,9); --choose off"
@@ -120,6 +118,23 @@ class NarxOptions:
             return {**given, "choose": "off"}
         return given
 
+    def networks(self) -> list[tuple[int, int]]:
+        """The candidates of ``choose_networks`` as (units, lags)."""
+        out = []
+        for text in self.choose_networks:
+            units, _, lags = text.partition("x")
+            if not (units.strip().isdigit() and lags.strip().isdigit()):
+                raise IdentificationError(
+                    f"choose_networks: {text!r} is not UNITSxLAGS (e.g. 9x5: 9 tanh units, "
+                    "5 past displacements and 5 past forces)"
+                )
+            if int(units) < 1 or int(lags) < 1:
+                raise IdentificationError(f"choose_networks: {text!r} needs units and lags >= 1")
+            out.append((int(units), int(lags)))
+        if not out:
+            raise IdentificationError("choose_networks: give at least one UNITSxLAGS")
+        return out
+
     def basis(self) -> str:
         """The input basis training uses ("auto" resolved by the recipe)."""
         if self.input_basis != "auto":
@@ -140,16 +155,9 @@ class NarxOptions:
             raise IdentificationError(
                 f"hidden must be one or two positive sizes, got {self.hidden}"
             )
-        if not (self.choose_hidden and self.choose_lags and min(self.choose_hidden) >= 1):
-            raise IdentificationError(
-                f"choose_hidden and choose_lags need at least one positive value each, got "
-                f"{self.choose_hidden} and {self.choose_lags}"
-            )
-        if min(self.choose_lags) < 1 or not 0.0 < self.choose_share <= 1.0:
-            raise IdentificationError(
-                f"choose_lags must be >= 1 and choose_share in (0, 1], got {self.choose_lags} "
-                f"and {self.choose_share}"
-            )
+        self.networks()
+        if not 0.0 < self.choose_share <= 1.0:
+            raise IdentificationError(f"choose_share must be in (0, 1], got {self.choose_share}")
         if self.time_limit_s < 0:
             raise IdentificationError(f"time_limit_s must be >= 0, got {self.time_limit_s}")
         for name in ("n_past_x", "n_past_f", "eval_every", "patience", "batch_windows"):
@@ -176,3 +184,18 @@ class NarxOptions:
             )
         if self.certified_holds < 2:
             raise IdentificationError(f"certified_holds must be >= 2, got {self.certified_holds}")
+
+
+@dataclass(frozen=True)
+class HybridOptions(NarxOptions):
+    """The hybrid's options: the NN's, but its network is not chosen unless asked (its
+    backbone carries the bulk of the force; a 9-unit residual fits the bushings measured in
+    docs/fit.md within 2.2 %)."""
+
+    choose: str = option(
+        "off",
+        "on: the network (units and lags) chosen on the validation parts among "
+        "--choose-networks, each trained with --choose-share of the iterations, the best then "
+        "in full; off: --hidden, --n-past-x, --n-past-f as given (giving one turns it off)",
+        choices=SWITCH,
+    )

@@ -42,7 +42,7 @@ def saved_arrays(model, path):
         ("linear", None),
         ("nn", QUICK_NN),
         ("hybrid", QUICK_NN),
-        ("nn", dict(QUICK_NN, choose="on", choose_hidden=(4, 8), choose_lags=(2, 4))),
+        ("nn", dict(QUICK_NN, choose="on", choose_networks=("4x2", "8x4"))),
         ("boucwen", QUICK_BW),
     ],
 )
