@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.identify.parameters import physical_parameters
 from bushenv.metrics import all_metrics
 from bushenv.persist import plain, write_json, write_text
 
@@ -150,29 +151,6 @@ def new_card(model: Any, model_path: str | os.PathLike, source: dict[str, Any]) 
     }
 
 
-# Units of the physical parameters a card lists (Bouc-Wen: seed 002 eqs 1-5).
-PARAMETER_UNITS = {
-    "k_n_per_m": "N/m",
-    "c_ns_per_m": "N s/m",
-    **{k: "N s/m" for k in ("c0", "c1", "c2")},
-    **{k: "N/m" for k in ("k0", "k1", "k2", "a1", "a2")},
-    **{k: "m^-n" for k in ("beta1", "beta2", "gamma1", "gamma2")},
-    **{k: "-" for k in ("A1", "A2", "n1", "n2")},
-}
-
-
-def physical_parameters(model: Any) -> dict[str, dict[str, Any]] | None:
-    """{name: {"value", "unit"}} of a physical model (linear or the hybrid's backbone: k, c;
-    Bouc-Wen: its sixteen, seed 002 order), None for a network alone."""
-    if model.name == "boucwen":
-        names = model.param_names
-    elif hasattr(model, "k_n_per_m") and hasattr(model, "c_ns_per_m"):
-        names = ("k_n_per_m", "c_ns_per_m")
-    else:
-        return None
-    return {n: {"value": float(getattr(model, n)), "unit": PARAMETER_UNITS[n]} for n in names}
-
-
 def write_card(card: dict[str, Any], model_path: str | os.PathLike) -> tuple[Path, Path]:
     """Write the card's JSON and markdown beside the model (atomically)."""
     json_path, md_path = card_paths(model_path)
@@ -205,6 +183,8 @@ def card_markdown(card: dict[str, Any]) -> str:
             lines.append(f"- budget used: {used}")
         if src.get("choice"):
             lines.append(f"- network chosen on validation: {src['choice']['summary']}")
+        if src.get("note"):
+            lines.append(f"- **note**: {src['note']}")
     else:
         lines.append(f"- torch file `{src['torch_file']}`, sha256 `{src['torch_sha256']}`")
     if card.get("parameters"):
@@ -377,6 +357,7 @@ def save_fit(
         "time_limited": bool(training.get("time_limited", False)),
         "budget_used": training.get("budget_used"),
         "choice": training.get("choice"),
+        "note": training.get("note"),
         "training": {k: training[k] for k in _TRAINING_SUMMARY if k in training},
     }
     card = new_card(model, model_path, source)
@@ -419,5 +400,6 @@ _TRAINING_SUMMARY = (
     "evaluations",
     "k_n_per_m",
     "c_ns_per_m",
+    "linear_validation_rms_ratio",
     "seconds",
 )

@@ -161,6 +161,8 @@ def summary(card: dict[str, Any], out: Path) -> str:
         lines.append(f"stopped early: {src['stopped']} (the card records the budget used)")
     if src.get("choice"):
         lines.append(f"network chosen on validation: {src['choice']['summary']}")
+    if src.get("note"):
+        lines.append(f"note: {src['note']}")
     if card.get("parameters"):
         params = card["parameters"].items()
         lines.append(

@@ -42,14 +42,17 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import ClassVar, Protocol
 
+import numpy as np
 import torch
 
 from bushenv.identify.data import IdentificationError, TrainingSet
+from bushenv.identify.linear import least_squares_kc
 from bushenv.identify.narx_choice import choose_and_train
 from bushenv.identify.narx_data import NarxProblem, narx_problem
 from bushenv.identify.narx_options import NarxOptions
 from bushenv.identify.narx_torch import TorchNarx
 from bushenv.identify.narx_train import Trainer
+from bushenv.metrics import rms_ratio
 from bushenv.models.hybrid import HybridBushing
 from bushenv.models.narx import NarxBushing
 from bushenv.progress import ProgressSpec
@@ -153,7 +156,30 @@ def fit_narx(
     model = export(trainer.net, trainer.problem)
     model.training = trainer.log
     model.training.update(choice=choice, options_used=opt)
+    if kind == "nn":
+        model.training.update(linear_check(trainer.problem, float(trainer.keep.val)))
     return model
+
+
+def linear_check(problem: NarxProblem, nn_val: float) -> dict:
+    """The least-squares Kelvin-Voigt model's RMS ratio on the same validation parts, and a
+    note when the network does not take at least half of that error away (then the records
+    may not excite what the network needs, or its training did not converge)."""
+    segs, n = problem.data.segments, [hi - lo for lo, hi in problem.train]
+    k, c = least_squares_kc(
+        *(np.concatenate([getattr(s, a)[:m] for s, m in zip(segs, n, strict=True)]) for a in "xfv")
+    )
+    pred = np.concatenate([k * s.x[m:] + c * s.v[m:] for s, m in zip(segs, n, strict=True)])
+    lin = rms_ratio(problem.f_val, pred)
+    out = {"linear_validation_rms_ratio": lin, "note": None}
+    if not nn_val < 0.5 * lin:
+        out["note"] = (
+            f"the network's validation free-run RMS ratio, {100 * nn_val:.2f} %, is not below "
+            f"half the linear model's ({100 * lin:.2f} %) on the same parts: it learned little "
+            "beyond a spring and a damper. Try the hybrid, longer or richer records (the range "
+            "and frequencies the bushing meets in use), or --choose-networks with larger ones"
+        )
+    return out
 
 
 def _stages(problem: NarxProblem, opt: NarxOptions) -> list[tuple[int, int]]:

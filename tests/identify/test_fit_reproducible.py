@@ -11,6 +11,9 @@ from standin import DT, standin_drive, standin_force
 from bushenv.cli import main
 from bushenv.identify import fit
 from bushenv.identify.card import load_card, save_fit
+from bushenv.identify.data import training_set
+from bushenv.identify.narx_data import narx_problem
+from bushenv.identify.neural import linear_check
 from bushenv.models.kernels import BW_ORDER
 from bushenv.records import Record, save_csv
 
@@ -148,3 +151,48 @@ def test_the_fit_table_shows_whole_record_names(tmp_path, capsys):
     stdout = capsys.readouterr().out
     assert str(train) in stdout
     assert "parameters: k_n_per_m = " in stdout
+
+
+def test_the_nn_network_is_chosen_on_validation_and_the_card_says_which(tmp_path):
+    rec = record(4.0, 0, "a")
+    opts = dict(QUICK_NN, choose="on", choose_networks=("4x2", "6x3"))
+    res = fit([rec], "nn", opts, seed=1, progress=False)
+    choice = res.model.training["choice"]
+    scores = {
+        (c["hidden"][0], c["n_past_x"]): c["validation_rms_ratio"] for c in choice["candidates"]
+    }
+    best = min(scores, key=scores.get)
+    # the network returned is the best-scoring candidate, and the options on the card say so
+    assert (res.options.hidden, res.options.n_past_x, res.options.n_past_f) == (
+        (best[0],),
+        best[1],
+        best[1],
+    )
+    assert res.model.n_past_x == best[1] and res.model.w1.shape[0] == best[0]
+    card = save_fit(res, tmp_path / "nn.npz", plots=False)
+    assert card["source"]["options"]["hidden"] == [best[0]]
+    assert card["source"]["choice"]["summary"].startswith(f"{best[0]} units, lags {best[1]}")
+
+
+def test_giving_a_size_or_lags_turns_the_choice_off():
+    res = fit(
+        [record(4.0, 0, "a")], "nn", dict(QUICK_NN, choose="on") | {"hidden": (5,)}, progress=False
+    )
+    assert res.model.training["choice"] is not None  # choose given explicitly wins
+    given = {k: v for k, v in QUICK_NN.items() if k != "choose"} | {"n_past_x": 3}
+    res = fit([record(4.0, 0, "a")], "nn", given, progress=False)
+    assert res.options.choose == "off" and res.model.training["choice"] is None
+
+
+def test_an_nn_that_learns_less_than_a_linear_model_gets_a_note_on_its_card(tmp_path):
+    untrained = dict(QUICK_NN, teacher_steps=1, iters_per_length=(0, 0))
+    res = fit([record(4.0, 0, "a")], "nn", untrained, progress=False)
+    tr = res.model.training
+    assert tr["linear_validation_rms_ratio"] < 0.5 < tr["best_validation_rms_ratio"]
+    card = save_fit(res, tmp_path / "nn.npz", plots=False)
+    assert "learned little beyond a spring and a damper" in card["source"]["note"]
+    # the rule itself: a network with less than half the linear model's error gets no note
+    problem = narx_problem("nn", training_set([record(4.0, 0, "a")]), 5, 5, 0.2)
+    lin = linear_check(problem, 1.0)["linear_validation_rms_ratio"]
+    assert linear_check(problem, 0.49 * lin)["note"] is None
+    assert linear_check(problem, 0.51 * lin)["note"] is not None
