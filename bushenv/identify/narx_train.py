@@ -89,6 +89,7 @@ class Trainer:
                 upper_bound=True,
             )
         self.work, self.unit = self.progress.done, sample_cost(opt)
+        self.t0 = self.progress.elapsed_s()  # this training's start on a shared clock
         self.teacher_done = self.it = 0
         self.time_limited = False
         self.rng = np.random.default_rng(seed)
@@ -291,7 +292,7 @@ class Trainer:
         if self.opt.recipe == "free-run" and not self.time_limited:
             self.free_run()
             self.net.load_state_dict(self.keep.state)
-        elapsed = self.progress.elapsed_s()
+        elapsed = self.progress.elapsed_s() - self.t0
         if not self.shared:
             self.work = self.progress.total
         self.say(
