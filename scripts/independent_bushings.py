@@ -3,7 +3,7 @@
 Nothing here imports bushenv: the physics, the excitation and the CSV writer are this file's
 own, so a fit that does well on these records did not learn them from the project's reference
 rubber or its diagnosis candidates. Each bushing differs from the reference rubber (radial:
-about 1.1 kN/mm, 204.8 Hz, one Maxwell branch, smooth hardening, a stiff friction element):
+about 1.1 kN/mm, 204.8 Hz, Maxwell branches, smooth hardening, a stiff friction element):
 
 - stiff-cubic, 500 Hz: 1.0 kN/mm plus a cubic spring (+50 % stiffness at 2 mm), viscous
   damping only: no memory.

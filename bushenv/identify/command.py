@@ -48,7 +48,7 @@ def _metavar(f: Any) -> str:
     if choices:
         return "{" + ",".join(choices) + "}"
     if isinstance(f.default, tuple):
-        return "N[,N...]"
+        return "V[,V...]" if f.default and isinstance(f.default[0], str) else "N[,N...]"
     return "N" if isinstance(f.default, int) else "X"
 
 

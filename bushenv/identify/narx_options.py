@@ -189,8 +189,8 @@ class NarxOptions:
 @dataclass(frozen=True)
 class HybridOptions(NarxOptions):
     """The hybrid's options: the NN's, but its network is not chosen unless asked (its
-    backbone carries the bulk of the force; a 9-unit residual fits the bushings measured in
-    docs/fit.md within 2.2 %)."""
+    backbone carries the bulk of the force; its 9x5 network fits the bushings measured in
+    docs/fit.md within 3.2 %)."""
 
     choose: str = option(
         "off",

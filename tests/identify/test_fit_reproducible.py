@@ -9,7 +9,7 @@ import pytest
 from standin import DT, standin_drive, standin_force
 
 from bushenv.cli import main
-from bushenv.identify import fit
+from bushenv.identify import IdentificationError, fit
 from bushenv.identify.card import load_card, save_fit
 from bushenv.identify.data import training_set
 from bushenv.identify.narx_data import narx_problem
@@ -196,3 +196,8 @@ def test_an_nn_that_learns_less_than_a_linear_model_gets_a_note_on_its_card(tmp_
     lin = linear_check(problem, 1.0)["linear_validation_rms_ratio"]
     assert linear_check(problem, 0.49 * lin)["note"] is None
     assert linear_check(problem, 0.51 * lin)["note"] is not None
+
+
+def test_a_candidate_that_is_not_units_x_lags_is_refused_naming_it():
+    with pytest.raises(IdentificationError, match="'9y5' is not UNITSxLAGS"):
+        fit([record(3.0, 0, "a")], "nn", dict(QUICK_NN, choose="on", choose_networks="9x5,9y5"))
