@@ -210,7 +210,7 @@ def fit_boucwen(
             "generations": log["generations"],
             "generations_planned": opt.generations,
             "search_evaluations": search.evaluations,
-            "polish_evaluations": whole.evaluations,
+            "all_records_evaluations": whole.evaluations,  # the population check and polish
         },
         options={k: getattr(opt, k) for k in opt.__dataclass_fields__},
         records=data.labels,
