@@ -74,9 +74,12 @@ def record_entry(
     """A card's description of ``record`` (and the model's metrics on it, if given); its file
     relative to ``card_dir`` when given, so a card moved with its records still finds them."""
     path = getattr(record, "path", None)
-    file = None
-    if path is not None:
-        file = os.path.relpath(path, card_dir) if card_dir is not None else os.fspath(path)
+    file = os.fspath(path) if path is not None else None
+    if path is not None and card_dir is not None:
+        try:
+            file = os.path.relpath(path, card_dir)
+        except ValueError:  # another drive (Windows): no relative path exists
+            file = os.path.abspath(path)
     entry = {
         "role": role,
         "name": getattr(record, "name", "") or (Path(path).stem if path else ""),
