@@ -97,7 +97,14 @@ def _identify(name: str, axis: str, train, seed: int, shipped: bool):
     if shipped and MODELS[name].shipped:
         model = get_model(name, axis=axis, dt=train.dt)
     else:
-        model = fit_model(name, train.displacement, train.force, train.dt, seed=seed, progress=True)
+        # the papers' network (5 + 5 lags, 9 units): no choice of size on validation here
+        options = MODELS[name].options_class()
+        fixed = (
+            {"choose": "off"} if "choose" in getattr(options, "__dataclass_fields__", {}) else {}
+        )
+        model = fit_model(
+            name, train.displacement, train.force, train.dt, seed=seed, progress=True, **fixed
+        )
     return model, time.perf_counter() - t0
 
 

@@ -62,9 +62,10 @@ EXPECTED = [
     ),
     *(
         f"fit_command.{m}{k}"
-        for m in ("nn", "hybrid", "boucwen")
+        for m in ("nn", "nn-choose-off", "hybrid", "boucwen")
         for k in ("", ".rms_ratio_unseen_n1")
     ),
+    "fit_command.nn.time_ratio_choice_vs_choose_off",
     "campaign.random.threads2.evaluations_per_s",
     "campaign.nn.random.seconds_to_first_divergence",
     "campaign.nn.float32_verdict_changes",

@@ -8,13 +8,14 @@ dataclass); ``bushenv fit`` is its command (``command.py``), which also writes a
 | name      | method                                              | module             |
 |-----------|-----------------------------------------------------|--------------------|
 | "linear"  | least squares of f on [x, v] (seed 000 §4.1)        | ``linear.py``      |
-| "nn"      | torch: one step ahead, then free-run fine-tuning    | ``neural.py``      |
+| "nn"      | network chosen on validation, then the NARX training | ``neural.py``      |
 | "hybrid"  | least-squares backbone + the same NARX training     | ``neural.py``      |
 | "boucwen" | differential evolution on eq. 6 + Powell polish     | ``global_search.py`` |
 
 ``fit_model(name, x, f, dt, seed=0, progress=True, v=None, **options)`` does the same for one
-record given as arrays. Every method is deterministic given ``seed``; long ones print progress
-lines with an estimate of the time left on stderr.
+record given as arrays. Every method is deterministic given ``seed`` (budgets are iterations,
+generations and evaluations; a wall-clock limit only when asked for, ``time_limit_s``); long
+ones print progress lines with an estimate of the time left on stderr.
 """
 
 from __future__ import annotations
@@ -109,6 +110,8 @@ def fit(
     t0 = time.perf_counter()
     fitted = fit_function(data, opts, seed=seed, progress=progress, **extra)
     seconds = time.perf_counter() - t0
+    # a method that chooses options itself (the NARX network's size) says which it used
+    opts = (getattr(fitted, "training", None) or {}).pop("options_used", None) or opts
     return FitResult(fitted, model, opts, records, data, int(seed), seconds)
 
 

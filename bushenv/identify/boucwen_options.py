@@ -27,12 +27,18 @@ class BoucWenOptions:
     max_substeps: int = option(
         400, "integrator trial steps allowed per sample before a member scores inf"
     )
-    time_budget_s: float = option(110.0, "wall-time cap of the search, s (reported if hit)")
+    time_limit_s: float = option(
+        0.0,
+        "wall-time limit of the search, s; 0: none (generations decide, so a seed reproduces "
+        "the parameters); a limit that stops it early is reported and on the card",
+    )
     progress_every_s: float = option(3.0, "seconds between progress lines")
 
     def check(self) -> None:
         for name in ("generations", "population", "max_substeps"):
             if getattr(self, name) < 1:
                 raise IdentificationError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.time_limit_s < 0:
+            raise IdentificationError(f"time_limit_s must be >= 0, got {self.time_limit_s}")
         if self.polish_evaluations < 0 or not self.fit_seconds > 0:
             raise IdentificationError("polish_evaluations must be >= 0 and fit_seconds > 0")

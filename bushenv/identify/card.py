@@ -7,7 +7,10 @@
 - ``source``: how it was made (``"fit"`` with ``seed``, ``wall_time_s``, ``options`` -- every
   option with its value --, ``training`` summary; or ``"torch-import"`` with the torch file and
   the stated scaling);
-- ``records``: each source record with ``role`` ("train" or "held-out"), ``file``, ``sha256``
+- ``parameters``: the physical parameters of a physical model, by name, with their units
+  (linear and the hybrid's backbone: k and c; Bouc-Wen: its sixteen); null for the NN;
+- ``records``: each source record with ``role`` ("train" or "held-out"), ``file`` (relative
+  to the card's folder; cards before that hold absolute paths, read the same), ``sha256``
   (of the file's bytes, or null for records made in memory), ``data_sha256`` (of the time,
   displacement and force values as float64), ``samples``, ``sample_rate_hz``, ``duration_s``,
   and ``metrics`` of the model's free run from rest on it (``bushenv.metrics.all_metrics``:
@@ -31,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.errors import BadInput
+from bushenv.identify.parameters import physical_parameters
 from bushenv.metrics import all_metrics
 from bushenv.persist import plain, write_json, write_text
 
@@ -65,13 +69,22 @@ def data_sha256(record: Any) -> str:
     return h.hexdigest()
 
 
-def record_entry(record: Any, role: str, model: Any | None = None) -> dict[str, Any]:
-    """A card's description of ``record`` (and the model's metrics on it, if given)."""
+def record_entry(
+    record: Any, role: str, model: Any | None = None, card_dir: str | os.PathLike | None = None
+) -> dict[str, Any]:
+    """A card's description of ``record`` (and the model's metrics on it, if given); its file
+    relative to ``card_dir`` when given, so a card moved with its records still finds them."""
     path = getattr(record, "path", None)
+    file = os.fspath(path) if path is not None else None
+    if path is not None and card_dir is not None:
+        try:
+            file = os.path.relpath(path, card_dir)
+        except ValueError:  # another drive (Windows): no relative path exists
+            file = os.path.abspath(path)
     entry = {
         "role": role,
         "name": getattr(record, "name", "") or (Path(path).stem if path else ""),
-        "file": os.fspath(path) if path is not None else None,
+        "file": file,
         "sha256": sha256_file(path) if path is not None else None,
         "data_sha256": data_sha256(record),
         "samples": len(record.force),
@@ -136,6 +149,7 @@ def new_card(model: Any, model_path: str | os.PathLike, source: dict[str, Any]) 
         "dt_s": model.dt,
         "sample_rate_hz": 1.0 / model.dt,
         "source": source,
+        "parameters": physical_parameters(model),
         "records": [],
         "plots": [],
     }
@@ -166,9 +180,21 @@ def card_markdown(card: dict[str, Any]) -> str:
     if src["kind"] == "fit":
         lines.append(f"- seed {src['seed']}, wall time {src['wall_time_s']:.1f} s")
         if src.get("stopped"):
-            lines.append(f"- training ended: {src['stopped']}")
+            early = "**stopped early** by the time limit: " if src.get("time_limited") else ""
+            lines.append(f"- training ended: {early}{src['stopped']}")
+        if src.get("budget_used"):
+            used = ", ".join(f"{k} {v}" for k, v in src["budget_used"].items())
+            lines.append(f"- budget used: {used}")
+        if src.get("choice"):
+            lines.append(f"- network chosen on validation: {src['choice']['summary']}")
+        if src.get("note"):
+            lines.append(f"- **note**: {src['note']}")
     else:
         lines.append(f"- torch file `{src['torch_file']}`, sha256 `{src['torch_sha256']}`")
+    if card.get("parameters"):
+        lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---:|---|"]
+        params = card["parameters"].items()
+        lines += [f"| {k} | {p['value']:.6g} | {p['unit']} |" for k, p in params]
     lines += _records_table(card["records"])
     lines += ["", "## Options", "", "| option | value |", "|---|---|"]
     for k, v in src.get("options", {}).items():
@@ -223,6 +249,14 @@ class ModelCard:
     @property
     def records(self) -> list[dict[str, Any]]:
         return self.data["records"]
+
+    def record_path(self, entry: dict[str, Any]) -> Path | None:
+        """Where a card record's file is: relative paths from the card's folder (absolute
+        ones, as older cards hold, as they are); None for a record made in memory."""
+        if not entry.get("file"):
+            return None
+        p = Path(entry["file"])
+        return p if p.is_absolute() else self.path.parent / p
 
     def held_out(self) -> list[dict[str, Any]]:
         return [r for r in self.records if r["role"] == "held-out"]
@@ -324,11 +358,16 @@ def save_fit(
         "wall_time_s": result.seconds,
         "options": as_dict(result.options),
         "stopped": training.get("stopped"),
+        "time_limited": bool(training.get("time_limited", False)),
+        "budget_used": training.get("budget_used"),
+        "choice": training.get("choice"),
+        "note": training.get("note"),
         "training": {k: training[k] for k in _TRAINING_SUMMARY if k in training},
     }
     card = new_card(model, model_path, source)
-    card["records"] = [record_entry(r, "train", model) for r in result.records]
-    card["records"] += [record_entry(r, "held-out", model) for r in held_out]
+    here = model_path.parent
+    card["records"] = [record_entry(r, "train", model, here) for r in result.records]
+    card["records"] += [record_entry(r, "held-out", model, here) for r in held_out]
     card["plots"] = figures
     write_card(card, model_path)
     return card
@@ -365,5 +404,6 @@ _TRAINING_SUMMARY = (
     "evaluations",
     "k_n_per_m",
     "c_ns_per_m",
+    "linear_validation_rms_ratio",
     "seconds",
 )

@@ -9,6 +9,7 @@ is declared once and shows each model's default.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -48,7 +49,7 @@ def _metavar(f: Any) -> str:
     if choices:
         return "{" + ",".join(choices) + "}"
     if isinstance(f.default, tuple):
-        return "N[,N...]"
+        return "V[,V...]" if f.default and isinstance(f.default[0], str) else "N[,N...]"
     return "N" if isinstance(f.default, int) else "X"
 
 
@@ -158,14 +159,31 @@ def summary(card: dict[str, Any], out: Path) -> str:
         f"model {card['model']} -> {out} (card {json_path.name}, {md_path.name}; "
         f"{len(card['plots'])} figures)",
         f"identified in {src['wall_time_s']:.1f} s, seed {src['seed']}",
+    ]
+    if src.get("time_limited"):
+        lines.append(f"stopped early: {src['stopped']} (the card records the budget used)")
+    if src.get("choice"):
+        lines.append(f"network chosen on validation: {src['choice']['summary']}")
+    if src.get("note"):
+        lines.append(f"note: {src['note']}")
+    if card.get("parameters"):
+        params = card["parameters"].items()
+        lines.append(
+            "parameters: " + ", ".join(f"{k} = {p['value']:.6g} {p['unit']}" for k, p in params)
+        )
+    # full names, the column as wide as the longest (the card's paths, relative to it)
+    names = [str(out.parent / r["file"]) if r["file"] else r["name"] for r in card["records"]]
+    names = [os.path.normpath(n) for n in names]
+    width = max(30, *(len(n) for n in names))
+    lines += [
         "",
-        f"{'record':30s} {'role':9s} {'RMS ratio %':>12s} {'ESR %':>8s} {'max err N':>10s} "
+        f"{'record':{width}s} {'role':9s} {'RMS ratio %':>12s} {'ESR %':>8s} {'max err N':>10s} "
         f"{'NRMSE %':>8s}",
     ]
-    for r in card["records"]:
+    for name, r in zip(names, card["records"], strict=True):
         m = r["metrics"]
         lines.append(
-            f"{(r['file'] or r['name'])[-30:]:30s} {r['role']:9s} {100 * m['rms_ratio']:12.2f} "
+            f"{name:{width}s} {r['role']:9s} {100 * m['rms_ratio']:12.2f} "
             f"{100 * m['esr']:8.3f} {m['max_error']:10.1f} {100 * m['nrmse']:8.2f}"
         )
     return "\n".join(lines)

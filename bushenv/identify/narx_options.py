@@ -15,6 +15,8 @@ RECIPES = ("free-run", "teacher-forcing")
 INPUT_BASES = ("auto", "lags", "differences")
 EARLY_STOPS = ("training", "stage")
 SWITCH = ("off", "on")
+CHOOSE_NETWORKS = ("9x5", "18x5", "9x10")  # units x lags; docs/fit.md: why these
+SET_BY_CHOICE = ("hidden", "n_past_x", "n_past_f")  # giving one of these turns the choice off
 
 
 @dataclass(frozen=True)
@@ -27,11 +29,26 @@ class NarxOptions:
         "teacher-forcing: one step ahead only (the papers' recipe, seed 000 §4.2)",
         choices=RECIPES,
     )
-    hidden: tuple[int, ...] = option(
-        HIDDEN, "tanh units per hidden layer, one or two layers (seed 001: 10,9)"
+    choose: str = option(
+        "on",
+        "on: the network (units and lags) chosen on the validation parts among "
+        "--choose-networks, each trained with --choose-share of the iterations, the best then "
+        "in full; off: --hidden, --n-past-x, --n-past-f as given (giving one turns it off)",
+        choices=SWITCH,
     )
-    n_past_x: int = option(N_PAST_X, "past displacements fed to the net (besides the current)")
-    n_past_f: int = option(N_PAST_F, "past own forces fed to the net")
+    choose_networks: tuple[str, ...] = option(
+        CHOOSE_NETWORKS, "candidate networks, UNITSxLAGS (one tanh layer; n-past-x = n-past-f)"
+    )
+    choose_share: float = option(
+        0.2, "share of the iteration counts each candidate trains with before the choice"
+    )
+    hidden: tuple[int, ...] = option(
+        HIDDEN, "tanh units per hidden layer, one or two layers (seed 001: 10,9); --choose off"
+    )
+    n_past_x: int = option(
+        N_PAST_X, "past displacements fed to the net (besides the current); --choose off"
+    )
+    n_past_f: int = option(N_PAST_F, "past own forces fed to the net; --choose off")
     val_fraction: float = option(0.2, "last part of each record kept for validation")
     teacher_steps: int = option(2000, "full-batch Adam steps one step ahead")
     teacher_lr: float = option(1e-2, "learning rate one step ahead (cosine decay to 0)")
@@ -87,8 +104,36 @@ class NarxOptions:
         choices=EARLY_STOPS,
     )
     threads: int = option(1, "torch threads")
-    time_budget_s: float = option(120.0, "wall-time cap, s (a safety stop, reported)")
+    time_limit_s: float = option(
+        0.0,
+        "wall-time limit, s; 0: none. Iteration counts decide when training ends, so a seed "
+        "reproduces the weights; a limit that stops it early is reported and on the card",
+    )
     progress_every_s: float = option(3.0, "seconds between progress lines")
+
+    @staticmethod
+    def implied(given: dict) -> dict:
+        """Options as given, with ``choose="off"`` when a size or lag is given without it."""
+        if "choose" not in given and any(k in given for k in SET_BY_CHOICE):
+            return {**given, "choose": "off"}
+        return given
+
+    def networks(self) -> list[tuple[int, int]]:
+        """The candidates of ``choose_networks`` as (units, lags)."""
+        out = []
+        for text in self.choose_networks:
+            units, _, lags = text.partition("x")
+            if not (units.strip().isdigit() and lags.strip().isdigit()):
+                raise IdentificationError(
+                    f"choose_networks: {text!r} is not UNITSxLAGS (e.g. 9x5: 9 tanh units, "
+                    "5 past displacements and 5 past forces)"
+                )
+            if int(units) < 1 or int(lags) < 1:
+                raise IdentificationError(f"choose_networks: {text!r} needs units and lags >= 1")
+            out.append((int(units), int(lags)))
+        if not out:
+            raise IdentificationError("choose_networks: give at least one UNITSxLAGS")
+        return out
 
     def basis(self) -> str:
         """The input basis training uses ("auto" resolved by the recipe)."""
@@ -110,6 +155,11 @@ class NarxOptions:
             raise IdentificationError(
                 f"hidden must be one or two positive sizes, got {self.hidden}"
             )
+        self.networks()
+        if not 0.0 < self.choose_share <= 1.0:
+            raise IdentificationError(f"choose_share must be in (0, 1], got {self.choose_share}")
+        if self.time_limit_s < 0:
+            raise IdentificationError(f"time_limit_s must be >= 0, got {self.time_limit_s}")
         for name in ("n_past_x", "n_past_f", "eval_every", "patience", "batch_windows"):
             if getattr(self, name) < 1:
                 raise IdentificationError(f"{name} must be >= 1, got {getattr(self, name)}")
@@ -134,3 +184,18 @@ class NarxOptions:
             )
         if self.certified_holds < 2:
             raise IdentificationError(f"certified_holds must be >= 2, got {self.certified_holds}")
+
+
+@dataclass(frozen=True)
+class HybridOptions(NarxOptions):
+    """The hybrid's options: the NN's, but its network is not chosen unless asked (its
+    backbone carries the bulk of the force; its 9x5 network fits the bushings measured in
+    docs/fit.md within 3.2 %)."""
+
+    choose: str = option(
+        "off",
+        "on: the network (units and lags) chosen on the validation parts among "
+        "--choose-networks, each trained with --choose-share of the iterations, the best then "
+        "in full; off: --hidden, --n-past-x, --n-past-f as given (giving one turns it off)",
+        choices=SWITCH,
+    )

@@ -18,6 +18,21 @@ from bushenv.metrics import rms_ratio
 from bushenv.progress import Progress, ProgressSpec
 
 
+def sample_cost(opt: Any) -> float:
+    """Relative cost of one sample through the net (multiply-adds plus a fixed overhead)."""
+    inputs = 1 + opt.n_past_x + opt.n_past_f
+    h = opt.hidden
+    return (inputs * h[0] + (h[0] * h[1] if len(h) > 1 else 0) + 100) / 200.0
+
+
+def training_work(problem: NarxProblem, opt: Any, stages: list[tuple[int, int]]) -> float:
+    """Units of work of one training (samples through the net, weighted by ``sample_cost``):
+    the progress lines' total."""
+    work = opt.teacher_steps * problem.n_train
+    work += sum(n * opt.batch_windows * length for length, n in stages)
+    return work * sample_cost(opt)
+
+
 class Keeper:
     """The weights a training keeps: admitted ones (every loss term with ``admits`` admits
     them) beat any others, then the lower validation error wins. Patience is a separate
@@ -58,17 +73,25 @@ class Trainer:
         stages: list[tuple[int, int]],
     ) -> None:
         self.problem, self.opt, self.terms, self.stages = problem, opt, loss_terms, stages
-        work = opt.teacher_steps * problem.n_train
-        work += sum(n * opt.batch_windows * length for length, n in stages)
-        self.progress = Progress.of(
-            progress,
-            total=work,
-            label=problem.kind,
-            every_s=opt.progress_every_s,
-            budget_s=opt.time_budget_s,
-            upper_bound=True,
-        )
-        self.work = 0.0
+        # a Progress given is shared with other trainings (the network choice): its work and
+        # clock go on from where they are
+        self.shared = isinstance(progress, Progress)
+        self.tag = ""
+        if isinstance(progress, Progress):
+            self.progress = progress
+        else:
+            self.progress = Progress.of(
+                progress,
+                total=training_work(problem, opt, stages),
+                label=problem.kind,
+                every_s=opt.progress_every_s,
+                budget_s=opt.time_limit_s or None,
+                upper_bound=True,
+            )
+        self.work, self.unit = self.progress.done, sample_cost(opt)
+        self.t0 = self.progress.elapsed_s()  # this training's start on a shared clock
+        self.teacher_done = self.it = 0
+        self.time_limited = False
         self.rng = np.random.default_rng(seed)
         nx, nf = problem.n_past_x, problem.n_past_f
         basis = None
@@ -99,7 +122,7 @@ class Trainer:
 
     # ----- pieces ----------------------------------------------------------------------------
     def say(self, msg: str, force: bool = False) -> None:
-        self.progress.update(self.work, msg, force)
+        self.progress.update(self.work, self.tag + msg, force)
 
     def total_loss(self, loss: torch.Tensor, stage: str) -> torch.Tensor:
         """The data loss plus every loss term that applies to ``stage``."""
@@ -111,6 +134,21 @@ class Trainer:
     def admitted(self) -> bool:
         """Whether every term that judges weights (``admits``) admits the current ones."""
         return all(t.admits(self.net, self.problem) for t in self.terms if hasattr(t, "admits"))
+
+    def out_of_time(self) -> bool:
+        """True once an explicit ``time_limit_s`` has passed (then the log says where)."""
+        limit = self.opt.time_limit_s
+        if self.time_limited or not limit or self.progress.elapsed_s() <= limit:
+            return self.time_limited
+        self.time_limited = True
+        where = (
+            f"free-run iteration {self.it} of {sum(n for _, n in self.stages)}"
+            if self.it
+            else f"teacher step {self.teacher_done} of {self.opt.teacher_steps}"
+        )
+        self.log["stopped"] = f"time limit {limit:g} s hit at {where}"
+        self.say(f"stopped early: {self.log['stopped']}", True)
+        return True
 
     def state(self) -> dict[str, torch.Tensor]:
         return {k: t.detach().clone() for k, t in self.net.state_dict().items()}
@@ -148,8 +186,11 @@ class Trainer:
             adam.step()
             sched.step()
             self.log["teacher_losses"].append(loss.item())
-            self.work += p.n_train
+            self.teacher_done = i + 1
+            self.work += self.unit * p.n_train
             self.say(f"teacher step {i + 1}/{opt.teacher_steps}: one-step MSE {loss.item():.3e}")
+            if self.out_of_time():
+                break
             if not select or ((i + 1) % opt.eval_every and i + 1 < opt.teacher_steps):
                 continue
             with torch.no_grad():
@@ -205,10 +246,7 @@ class Trainer:
                         f"early stop at iteration {self.it} (patience {opt.patience})"
                     )
                     return True
-            if self.progress.elapsed_s() > opt.time_budget_s:
-                self.log["stopped"] = (
-                    f"time budget {opt.time_budget_s} s hit at iteration {self.it}"
-                )
+            if self.out_of_time():
                 return True
         return False
 
@@ -223,7 +261,7 @@ class Trainer:
         self.adam.step()
         self.sched.step()
         self.log["free_run_losses"].append(loss.item())
-        self.work += opt.batch_windows * length
+        self.work += self.unit * opt.batch_windows * length
         return loss.item()
 
     def _evaluate(self, length: int, loss: float) -> None:
@@ -249,12 +287,14 @@ class Trainer:
         )
         self.keep, self.history = Keeper(self), [(0, val)]
         self.keep.offer(val)
-        self.log["stopped"] = "one step ahead only (teacher-forcing recipe)"
-        if self.opt.recipe == "free-run":
+        if not self.time_limited:
+            self.log["stopped"] = "one step ahead only (teacher-forcing recipe)"
+        if self.opt.recipe == "free-run" and not self.time_limited:
             self.free_run()
             self.net.load_state_dict(self.keep.state)
-        elapsed = self.progress.elapsed_s()
-        self.work = self.progress.total
+        elapsed = self.progress.elapsed_s() - self.t0
+        if not self.shared:
+            self.work = self.progress.total
         self.say(
             f"done in {elapsed:.1f} s ({self.log['stopped']}); best validation free-run RMS "
             f"ratio {self.keep.val:.4f}",
@@ -272,5 +312,12 @@ class Trainer:
             validation_after_teacher=val,
             loss_terms=terms,
             seconds=elapsed,
+            time_limited=self.time_limited,
+            budget_used={
+                "teacher_steps": self.teacher_done,
+                "teacher_steps_planned": self.opt.teacher_steps,
+                "free_run_iterations": self.it,
+                "free_run_iterations_planned": sum(n for _, n in self.stages),
+            },
         )
         return self.log

@@ -21,8 +21,9 @@ Torch trains; it never runs per step in use: the result is exported to the numpy
 
 Why step 5's free run: a net trained one step ahead on measured past forces, then run on its
 own, can self-oscillate on data like its training data (DESIGN-NOTES). Iteration counts, not
-the clock, decide when to stop, so a seed reproduces the weights; ``time_budget_s`` is only a
-safety cap (reported if hit). docs/fit.md explains each option and what the recipes give.
+the clock, decide when to stop, so a seed reproduces the weights; ``time_limit_s`` (off by
+default) is an explicit wall-time limit, reported and logged (``time_limited``, ``budget_used``)
+when it stops the training early. docs/fit.md explains each option and what the recipes give.
 
 Extra loss terms plug in through ``loss_terms`` (objects with ``name``, ``stages`` and
 ``__call__(net, problem) -> tensor``, added to the data loss of the stages they name);
@@ -41,13 +42,17 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import ClassVar, Protocol
 
+import numpy as np
 import torch
 
 from bushenv.identify.data import IdentificationError, TrainingSet
+from bushenv.identify.linear import least_squares_kc
+from bushenv.identify.narx_choice import choose_and_train
 from bushenv.identify.narx_data import NarxProblem, narx_problem
 from bushenv.identify.narx_options import NarxOptions
 from bushenv.identify.narx_torch import TorchNarx
 from bushenv.identify.narx_train import Trainer
+from bushenv.metrics import rms_ratio
 from bushenv.models.hybrid import HybridBushing
 from bushenv.models.narx import NarxBushing
 from bushenv.progress import ProgressSpec
@@ -126,25 +131,55 @@ def fit_narx(
 ) -> NarxBushing:
     """Identify a "nn" (NarxBushing) or "hybrid" (HybridBushing) model from ``data``.
 
-    The returned model carries a ``training`` dict (losses, validation RMS ratios, times, the
-    options) as an attribute; it is not saved in the model file.
+    With ``options.choose == "on"`` the network's size and lags are first chosen on the
+    validation parts (``narx_choice.py``). The returned model carries a ``training`` dict
+    (losses, validation RMS ratios, times, the choice, ``options_used``: the options of the
+    network returned) as an attribute; it is not saved in the model file.
     """
     if kind not in ("nn", "hybrid"):
         raise IdentificationError(f"fit_narx: kind must be 'nn' or 'hybrid', got {kind!r}")
     opt = options
-    problem = narx_problem(kind, data, opt.n_past_x, opt.n_past_f, opt.val_fraction)
-    stages = _stages(problem, opt)
+    terms = [*loss_terms_of(opt), *loss_terms]
     old_threads = torch.get_num_threads()
     torch.set_num_threads(max(1, int(opt.threads)))
-    torch.manual_seed(seed)
     try:
-        trainer = Trainer(problem, opt, [*loss_terms_of(opt), *loss_terms], seed, progress, stages)
-        training = trainer.run()
+        if opt.choose == "on":
+            trainer, opt, choice = choose_and_train(kind, data, opt, seed, progress, terms, _stages)
+        else:
+            problem = narx_problem(kind, data, opt.n_past_x, opt.n_past_f, opt.val_fraction)
+            torch.manual_seed(seed)
+            trainer = Trainer(problem, opt, terms, seed, progress, _stages(problem, opt))
+            trainer.run()
+            choice = None
     finally:
         torch.set_num_threads(old_threads)
-    model = export(trainer.net, problem)
-    model.training = training
+    model = export(trainer.net, trainer.problem)
+    model.training = trainer.log
+    model.training.update(choice=choice, options_used=opt)
+    if kind == "nn":
+        model.training.update(linear_check(trainer.problem, float(trainer.keep.val)))
     return model
+
+
+def linear_check(problem: NarxProblem, nn_val: float) -> dict:
+    """The least-squares Kelvin-Voigt model's RMS ratio on the same validation parts, and a
+    note when the network does not take at least half of that error away (then the records
+    may not excite what the network needs, or its training did not converge)."""
+    segs, n = problem.data.segments, [hi - lo for lo, hi in problem.train]
+    k, c = least_squares_kc(
+        *(np.concatenate([getattr(s, a)[:m] for s, m in zip(segs, n, strict=True)]) for a in "xfv")
+    )
+    pred = np.concatenate([k * s.x[m:] + c * s.v[m:] for s, m in zip(segs, n, strict=True)])
+    lin = rms_ratio(problem.f_val, pred)
+    out = {"linear_validation_rms_ratio": lin, "note": None}
+    if not nn_val < 0.5 * lin:
+        out["note"] = (
+            f"the network's validation free-run RMS ratio, {100 * nn_val:.2f} %, is not below "
+            f"half the linear model's ({100 * lin:.2f} %) on the same parts: it learned little "
+            "beyond a spring and a damper. Try the hybrid, longer or richer records (the range "
+            "and frequencies the bushing meets in use), or --choose-networks with larger ones"
+        )
+    return out
 
 
 def _stages(problem: NarxProblem, opt: NarxOptions) -> list[tuple[int, int]]:

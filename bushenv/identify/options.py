@@ -50,6 +50,8 @@ def options_of(cls: type, given: Any, model: str) -> Any:
     if isinstance(given, cls):
         opts = given
     elif isinstance(given, Mapping):
+        implied = getattr(cls, "implied", None)  # options one given option implies
+        given = implied(dict(given)) if implied else given
         known = {f.name: f for f in option_fields(cls)}
         unknown = sorted(set(given) - set(known))
         if unknown:

@@ -95,7 +95,7 @@ MODELS.add(
         "bushenv.models.hybrid:HybridBushing",
         "linear backbone plus a bounded NARX residual network (seed 000 §3)",
         fit="bushenv.identify.neural:fit_hybrid",
-        options="bushenv.identify.narx_options:NarxOptions",
+        options="bushenv.identify.narx_options:HybridOptions",
         shipped=True,
     ),
 )

@@ -10,8 +10,6 @@ given). Rows of another bushing's models would say nothing about this one.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from bushenv.identify.linear import CONTROL_RECORD_S, fitted_linear  # noqa: F401 (re-export)
@@ -63,11 +61,14 @@ def card_displacements(spec: str | None) -> list[np.ndarray] | None:
     card = card_of(spec)
     if card is None:
         return None
-    paths = [r.get("file") for r in card["records"] if r.get("role") == "train"]
-    if not paths or not all(p and Path(p).is_file() for p in paths):
-        return None
-    from bushenv.identify.card import load_card
+    from bushenv.identify.card import card_paths, load_card
     from bushenv.records import load_csv
+
+    # record files are relative to the card (older cards: absolute)
+    here = card_paths(spec)[0].parent
+    paths = [here / r["file"] for r in card["records"] if r.get("role") == "train" and r["file"]]
+    if not paths or not all(p.is_file() for p in paths):
+        return None
 
     load_card(spec, records=paths)  # CardError naming a record that changed since
     return [load_csv(p).displacement for p in paths]

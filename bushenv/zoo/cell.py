@@ -134,7 +134,8 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
         seed=seed,
         progress=False,
         recipe=cell["recipe"],
-        **cell.get("train_options", {}),
+        # a recipe's population at the papers' network size (no choice of size on validation)
+        **{"choose": "off", **cell.get("train_options", {})},
     )
     train_s = time.perf_counter() - t0
     path = model.save(Path(cell["out"]) / "models" / f"{cell_name(cell)}.npz")
