@@ -245,3 +245,14 @@ def test_every_saved_case_records_the_judge_of_its_report(tmp_path):
     assert cases
     for path in cases:
         assert json.loads(path.read_text())["judge"] == report["judge"]
+
+
+def test_rl_searchers_attack_a_model_file_without_a_reference(tmp_path, capsys):
+    # the agent's rig runs the model beside itself; the judge (no reference) is the
+    # evaluator's, so the env must not vet the model as if it were a reference
+    k = TABLE1["axial"]
+    mine = LinearBushing(k_n_per_m=-0.05 * k["k_n_per_m"], c_ns_per_m=k["c_ns_per_m"])
+    path = mine.save(tmp_path / "pulling.npz")
+    argv = ["attack", "--model", str(path), "--searchers", "ppo", "--budget", "4"]
+    argv += ["--rl-budget", "4", "--max-shrink", "0", "--no-plots", "--quiet", "--stroke-mm", "3"]
+    assert main([*argv, "--out", str(tmp_path / "a")]) == 0

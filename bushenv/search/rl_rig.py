@@ -242,6 +242,9 @@ def _rig_vec_env(model, reference, axis, n_envs, episode_steps, reward, scales=M
         dt_s=model.dt,
         max_episode_steps=episode_steps,
         reward_fn=reward,
+        # the agent's episodes are judged by the evaluator, whose reference the one judge
+        # vetted already (or the user trusted); with none, the model is its own twin here
+        trust_reference=True,
         **_limits_kwargs(scales),
     )
 

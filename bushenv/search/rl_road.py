@@ -96,5 +96,6 @@ def road_agent_env(evaluator, n_envs, episode_steps, on_episodes, actions=None):
         max_episode_steps=episode_steps,
         autoreset_mode="SameStep",
         reward_fn=RoadReward(n_envs, episode_steps, evaluator, on_episodes),
+        trust_reference=True,  # the evaluator's judge vetted it already
     )
     return RoadActions(SB3VecEnv(venv))
