@@ -18,6 +18,7 @@ from bushenv.planar.base import FORMAT, FORMAT_VERSION, PlanarModel, PlanarModel
 from bushenv.registry import Registry, load_entry_point
 
 PLANAR_MODELS: Registry[str | type] = Registry("planar model", PlanarModelError)
+PLANAR_MODELS.add("reference", "bushenv.planar.reference:PlanarRubber")
 PLANAR_MODELS.add("linear", "bushenv.planar.linear:PlanarLinear")
 
 
