@@ -20,6 +20,9 @@ from bushenv.registry import Registry, load_entry_point
 PLANAR_MODELS: Registry[str | type] = Registry("planar model", PlanarModelError)
 PLANAR_MODELS.add("reference", "bushenv.planar.reference:PlanarRubber")
 PLANAR_MODELS.add("linear", "bushenv.planar.linear:PlanarLinear")
+PLANAR_MODELS.add("nn", "bushenv.planar.narx:PlanarNarx")
+PLANAR_MODELS.add("nn-axis", "bushenv.planar.narx:PlanarNarxPerAxis")
+PLANAR_MODELS.add("hybrid", "bushenv.planar.narx:PlanarHybrid")
 
 
 def model_class(name: str) -> type:
