@@ -68,8 +68,11 @@ def preload_sweep(
 
 
 def programme(dt: float, seed: int, n_verify: float = 1.5) -> dict[str, np.ndarray]:
-    """The unseen verification records, by name (20 s each)."""
+    """The unseen verification records, by name (20 s each): random at the training amplitude
+    n = 1 (new seeds), then the verification amplitude ``n_verify`` and the preload sets."""
     return {
+        "random independent n=1": random_independent(1.0, 20.0, dt, 3000 + seed),
+        "random correlated n=1": random_correlated(1.0, 20.0, dt, 4000 + seed),
         "random independent": random_independent(n_verify, 20.0, dt, 1000 + seed),
         "random correlated": random_correlated(n_verify, 20.0, dt, 2000 + seed),
         "radial preload + rotation sweep": preload_sweep(

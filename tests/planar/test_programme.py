@@ -45,3 +45,24 @@ def test_every_record_is_within_the_machine_limits():
         assert np.abs(q[:, :2]).max() <= MAX_DISPLACEMENT_M
         assert np.abs(np.diff(q[:, :2], axis=0)).max() / DT <= MAX_VELOCITY_M_PER_S
         assert np.abs(q[:, 2]).max() <= MAX_ROTATION_RAD
+
+
+def test_benchmark_table_reports_ratio_and_axes_at_rest_in_newtons():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parents[2] / "scripts" / "planar_benchmark.py"
+    spec = importlib.util.spec_from_file_location("planar_benchmark", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+
+    def cell(rms, rest=False):
+        return {"rms": rms, "max": 2 * rms, "max_abs": 7.0, "at_rest": rest}
+
+    row = {
+        k: {"axial": cell(1.0, rest=True), "radial": cell(r), "rotation": cell(r)}
+        for k, r in zip(mod.MODELS, (10.0, 8.0, 4.0, 3.0), strict=True)
+    }
+    lines = mod.table({0: {"set": row}}).splitlines()
+    assert "axial at rest: max error | 7 N" in lines[2]
+    assert lines[3].endswith("| 2.00 |")  # nn-axis 8 % over nn 4 %
