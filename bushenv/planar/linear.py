@@ -15,6 +15,7 @@ import numpy as np
 
 from bushenv.models.base import PAPER_DT
 from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
+from bushenv.planar.reference import ROTATION_K_NM_PER_RAD
 
 
 class PlanarLinear(PlanarModel):
@@ -27,6 +28,15 @@ class PlanarLinear(PlanarModel):
         self.k_matrix = as_matrix("linear: k_matrix", k_matrix)
         self.c_matrix = as_matrix("linear: c_matrix", c_matrix)
         super().__init__(dt)
+
+    @classmethod
+    def preset(cls, dt: float = PAPER_DT) -> PlanarLinear:
+        """Seed 000 Table 1 on the diagonal (axial, radial); the rotation: the reference's
+        assumed 3000 N m/rad with Table 1's radial loss time c/k (29.6 N m s/rad); no coupling."""
+        k_t = ROTATION_K_NM_PER_RAD
+        k = np.diag([379.68e3, 1518.73e3, k_t])
+        c = np.diag([4.4e3, 15.0e3, k_t * 15.0e3 / 1518.73e3])
+        return cls(k, c, dt=dt)
 
     def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         np.matmul(q, self.k_matrix.T, out=out)

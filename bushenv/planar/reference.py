@@ -54,6 +54,7 @@ from bushenv.reference.rubber import PRESETS as ONE_AXIS
 
 EFFECTS = ("coupling", "hardening", "relaxation", "friction", "noise")
 PHYSICAL_EFFECTS = EFFECTS[:4]
+ROTATION_K_NM_PER_RAD = 3000.0  # assumed: a control-arm bushing, cardanic mode (52 N m/deg)
 THETA_N1_RAD = 0.05  # rotation peak at amplitude index n = 1 (assumed; 2 mm over a 40 mm arm)
 MAX_ROTATION_RAD = 0.15  # the rotation the planar programmes stay within (assumed)
 FRICTION_YIELDS = ("vector", "axis")
@@ -61,7 +62,7 @@ FRICTION_YIELDS = ("vector", "axis")
 
 def _preset() -> dict[str, Any]:
     ax, rad = ONE_AXIS["axial"], ONE_AXIS["radial"]
-    k_t = 3000.0
+    k_t = ROTATION_K_NM_PER_RAD
     loss_s = rad["c_ns_per_m"] / rad["k_n_per_m"]
     w_ax = np.array(ax["relax_k_n_per_m"]) / ax["k_n_per_m"]
     w_rad = np.array(rad["relax_k_n_per_m"]) / rad["k_n_per_m"]
