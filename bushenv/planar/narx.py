@@ -94,6 +94,31 @@ class PlanarNarx(PlanarModel):
         self._check_structure()
         super().__init__(dt)
 
+    @classmethod
+    def untrained(cls, seed: int = 0, hidden: int = 3 * HIDDEN_PER_AXIS, dt: float = PAPER_DT):
+        """A network with random weights (normal, std 0.3) scaled to the n = 1 amplitudes and
+        forces of Table 1: for tests and checks, deterministic given ``seed``."""
+        rng = np.random.default_rng(seed)
+        m1, mo = axis_masks(hidden) if cls.name == "nn-axis" else (1.0, 1.0)
+        extra = {}
+        if cls.name == "hybrid":
+            extra = {
+                "k_matrix": np.diag([379.68e3, 1518.73e3, 3.0e3]),
+                "c_matrix": np.zeros((3, 3)),
+            }
+        return cls(
+            q_offset=np.zeros(3),
+            q_scale=np.array([2e-3, 2e-3, 0.05]),
+            f_offset=np.zeros(3),
+            f_scale=np.array([760.0, 3040.0, 150.0]),
+            w1=rng.normal(0, 0.3, (hidden, N_IN)) * m1,
+            b1=rng.normal(0, 0.1, hidden),
+            w_out=rng.normal(0, 0.3, (3, hidden)) * mo,
+            b_out=rng.normal(0, 0.1, 3),
+            dt=dt,
+            **extra,
+        )
+
     def _check_structure(self) -> None:
         """The MIMO network takes any weights."""
 
@@ -155,7 +180,7 @@ class PlanarHybrid(PlanarNarx):
     name = "hybrid"
     param_names = ("k_matrix", "c_matrix", *PlanarNarx.param_names)
 
-    def __init__(self, k_matrix: Any, c_matrix: Any, **network: Any) -> None:
+    def __init__(self, k_matrix: Any, c_matrix: Any, **network: Any) -> None:  # noqa: D107
         self.k_matrix = as_matrix("hybrid: k_matrix", k_matrix)
         self.c_matrix = as_matrix("hybrid: c_matrix", c_matrix)
         super().__init__(**network)

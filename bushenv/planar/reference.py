@@ -219,7 +219,11 @@ class PlanarRubber(PlanarModel):
 
     def without_effects(self, names: Any) -> PlanarRubber:
         names = (names,) if isinstance(names, str) else tuple(names)
-        self._switched_on(tuple(n for n in names if n in self._configured()))  # names checked
+        unknown = [n for n in names if n not in EFFECTS]
+        if unknown:
+            raise PlanarModelError(
+                f"reference: unknown effect(s) {unknown}; known: {list(EFFECTS)}"
+            )
         return self.only_effects(tuple(e for e in self.effects if e not in names))
 
     def elastic_params(self) -> np.ndarray:

@@ -125,6 +125,8 @@ def test_save_load_keeps_effects_and_force(tmp_path):
 def test_bad_arguments_name_the_value():
     with pytest.raises(PlanarModelError, match="unknown effect"):
         PlanarRubber.preset(effects=("thermal",))
+    with pytest.raises(PlanarModelError, match="unknown effect"):
+        PlanarRubber.preset().without_effects("thermal")
     with pytest.raises(PlanarModelError, match="friction_yield"):
         PlanarRubber.preset(friction_yield="box")
     with pytest.raises(PlanarModelError, match="stiffness"):
