@@ -13,6 +13,7 @@ Table 3) per axis, beside Table 3, and writes the numbers as JSON.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import time
 
@@ -24,7 +25,7 @@ from bushenv.planar.base import COORDS
 from bushenv.planar.linear import fit_linear
 from bushenv.planar.programme import programme, random_independent
 from bushenv.planar.reference import PlanarRubber
-from bushenv.planar.train import fit_planar_network
+from bushenv.planar.train import TrainOptions, fit_planar_network
 from bushenv.progress import Progress
 
 MODELS = ("linear", "nn-axis", "nn", "hybrid")
@@ -42,14 +43,32 @@ def reference(uncoupled: bool, seed: int) -> PlanarRubber:
     return ref.without_effects("coupling")
 
 
-def run_seed(seed: int, progress: Progress, done: list[int], uncoupled: bool = False) -> dict:
+def parse_options(text: str) -> TrainOptions:
+    """``key=value,key=value`` over ``TrainOptions``; ValueError naming an unknown key or value."""
+    fields = {f.name: f.type for f in dataclasses.fields(TrainOptions)}
+    kwargs = {}
+    for item in filter(None, text.split(",")):
+        key, _, value = item.partition("=")
+        key = key.strip()
+        if key not in fields:
+            raise ValueError(f"--options: unknown key {key!r}; known: {', '.join(fields)}")
+        try:
+            kwargs[key] = (int if fields[key] in (int, "int") else float)(value)
+        except ValueError:
+            raise ValueError(f"--options: {key}={value!r} is not a number") from None
+    return TrainOptions(**kwargs)
+
+
+def run_seed(
+    seed: int, progress: Progress, done: list[int], uncoupled: bool = False, options=None
+) -> dict:
     dt = PAPER_DT
     q = random_independent(1.0, 60.0, dt, seed)
     f = reference(uncoupled, seed).simulate(q)
     models = {"linear": fit_linear(q, velocity_of(q, dt), f, dt)}
     for kind in MODELS[1:]:
         t0 = time.perf_counter()
-        models[kind] = fit_planar_network(q, f, dt, kind=kind, seed=seed)
+        models[kind] = fit_planar_network(q, f, dt, kind=kind, seed=seed, options=options)
         done[0] += 1
         progress.update(done[0], f"seed {seed}: {kind} trained in {time.perf_counter() - t0:.0f} s")
     out = {}
@@ -141,11 +160,18 @@ def main() -> None:
     ap.add_argument(
         "--uncoupled", action="store_true", help="reference without coupling, axis friction"
     )
+    ap.add_argument(
+        "--options", default="", help="training budget, e.g. teacher_steps=1500,window=256"
+    )
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args()
     progress = Progress(3 * len(args.seeds), quiet=args.quiet, label="planar benchmark")
     done = [0]
-    results = {s: run_seed(s, progress, done, args.uncoupled) for s in args.seeds}
+    try:
+        opts = parse_options(args.options)
+    except ValueError as exc:
+        ap.error(str(exc))  # exit 2
+    results = {s: run_seed(s, progress, done, args.uncoupled, opts) for s in args.seeds}
     progress.update(None, "done", force=True)
     print(table(results))
     print(coupling_shares(args.seeds[0]))
