@@ -1,0 +1,64 @@
+"""Linear planar bushing: full 3x3 stiffness and damping matrices.
+
+    f = K q + C v,   q = (axial m, radial m, rotation rad),  f = (N, N, N m)
+
+The constant-matrix element of the vehicle tools (Adams FIELD, Chrono's generic bushing) in
+the plane; seed 000 eq. 1 per axis when K and C are diagonal. ``TABLE1`` gives seed 000
+Table 1 on the diagonal and an assumed rotational stiffness (see ``reference.py``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from bushenv.models.base import PAPER_DT
+from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
+from bushenv.planar.reference import ROTATION_K_NM_PER_RAD
+
+
+class PlanarLinear(PlanarModel):
+    """Kelvin-Voigt in three coordinates; stateless, so batched and looped runs agree."""
+
+    name = "linear"
+    param_names = ("k_matrix", "c_matrix")
+
+    def __init__(self, k_matrix: Any, c_matrix: Any, dt: float = PAPER_DT) -> None:
+        self.k_matrix = as_matrix("linear: k_matrix", k_matrix)
+        self.c_matrix = as_matrix("linear: c_matrix", c_matrix)
+        super().__init__(dt)
+
+    @classmethod
+    def preset(cls, dt: float = PAPER_DT) -> PlanarLinear:
+        """Seed 000 Table 1 on the diagonal (axial, radial); the rotation: the reference's
+        assumed 3000 N m/rad with Table 1's radial loss time c/k (29.6 N m s/rad); no coupling."""
+        k_t = ROTATION_K_NM_PER_RAD
+        k = np.diag([379.68e3, 1518.73e3, k_t])
+        c = np.diag([4.4e3, 15.0e3, k_t * 15.0e3 / 1518.73e3])
+        return cls(k, c, dt=dt)
+
+    def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        np.matmul(q, self.k_matrix.T, out=out)
+        out += v @ self.c_matrix.T
+
+
+def fit_linear(q: np.ndarray, v: np.ndarray, f: np.ndarray, dt: float = PAPER_DT) -> PlanarLinear:
+    """Least-squares K, C from records: f ~ K q + C v over every sample.
+
+    ``q``, ``v``, ``f`` of shape (T, 3) or (T, B, 3); one least-squares problem for the three
+    force rows (each row of [K C] is the solution for its force).
+    """
+    q2 = np.asarray(q, dtype=np.float64).reshape(-1, 3)
+    v2 = np.asarray(v, dtype=np.float64).reshape(-1, 3)
+    f2 = np.asarray(f, dtype=np.float64).reshape(-1, 3)
+    if not (q2.shape == v2.shape == f2.shape) or q2.shape[0] < 6:
+        raise PlanarModelError(
+            f"fit_linear: q, v, f must be equal (T, 3) arrays with T >= 6, got "
+            f"{np.shape(q)}, {np.shape(v)}, {np.shape(f)}"
+        )
+    a = np.hstack([q2, v2])
+    scale = np.maximum(np.abs(a).max(axis=0), 1e-300)  # mm and rad differ by orders
+    coef, *_ = np.linalg.lstsq(a / scale, f2, rcond=None)
+    coef = (coef / scale[:, None]).T  # (3, 6): force row i = [K_i, C_i]
+    return PlanarLinear(coef[:, :3], coef[:, 3:], dt=dt)

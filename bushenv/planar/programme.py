@@ -1,0 +1,84 @@
+"""The 3-axis test programme: random on all axes with the amplitude index n per axis
+(independent and correlated), and the coupled sine sets (radial preload under a rotation
+sweep, and the reverse). Pure functions: (T, 3) profiles in m, m, rad, deterministic per seed.
+
+Amplitude index (seed 001 §3.2.2, as ``bushenv.excitation.random_rpc``): the peak of each
+coordinate is n times its peak at n = 1, ``PEAK_AT_N1`` = (2 mm, 2 mm, 0.05 rad; the rotation
+assumed, see ``reference.py``). n = 1 identifies, n = 1.5 verifies.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bushenv.excitation import chirp, random_rpc
+from bushenv.planar.reference import THETA_N1_RAD
+
+PEAK_AT_N1 = np.array([2.0e-3, 2.0e-3, THETA_N1_RAD])
+CORRELATION = 0.8  # share of the common drive in the correlated set
+
+
+def random_independent(n_index: float, duration_s: float, dt: float, seed: int) -> np.ndarray:
+    """Each coordinate its own RPC-like random drive, peak n * PEAK_AT_N1."""
+    return np.stack(
+        [
+            random_rpc(n_index, duration_s, dt, 3 * seed + i, peak_m_at_n1=PEAK_AT_N1[i])
+            for i in range(3)
+        ],
+        axis=1,
+    )
+
+
+def random_correlated(n_index: float, duration_s: float, dt: float, seed: int) -> np.ndarray:
+    """All coordinates driven by one common random drive (weight 0.8) plus their own (0.6),
+    signs (+, +, -): the axes move together, as on a car where one load path drives all."""
+    common = random_rpc(1.0, duration_s, dt, 10_000 + seed, peak_m_at_n1=1.0)
+    own = random_independent(1.0, duration_s, dt, seed) / PEAK_AT_N1
+    mix = (
+        CORRELATION * common[:, None] * np.array([1.0, 1.0, -1.0])
+        + np.sqrt(1 - CORRELATION**2) * own
+    )
+    return mix / np.abs(mix).max(axis=0) * n_index * PEAK_AT_N1
+
+
+def _hold(level: float, T: int, ramp_n: int) -> np.ndarray:
+    out = np.full(T, level)
+    out[:ramp_n] = level * 0.5 * (1 - np.cos(np.pi * np.arange(ramp_n) / ramp_n))
+    return out
+
+
+def preload_sweep(
+    held: int,
+    held_value: float,
+    swept_amplitude: float,
+    duration_s: float,
+    dt: float,
+    f_hz: tuple[float, float] = (0.5, 5.0),
+) -> np.ndarray:
+    """Coordinate ``held`` ramped (1 s, half-cosine) to ``held_value`` and held; the other of
+    (radial, rotation) swept from 1.5 s on (linear chirp ``f_hz``, ``swept_amplitude``); axial
+    at rest. ``held=1``: radial preload with a rotation sweep; ``held=2``: the reverse."""
+    T = int(round(duration_s / dt))
+    q = np.zeros((T, 3))
+    q[:, held] = _hold(held_value, T, int(round(1.0 / dt)))
+    start = int(round(1.5 / dt))
+    swept = 2 if held == 1 else 1
+    q[start:, swept] = chirp(f_hz[0], f_hz[1], swept_amplitude, (T - start) * dt, dt)[: T - start]
+    return q
+
+
+def programme(dt: float, seed: int, n_verify: float = 1.5) -> dict[str, np.ndarray]:
+    """The unseen verification records, by name (20 s each): random at the training amplitude
+    n = 1 (new seeds), then the verification amplitude ``n_verify`` and the preload sets."""
+    return {
+        "random independent n=1": random_independent(1.0, 20.0, dt, 3000 + seed),
+        "random correlated n=1": random_correlated(1.0, 20.0, dt, 4000 + seed),
+        "random independent": random_independent(n_verify, 20.0, dt, 1000 + seed),
+        "random correlated": random_correlated(n_verify, 20.0, dt, 2000 + seed),
+        "radial preload + rotation sweep": preload_sweep(
+            1, 3.0e-3, n_verify * THETA_N1_RAD, 20.0, dt
+        ),
+        "rotation preload + radial sweep": preload_sweep(
+            2, n_verify * THETA_N1_RAD, 3.0e-3, 20.0, dt
+        ),
+    }

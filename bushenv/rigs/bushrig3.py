@@ -1,0 +1,278 @@
+"""BushRig3-v0: the three-axis test machine driving axial, radial and rotation at once.
+
+``BushRig3Env`` and ``BushRig3VectorEnv`` share ``Rig3Core``: one batched step of (B, 3)
+arrays for both, so N single envs and one vector env of N columns give the same numbers, and
+the episode's end is decided by ``divergence.force_termination`` per coordinate.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from bushenv.divergence import force_termination
+from bushenv.errors import BadInput, ModelRaised
+from bushenv.planar import PLANAR_MODELS, PlanarModel, load_planar_model, model_class
+from bushenv.rigs.common import RigError, positive, positive_int
+from bushenv.rigs.specs import spec_kwargs
+from bushenv.rigs.vector_base import ArrayVectorEnv
+
+ENV_ID = "BushRig3-v0"
+COORDS = ("axial", "radial", "rotation")
+MODEL_ERRORS = (BadInput, ModelRaised, ArithmeticError)
+
+
+def resolve_planar(value: Any, dt: float, what: str) -> PlanarModel:
+    """A planar model from a registered name (its ``preset``), an ``.npz`` file or an object."""
+    if isinstance(value, PlanarModel):
+        return value.copy()
+    if isinstance(value, str) and value in PLANAR_MODELS:
+        cls = model_class(value)
+        if not hasattr(cls, "preset"):
+            raise RigError(
+                f"{ENV_ID}: {what} {value!r} has no preset (a network must be trained): pass "
+                "its .npz file from fit_planar_network(...).save(path)"
+            )
+        kwargs = {"measurement": False} if value == "reference" else {}
+        return cls.preset(dt=dt, **kwargs)
+    if isinstance(value, str | Path) and str(value).endswith(".npz"):
+        return load_planar_model(value, dt=dt)
+    raise RigError(
+        f"{ENV_ID}: {what} {value!r}: {PLANAR_MODELS.unknown_message(value)}, "
+        "or a .npz planar model file"
+    )
+
+
+def _per_coord(name: str, table: Any) -> np.ndarray:
+    if not isinstance(table, dict) or sorted(table) != sorted(COORDS):
+        raise RigError(f"{ENV_ID}: {name} must be a table with keys {list(COORDS)}, got {table!r}")
+    return np.array([positive(f"{name}.{c}", table[c]) for c in COORDS])
+
+
+class Rig3Core:
+    """The spec's kwargs checked, the two models, and the batched step."""
+
+    def __init__(self, kwargs: dict[str, Any], batch: int) -> None:
+        self.dt = positive("dt_s", kwargs["dt_s"])
+        self.history = positive_int("history", kwargs["history"])
+        self.limit = _per_coord("stroke", kwargs["stroke"])
+        self.rate = _per_coord("rate", kwargs["rate"])
+        self.force_limit = _per_coord("force_limit", kwargs["force_limit"])
+        self.force_scale = _per_coord("force_scale", kwargs["force_scale"])
+        self.reward_cap = positive("reward_cap", kwargs["reward_cap"])
+        self.model = resolve_planar(kwargs["model"], self.dt, "model")
+        self.reference = resolve_planar(kwargs["reference"], self.dt, "reference")
+        self.batch = batch
+        self.reset(np.ones(batch, dtype=bool))
+
+    def reset(self, mask: np.ndarray) -> None:
+        if not hasattr(self, "q"):
+            self.q = np.zeros((self.batch, 3))
+            self.obs = np.zeros((self.batch, 3, 3, self.history), dtype=np.float32)
+            self.model.reset(self.batch)
+            self.reference.reset(self.batch)
+        for m in (self.model, self.reference):
+            m.state[:, mask] = m.initial_state(self.batch)[:, mask]
+        self.q[mask] = 0.0
+        self.obs[mask] = 0.0
+
+    def step(self, action: np.ndarray) -> dict[str, np.ndarray]:
+        """action (B, 3) in [-1, 1] (NaN as 0) -> the step's arrays."""
+        a = np.clip(np.nan_to_num(np.asarray(action, dtype=np.float64), nan=0.0), -1.0, 1.0)
+        q_new = np.clip(self.q + a * self.rate * self.dt, -self.limit, self.limit)
+        v = (q_new - self.q) / self.dt
+        self.q = q_new
+        try:
+            f_model = self.model.step(q_new, v)
+            raised = ""
+        except MODEL_ERRORS as exc:
+            f_model, raised = np.full((self.batch, 3), np.nan), str(exc)
+        f_ref = self.reference.step(q_new, v)
+        non_finite, model_over, ref_over = force_termination(f_model, f_ref, self.force_limit)
+        err = np.abs(f_model - f_ref) / self.force_scale
+        reward = np.minimum(np.nan_to_num(err.sum(axis=1), nan=np.inf), self.reward_cap)
+        self.obs[:, :, :, 1:] = self.obs[:, :, :, :-1]
+        for j, f in enumerate(
+            (q_new / self.limit, f_model / self.force_limit, f_ref / self.force_limit)
+        ):
+            self.obs[:, j, :, 0] = np.clip(np.nan_to_num(f, nan=0.0), -1.0, 1.0)
+        return {
+            "q": q_new,
+            "v": v,
+            "f_model": f_model,
+            "f_ref": f_ref,
+            "reward": reward,
+            "terminated": non_finite.any(axis=1) | model_over.any(axis=1),
+            "truncated": ref_over.any(axis=1),
+            "raised": raised,
+        }
+
+    def spaces(self) -> tuple[spaces.Box, spaces.Box]:
+        return (
+            spaces.Box(-1.0, 1.0, shape=(3,), dtype=np.float32),
+            spaces.Box(-1.0, 1.0, shape=(9 * self.history,), dtype=np.float32),
+        )
+
+
+def _info(s: dict[str, Any], i: int, t: int, dt: float) -> dict[str, Any]:
+    return {
+        "time_s": t * dt,
+        "step": t,
+        **{f"q_{c}": float(s["q"][i, k]) for k, c in enumerate(COORDS)},
+        **{f"force_model_{c}": float(s["f_model"][i, k]) for k, c in enumerate(COORDS)},
+        **{f"force_reference_{c}": float(s["f_ref"][i, k]) for k, c in enumerate(COORDS)},
+        "diverged": bool(s["terminated"][i]),
+        "machine_limit": bool(s["truncated"][i]),
+        "model_error": s["raised"],
+    }
+
+
+class BushRig3Env(gym.Env):
+    """
+    ## Description
+    The 3-axis elastomer tester (seed 000 §4.1, Fig. 8; seed 002 Table 1) in the bushing's
+    plane: it drives axial and radial translation and the in-plane rotation at once, under
+    displacement control (the motion is prescribed; no force feeds back into it). The planar
+    model under test (``model``) and the planar reference (``reference``, the coupled rubber of
+    ``bushenv.planar.reference`` without load-cell noise) see the same motion side by side.
+
+    ## Action Space
+    ``Box(-1, 1, (3,), float32)``: per coordinate the change of the commanded position as a
+    fraction of the machine's rate limit, q_k = clip(q_{k-1} + a rate dt, -stroke, stroke).
+    NaN counts as 0, beyond +-1 as +-1.
+
+    ## Observation Space
+    ``Box(-1, 1, (9 H,), float32)``, H = ``history``: q / stroke (3 x H), F_model / force_limit
+    (3 x H), F_reference / force_limit (3 x H), newest first, clipped, NaN as 0.
+
+    ## Rewards
+    min(sum_i |F_model,i - F_ref,i| / force_scale_i, reward_cap).
+
+    ## Starting State
+    At rest, both models reset; nothing is random.
+
+    ## Episode End
+    Terminated: the model's force is not finite, it raised, or it exceeds a force limit while
+    the reference stays within (``divergence.force_termination`` per coordinate). Truncated:
+    the reference exceeds a limit (the motion cannot run on the machine), or the spec's
+    ``max_episode_steps`` (2048 = 10 s).
+
+    ## Arguments
+    Every key of ``envs/BushRig3-v0.toml`` ``[kwargs]``: ``model`` and ``reference`` (a name in
+    ``bushenv.planar.PLANAR_MODELS`` with a preset, a ``.npz`` planar model file, or a model),
+    ``dt_s``, ``history``, ``stroke``, ``rate``, ``force_limit``, ``force_scale``,
+    ``reward_cap``.
+
+    ## Example
+    >>> import gymnasium as gym
+    >>> import numpy as np
+    >>> import bushenv
+    >>> env = gym.make("BushRig3-v0", model="linear")
+    >>> obs, info = env.reset(seed=0)
+    >>> obs.shape
+    (36,)
+    >>> obs, reward, terminated, truncated, info = env.step(np.array([1, 0, -1], np.float32))
+    >>> round(info["q_axial"] * 1e3, 3), round(info["q_rotation"], 4)
+    (6.136, -0.0736)
+
+    ## Version History
+    - v0: first version.
+    """
+
+    metadata = {"render_modes": [], "render_fps": 204.8}
+
+    def __init__(self, **spec_overrides: Any) -> None:
+        self.core = Rig3Core(spec_kwargs(ENV_ID, spec_overrides), 1)
+        self.metadata = {**type(self).metadata, "render_fps": 1.0 / self.core.dt}
+        self.action_space, self.observation_space = self.core.spaces()
+        self._t = 0
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        self.core.reset(np.ones(1, dtype=bool))
+        self._t = 0
+        return self.core.obs[0].reshape(-1).copy(), {"time_s": 0.0, "step": 0}
+
+    def step(self, action):
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != (3,):
+            raise RigError(
+                f"{ENV_ID}: action must have shape (3,) ({', '.join(COORDS)}), got {a.shape}"
+            )
+        s = self.core.step(a[None, :])
+        self._t += 1
+        return (
+            self.core.obs[0].reshape(-1).copy(),
+            float(s["reward"][0]),
+            bool(s["terminated"][0]),
+            bool(s["truncated"][0]),
+            _info(s, 0, self._t, self.core.dt),
+        )
+
+
+class BushRig3VectorEnv(ArrayVectorEnv):
+    """N rigs as arrays (next-step autoreset by default), the same ``Rig3Core`` step."""
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        max_episode_steps: int | None = None,
+        episode_steps: int | None = None,
+        autoreset_mode: Any = "NextStep",
+        render_mode: str | None = None,
+        **spec_overrides: Any,
+    ) -> None:
+        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode)
+        self.core = Rig3Core(spec_kwargs(ENV_ID, spec_overrides), self.num_envs)
+        self.reward_fn = self.divergence_monitor = None
+        self.render_mode = render_mode
+        self.single_action_space, self.single_observation_space = self.core.spaces()
+        n = self.num_envs
+        self.action_space = gym.vector.utils.batch_space(self.single_action_space, n)
+        self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, n)
+
+    def _reset_columns(self, mask: np.ndarray) -> None:
+        self.core.reset(mask)
+
+    def _rest_info(self) -> dict[str, Any]:
+        return {"time_s": 0.0, "step": 0}
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        everyone = np.ones(self.num_envs, dtype=bool)
+        self.core.reset(everyone)
+        self._t[:] = 0
+        self._prev_done[:] = False
+        return self._obs(), self._masks(
+            {"time_s": np.zeros(self.num_envs), "step": np.zeros(self.num_envs, np.int64)}
+        )
+
+    def _obs(self) -> np.ndarray:
+        return self.core.obs.reshape(self.num_envs, -1).copy()
+
+    def step(self, actions):
+        a = np.asarray(actions, dtype=np.float64)
+        if a.shape != (self.num_envs, 3):
+            raise RigError(f"{ENV_ID}: actions must have shape ({self.num_envs}, 3), got {a.shape}")
+        waiting = self._prev_done.copy()
+        a[waiting] = 0.0
+        s = self.core.step(a)
+        self._t += 1
+        info = {"time_s": self._t * self.core.dt, "step": self._t.copy()}
+        obs = self._obs()
+        reward = s["reward"].astype(np.float64)
+        obs, reward, terminated, truncated, info = self._end_step(
+            obs, reward, s["terminated"].copy(), s["truncated"].copy(), info
+        )
+        return obs, reward, terminated, truncated, self._masks(info)
+
+
+def rotation_rate_limit(rotation_stroke_rad: float) -> float:
+    """The rotation's rate limit by the translation's rule (see excitation.py): a sine at 80 Hz
+    with a tenth of the whole angle range as amplitude, 2 pi 80 (0.1 * 2 * stroke)."""
+    return 2.0 * math.pi * 80.0 * 0.2 * rotation_stroke_rad

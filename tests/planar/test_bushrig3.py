@@ -1,0 +1,99 @@
+"""BushRig3-v0: both env checkers, vector = single envs, pickling, limits, divergence."""
+
+import doctest
+import pickle
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+import bushenv  # noqa: F401  (registers the envs)
+from bushenv.planar.linear import PlanarLinear
+from bushenv.planar.narx import N_IN, PlanarNarx
+from bushenv.rigs import bushrig3
+from bushenv.rigs.common import RigError
+
+
+def _nn_file(tmp_path):
+    rng = np.random.default_rng(0)
+    m = PlanarNarx(
+        q_offset=np.zeros(3),
+        q_scale=np.array([2e-3, 2e-3, 0.05]),
+        f_offset=np.zeros(3),
+        f_scale=np.array([500.0, 2000.0, 150.0]),
+        w1=rng.normal(0, 0.3, (9, N_IN)),
+        b1=np.zeros(9),
+        w_out=rng.normal(0, 0.3, (3, 9)),
+        b_out=np.zeros(3),
+    )
+    return str(m.save(tmp_path / "nn.npz"))
+
+
+@pytest.mark.parametrize("model", ["linear", "reference", "file"])
+def test_gymnasium_and_sb3_checkers_pass(model, tmp_path):
+    env = gym.make("BushRig3-v0", model=_nn_file(tmp_path) if model == "file" else model)
+    check_env(env.unwrapped, skip_render_check=True)
+    sb3_check_env(env.unwrapped, warn=False)
+
+
+def test_vector_env_equals_single_envs_bit_for_bit():
+    rng = np.random.default_rng(1)
+    actions = rng.uniform(-0.2, 0.2, (40, 3, 3)).astype(np.float32)  # within every limit
+    vec = gym.make_vec("BushRig3-v0", num_envs=3, vectorization_mode="vector_entry_point")
+    obs_v, _ = vec.reset(seed=0)
+    singles = [gym.make("BushRig3-v0") for _ in range(3)]
+    for e in singles:
+        e.reset(seed=0)
+    for t in range(40):
+        obs_v, rew_v, term_v, trunc_v, _ = vec.step(actions[t])
+        assert not (term_v.any() or trunc_v.any())
+        for i, e in enumerate(singles):
+            obs, rew, *_ = e.step(actions[t, i])
+            np.testing.assert_array_equal(obs, obs_v[i])
+            assert rew == rew_v[i]
+
+
+def test_pickled_env_continues_identically():
+    env = gym.make("BushRig3-v0").unwrapped
+    env.reset(seed=0)
+    for _ in range(5):
+        env.step(np.array([0.3, -0.2, 0.5], np.float32))
+    twin = pickle.loads(pickle.dumps(env))
+    a = np.array([0.1, 0.4, -0.6], np.float32)
+    np.testing.assert_array_equal(env.step(a)[0], twin.step(a)[0])
+
+
+def test_stroke_and_rate_limits_hold():
+    env = gym.make("BushRig3-v0").unwrapped
+    env.reset(seed=0)
+    info = env.step(np.ones(3, np.float32))[4]
+    assert info["q_axial"] == pytest.approx(1.2566370614359172 * env.core.dt)
+    for _ in range(20):
+        info = env.step(np.ones(3, np.float32))[4]
+    assert info["q_axial"] == 0.0125 and info["q_rotation"] == 0.15
+
+
+def test_a_model_beyond_the_force_limit_terminates():
+    stiff = PlanarLinear(np.diag([1e9, 1e9, 1e9]), np.zeros((3, 3)))
+    env = gym.make("BushRig3-v0", model=stiff)
+    env.reset(seed=0)
+    _, _, terminated, truncated, info = env.step(np.array([0.01, 0, 0], np.float32))
+    assert terminated and not truncated and info["diverged"]
+
+
+def test_bad_models_and_actions_are_refused_with_the_fix():
+    with pytest.raises(RigError, match="known names"):
+        gym.make("BushRig3-v0", model="lstm")
+    with pytest.raises(RigError, match="no preset.*npz"):
+        gym.make("BushRig3-v0", model="nn")
+    env = gym.make("BushRig3-v0").unwrapped
+    env.reset(seed=0)
+    with pytest.raises(RigError, match=r"shape \(3,\)"):
+        env.step(np.zeros(2, np.float32))
+
+
+def test_the_docstring_example_runs():
+    result = doctest.testmod(bushrig3)
+    assert result.attempted > 0 and result.failed == 0

@@ -1,0 +1,120 @@
+"""Planar networks: per-axis independence, step = simulate, files, hybrid bound, training."""
+
+import numpy as np
+import pytest
+
+from bushenv.excitation import random_rpc
+from bushenv.metrics import rms_ratio
+from bushenv.planar import PlanarModelError, load_planar_model
+from bushenv.planar.narx import N_IN, PlanarHybrid, PlanarNarx, PlanarNarxPerAxis, axis_masks
+from bushenv.planar.reference import THETA_N1_RAD, PlanarRubber
+from bushenv.planar.train import TrainOptions, fit_planar_network
+
+DT = 1 / 204.8
+PEAKS = np.array([2e-3, 2e-3, THETA_N1_RAD])
+
+
+def _arrays(hidden=27, seed=0, per_axis=False):
+    rng = np.random.default_rng(seed)
+    w1 = rng.normal(0, 0.3, (hidden, N_IN))
+    w_out = rng.normal(0, 0.3, (3, hidden))
+    if per_axis:
+        m1, mo = axis_masks(hidden)
+        w1, w_out = w1 * m1, w_out * mo
+    return dict(
+        q_offset=np.zeros(3),
+        q_scale=PEAKS,
+        f_offset=np.array([1.0, -2.0, 0.5]),
+        f_scale=np.array([500.0, 2000.0, 150.0]),
+        w1=w1,
+        b1=rng.normal(0, 0.1, hidden),
+        w_out=w_out,
+        b_out=rng.normal(0, 0.1, 3),
+    )
+
+
+def _drive(T=300, B=None, seed=0):
+    q = np.stack(
+        [random_rpc(1.0, T * DT, DT, seed + i, peak_m_at_n1=PEAKS[i]) for i in range(3)], 1
+    )
+    return q if B is None else np.stack([np.roll(q, 7 * b, axis=0) for b in range(B)], axis=1)
+
+
+def test_per_axis_output_ignores_the_other_axes_and_mimo_does_not():
+    q = _drive()
+    other = q.copy()
+    other[:, 1:] *= -0.5
+    per_axis = PlanarNarxPerAxis(**_arrays(per_axis=True))
+    mimo = PlanarNarx(**_arrays())
+    np.testing.assert_array_equal(per_axis.simulate(q)[:, 0], per_axis.simulate(other)[:, 0])
+    assert np.abs(mimo.simulate(q)[:, 0] - mimo.simulate(other)[:, 0]).max() > 1.0
+
+
+def test_per_axis_refuses_weights_across_axes():
+    with pytest.raises(PlanarModelError, match="across axes"):
+        PlanarNarxPerAxis(**_arrays())
+
+
+@pytest.mark.parametrize("cls", [PlanarNarx, PlanarHybrid])
+def test_step_loop_equals_batched_simulate(cls):
+    extra = (
+        {"k_matrix": np.diag([2e5, 7e5, 3e3]), "c_matrix": np.eye(3)} if cls is PlanarHybrid else {}
+    )
+    m = cls(**_arrays(), **extra)
+    q = _drive(80, B=3)
+    v = np.gradient(q, DT, axis=0)
+    f = m.simulate(q, v)
+    m.reset(3)
+    np.testing.assert_array_equal(np.stack([m.step(q[t], v[t]) for t in range(80)]), f)
+
+
+def test_hybrid_stays_within_its_bound_under_wild_input():
+    k = np.diag([2e5, 7e5, 3e3])
+    m = PlanarHybrid(k_matrix=k, c_matrix=np.zeros((3, 3)), **_arrays(seed=4))
+    q = np.random.default_rng(2).uniform(-1, 1, (500, 3)) * np.array([12.5e-3, 12.5e-3, 0.15])
+    resid = m.simulate(q, np.zeros_like(q)) - q @ k.T
+    assert np.all(np.abs(resid) <= m.nn_bound() + 1e-9)
+
+
+@pytest.mark.parametrize("cls", [PlanarNarx, PlanarNarxPerAxis, PlanarHybrid])
+def test_save_load_roundtrip(tmp_path, cls):
+    extra = {"k_matrix": np.eye(3), "c_matrix": np.eye(3)} if cls is PlanarHybrid else {}
+    m = cls(**_arrays(per_axis=cls is PlanarNarxPerAxis), **extra)
+    back = load_planar_model(m.save(tmp_path / "m.npz"))
+    assert type(back) is cls
+    q = _drive(50)
+    np.testing.assert_array_equal(back.simulate(q), m.simulate(q))
+
+
+def _record(T=2048, seed=0):
+    q = _drive(T, seed=seed)
+    return q, PlanarRubber.preset(measurement=False).simulate(q)
+
+
+def test_tiny_training_learns_the_record_and_is_deterministic():
+    q, f = _record()
+    opt = TrainOptions(
+        hidden=9, teacher_steps=150, free_run_steps=4, windows=8, window=32, eval_every=2
+    )
+    a = fit_planar_network(q, f, DT, kind="nn", options=opt, seed=1)
+    b = fit_planar_network(q, f, DT, kind="nn", options=opt, seed=1)
+    np.testing.assert_array_equal(a.w1, b.w1)
+    pred = a.simulate(q)
+    assert max(rms_ratio(f[:, i], pred[:, i]) for i in range(3)) < 0.5
+
+
+def test_training_rejects_short_or_misshapen_records():
+    with pytest.raises(PlanarModelError, match=r"\(T, 3\)"):
+        fit_planar_network(np.zeros((100, 3)), np.zeros((100, 3)), DT)
+    with pytest.raises(PlanarModelError, match="known"):
+        fit_planar_network(np.zeros((4000, 3)), np.zeros((4000, 3)), DT, kind="lstm")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["nn", "nn-axis", "hybrid"])
+def test_default_training_reaches_15_percent_on_unseen_record(kind):
+    q, f = _record(T=8192, seed=10)
+    m = fit_planar_network(q, f, DT, kind=kind, seed=0)
+    qt, ft = _record(T=2048, seed=40)
+    pred = m.simulate(qt)
+    assert max(rms_ratio(ft[:, i], pred[:, i]) for i in range(3)) < 0.15

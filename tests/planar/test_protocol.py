@@ -1,0 +1,94 @@
+"""The planar protocol: shapes, step = simulate, files, registry errors (on the linear model)."""
+
+import numpy as np
+import pytest
+
+from bushenv.errors import BadInput
+from bushenv.planar import PLANAR_MODELS, PlanarModelError, load_planar_model, model_class
+from bushenv.planar.linear import PlanarLinear, fit_linear
+
+K = np.array([[380e3, 1e3, 0.0], [2e3, 1500e3, 5e3], [0.0, 40.0, 1500.0]])
+C = np.diag([4.4e3, 15e3, 15.0])
+
+
+def _q(T=50, B=None, seed=0):
+    rng = np.random.default_rng(seed)
+    shape = (T, 3) if B is None else (T, B, 3)
+    return rng.standard_normal(shape) * np.array([1e-3, 1e-3, 0.02])
+
+
+def test_linear_simulate_matches_k_q_plus_c_v_and_shapes():
+    m = PlanarLinear(K, C)
+    q = _q(40)
+    v = np.gradient(q, m.dt, axis=0)
+    f = m.simulate(q)
+    assert f.shape == (40, 3)
+    np.testing.assert_allclose(f, q @ K.T + v @ C.T, rtol=1e-12)
+    fb = m.simulate(_q(40, B=4))
+    assert fb.shape == (40, 4, 3)
+
+
+def test_step_loop_equals_batched_simulate_bit_for_bit():
+    m = PlanarLinear(K, C)
+    q = _q(30, B=3)
+    v = np.gradient(q, m.dt, axis=0)
+    f = m.simulate(q, v)
+    m.reset(3)
+    looped = np.stack([m.step(q[t], v[t]) for t in range(30)])
+    np.testing.assert_array_equal(looped, f)
+
+
+def test_step_rejects_wrong_shapes_naming_the_order():
+    m = PlanarLinear(K, C)
+    with pytest.raises(PlanarModelError, match="axial, radial, rotation"):
+        m.step(np.zeros(2), np.zeros(2))
+    with pytest.raises(PlanarModelError, match=r"\(T, 3\)"):
+        m.simulate(np.zeros((10, 2)))
+
+
+def test_save_load_roundtrip_and_copy(tmp_path):
+    m = PlanarLinear(K, C)
+    back = load_planar_model(m.save(tmp_path / "lin.npz"))
+    assert isinstance(back, PlanarLinear)
+    np.testing.assert_array_equal(back.k_matrix, K)
+    q = _q(20)
+    np.testing.assert_array_equal(back.simulate(q), m.simulate(q))
+    np.testing.assert_array_equal(m.copy().simulate(q), m.simulate(q))
+
+
+def test_one_axis_file_is_refused_with_a_hint(tmp_path):
+    from bushenv.models.linear import LinearBushing
+
+    path = LinearBushing.preset("axial").save(tmp_path / "one.npz")
+    with pytest.raises(PlanarModelError, match="one-axis model file"):
+        load_planar_model(path)
+
+
+def test_bad_files_name_the_file(tmp_path):
+    txt = tmp_path / "x.npz"
+    txt.write_text("hello")
+    with pytest.raises(BadInput, match="x.npz"):
+        load_planar_model(txt)
+    with pytest.raises(BadInput, match="no such"):
+        load_planar_model(tmp_path / "missing.npz")
+
+
+def test_unknown_name_lists_known_names():
+    with pytest.raises(PlanarModelError, match="known names: .*linear"):
+        model_class("lstm")
+    assert "linear" in PLANAR_MODELS
+
+
+def test_fit_linear_recovers_full_matrices():
+    m = PlanarLinear(K, C)
+    q = _q(400, seed=3)
+    v = np.gradient(q, m.dt, axis=0)
+    fit = fit_linear(q, v, m.simulate(q, v))
+    np.testing.assert_allclose(fit.k_matrix, K, rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(fit.c_matrix, C, rtol=1e-6, atol=1e-6)
+
+
+def test_one_axis_models_unchanged():
+    from bushenv.models.registry import MODELS
+
+    assert {"linear", "nn", "hybrid"} <= set(MODELS.names())

@@ -1,0 +1,71 @@
+"""Multi-axis CSV records: round trip, units in the header, errors naming file, line, value."""
+
+import numpy as np
+import pytest
+
+from bushenv.planar.records import HEADER_TEXT, RecordError, load_planar_csv, save_planar_csv
+
+DT = 1 / 204.8
+
+
+def _data(T=20):
+    rng = np.random.default_rng(0)
+    q = rng.normal(size=(T, 3)) * np.array([1e-3, 1e-3, 0.02])
+    f = rng.normal(size=(T, 3)) * np.array([300.0, 1500.0, 60.0])
+    return np.arange(T) * DT, q, f
+
+
+def test_save_load_roundtrip_bit_for_bit(tmp_path):
+    t, q, f = _data()
+    rec = load_planar_csv(save_planar_csv(tmp_path / "r.csv", t, q, f))
+    np.testing.assert_array_equal(rec.q, q)
+    np.testing.assert_array_equal(rec.f, f)
+    assert rec.dt == pytest.approx(DT)
+    with pytest.raises(RecordError, match="overwrite=True"):
+        save_planar_csv(tmp_path / "r.csv", t, q, f)
+
+
+def test_units_in_the_header_are_converted(tmp_path):
+    p = tmp_path / "u.csv"
+    p.write_text(
+        "time [ms],displacement_axial [mm],displacement_radial [mm],rotation [deg],"
+        "force_axial [kN],force_radial [N],moment [N mm]\n0,1,2,90,1,5,1000\n5,0,0,0,0,0,0\n"
+    )
+    rec = load_planar_csv(p)
+    np.testing.assert_allclose(rec.q[0], [1e-3, 2e-3, np.pi / 2])
+    np.testing.assert_allclose(rec.f[0], [1000.0, 5.0, 1.0])
+    np.testing.assert_allclose(rec.time, [0.0, 0.005])
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        (
+            "time,displacement,force\n0,0,0\n",
+            r"line 1: header .* expected 'time,displacement_axial",
+        ),
+        (HEADER_TEXT.replace("rotation", "rotation [grad]") + "\n", r"line 1: unknown unit 'grad'"),
+        (HEADER_TEXT + "\ns,m,m,rad,N,N,N m\n", r"line 2: time 's' is not a number \(units go"),
+        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0\n", r"line 3: 6 values, expected 7"),
+        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,0,0,nan,0,0,0\n", r"line 3: rotation is nan"),
+        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,0,0,45,0,0,0\n", r"line 3: rotation 45.0 .*\[deg\]"),
+        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,2,0,0,0,0,0\n", r"line 3: displacement_axial .*mm"),
+        (HEADER_TEXT + "\n0.1,0,0,0,0,0,0\n0.0,0,0,0,0,0,0\n", r"line 3: time goes backwards"),
+        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n", r"1 sample\(s\)"),
+        (
+            HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0,0\n0.3,0,0,0,0,0,0\n0.4,0,0,0,0,0,0\n",
+            r"line 4: time step",
+        ),
+    ],
+)
+def test_bad_records_name_file_line_and_value(tmp_path, text, match):
+    p = tmp_path / "bad.csv"
+    p.write_text(text)
+    with pytest.raises(RecordError, match=match) as err:
+        load_planar_csv(p)
+    assert "bad.csv" in str(err.value)
+
+
+def test_missing_file_is_named(tmp_path):
+    with pytest.raises(RecordError, match="no such record file"):
+        load_planar_csv(tmp_path / "none.csv")
