@@ -256,3 +256,24 @@ def test_rl_searchers_attack_a_model_file_without_a_reference(tmp_path, capsys):
     argv = ["attack", "--model", str(path), "--searchers", "ppo", "--budget", "4"]
     argv += ["--rl-budget", "4", "--max-shrink", "0", "--no-plots", "--quiet", "--stroke-mm", "3"]
     assert main([*argv, "--out", str(tmp_path / "a")]) == 0
+
+
+def test_the_envelope_is_the_reference_cards_records_and_a_failure_says_if_it_left_it(tmp_path):
+    from bushenv.machine import random_test
+    from bushenv.records import save_csv
+    from bushenv.reference.rubber import RubberBushing
+
+    rec = random_test(RubberBushing.preset("axial", seed=3), 1.0, duration_s=8.0, seed=3)
+    train = save_csv(rec, tmp_path / "train.csv")
+    ref = tmp_path / "ref.npz"
+    assert main(["fit", str(train), "--model", "linear", "--out", str(ref), "--quiet"]) == 0
+    model = get_model("nn", axis="axial")
+    judge = build_judge("nn", str(ref), axis="axial", dt=model.dt, model_object=model)
+    peak = float(np.max(np.abs(rec.displacement)))
+    x_max, v_max, source = judge.envelope
+    assert x_max == pytest.approx(peak) and "card's training records" in source
+    slow = np.linspace(0.0, 0.9 * peak, 400)
+    assert judge.in_envelope(slow, model.dt) is True
+    assert judge.in_envelope(1.2 / 0.9 * slow, model.dt) is False  # beyond the records' peak
+    jump = np.array([0.0, 0.9 * peak])  # within the stroke, faster than the records went
+    assert judge.in_envelope(jump, model.dt) is False

@@ -117,6 +117,8 @@ def _search_row(key: str, role: str, name: str, s: dict[str, Any]) -> str:
         if s["diverged"]
         else "-"
     )
+    if s["diverged"] and ff.get("reference_in_envelope") is False:
+        fam += " [reference outside its envelope]"
     wd = s.get("worst_deviation")
     stf = f"{s['seconds_to_failure']:.2f}" if s["diverged"] else "-"
     wds = f"{wd:.3g}" if wd is not None else "-"
