@@ -44,3 +44,33 @@ def test_every_declared_dependency_is_locked():
         name = re.split(r"[<>=!\[; ]", req, maxsplit=1)[0]
         assert re.sub(r"[-_.]+", "-", name).lower() in pins, f"{name} is not in constraints.txt"
     assert pins["torch"] == "2.13.0"
+
+
+def test_everything_the_package_pulls_in_is_locked():
+    # walk the installed dependency closure of bushenv[test,ray,fmi]: every distribution a
+    # fresh install brings must have its version fixed by the lock
+    from importlib import metadata
+
+    from packaging.requirements import Requirement
+
+    pins = _locked()
+    seen, todo, missing = set(), [("bushenv", {"test", "ray", "fmi"})], []
+    while todo:
+        name, extras = todo.pop()
+        key = re.sub(r"[-_.]+", "-", name).lower()
+        if (key, frozenset(extras)) in seen:
+            continue
+        seen.add((key, frozenset(extras)))
+        try:
+            dist = metadata.distribution(name)
+        except metadata.PackageNotFoundError:
+            continue  # not installed here (a marker for another platform)
+        # pip and setuptools come with the venv itself (ensurepip's, fixed per Python release)
+        if key not in ("bushenv", "pip", "setuptools", "wheel") and key not in pins:
+            missing.append(key)
+        for text in dist.requires or []:
+            req = Requirement(text)
+            envs = [{"extra": e} for e in extras] or [{"extra": ""}]
+            if req.marker is None or any(req.marker.evaluate(env) for env in envs):
+                todo.append((req.name, set(req.extras)))
+    assert not missing, f"installed but not locked in constraints.txt: {sorted(set(missing))}"
