@@ -37,7 +37,7 @@ def test_diagnose_command_writes_the_contract_files(case):
     )
     assert [r["effect"] for r in report["ranking"]][0] == "friction"
     assert sorted(r["effect"] for r in report["ranking"]) == sorted(effect_names())
-    assert report["mode"] == "held_out"
+    assert report["mode"] == "cross"  # every record is used by default
     assert 0 <= report["unexplained"]["unexplained_share"] <= 1
     for r in report["ranking"]:
         assert {"effect", "gap_before", "gap_after", "shrink"} <= set(r)
