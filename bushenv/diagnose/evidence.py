@@ -13,7 +13,8 @@ import numpy as np
 from bushenv.diagnose.design import whole_record_psd
 
 BLOCK_S = 1.0  # seconds per block: longer than a misfit's correlation at bushing rates
-NOISE_BAND = 0.8  # the noise floor is read above this fraction of Nyquist
+QUIET = 1e-4  # a frequency where the displacement's PSD is below this share of its peak ...
+NOISE_TOP = 0.75  # ... and below this share of Nyquist holds noise only
 
 
 def block_edges(sizes: list[int], dts: list[float]) -> list[tuple[int, int]]:
@@ -50,19 +51,23 @@ def cut_z(
     return cut / (2.0 * np.sqrt(var))
 
 
-def noise_variance(residuals: list[np.ndarray], dts: list[float]) -> float:
-    """Force measurement-noise variance (N^2) from residuals: the median of their PSD above
-    ``NOISE_BAND`` of Nyquist, where a bushing programme has no motion, taken as white.
+def noise_variance(residuals: list[np.ndarray], xs: list[np.ndarray], dts: list[float]) -> float:
+    """Force measurement-noise variance (N^2) from residuals, taken as white: the median of
+    their PSD over the frequencies where the displacement has no motion (PSD below
+    ``QUIET`` of its peak) up to ``NOISE_TOP`` of Nyquist (an anti-alias filter may cut the
+    top), times the band; where there are no such frequencies, the median above it.
 
-    Per record, pooled by sample count. Coloured noise is underestimated (its floor there is
-    lower than its mean).
+    Per record, pooled by sample count.
     """
     total, count = 0.0, 0
-    for e, dt in zip(residuals, dts, strict=True):
+    for e, x, dt in zip(residuals, xs, dts, strict=True):
         if e.size < 256:
             continue
         f, p = whole_record_psd(e, dt, 1024)
-        floor = float(np.median(p[f >= NOISE_BAND * f[-1]]))
-        total += floor * f[-1] * e.size
+        _, px = whole_record_psd(x, dt, 1024)
+        quiet = (f > 0) & (px < QUIET * px.max()) & (f <= NOISE_TOP * f[-1])
+        if quiet.sum() < 8:
+            quiet = f >= NOISE_TOP * f[-1]
+        total += float(np.median(p[quiet])) * f[-1] * e.size
         count += e.size
     return total / count if count else 0.0

@@ -67,7 +67,8 @@ class Run:
         self.gap_null = rms_ratio(self.force, self.stack(self.null.predictions))
         self.edges = evidence.block_edges([p.n for p in self.judged], [p.dt for p in self.judged])
         null_res = [p.force - self.null.predictions[p.uid] for p in self.judged]
-        noise = evidence.noise_variance(null_res, [p.dt for p in self.judged])
+        xs = [p.signals.x for p in self.judged]
+        noise = evidence.noise_variance(null_res, xs, [p.dt for p in self.judged])
         self.gap_noise = float(np.sqrt(noise / np.mean(self.force**2)))
 
     def stack(self, preds: dict[int, np.ndarray]) -> np.ndarray:
@@ -238,7 +239,10 @@ def diagnose(
     store = ColumnStore(Scales.of([p.signals for p in fitting]), admissible=linear_base)
     run = Run(store, make_folds(tr, te, cross), linear_base)
     say(f"baseline gap on the judged records: {100 * run.gap_before:.2f} % (RMS ratio)")
-    lag = lag_evidence([(p.name, p.signals.x, p.force - p.b0, p.dt) for p in tr + te])
+    raw = [np.asarray(r.displacement, float) for r in list(trains) + list(tests)]
+    lag = lag_evidence(
+        [(p.name, x, p.force - p.b0, p.dt) for p, x in zip(tr + te, raw, strict=True)]
+    )
     say(f"delay: {lag.text}")
     null_pred = run.stack(run.null.predictions)
     ctx = rule.Context(run.force, null_pred, run.edges, run.gap_null, run.gap_noise, lag)

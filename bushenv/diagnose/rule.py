@@ -101,9 +101,7 @@ def mark_passes(rows: list[dict[str, Any]], ctx: Context) -> None:
     for r in rows:
         r["z_vs_null"] = float(cut_z(ctx.force, ctx.null_pred, r["_pred"], ctx.edges))
         r["closes_excess"] = ctx.closes(r["gap_after"], ctx.gap_null)
-        r["significant"] = bool(
-            r["z_vs_null"] >= Z_NAME or r["closes_excess"] >= CLEAR_CUT
-        )
+        r["significant"] = bool(r["z_vs_null"] >= Z_NAME or r["closes_excess"] >= CLEAR_CUT)
         r["passes"] = bool(
             not r["failed_to_fit"]
             and r["significant"]
