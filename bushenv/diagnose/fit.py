@@ -66,10 +66,14 @@ class Run:
         self.gap_before = rms_ratio(self.force, self.stack(self.base_pred))
         self.gap_null = rms_ratio(self.force, self.stack(self.null.predictions))
         self.edges = evidence.block_edges([p.n for p in self.judged], [p.dt for p in self.judged])
-        null_res = [p.force - self.null.predictions[p.uid] for p in self.judged]
+        self.gap_noise = self.noise_gap(self.stack(self.null.predictions))
+
+    def noise_gap(self, pred: np.ndarray) -> float:
+        """The force's measurement noise as a gap, read from the residual of ``pred``."""
+        res = np.split(self.force - pred, np.cumsum([p.n for p in self.judged])[:-1])
         xs = [p.signals.x for p in self.judged]
-        noise = evidence.noise_variance(null_res, xs, [p.dt for p in self.judged])
-        self.gap_noise = float(np.sqrt(noise / np.mean(self.force**2)))
+        noise = evidence.noise_variance(res, xs, [p.dt for p in self.judged])
+        return float(np.sqrt(noise / np.mean(self.force**2)))
 
     def stack(self, preds: dict[int, np.ndarray]) -> np.ndarray:
         return np.concatenate([preds[p.uid] for p in self.judged])
@@ -106,6 +110,10 @@ def _judge_all(run: Run, effects, say: Progress, ctx: rule.Context) -> tuple[lis
     singles = [r for r in rows if len(r["members"]) == 1]
     pairs = [r for r in rows if len(r["members"]) == 2]
     rule.mark_failed(rows, ctx)
+    best = min(rows, key=lambda r: r["gap_after"])
+    if best["gap_after"] < run.gap_null:  # the noise is what not even the best model explains
+        ctx.gap_noise = min(ctx.gap_noise, run.noise_gap(best["_pred"]))
+        run.gap_noise = ctx.gap_noise
     rule.mark_passes(rows, ctx)
     singles = rule.rank(singles, [r["effect"] for r in singles], ctx)
     order = [r["effect"] for r in singles]

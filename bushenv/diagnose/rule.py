@@ -41,7 +41,7 @@ from bushenv.diagnose.lag import LagEvidence
 FAIL_RATIO = 1.25
 Z_NAME = 3.0
 SHRINK_MIN = 0.10
-CLEAR_CUT = 1 / 3  # a held-out cut of this share of the excess gap is no accident of noise
+CLEAR_CUT = 0.25  # a held-out cut of this share of the excess gap is no accident of noise
 PAIR_GAIN_MIN = 0.25
 PAIR_TRY_IF_LEFT = 0.10
 OUTSIDE_NOISE = 2.0
