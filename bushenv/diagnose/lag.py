@@ -14,7 +14,8 @@ the displacement is fitted by that passive family (non-negative weights, its own
 a non-linear bushing's best linear approximation depends on the amplitude) with and without a
 shared lag ``d``. The lag is **seen** when it removes at least ``LAG_SHARE`` of the family's
 weighted misfit and the drop is significant (an F test at ``LAG_P``) on records that cover a
-frequency ratio of at least ``MIN_SPAN``.
+frequency ratio of at least ``MIN_SPAN``; seen **in part** when significant and removing at
+least ``PARTIAL_SHARE`` (then a delay is neither named nor ruled out).
 """
 
 from __future__ import annotations
@@ -28,14 +29,16 @@ RESOLUTION_HZ = 0.25  # the frequency step aimed at
 COHERENCE_MIN = 0.8
 MIN_BINS = 12
 MIN_SPAN = 3.0  # highest / lowest coherent frequency of a record that counts
-LAG_SHARE = 0.5  # the lag must remove at least half the passive family's misfit ...
+LAG_SHARE = 0.3  # the lag must remove at least this share of the passive family's misfit
 LAG_P = 1e-3  # ... and the drop must be significant at this level
+PARTIAL_SHARE = 0.15  # a significant lag removing this much is seen in part: no answer
 LAG_GRID_S = np.concatenate([[0.0], 1e-3 * np.geomspace(0.05, 60.0, 120)])
 
 
 @dataclass
 class LagEvidence:
     seen: bool
+    partial: bool  # significant but below LAG_SHARE: neither a delay nor its absence
     delay_s: float
     misfit_share_removed: float  # 1 - SSE(d) / SSE(0)
     p_value: float
@@ -45,6 +48,7 @@ class LagEvidence:
     def as_dict(self) -> dict:
         return {
             "seen": self.seen,
+            "partial": self.partial,
             "delay_s": self.delay_s,
             "misfit_share_removed": self.misfit_share_removed,
             "p_value": self.p_value,
@@ -126,7 +130,7 @@ def lag_evidence(records: list[tuple[str, np.ndarray, np.ndarray, float]]) -> La
     """
     resp = [r for r in (_response(*rec) for rec in records) if r is not None]
     if not resp:
-        return LagEvidence(False, 0.0, 0.0, 1.0, [], "no record has a broad coherent band")
+        return LagEvidence(False, False, 0.0, 0.0, 1.0, [], "no record has a broad coherent band")
 
     def total(d: float) -> float:
         return sum(r.misfit(d) for r in resp)
@@ -147,6 +151,7 @@ def lag_evidence(records: list[tuple[str, np.ndarray, np.ndarray, float]]) -> La
     fstat = (sse0 - sse_best) / max(sse_best / dof, 1e-300)
     p = float(stats.f.sf(fstat, 1, dof)) if d_best > 0 else 1.0
     seen = bool(d_best > 0 and removed >= LAG_SHARE and p <= LAG_P)
+    partial = bool(not seen and d_best > 0 and removed >= PARTIAL_SHARE and p <= LAG_P)
     names = [r.name for r in resp]
     text = (
         f"phase lag linear in frequency at unchanged gain: a delay of {1e3 * d_best:.3g} ms "
@@ -159,4 +164,6 @@ def lag_evidence(records: list[tuple[str, np.ndarray, np.ndarray, float]]) -> La
             f"(minimum-phase) response leaves on {', '.join(names)} (needs "
             f"{100 * LAG_SHARE:.0f} % at p <= {LAG_P:g})"
         )
-    return LagEvidence(seen, d_best, removed, p, names, text)
+    if partial:
+        text = text.replace("no delay:", "a delay in part:")
+    return LagEvidence(seen, partial, d_best, removed, p, names, text)

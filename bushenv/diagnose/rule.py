@@ -9,22 +9,24 @@ above the noise: ``excess(g) = sqrt(max(g^2 - gap_noise^2, 0))``.
 1. A candidate **failed to fit** when its judged gap exceeds ``FAIL_RATIO`` x the null's (it
    makes the gap much worse: extrapolated beyond what it was fitted on): it is listed apart,
    never ranked or named.
-2. A single effect **passes** when its per-block cut in judged MSE against the null is
-   significant (paired t over ``evidence.BLOCK_S`` blocks >= ``Z_NAME``) and it closes at
+2. A single effect **passes** when its cut in judged squared error against the null is
+   significant (``evidence.cut_z`` >= ``Z_NAME``, its spread summed over
+   ``evidence.BLOCK_S`` blocks; or a cut of ``CLEAR_CUT`` of the excess gap) and it closes at
    least ``SHRINK_MIN`` of the null's excess gap. A **delay** must also be *seen*
    (``lag.py``: a phase lag linear in frequency at unchanged gain), whatever it fits.
 3. A **pair** ``{A, B}`` passes when it passes as a single would, the best single leaves more
    than ``PAIR_TRY_IF_LEFT`` of the null's gap (or none passes), the pair closes at least
    ``PAIR_GAIN_MIN`` of the best single's gap, and **each member passes given the other**:
-   the pair's per-block cut against the other member alone is significant (``Z_NAME``) and
+   the pair's cut against the other member alone is significant in the same sense and
    closes ``SHRINK_MIN`` of that member's excess gap.
 4. The answer (``effect``): the best passing pair; else the best passing single -- unless the
-   next passing single is a different effect the judged errors cannot tell from it (paired
-   t within ``Z_TIE`` and gaps within ``TIE_GAP``): then ``"ambiguous"``; if nothing passes,
+   next passing single is a different effect the judged errors cannot tell from it (z
+   within ``Z_TIE`` and gaps within ``TIE_GAP``), or the lag is seen only in part and the
+   delay fits as well: then ``"ambiguous"``; if nothing passes,
    ``"outside_candidates"`` when the null's gap stands clear of the noise (excess above
    ``OUTSIDE_NOISE`` x the noise gap), else ``"none"``.
 
-Ranking: by judged gap; of two rows the blocks cannot tell apart (paired t within ``Z_TIE``,
+Ranking: by judged gap; of two rows the judged errors cannot tell apart (z within ``Z_TIE``,
 gaps within ``TIE_GAP``), the one with fewer parameters first.
 """
 
@@ -55,13 +57,15 @@ OUTSIDE = "outside_candidates"
 RULE_TEXT = (
     f"A candidate whose judged gap exceeds {FAIL_RATIO:g} x the null's (the baseline with its "
     f"spring and damper refitted) failed to fit and is not ranked. A single effect passes when "
-    f"its cut in judged mean squared error against the null is significant over "
-    f"{Z_NAME:g} standard errors of {'2 s'} blocks and it closes at least "
+    f"its cut in judged squared error against the null is significant (z >= {Z_NAME:g}, the "
+    f"spread summed over 1 s blocks, or a cut of {100 * CLEAR_CUT:.0f} % of the gap above the "
+    f"noise) and it closes at least "
     f"{100 * SHRINK_MIN:.0f} % of the null's gap above the noise; a delay must also be seen as "
     f"a phase lag linear in frequency at unchanged gain. A pair passes when it passes so, "
     f"closes at least {100 * PAIR_GAIN_MIN:.0f} % of what the best single leaves, and each of "
     f"its effects passes the same test given the other. Named: the best passing pair, else the "
-    f"best passing single ('ambiguous' when the next passing single cannot be told from it); "
+    f"best passing single ('ambiguous' when the next passing single cannot be told from it, or "
+    f"a lag seen only in part leaves delay as likely); "
     f"if nothing passes, 'outside_candidates' when the gap stands clear of the noise "
     f"({OUTSIDE_NOISE:g} x), else 'none'."
 )
@@ -171,6 +175,18 @@ def runner_up(first: str, with_first: list[dict], singles: list[dict], ctx: Cont
     return min(partners, key=order.index)
 
 
+def _delay_in_part(ok: list[dict], first: dict, ctx: Context) -> dict | None:
+    """The delay row, when the lag is seen in part and the delay would pass on its fit alone
+    and fit as well as ``first`` or better: the records cannot say which it is."""
+    if not ctx.lag.partial or first["effect"] == "delay":
+        return None
+    for r in ok:
+        if r["effect"] == "delay" and r["significant"] and r["closes_excess"] >= SHRINK_MIN:
+            if r["gap_after"] <= (1.0 + TIE_GAP) * first["gap_after"]:
+                return r
+    return None
+
+
 @dataclass
 class Answer:
     """``effect``: a candidate's name, ``"none"``, ``AMBIGUOUS`` or ``OUTSIDE``; ``row`` the
@@ -203,6 +219,10 @@ def answer(singles: list[dict], pairs: list[dict], ctx: Context) -> Answer:
         top_two = [name, runner_up(name, with_first, ok, ctx)] if with_first else best_two
         if len(passing) > 1 and indistinguishable(first, passing[1], ctx):
             between = [name, passing[1]["effect"]]
+            return Answer(AMBIGUOUS, first, between, between)
+        lagged = _delay_in_part(ok, first, ctx)
+        if lagged is not None:
+            between = [name, "delay"]
             return Answer(AMBIGUOUS, first, between, between)
         return Answer(name, first, top_two, [])
     if ctx.excess(ctx.gap_null) > OUTSIDE_NOISE * ctx.gap_noise:
