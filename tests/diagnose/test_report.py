@@ -148,3 +148,11 @@ def test_unavailable_baseline_is_a_clear_error(tmp_path, capsys, monkeypatch):
     )
     assert code == 2
     assert "fit_model" in capsys.readouterr().err
+
+
+def test_quiet_writes_nothing_on_stderr(tmp_path, capsys):
+    train = write_csv(tmp_path / "train.csv", record(61, "relaxation", duration_s=8.0))
+    test = write_csv(tmp_path / "test.csv", record(62, "relaxation", duration_s=8.0))
+    out = tmp_path / "out"
+    assert main(["diagnose", str(train), str(test), "--out", str(out), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
