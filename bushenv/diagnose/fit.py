@@ -124,54 +124,6 @@ def _judge_all(run: Run, effects, say: Progress, ctx: rule.Context) -> tuple[lis
     return singles, rule.rank(pairs, order, ctx)
 
 
-def _unexplained(ans: rule.Answer, rows: list[dict], run: Run, ctx: rule.Context) -> dict:
-    """The share of the gap the answer leaves, what the best candidate leaves, both above the
-    measurement noise; "mostly outside the candidates" only when that is so."""
-    ok = [r for r in rows if not r["failed_to_fit"]]
-    best = min(ok, key=lambda r: r["gap_after"]) if ok else None
-    named = ans.row
-    share = named["gap_after"] / run.gap_before if named and run.gap_before > 0 else 1.0
-    best_share = best["gap_after"] / run.gap_before if best and run.gap_before > 0 else 1.0
-    best_share = min(best_share, 1.0)
-    left = 1.0 - ctx.closes(named["gap_after"], ctx.gap_null) if named else 1.0
-    best_left = 1.0 - ctx.closes(best["gap_after"], ctx.gap_null) if best else 1.0
-    noise = f"the force's measurement noise alone is a {100 * ctx.gap_noise:.2g} % gap"
-    text = []
-    if ans.effect == "none":
-        text.append(f"No candidate passes the rule and the gap is close to the noise ({noise}).")
-    elif ans.effect == rule.OUTSIDE:
-        text.append(
-            "The cause lies outside the candidates: no candidate passes the rule, and the gap "
-            f"stands clear of the noise ({noise})"
-            + (
-                f"; the best, {best['effect']}, would leave {100 * best_share:.0f} %."
-                if best
-                else "."
-            )
-        )
-    else:
-        text.append(
-            f"{named['effect']} leaves {100 * share:.0f} % of the gap unexplained "
-            f"({100 * left:.0f} % of what stands above the noise; {noise})."
-        )
-    mostly = ans.effect == rule.OUTSIDE or (named is not None and left > rule.MOSTLY_UNEXPLAINED)
-    if mostly and ans.effect != rule.OUTSIDE:
-        text.append(
-            f"The gap lies mostly outside the candidate set: the named model leaves "
-            f"{100 * left:.0f} % of what stands above the noise."
-        )
-    return {
-        "unexplained_share": float(share),
-        "unexplained_share_above_noise": float(left),
-        "best_candidate": best["effect"] if best else "none",
-        "best_unexplained_share": float(best_share),
-        "best_unexplained_share_above_noise": float(best_left),
-        "gap_noise": ctx.gap_noise,
-        "mostly_outside_candidates": bool(mostly),
-        "text": text,
-    }
-
-
 def _test_only_hint(run: Run, te: list[Prepared], singles: list[dict]) -> list[dict]:
     """Fitted on the TESTs themselves, does some effect close far more than held out?"""
     force = np.concatenate([p.force for p in te])
@@ -343,7 +295,7 @@ def _result(run: Run, singles, pairs, ans: rule.Answer, ctx, baseline: str, cros
         "gap_noise": run.gap_noise,
         "gap_after": gap_after,
         "shrink": 1.0 - gap_after / run.gap_before if run.gap_before > 0 else 0.0,
-        "unexplained": _unexplained(ans, rows, run, ctx),
+        "unexplained": rule.unexplained(ans, rows, run.gap_before, ctx),
         "ranking": [_clean(r) for r in singles if not r["failed_to_fit"]],
         "pairs": [_clean(r) for r in pairs if not r["failed_to_fit"]],
         "failed_to_fit": [_clean(r) for r in rows if r["failed_to_fit"]],

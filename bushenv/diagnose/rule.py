@@ -228,3 +228,51 @@ def answer(singles: list[dict], pairs: list[dict], ctx: Context) -> Answer:
     if ctx.excess(ctx.gap_null) > OUTSIDE_NOISE * ctx.gap_noise:
         return Answer(OUTSIDE, None, best_two, [])
     return Answer("none", None, best_two, [])
+
+
+def unexplained(ans: Answer, rows: list[dict], gap_before: float, ctx: Context) -> dict:
+    """The share of the gap the answer leaves, what the best candidate leaves, both above the
+    measurement noise; "mostly outside the candidates" only when that is so."""
+    ok = [r for r in rows if not r["failed_to_fit"]]
+    best = min(ok, key=lambda r: r["gap_after"]) if ok else None
+    named = ans.row
+    share = named["gap_after"] / gap_before if named and gap_before > 0 else 1.0
+    best_share = best["gap_after"] / gap_before if best and gap_before > 0 else 1.0
+    best_share = min(best_share, 1.0)
+    left = 1.0 - ctx.closes(named["gap_after"], ctx.gap_null) if named else 1.0
+    best_left = 1.0 - ctx.closes(best["gap_after"], ctx.gap_null) if best else 1.0
+    noise = f"the force's measurement noise alone is a {100 * ctx.gap_noise:.2g} % gap"
+    text = []
+    if ans.effect == "none":
+        text.append(f"No candidate passes the rule and the gap is close to the noise ({noise}).")
+    elif ans.effect == OUTSIDE:
+        text.append(
+            "The cause lies outside the candidates: no candidate passes the rule, and the gap "
+            f"stands clear of the noise ({noise})"
+            + (
+                f"; the best, {best['effect']}, would leave {100 * best_share:.0f} %."
+                if best
+                else "."
+            )
+        )
+    else:
+        text.append(
+            f"{named['effect']} leaves {100 * share:.0f} % of the gap unexplained "
+            f"({100 * left:.0f} % of what stands above the noise; {noise})."
+        )
+    mostly = ans.effect == OUTSIDE or (named is not None and left > MOSTLY_UNEXPLAINED)
+    if mostly and ans.effect != OUTSIDE:
+        text.append(
+            f"The gap lies mostly outside the candidate set: the named model leaves "
+            f"{100 * left:.0f} % of what stands above the noise."
+        )
+    return {
+        "unexplained_share": float(share),
+        "unexplained_share_above_noise": float(left),
+        "best_candidate": best["effect"] if best else "none",
+        "best_unexplained_share": float(best_share),
+        "best_unexplained_share_above_noise": float(best_left),
+        "gap_noise": ctx.gap_noise,
+        "mostly_outside_candidates": bool(mostly),
+        "text": text,
+    }
