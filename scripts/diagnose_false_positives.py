@@ -28,7 +28,11 @@ def main(paths: list[str]) -> int:
         return 2
     rows = []
     for p in paths:
-        rows += json.loads(open(p, encoding="utf-8").read())["cases"]
+        try:
+            rows += json.loads(open(p, encoding="utf-8").read())["cases"]
+        except (OSError, ValueError, KeyError) as exc:
+            print(f"{p}: not a validation.json ({type(exc).__name__}: {exc})", file=sys.stderr)
+            return 2
     label = [set() if r["label"] == "none" else set(r["label"].split("+")) for r in rows]
     named = [named_set(r["named"]) for r in rows]
     print(f"{len(rows)} cases from {', '.join(paths)}")
