@@ -1,13 +1,15 @@
-"""``diagnose()``: where a baseline's held-out gap lies, which candidate closes it, how far.
+"""``diagnose()``: where a baseline's gap lies, which candidate closes it, how far.
 
 Records are any objects with ``.time``, ``.displacement``, ``.force`` ((T,) arrays, s, m, N)
 and ``.dt`` (s), such as ``bushenv.records.Record``. ``report.py`` writes the files; the
 naming rule is ``rule.py``, the fitting ``fitting.py``, the candidates ``candidates.py``.
 
-Two modes. **Held out** (default): weights and shapes fitted on the TRAIN records, every gap
-measured on the TESTs. **Cross** (``cross=True``): each record, TRAIN or TEST, is judged by
-weights fitted on all the others (leave one record out), so an effect only some records
-excite is identified and still judged on a record it was not fitted on.
+Two modes. **Every record** (``cross=True``, the default with the linear baseline): each
+record, TRAIN or TEST, is judged by weights fitted on all the others (leave one record out),
+so an effect only some records excite is identified and still judged on a record it was not
+fitted on. **Held out** (``cross=False``, the default with another baseline): weights and
+shapes fitted on the TRAIN records, every gap measured on the TESTs. The delay's phase test
+(``lag.py``) reads every record.
 
 Baselines: ``linear`` (``F = k x + c v``, refitted with every candidate: continuous-time, so
 TESTs at other sample rates are handled) or a registered model identified on the first TRAIN
