@@ -50,6 +50,7 @@ OUTSIDE_NOISE = 2.0
 MOSTLY_UNEXPLAINED = 0.5  # the named model leaves more than this share of the excess gap
 Z_TIE = 2.0
 TIE_GAP = 0.05
+ADDS_MIN = 0.01  # a pair partner that cuts the first effect's gap by less adds nothing
 
 AMBIGUOUS = "ambiguous"
 OUTSIDE = "outside_candidates"
@@ -165,8 +166,10 @@ def rank(rows: list[dict[str, Any]], order: list[str], ctx: Context) -> list[dic
 
 
 def runner_up(first: str, with_first: list[dict], singles: list[dict], ctx: Context) -> str:
-    """The effect that adds most to ``first``: the partner in its best pair; among pairs the
-    data cannot tell apart from that one, the partner that is the better single effect."""
+    """The effect that adds most to ``first``: the partner in its best pair (``with_first``:
+    pairs that improve on ``first``, best first); among pairs the data cannot tell apart from
+    that one, the partner that is the better single effect (``singles`` ranked, those that
+    failed to fit alone last)."""
     order = [r["effect"] for r in singles]
     close = [
         r for r in with_first if r is with_first[0] or indistinguishable(r, with_first[0], ctx)
@@ -210,13 +213,19 @@ def answer(singles: list[dict], pairs: list[dict], ctx: Context) -> Answer:
     if passing:
         first = passing[0]
         name = first["effect"]
-        names = {r["effect"] for r in ok}
+        # pairs with the first that add to it (a partner that adds nothing is no runner-up;
+        # one that fails to fit alone may still add beside the first)
         with_first = [
             r
             for r in pairs
-            if name in r["members"] and set(r["members"]) <= names and not r["failed_to_fit"]
+            if name in r["members"]
+            and not r["failed_to_fit"]
+            and r["gap_after"] < (1.0 - ADDS_MIN) * first["gap_after"]
         ]
-        top_two = [name, runner_up(name, with_first, ok, ctx)] if with_first else best_two
+        others = [r["effect"] for r in ok if r["effect"] != name]
+        top_two = (
+            [name, runner_up(name, with_first, singles, ctx)] if with_first else [name] + others[:1]
+        )
         if len(passing) > 1 and indistinguishable(first, passing[1], ctx):
             between = [name, passing[1]["effect"]]
             return Answer(AMBIGUOUS, first, between, between)
