@@ -99,7 +99,7 @@ def main_(argv: list[str] | None = None) -> int:
         out = root / label
         cmd = ["diagnose", str(paths[train[0]]), *(str(paths[t]) for t in tests)]
         cmd += ["--out", str(out), "--force"]
-        cmd += ["--cross"] if cross else []
+        cmd += ["--cross"] if cross else ["--held-out"]  # the default uses every record
         cmd += ["--quiet"] if args.quiet else []
         if main(cmd) != 0:
             return 1

@@ -26,6 +26,7 @@ SPRING = ("spring", "x,v")  # the linear spring and damper block (or the baselin
 DAMPER = ("spring", "v")  # the damper alone, when a backbone replaces the spring
 
 Block = tuple[str, Any]
+EDGE_FACTOR = 2.0  # the low-pass edge over the top of the displacement's signal band
 TARGETS_KEPT = 256  # force targets (one per record and delay) kept
 
 
@@ -55,21 +56,42 @@ class Prepared:
         return int(self.force.size)
 
 
+def whole_record_psd(x: np.ndarray, dt: float, nper: int) -> tuple[np.ndarray, np.ndarray]:
+    """(f, PSD) averaged over Hann-windowed segments spread evenly from the first sample to the
+    last, so every sample counts and the record read backwards gives the same estimate.
+
+    (scipy's Welch steps by half a segment and drops what is left at the end: up to a third
+    of a record, the top of a sweep that runs low to high.)
+    """
+    nper = int(min(nper, x.size))
+    count_ = max(int(np.ceil(2 * x.size / nper)) - 1, 1)
+    starts = np.unique(np.round(np.linspace(0, x.size - nper, count_)).astype(int))
+    win = signal.get_window("hann", nper)
+    segs = np.stack([x[s : s + nper] for s in starts])
+    segs = (segs - segs.mean(axis=1, keepdims=True)) * win
+    p = np.mean(np.abs(np.fft.rfft(segs, axis=1)) ** 2, axis=0) * 2 * dt / np.sum(win * win)
+    return np.fft.rfftfreq(nper, dt), p
+
+
 def noise_band_edge(x: np.ndarray, dt: float) -> float | None:
     """Upper edge (Hz) of a displacement's signal band when a noise floor lies above it.
 
-    The floor is the median Welch PSD over the top fifth of the band; the edge is the highest
-    frequency 10 dB above it (+20 %). None when there is no clear floor (less than 40 dB below
-    the peak) or the edge is within 80 % of Nyquist: then there is nothing to filter away.
+    The PSD is taken over the whole record (``whole_record_psd``, independent of sample
+    order). The floor is its median over the top fifth of the band; the edge is the highest
+    frequency 10 dB above it, times ``EDGE_FACTOR``. None when there is no clear floor (less
+    than 40 dB below the peak) or the edge is within 80 % of Nyquist: then there is nothing
+    to filter away.
     """
-    nper = int(min(x.size, 4096))
-    if nper < 64:
+    if x.size < 64:
         return None
-    f, p = signal.welch(x, fs=1.0 / dt, nperseg=nper)
+    f, p = whole_record_psd(x, dt, 4096)
     floor = float(np.median(p[f >= 0.8 * f[-1]]))
     if not (floor > 0 and floor < 1e-4 * p.max()):
         return None
-    edge = 1.2 * float(f[np.nonzero(p >= 10.0 * floor)[0][-1]])
+    # twice the top of the signal band: the 4th-order zero-phase filter then leaves the band
+    # within 0.5 % (at 1.2x it took 12 % off the band's top and made a phase-free bushing
+    # look delayed)
+    edge = EDGE_FACTOR * float(f[np.nonzero(p >= 10.0 * floor)[0][-1]])
     return edge if edge < 0.8 * f[-1] else None
 
 
@@ -87,10 +109,17 @@ def smoothed_displacement(x: np.ndarray, dt: float) -> tuple[np.ndarray, float |
 
 
 class ColumnStore:
-    """Columns of every (record, block), and their products, computed once."""
+    """Columns of every (record, block), and their products, computed once.
 
-    def __init__(self, scales: Scales) -> None:
+    ``admissible``: the spring and damper are the specimen's own (the linear baseline), so
+    their weights are bounded at 0 -- no passive bushing has a negative stiffness or damping
+    (a force-channel lag fitted as a mass and a negative damper is not an answer). With a
+    non-linear baseline they are corrections to it, of either sign.
+    """
+
+    def __init__(self, scales: Scales, admissible: bool = True) -> None:
         self.scales = scales
+        self.admissible = admissible
         self._cols: dict[tuple, np.ndarray] = {}
         self._gram: dict[tuple, np.ndarray] = {}
         self._rhs: dict[tuple, np.ndarray] = {}
@@ -156,11 +185,12 @@ class ColumnStore:
         return get_effect(block[0]).columns_count(block[1], self.scales)
 
     def lower(self, blocks: tuple[Block, ...]) -> np.ndarray:
-        """Lower bounds of the weights: free spring and damper, the effects' own bounds."""
+        """Lower bounds of the weights: spring and damper >= 0 when ``admissible`` (else free),
+        the effects' own bounds."""
         out = []
         for b in blocks:
             if b[0] == "spring":
-                out.append(np.full(len(b[1].split(",")), -np.inf))
+                out.append(np.full(len(b[1].split(",")), 0.0 if self.admissible else -np.inf))
             else:
                 out.append(get_effect(b[0]).lower(b[1], self.scales))
         return np.concatenate(out)

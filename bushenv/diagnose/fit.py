@@ -1,13 +1,15 @@
-"""``diagnose()``: where a baseline's held-out gap lies, which candidate closes it, how far.
+"""``diagnose()``: where a baseline's gap lies, which candidate closes it, how far.
 
 Records are any objects with ``.time``, ``.displacement``, ``.force`` ((T,) arrays, s, m, N)
 and ``.dt`` (s), such as ``bushenv.records.Record``. ``report.py`` writes the files; the
 naming rule is ``rule.py``, the fitting ``fitting.py``, the candidates ``candidates.py``.
 
-Two modes. **Held out** (default): weights and shapes fitted on the TRAIN records, every gap
-measured on the TESTs. **Cross** (``cross=True``): each record, TRAIN or TEST, is judged by
-weights fitted on all the others (leave one record out), so an effect only some records
-excite is identified and still judged on a record it was not fitted on.
+Two modes. **Every record** (``cross=True``, the default with the linear baseline): each
+record, TRAIN or TEST, is judged by weights fitted on all the others (leave one record out),
+so an effect only some records excite is identified and still judged on a record it was not
+fitted on. **Held out** (``cross=False``, the default with another baseline): weights and
+shapes fitted on the TRAIN records, every gap measured on the TESTs. The delay's phase test
+(``lag.py``) reads every record.
 
 Baselines: ``linear`` (``F = k x + c v``, refitted with every candidate: continuous-time, so
 TESTs at other sample rates are handled) or a registered model identified on the first TRAIN
@@ -23,8 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose import regimes, rule
-from bushenv.diagnose.candidates import candidate_sets
+from bushenv.diagnose import evidence, regimes, rule
+from bushenv.diagnose.candidates import candidate_sets, get_effect
 from bushenv.diagnose.design import ColumnStore, Prepared
 from bushenv.diagnose.effects.base import NULL, Scales
 from bushenv.diagnose.errors import DiagnoseError
@@ -41,6 +43,7 @@ from bushenv.diagnose.inputs import (
     prepare_records,
     record_name,
 )
+from bushenv.diagnose.lag import lag_evidence
 from bushenv.diagnose.shift import shift_warnings
 from bushenv.metrics import rms_ratio
 
@@ -64,6 +67,15 @@ class Run:
         }
         self.gap_before = rms_ratio(self.force, self.stack(self.base_pred))
         self.gap_null = rms_ratio(self.force, self.stack(self.null.predictions))
+        self.edges = evidence.block_edges([p.n for p in self.judged], [p.dt for p in self.judged])
+        self.gap_noise = self.noise_gap(self.stack(self.null.predictions))
+
+    def noise_gap(self, pred: np.ndarray) -> float:
+        """The force's measurement noise as a gap, read from the residual of ``pred``."""
+        res = np.split(self.force - pred, np.cumsum([p.n for p in self.judged])[:-1])
+        xs = [p.signals.x for p in self.judged]
+        noise = evidence.noise_variance(res, xs, [p.dt for p in self.judged])
+        return float(np.sqrt(noise / np.mean(self.force**2)))
 
     def stack(self, preds: dict[int, np.ndarray]) -> np.ndarray:
         return np.concatenate([preds[p.uid] for p in self.judged])
@@ -71,7 +83,6 @@ class Run:
     def row(self, j: Judged) -> dict[str, Any]:
         pred = self.stack(j.predictions)
         gap = rms_ratio(self.force, pred)
-        blocks = np.array_split((self.force - pred) ** 2, rule.BLOCKS)
         return {
             "effect": j.combo.name,
             "members": list(j.combo.names),
@@ -83,12 +94,12 @@ class Run:
             "shape": describe_shapes(j.fits[0]),
             "gap_train": j.gap_train,
             "_mse": j.mse,
-            "_block_mse": np.array([b.mean() for b in blocks]),
+            "_pred": pred,
             "_judged": j,
         }
 
 
-def _judge_all(run: Run, effects, say: Progress) -> tuple[list[dict], list[dict]]:
+def _judge_all(run: Run, effects, say: Progress, ctx: rule.Context) -> tuple[list, list]:
     """Rows of every single effect and every pair, ranked best first (rule applied)."""
     sets = candidate_sets(effects)
     rows = []
@@ -100,48 +111,19 @@ def _judge_all(run: Run, effects, say: Progress) -> tuple[list[dict], list[dict]
         rows.append(run.row(judge(run.store, combo, run.folds, run.linear_base)))
     singles = [r for r in rows if len(r["members"]) == 1]
     pairs = [r for r in rows if len(r["members"]) == 2]
-    mse_null = run.null.mse
-    rule.mark_passes(rows, mse_null, run.n_fit)
-    singles = rule.rank(singles, [r["effect"] for r in singles])
+    rule.mark_failed(rows, ctx)
+    best = min(rows, key=lambda r: r["gap_after"])
+    if best["gap_after"] < run.gap_null:  # the noise is what not even the best model explains
+        ctx.gap_noise = min(ctx.gap_noise, run.noise_gap(best["_pred"]))
+        run.gap_noise = ctx.gap_noise
+    rule.mark_passes(rows, ctx)
+    singles = rule.rank(singles, [r["effect"] for r in singles], ctx)
     order = [r["effect"] for r in singles]
     for r in pairs:  # the better single first
         r["members"] = sorted(r["members"], key=order.index)
         r["effect"] = "+".join(r["members"])
-    rule.mark_pairs(singles, pairs, run.n_fit, run.gap_null)
-    return singles, rule.rank(pairs, order)
-
-
-def _unexplained(named: dict | None, rows: list[dict], gap_before: float) -> dict[str, Any]:
-    """The share of the gap the named effect(s) leave, and what the best candidates leave."""
-    best = min(rows, key=lambda r: r["gap_after"]) if rows else None
-    share = named["gap_after"] / gap_before if named and gap_before > 0 else 1.0
-    best_share = best["gap_after"] / gap_before if best and gap_before > 0 else 1.0
-    best_share = min(best_share, 1.0)
-    text = []
-    if named is None:
-        text.append(
-            "No candidate passes the rule: the whole gap stays unexplained"
-            + (
-                f" (the best, {best['effect']}, would leave {100 * best_share:.0f} %)."
-                if best
-                else "."
-            )
-        )
-    else:
-        text.append(f"{named['effect']} leaves {100 * share:.0f} % of the gap unexplained.")
-    mostly = best_share > rule.MOSTLY_UNEXPLAINED
-    if mostly:
-        text.append(
-            f"The gap lies mostly outside the candidate set: even the best candidates "
-            f"({best['effect'] if best else 'none'}) leave {100 * best_share:.0f} % of it."
-        )
-    return {
-        "unexplained_share": float(share),
-        "best_candidate": best["effect"] if best else "none",
-        "best_unexplained_share": float(best_share),
-        "mostly_outside_candidates": bool(mostly),
-        "text": text,
-    }
+    rule.mark_pairs(singles, pairs, ctx)
+    return singles, rule.rank(pairs, order, ctx)
 
 
 def _test_only_hint(run: Run, te: list[Prepared], singles: list[dict]) -> list[dict]:
@@ -181,17 +163,19 @@ def diagnose(
     seed: int = 0,
     test_names: Sequence[str] | None = None,
     *,
-    cross: bool = False,
+    cross: bool | None = None,
     effects: Sequence[str] | None = None,
     train_names: Sequence[str] | None = None,
 ) -> dict[str, Any]:
-    """Where the held-out gap lies, which candidate effect closes it, and by how much.
+    """Where the gap lies, which candidate effect closes it, and by how much.
 
-    ``train`` is one record or a sequence of identification records. Returns a JSON-ready
-    dict (docs/diagnose.md) plus ``"predictions"``: one dict per judged record (the TESTs;
-    in cross mode every record) with ``name``, ``role`` and (T,) arrays ``time``,
-    ``displacement``, ``force_measured``, ``force_baseline``, ``force_augmented`` (the named
-    model's held-out prediction).
+    ``train`` is one record or a sequence of identification records. ``cross``: None (the
+    default) uses every record -- each judged by a fit on all the others -- with the linear
+    baseline, and holds out the TESTs with another baseline (it is identified once, on
+    TRAIN); True / False ask for the cross / held-out mode. Returns a JSON-ready dict
+    (docs/diagnose.md) plus ``"predictions"``: one dict per judged record with ``name``,
+    ``role`` and (T,) arrays ``time``, ``displacement``, ``force_measured``,
+    ``force_baseline``, ``force_augmented`` (the answer's held-out prediction).
     """
     say = progress or (lambda msg: None)
     trains = list(train) if isinstance(train, list | tuple) else [train]
@@ -205,21 +189,30 @@ def diagnose(
     )
     names = names_of(tests, test_names, "test")
     eff = tuple(effects) if effects is not None else None
-    check_inputs(trains, list(tests), t_names, names, baseline, cross, eff)
     linear_base = baseline == LINEAR
+    default_mode = cross is None
+    cross = linear_base if cross is None else bool(cross)
+    check_inputs(trains, list(tests), t_names, names, baseline, cross, eff)
     n_train = sum(np.size(r.force) for r in trains)
     say(f"identifying baseline {baseline!r} on TRAIN ({n_train} samples)")
-    model = None if linear_base else fit_nonlinear_baseline(baseline, trains[0], seed)
+    model = None if linear_base else fit_nonlinear_baseline(baseline, trains[0], seed, say)
     tr, te, stencil = prepare_records(trains, tests, t_names, names, model, cross, say)
     fitting = tr + (te if cross else [])
-    store = ColumnStore(Scales.of([p.signals for p in fitting]))
+    store = ColumnStore(Scales.of([p.signals for p in fitting]), admissible=linear_base)
     run = Run(store, make_folds(tr, te, cross), linear_base)
     say(f"baseline gap on the judged records: {100 * run.gap_before:.2f} % (RMS ratio)")
-    singles, pairs = _judge_all(run, eff, say)
-    named, top_two = rule.named_and_top_two(singles, pairs)
-    effect = named["effect"] if named else "none"
-    say(f"named effect: {effect}")
-    result = _result(run, singles, pairs, named, top_two, baseline, cross)
+    raw = [np.asarray(r.displacement, float) for r in list(trains) + list(tests)]
+    lag = lag_evidence(
+        [(p.name, x, p.force - p.b0, p.dt) for p, x in zip(tr + te, raw, strict=True)]
+    )
+    say(f"delay: {lag.text}")
+    null_pred = run.stack(run.null.predictions)
+    ctx = rule.Context(run.force, null_pred, run.edges, run.gap_null, run.gap_noise, lag)
+    singles, pairs = _judge_all(run, eff, say, ctx)
+    ans = rule.answer(singles, pairs, ctx)
+    say(f"answer: {ans.effect}" + (f" ({' or '.join(ans.between)})" if ans.between else ""))
+    result = _result(run, singles, pairs, ans, ctx, baseline, cross)
+    result["delay_evidence"] = lag.as_dict()
     result["shift_warnings"] = shift_warnings(
         [(p.signals.x, p.dt) for p in tr], [(p.name, p.signals.x, p.dt) for p in te]
     )
@@ -228,18 +221,27 @@ def diagnose(
         if result["shift_warnings"] and result["unexplained"]["mostly_outside_candidates"]:
             result["unexplained"]["text"].append(
                 "The TESTs hold regimes the TRAIN records lack (shift warning): an effect only "
-                "they excite cannot be identified on TRAIN; --cross fits on them too."
+                "they excite cannot be identified on TRAIN; the default mode fits on them too."
             )
     result["records"] = {
         "train": [{"name": p.name, "samples": p.n, "rate_hz": 1.0 / p.dt} for p in tr],
         "tests": [{"name": p.name, "samples": p.n, "rate_hz": 1.0 / p.dt} for p in te],
         "judged": [p.name for p in run.judged],
+        "folds": [
+            {"identified_on": [p.name for p in f.fit], "judged": [p.name for p in f.judged]}
+            for f in run.folds
+        ],
     }
     result["derivative_stencil"] = stencil
     result["displacement_band_hz"] = {
         p.name: p.band_edge_hz for p in tr + te if p.band_edge_hz is not None
     }
     result["notes"] = _notes(tr, te, baseline, cross)
+    if default_mode and not linear_base:
+        result["notes"].append(
+            f"baseline {baseline!r} is identified once, on TRAIN: the TESTs are held out "
+            "(every record is used by fitting on the others only with the linear baseline)."
+        )
     return result
 
 
@@ -247,8 +249,8 @@ def _mode(cross: bool, n_records: int) -> dict[str, str]:
     if cross:
         return {
             "mode": "cross",
-            "mode_text": f"cross: each of the {n_records} records (TRAIN and TEST) is judged by "
-            f"weights fitted on the other {n_records - 1} (leave one record out)",
+            "mode_text": f"every record used: each of the {n_records} records (TRAIN and TEST) "
+            f"is judged by weights fitted on the other {n_records - 1} (leave one record out)",
         }
     return {
         "mode": "held_out",
@@ -256,8 +258,12 @@ def _mode(cross: bool, n_records: int) -> dict[str, str]:
     }
 
 
-def _result(run: Run, singles, pairs, named, top_two, baseline: str, cross: bool) -> dict:
-    effect = named["effect"] if named else "none"
+def _clean(r: dict[str, Any]) -> dict[str, Any]:
+    return {k: v for k, v in r.items() if not k.startswith("_")}
+
+
+def _result(run: Run, singles, pairs, ans: rule.Answer, ctx, baseline: str, cross: bool) -> dict:
+    named = ans.row
     aug = named["_judged"].predictions if named else run.base_pred
     gap_after = rms_ratio(run.force, run.stack(aug))
     rows = singles + pairs
@@ -266,39 +272,43 @@ def _result(run: Run, singles, pairs, named, top_two, baseline: str, cross: bool
         final = best_shapes(run.store, named["_judged"].combo, every, run.linear_base)
     else:
         final = (named or {"_judged": run.null})["_judged"].fits[0]
+    judged_x = [p.signals.x for p in run.judged]
+    dts = [p.dt for p in run.judged]
     where = regimes.where_analysis(
-        [p.signals.x for p in run.judged],
-        [p.force - run.base_pred[p.uid] for p in run.judged],
-        [p.dt for p in run.judged],
+        judged_x, [p.force - run.base_pred[p.uid] for p in run.judged], dts
     )
     where_after = where
     if named is not None:
         where_after = regimes.where_analysis(
-            [p.signals.x for p in run.judged],
-            [p.force - aug[p.uid] for p in run.judged],
-            [p.dt for p in run.judged],
+            judged_x, [p.force - aug[p.uid] for p in run.judged], dts
         )
-
-    def clean(r: dict[str, Any]) -> dict[str, Any]:
-        return {k: v for k, v in r.items() if not k.startswith("_")}
-
+    members = set(named["members"]) if named else set()
+    others = [r["effect"] for r in singles if not r["failed_to_fit"] and r["effect"] not in members]
     return {
-        "effect": effect,
-        "top_two": top_two,
+        "effect": ans.effect,
+        "ambiguous_between": ans.between,
+        "telling_test": _telling_test(ans.between),
+        "top_two": ans.top_two,
+        "runner_up": others[0] if others else None,
         "baseline": baseline,
         **_mode(cross, len(run.judged) if cross else 0),
         "gap_before": run.gap_before,
         "gap_null": run.gap_null,
+        "gap_noise": run.gap_noise,
         "gap_after": gap_after,
         "shrink": 1.0 - gap_after / run.gap_before if run.gap_before > 0 else 0.0,
-        "unexplained": _unexplained(named, rows, run.gap_before),
-        "ranking": [clean(r) for r in singles],
-        "pairs": [clean(r) for r in pairs],
+        "unexplained": rule.unexplained(ans, rows, run.gap_before, ctx),
+        "ranking": [_clean(r) for r in singles if not r["failed_to_fit"]],
+        "pairs": [_clean(r) for r in pairs if not r["failed_to_fit"]],
+        "failed_to_fit": [_clean(r) for r in rows if r["failed_to_fit"]],
         "rule": {
+            "fail_ratio": rule.FAIL_RATIO,
+            "z_name": rule.Z_NAME,
             "shrink_min": rule.SHRINK_MIN,
-            "noise_margin": rule.NOISE_MARGIN,
             "pair_gain_min": rule.PAIR_GAIN_MIN,
             "pair_try_if_left": rule.PAIR_TRY_IF_LEFT,
+            "outside_noise": rule.OUTSIDE_NOISE,
+            "block_s": evidence.BLOCK_S,
             "text": rule.RULE_TEXT,
         },
         "where": where,
@@ -318,6 +328,17 @@ def _result(run: Run, singles, pairs, named, top_two, baseline: str, cross: bool
             for p in run.judged
         ],
     }
+
+
+def _telling_test(between: list[str]) -> str:
+    """A programme that would tell the two effects of an ambiguous answer apart."""
+    if not between:
+        return ""
+    parts = [f"{n}: {get_effect(n).telling_test}" for n in between]
+    return (
+        f"{' or '.join(between)}: these records cannot tell them apart; a test that would: "
+        + "; ".join(parts)
+    )
 
 
 def _notes(tr: list[Prepared], te: list[Prepared], baseline: str, cross: bool) -> list[str]:

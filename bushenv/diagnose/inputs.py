@@ -105,7 +105,7 @@ def check_inputs(trains, tests, train_names, test_names, baseline, cross, effect
             )
 
 
-def fit_nonlinear_baseline(name: str, rec: Any, seed: int):
+def fit_nonlinear_baseline(name: str, rec: Any, seed: int, say: Progress):
     try:
         from bushenv.identify import fit_model  # the baselines' identification dispatcher
     except ImportError:
@@ -114,7 +114,9 @@ def fit_nonlinear_baseline(name: str, rec: Any, seed: int):
             "this checkout; use --baseline linear"
         ) from None
     x = np.asarray(rec.displacement, dtype=np.float64)
-    return fit_model(name, x, np.asarray(rec.force, dtype=np.float64), float(rec.dt), seed)
+    # its training lines go where the diagnosis's own go (nowhere with --quiet)
+    f = np.asarray(rec.force, dtype=np.float64)
+    return fit_model(name, x, f, float(rec.dt), seed, progress=say)
 
 
 def _simulate(model: Any, x: np.ndarray) -> np.ndarray:

@@ -45,15 +45,23 @@ def _header(data: dict[str, Any]) -> list[str]:
 
 
 def _which(data: dict[str, Any]) -> list[str]:
+    effect = data["effect"]
+    if data.get("ambiguous_between"):
+        effect += ": " + " or ".join(data["ambiguous_between"])
     lines = [
-        f"## Which effect: **{data['effect']}**",
+        f"## Which effect: **{effect}**",
         "",
         f"Gap (RMS ratio, seed 000 eq. 8, all judged records together): "
-        f"{_pct(data['gap_before'])} with the baseline, {_pct(data['gap_after'])} with the named "
-        f"effect added (shrink {100 * data['shrink']:.1f} %). Runner-up: "
-        f"{' then '.join(data['top_two'])}.",
+        f"{_pct(data['gap_before'])} with the baseline, {_pct(data['gap_after'])} with the "
+        f"answer's model (shrink {100 * data['shrink']:.1f} %). Top two: "
+        f"{', '.join(data['top_two'])}; runner-up (the best other candidate): "
+        f"{data.get('runner_up') or '-'}.",
         "",
     ]
+    if data.get("telling_test"):
+        lines += [data["telling_test"] + ".", ""]
+    if data.get("delay_evidence"):
+        lines += [f"Delay: {data['delay_evidence']['text']}.", ""]
     lines += [f"- {t}" for t in data["unexplained"]["text"]]
     if data["shift_warnings"]:
         lines += ["", "**Shift warning** -- regimes the judged records hold that TRAIN lacks:", ""]
@@ -65,6 +73,11 @@ def _which(data: dict[str, Any]) -> list[str]:
         lines.append(
             f"| {i} | {r['effect']} | {_pct(r['gap_after'])} | {100 * r['shrink']:.1f} % | "
             f"{100 * r['shrink_vs_null']:.1f} % | {r['n_extra_parameters']} | {r['passes']} |"
+        )
+    if data.get("failed_to_fit"):
+        lines += ["", "Failed to fit (the judged gap much worse than the null's; not ranked): "]
+        lines[-1] += ", ".join(
+            f"{r['effect']} ({_pct(r['gap_after'])})" for r in data["failed_to_fit"]
         )
     if data["pairs"]:
         lines += ["", "Pairs:", "", "| pair | gap after | shrink | each adds | passes |"]

@@ -1,9 +1,11 @@
 """``bushenv diagnose``: a baseline's sim-to-real gap, where it lies, which effect closes it.
 
-    bushenv diagnose TRAIN_CSV TEST_CSV [TEST_CSV ...] --out DIR [--train CSV ...] [--cross]
+    bushenv diagnose TRAIN_CSV TEST_CSV [TEST_CSV ...] --out DIR [--train CSV ...]
+                     [--cross | --held-out]
 
-The TRAIN records identify the baseline and every candidate effect; the TESTs judge (held
-out), or with ``--cross`` every record is judged by a fit on the others. Writes
+Every record is used: each record, TRAIN or TEST, is judged by a fit on all the others (the
+default with the linear baseline, ``--cross``); ``--held-out`` fits on TRAIN only and judges
+the TESTs. Writes
 
 - ``DIR/report.json``: effect named, ranking, pairs, unexplained share, shift warnings, where
   the gap lies, parameters (docs/diagnose.md)
@@ -37,7 +39,7 @@ from bushenv.record_rates import add_resample_option, one_rate
 
 EXAMPLE = (
     "bushenv diagnose train.csv test_random.csv test_steps.csv --out diag/ "
-    "[--train more.csv] [--cross] [--max-displacement 0.5]"
+    "[--train more.csv] [--held-out] [--max-displacement 0.5]"
 )
 
 
@@ -55,10 +57,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="CSV",
         help="a further identification record (repeatable)",
     )
-    parser.add_argument(
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument(
         "--cross",
         action="store_true",
-        help="judge every record (TRAIN and TEST) by a fit on all the others (leave one out)",
+        help="judge every record (TRAIN and TEST) by a fit on all the others (leave one out); "
+        "the default with the linear baseline",
+    )
+    mode.add_argument(
+        "--held-out",
+        action="store_true",
+        help="fit on the TRAIN records only and judge on the TESTs (the default with another "
+        "baseline)",
     )
     parser.add_argument(
         "--effects",
@@ -130,7 +140,9 @@ def run(args: argparse.Namespace) -> int:
 
     train_paths = [args.train] + list(args.more_train)
     stems = [Path(p).stem for p in args.tests]
-    judged = stems + ([Path(p).stem for p in train_paths] if args.cross else [])
+    cross = True if args.cross else False if args.held_out else None
+    every = cross or (cross is None and args.baseline == "linear")
+    judged = stems + ([Path(p).stem for p in train_paths] if every else [])
     if len(set(judged)) != len(judged):
         raise DiagnoseError(
             f"judged files need distinct file names (stems {judged}): each one's predictions "
@@ -147,7 +159,7 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         test_names=stems,
         train_names=[Path(p).stem for p in train_paths],
-        cross=args.cross,
+        cross=cross,
         effects=args.effects,
     )
     result["files"] = {"train": [str(p) for p in train_paths], "tests": list(args.tests)}

@@ -1,146 +1,287 @@
-"""The naming rule: which candidate is named, and the two effects ranked first.
+"""The naming rule: which candidate is named, when the answer abstains, and the two effects
+ranked first.
 
 Gaps are ``rms_ratio(measured, predicted)`` (seed 000 eq. 8) over all judged samples; the
-*null* is the baseline with its spring and damper refitted. A candidate set ``S`` with ``p``
-extra parameters, judged mean squared error ``MSE_S`` and fitted on ``N`` samples:
+*null* is the baseline with its spring and damper refitted; ``gap_noise`` the force's
+measurement noise as a gap (``evidence.noise_variance``). What a model explains is judged
+above the noise: ``excess(g) = sqrt(max(g^2 - gap_noise^2, 0))``.
 
-1. **passes** when it shrinks the null's gap by at least ``SHRINK_MIN`` and its cut in judged
-   MSE exceeds what fitting ``p`` weights to noise could explain,
-   ``MSE_null - MSE_S > NOISE_MARGIN p MSE_S / N`` (``MSE_S`` bounds the noise variance);
-2. a **pair** ``{A, B}`` is named when the best single effect leaves more than
-   ``PAIR_TRY_IF_LEFT`` of the null's gap (or none passes), the pair passes, closes at least
-   ``PAIR_GAIN_MIN`` of the gap the best single leaves, and **each member adds** more than
-   the noise margin to the other alone (``MSE_A - MSE_AB > NOISE_MARGIN p_B MSE_AB / N``,
-   and the same for B): a single effect does not gain a second one that fits noise;
-3. otherwise the best single is named if it passes, else ``none``.
+1. A candidate **failed to fit** when its judged gap exceeds ``FAIL_RATIO`` x the null's (it
+   makes the gap much worse: extrapolated beyond what it was fitted on): it is listed apart,
+   never ranked or named.
+2. A single effect **passes** when its cut in judged squared error against the null is
+   significant (``evidence.cut_z`` >= ``Z_NAME``, its spread summed over
+   ``evidence.BLOCK_S`` blocks; or a cut of ``CLEAR_CUT`` of the excess gap) and it closes at
+   least ``SHRINK_MIN`` of the null's excess gap. A **delay** must also be *seen*
+   (``lag.py``: a phase lag linear in frequency at unchanged gain), whatever it fits.
+3. A **pair** ``{A, B}`` passes when it passes as a single would, the best single leaves more
+   than ``PAIR_TRY_IF_LEFT`` of the null's gap (or none passes), the pair closes at least
+   ``PAIR_GAIN_MIN`` of the best single's gap, and **each member passes given the other**:
+   the pair's cut against the other member alone is significant in the same sense and
+   closes ``SHRINK_MIN`` of that member's excess gap.
+4. The answer (``effect``): the best passing pair; else the best passing single -- unless the
+   next passing single is a different effect the judged errors cannot tell from it (z
+   within ``Z_TIE`` and gaps within ``TIE_GAP``), or the lag is seen only in part and the
+   delay fits as well: then ``"ambiguous"``; if nothing passes,
+   ``"outside_candidates"`` when the null's gap stands clear of the noise (excess above
+   ``OUTSIDE_NOISE`` x the noise gap), else ``"none"``.
 
-Ranking: by judged gap; but of two rows whose judged errors the data cannot tell apart
-(gaps within ``TIE_GAP`` of each other, and the mean difference of their MSE over
-``BLOCKS`` contiguous blocks of the judged samples within ``TIE_T`` standard errors), the
-one with fewer parameters goes first.
-
-``top_two``: a named pair's members (the better single first); for a named single ``A``,
-``A`` and the effect whose pair with ``A`` is best (of pairs the data cannot tell apart from
-the best, the better single); for ``none``, the two best singles.
+Ranking: by judged gap; of two rows the judged errors cannot tell apart (z within ``Z_TIE``,
+gaps within ``TIE_GAP``), the one with fewer parameters first.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-SHRINK_MIN = 0.05
-NOISE_MARGIN = 2.0
+from bushenv.diagnose.evidence import cut_z
+from bushenv.diagnose.lag import LagEvidence
+
+FAIL_RATIO = 1.25
+Z_NAME = 3.0
+SHRINK_MIN = 0.10
+CLEAR_CUT = 0.25  # a held-out cut of this share of the excess gap is no accident of noise
 PAIR_GAIN_MIN = 0.25
-PAIR_TRY_IF_LEFT = 0.10  # a pair is not named for the last tenth of the null's gap
-MOSTLY_UNEXPLAINED = 0.5  # the best candidates leave more than this share of the gap
-BLOCKS = 20  # contiguous blocks of the judged samples, for the spread of an MSE difference
-TIE_T = 2.0  # a difference within TIE_T standard errors cannot tell two rows apart ...
-TIE_GAP = 0.1  # ... if their gaps are also within 10 % of each other
+PAIR_TRY_IF_LEFT = 0.10
+OUTSIDE_NOISE = 2.0
+MOSTLY_UNEXPLAINED = 0.5  # the named model leaves more than this share of the excess gap
+Z_TIE = 2.0
+TIE_GAP = 0.05
+ADDS_MIN = 0.01  # a pair partner that cuts the first effect's gap by less adds nothing
+
+AMBIGUOUS = "ambiguous"
+OUTSIDE = "outside_candidates"
 
 RULE_TEXT = (
-    f"A candidate passes when it shrinks the held-out gap of the baseline with its spring and "
-    f"damper refitted (the null) by at least {100 * SHRINK_MIN:.0f} % and its cut in held-out "
-    f"mean squared error exceeds {NOISE_MARGIN:g} x (extra parameters) x (remaining MSE) / "
-    f"(samples fitted), the most that fitting noise could explain. A pair is named when it "
-    f"passes, the best single effect leaves more than {100 * PAIR_TRY_IF_LEFT:.0f} % of the "
-    f"null's gap, the pair closes at least {100 * PAIR_GAIN_MIN:.0f} % of what it leaves, and "
-    f"each of its effects adds more than that noise margin to the other alone; "
-    f"otherwise the best single effect if it passes; otherwise 'none'."
+    f"A candidate whose judged gap exceeds {FAIL_RATIO:g} x the null's (the baseline with its "
+    f"spring and damper refitted) failed to fit and is not ranked. A single effect passes when "
+    f"its cut in judged squared error against the null is significant (z >= {Z_NAME:g}, the "
+    f"spread summed over 1 s blocks, or a cut of {100 * CLEAR_CUT:.0f} % of the gap above the "
+    f"noise) and it closes at least "
+    f"{100 * SHRINK_MIN:.0f} % of the null's gap above the noise; a delay must also be seen as "
+    f"a phase lag linear in frequency at unchanged gain. A pair passes when it passes so, "
+    f"closes at least {100 * PAIR_GAIN_MIN:.0f} % of what the best single leaves, and each of "
+    f"its effects passes the same test given the other. Named: the best passing pair, else the "
+    f"best passing single ('ambiguous' when the next passing single cannot be told from it, or "
+    f"a lag seen only in part leaves delay as likely); "
+    f"if nothing passes, 'outside_candidates' when the gap stands clear of the noise "
+    f"({OUTSIDE_NOISE:g} x), else 'none'."
 )
 
 
-def margin(n_extra: int, mse_after: float, n_fit: int) -> float:
-    """The most a cut in MSE from fitting ``n_extra`` weights to noise could be."""
-    return NOISE_MARGIN * max(n_extra, 1) * mse_after / max(n_fit, 1)
+@dataclass
+class Context:
+    """What every row is judged against."""
+
+    force: np.ndarray  # judged samples, stacked
+    null_pred: np.ndarray
+    edges: list[tuple[int, int]]
+    gap_null: float
+    gap_noise: float
+    lag: LagEvidence
+
+    def excess(self, gap: float) -> float:
+        return float(np.sqrt(max(gap * gap - self.gap_noise**2, 0.0)))
+
+    def closes(self, gap_after: float, gap_ref: float) -> float:
+        """Share of ``gap_ref``'s excess over the noise that ``gap_after`` closes."""
+        ref = self.excess(gap_ref)
+        return 1.0 - self.excess(gap_after) / ref if ref > 0 else 0.0
 
 
-def mark_passes(rows: list[dict[str, Any]], mse_null: float, n_fit: int) -> None:
-    """Set ``beats_noise_margin`` and ``passes`` (rule 1) on every row."""
+def mark_failed(rows: list[dict[str, Any]], ctx: Context) -> None:
     for r in rows:
-        r["beats_noise_margin"] = bool(
-            mse_null - r["_mse"] > margin(r["n_extra_parameters"], r["_mse"], n_fit)
+        r["failed_to_fit"] = bool(r["gap_after"] > FAIL_RATIO * ctx.gap_null)
+
+
+def _lag_ok(r: dict[str, Any], ctx: Context) -> bool:
+    return "delay" not in r["members"] or ctx.lag.seen
+
+
+def mark_passes(rows: list[dict[str, Any]], ctx: Context) -> None:
+    """Rule 2 (``t_vs_null``, ``closes_excess``, ``passes``) on every row."""
+    for r in rows:
+        r["z_vs_null"] = float(cut_z(ctx.force, ctx.null_pred, r["_pred"], ctx.edges))
+        r["closes_excess"] = ctx.closes(r["gap_after"], ctx.gap_null)
+        r["significant"] = bool(r["z_vs_null"] >= Z_NAME or r["closes_excess"] >= CLEAR_CUT)
+        r["passes"] = bool(
+            not r["failed_to_fit"]
+            and r["significant"]
+            and r["closes_excess"] >= SHRINK_MIN
+            and _lag_ok(r, ctx)
         )
-        r["passes"] = bool(r["shrink_vs_null"] >= SHRINK_MIN and r["beats_noise_margin"])
 
 
-def mark_pairs(
-    singles: list[dict[str, Any]], pairs: list[dict[str, Any]], n_fit: int, gap_null: float
-) -> None:
-    """Rule 2 on every pair row: ``members_add`` and ``passes``."""
+def mark_pairs(singles: list[dict], pairs: list[dict], ctx: Context) -> None:
+    """Rule 3 on every pair row: ``members_add`` and ``passes``."""
     by_name = {r["effect"]: r for r in singles}
-    best_gap = singles[0]["gap_after"] if singles else float("inf")
-    open_for_pairs = not (singles and singles[0]["passes"]) or (
-        best_gap > PAIR_TRY_IF_LEFT * gap_null
-    )
+    ok = [r for r in singles if not r["failed_to_fit"]]
+    best_gap = ok[0]["gap_after"] if ok else ctx.gap_null
+    open_for_pairs = not (ok and ok[0]["passes"]) or best_gap > PAIR_TRY_IF_LEFT * ctx.gap_null
     for r in pairs:
         adds = []
         for m in r["members"]:
-            alone = by_name[m]
-            extra = r["n_extra_parameters"] - alone["n_extra_parameters"]
-            adds.append(alone["_mse"] - r["_mse"] > margin(extra, r["_mse"], n_fit))
+            other = by_name[next(o for o in r["members"] if o != m)]
+            t = cut_z(ctx.force, other["_pred"], r["_pred"], ctx.edges)
+            share = ctx.closes(r["gap_after"], other["gap_after"])
+            adds.append((t >= Z_NAME or share >= CLEAR_CUT) and share >= SHRINK_MIN)
         r["members_add"] = bool(all(adds))
         closes = r["gap_after"] <= (1.0 - PAIR_GAIN_MIN) * best_gap
         r["passes"] = bool(open_for_pairs and r["passes"] and r["members_add"] and closes)
 
 
-def indistinguishable(a: dict[str, Any], b: dict[str, Any]) -> bool:
-    """Whether the judged errors of two rows differ by less than their spread explains.
-
-    Their gaps must be within TIE_GAP of each other, and the mean of their MSE differences
-    over BLOCKS contiguous blocks of the judged samples (neighbouring residuals are
-    correlated) within TIE_T standard errors.
-    """
+def indistinguishable(a: dict[str, Any], b: dict[str, Any], ctx: Context) -> bool:
+    """Whether two rows' judged errors differ by less than their spread explains."""
     lo, hi = sorted((a["gap_after"], b["gap_after"]))
     if hi > (1.0 + TIE_GAP) * lo:
         return False
-    d = a["_block_mse"] - b["_block_mse"]
-    se = float(np.std(d, ddof=1)) / np.sqrt(d.size)
-    return bool(abs(float(np.mean(d))) <= TIE_T * se)
+    worse, better = (a, b) if a["gap_after"] >= b["gap_after"] else (b, a)
+    return cut_z(ctx.force, worse["_pred"], better["_pred"], ctx.edges) < Z_TIE
 
 
-def rank(rows: list[dict[str, Any]], order: list[str]) -> list[dict[str, Any]]:
+def rank(rows: list[dict[str, Any]], order: list[str], ctx: Context) -> list[dict[str, Any]]:
     """Best first: by judged gap (then fitting error, then the members' single ranks); a row
-    with fewer extra parameters whose judged error is indistinguishable from a better row's
-    goes before it -- of two explanations the data cannot tell apart, the simpler."""
+    with fewer extra parameters that the blocks cannot tell from a better one goes first.
+    Rows that failed to fit go last."""
 
     def key(r: dict[str, Any]):
-        return (r["gap_after"], r["gap_train"], [order.index(m) for m in r["members"]])
+        return (r["failed_to_fit"], r["gap_after"], r["gap_train"],
+                [order.index(m) for m in r["members"]])  # fmt: skip
 
     ranked = sorted(rows, key=key)
     for i in range(1, len(ranked)):
         j = i
         while (
             j > 0
+            and not ranked[j]["failed_to_fit"]
             and ranked[j]["n_extra_parameters"] < ranked[j - 1]["n_extra_parameters"]
-            and indistinguishable(ranked[j], ranked[j - 1])
+            and indistinguishable(ranked[j], ranked[j - 1], ctx)
         ):
             ranked[j - 1], ranked[j] = ranked[j], ranked[j - 1]
             j -= 1
     return ranked
 
 
-def runner_up(first: str, with_first: list[dict], singles: list[dict]) -> str:
-    """The effect that adds most to ``first``: the partner in its best pair; among pairs the
-    data cannot tell apart from that one, the partner that is the better single effect."""
+def runner_up(first: str, with_first: list[dict], singles: list[dict], ctx: Context) -> str:
+    """The effect that adds most to ``first``: the partner in its best pair (``with_first``:
+    pairs that improve on ``first``, best first); among pairs the data cannot tell apart from
+    that one, the partner that is the better single effect (``singles`` ranked, those that
+    failed to fit alone last)."""
     order = [r["effect"] for r in singles]
-    close = [r for r in with_first if r is with_first[0] or indistinguishable(r, with_first[0])]
+    close = [
+        r for r in with_first if r is with_first[0] or indistinguishable(r, with_first[0], ctx)
+    ]
     partners = [next(m for m in r["members"] if m != first) for r in close]
     return min(partners, key=order.index)
 
 
-def named_and_top_two(
-    singles: list[dict[str, Any]], pairs: list[dict[str, Any]]
-) -> tuple[dict[str, Any] | None, list[str]]:
-    """(the named row or None, top_two). ``singles`` and ``pairs`` are ranked best first."""
+def _delay_in_part(ok: list[dict], first: dict, ctx: Context) -> dict | None:
+    """The delay row, when the lag is seen in part and the delay would pass on its fit alone
+    and fit as well as ``first`` or better: the records cannot say which it is."""
+    if not ctx.lag.partial or first["effect"] == "delay":
+        return None
+    for r in ok:
+        if r["effect"] == "delay" and r["significant"] and r["closes_excess"] >= SHRINK_MIN:
+            if r["gap_after"] <= (1.0 + TIE_GAP) * first["gap_after"]:
+                return r
+    return None
+
+
+@dataclass
+class Answer:
+    """``effect``: a candidate's name, ``"none"``, ``AMBIGUOUS`` or ``OUTSIDE``; ``row`` the
+    model whose predictions are reported (None: the baseline's); ``between`` the two
+    candidates an ambiguous answer cannot tell apart."""
+
+    effect: str
+    row: dict[str, Any] | None
+    top_two: list[str]
+    between: list[str]
+
+
+def answer(singles: list[dict], pairs: list[dict], ctx: Context) -> Answer:
+    """The answer from ranked ``singles`` and ``pairs`` (rules 4)."""
+    ok = [r for r in singles if not r["failed_to_fit"]]
+    best_two = [r["effect"] for r in ok[:2]]
     winners = [r for r in pairs if r["passes"]]
     if winners:
-        return winners[0], list(winners[0]["members"])
-    if singles and singles[0]["passes"]:
-        first = singles[0]["effect"]
-        with_first = [r for r in pairs if first in r["members"]]
-        if with_first:
-            return singles[0], [first, runner_up(first, with_first, singles)]
-        return singles[0], [first] + [r["effect"] for r in singles[1:2]]
-    return None, [r["effect"] for r in singles[:2]]
+        return Answer(winners[0]["effect"], winners[0], list(winners[0]["members"]), [])
+    passing = [r for r in ok if r["passes"]]
+    if passing:
+        first = passing[0]
+        name = first["effect"]
+        # pairs with the first that add to it (a partner that adds nothing is no runner-up;
+        # one that fails to fit alone may still add beside the first)
+        with_first = [
+            r
+            for r in pairs
+            if name in r["members"]
+            and not r["failed_to_fit"]
+            and r["gap_after"] < (1.0 - ADDS_MIN) * first["gap_after"]
+        ]
+        others = [r["effect"] for r in ok if r["effect"] != name]
+        top_two = (
+            [name, runner_up(name, with_first, singles, ctx)] if with_first else [name] + others[:1]
+        )
+        if len(passing) > 1 and indistinguishable(first, passing[1], ctx):
+            between = [name, passing[1]["effect"]]
+            return Answer(AMBIGUOUS, first, between, between)
+        lagged = _delay_in_part(ok, first, ctx)
+        if lagged is not None:
+            between = [name, "delay"]
+            return Answer(AMBIGUOUS, first, between, between)
+        return Answer(name, first, top_two, [])
+    if ctx.excess(ctx.gap_null) > OUTSIDE_NOISE * ctx.gap_noise:
+        return Answer(OUTSIDE, None, best_two, [])
+    return Answer("none", None, best_two, [])
+
+
+def unexplained(ans: Answer, rows: list[dict], gap_before: float, ctx: Context) -> dict:
+    """The share of the gap the answer leaves, what the best candidate leaves, both above the
+    measurement noise; "mostly outside the candidates" only when that is so."""
+    ok = [r for r in rows if not r["failed_to_fit"]]
+    best = min(ok, key=lambda r: r["gap_after"]) if ok else None
+    named = ans.row
+    share = named["gap_after"] / gap_before if named and gap_before > 0 else 1.0
+    best_share = best["gap_after"] / gap_before if best and gap_before > 0 else 1.0
+    best_share = min(best_share, 1.0)
+    left = 1.0 - ctx.closes(named["gap_after"], ctx.gap_null) if named else 1.0
+    best_left = 1.0 - ctx.closes(best["gap_after"], ctx.gap_null) if best else 1.0
+    noise = f"the force's measurement noise alone is a {100 * ctx.gap_noise:.2g} % gap"
+    text = []
+    if ans.effect == "none":
+        text.append(f"No candidate passes the rule and the gap is close to the noise ({noise}).")
+    elif ans.effect == OUTSIDE:
+        text.append(
+            "The cause lies outside the candidates: no candidate passes the rule, and the gap "
+            f"stands clear of the noise ({noise})"
+            + (
+                f"; the best, {best['effect']}, would leave {100 * best_share:.0f} %."
+                if best
+                else "."
+            )
+        )
+    else:
+        text.append(
+            f"{named['effect']} leaves {100 * share:.0f} % of the gap unexplained "
+            f"({100 * left:.0f} % of what stands above the noise; {noise})."
+        )
+    mostly = ans.effect == OUTSIDE or (named is not None and left > MOSTLY_UNEXPLAINED)
+    if mostly and ans.effect != OUTSIDE:
+        text.append(
+            f"The gap lies mostly outside the candidate set: the named model leaves "
+            f"{100 * left:.0f} % of what stands above the noise."
+        )
+    return {
+        "unexplained_share": float(share),
+        "unexplained_share_above_noise": float(left),
+        "best_candidate": best["effect"] if best else "none",
+        "best_unexplained_share": float(best_share),
+        "best_unexplained_share_above_noise": float(best_left),
+        "gap_noise": ctx.gap_noise,
+        "mostly_outside_candidates": bool(mostly),
+        "text": text,
+    }

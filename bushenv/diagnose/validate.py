@@ -11,7 +11,10 @@ the answer is scored:
   member) against the label, a confusion matrix, and how often exactly one effect was named;
 - two-effect cases: a hit when both effects are ``top_two`` and something was named;
 - the median shrink on cases named right (``none`` cases excluded), recomputed from the
-  predictions the diagnosis returns, as a reader of ``predictions/*.csv`` would.
+  predictions the diagnosis returns, as a reader of ``predictions/*.csv`` would;
+- abstentions (``ambiguous``, ``outside_candidates``) counted apart: in the rates they are
+  not hits, and they name no effect; the share of answers naming an effect that is not in
+  the label (the false-positive rate the rule is held to).
 
 ``reference``: the reference rubber (``reference_cases.py``). ``widened``: forms, programmes,
 rates and noise the candidates do not assume (``widened_cases.py``).
@@ -33,6 +36,7 @@ from bushenv.diagnose.candidates import effect_names
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import diagnose
 from bushenv.diagnose.reference_cases import Case, make_case
+from bushenv.diagnose.rule import AMBIGUOUS, OUTSIDE
 from bushenv.diagnose.widened_cases import make_widened_case
 
 SETS: dict[str, Callable[[int, int], Case]] = {
@@ -52,9 +56,17 @@ def recomputed_shrink(result: dict[str, Any]) -> float:
     return 1.0 - float(np.sqrt(np.mean((fm - fa) ** 2))) / before if before > 0 else 0.0
 
 
+def named_effects(result: dict[str, Any]) -> set[str]:
+    """The effects an answer claims are there (none for an abstention or 'none')."""
+    if result["effect"] in ("none", AMBIGUOUS, OUTSIDE):
+        return set()
+    return set(result["effect"].split("+"))
+
+
 def judge_case(case: Case, result: dict[str, Any]) -> dict[str, Any]:
     named = result["effect"]
     first = named.split("+")[0]
+    absent = sorted(named_effects(result) - set(case.label))
     row = {
         "case": case.index,
         "label": case.label_text,
@@ -65,6 +77,8 @@ def judge_case(case: Case, result: dict[str, Any]) -> dict[str, Any]:
         "gap_before": result["gap_before"],
         "gap_after": result["gap_after"],
         "mode": result["mode"],
+        "abstained": named in (AMBIGUOUS, OUTSIDE),
+        "absent_named": absent,
         "drawn": case.drawn,
     }
     if len(case.label) <= 1:
@@ -101,6 +115,9 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "pair_hit_rate": _rate(pairs, "right"),
         "pair_named_exactly_rate": _rate(pairs, "pair_named"),
         "median_shrink_named_right": float(np.median(right)) if right else None,
+        "abstained_ambiguous": sum(r.get("named") == AMBIGUOUS for r in rows),
+        "abstained_outside": sum(r.get("named") == OUTSIDE for r in rows),
+        "absent_effect_named_rate": _rate([{"x": bool(r.get("absent_named"))} for r in rows], "x"),
         "classes": classes,
         "confusion": confusion.tolist(),
     }
@@ -125,7 +142,8 @@ def run_validation(
     for i in range(start, start + n_cases):
         t0 = time.monotonic()
         case = make(seed, i)
-        result = diagnose(case.train, case.tests, cross=case.cross)
+        # the default mode, or the cross mode where the case asks for it
+        result = diagnose(case.train, case.tests, cross=True if case.cross else None)
         row = judge_case(case, result)
         row["seconds"] = round(time.monotonic() - t0, 2)
         rows.append(row)
@@ -158,6 +176,11 @@ def report_text(summary: dict[str, Any], seed: int, case_set: str) -> str:
             f"{pct(summary['pair_named_exactly_rate'])})",
             f"- median shrink on cases named right (recomputed from the predictions): "
             f"{pct(summary['median_shrink_named_right'])}",
+            f"- abstentions (counted as neither hit nor wrong effect): "
+            f"{summary['abstained_ambiguous']} '{AMBIGUOUS}', {summary['abstained_outside']} "
+            f"'{OUTSIDE}'",
+            f"- answers naming an effect that is not there: "
+            f"{pct(summary['absent_effect_named_rate'])} of {summary['cases']}",
             "",
         ]
     )

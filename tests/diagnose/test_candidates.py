@@ -111,8 +111,9 @@ def _fake_identify(monkeypatch, calls):
     import bushenv.identify as identify
     from bushenv.models.linear import LinearBushing
 
-    def fit_model(name, x, f, dt, seed):
+    def fit_model(name, x, f, dt, seed, progress=True):
         calls.append((name, x.size, dt, seed))
+        progress("epoch 1/1")  # a training line: the diagnosis's own progress gets it
         v = np.gradient(x, dt)
         k, c = np.linalg.lstsq(np.stack([x, v], axis=1), f, rcond=None)[0]
         return LinearBushing(k, c, dt=dt)
@@ -121,10 +122,12 @@ def _fake_identify(monkeypatch, calls):
 
 
 def test_other_baselines_come_from_the_identify_dispatcher_and_are_augmented(monkeypatch):
-    calls = []
+    calls, lines = [], []
     _fake_identify(monkeypatch, calls)
     train = record(8, "inertia", noise=0.002, duration_s=20.0)
-    result = diagnose(train, [record(9, "inertia", noise=0.002, name="t")], baseline="boucwen")
+    test = record(9, "inertia", noise=0.002, name="t")
+    result = diagnose(train, [test], baseline="boucwen", progress=lines.append)
+    assert "epoch 1/1" in lines  # so --quiet (no progress) silences the training too
     assert calls == [("boucwen", train.force.size, train.dt, 0)]
     assert result["baseline"] == "boucwen"
     assert result["effect"] == "inertia"
@@ -145,6 +148,37 @@ def test_other_baselines_refuse_a_test_at_another_rate_and_the_cross_mode(monkey
 def test_a_test_equal_to_train_is_flagged_as_not_held_out():
     train = record(10, "none", duration_s=8.0)
     result = diagnose(train, [train], test_names=["same"])
-    assert result["notes"] == [
-        "TEST same is the TRAIN record rec10 itself: its gap is not held out."
-    ]
+    assert "TEST same is the TRAIN record rec10 itself: its gap is not held out." in (
+        result["notes"]
+    )
+
+
+def test_a_force_channel_lag_is_seen_by_its_phase_and_a_relaxation_is_not():
+    from bushenv.diagnose.lag import lag_evidence
+
+    def evidence(effect):
+        recs = [record(s, effect, noise=0.005, duration_s=20.0) for s in (1, 2)]
+        return lag_evidence([(r.name, r.displacement, r.force, r.dt) for r in recs])
+
+    lagged = evidence("delay")
+    # the passive family takes up part of a lag (a smaller damper): what is left is a lower
+    # bound of the 6 ms
+    assert lagged.seen and 0.003 < lagged.delay_s <= 0.0066
+    for effect in ("none", "relaxation", "thermal", "inertia", "hardening"):
+        assert not evidence(effect).seen, effect
+
+
+def test_fitted_spring_damper_and_mass_stay_physical_on_a_lagged_force():
+    train = record(1, "delay", noise=0.002, duration_s=20.0)
+    result = diagnose(train, [record(2, "delay", noise=0.002, name="t")], effects=["inertia"])
+    params = result["parameters"]
+    assert params["c_ns_per_m"] >= 0 and params["k_n_per_m"] >= 0
+    assert params.get("inertia", {"mass_kg": 0.0})["mass_kg"] >= 0
+    assert result["effect"] in ("none", "outside_candidates", "inertia")
+
+
+def test_the_runner_up_is_another_candidate_than_the_answer():
+    train = record(1, "relaxation", noise=0.002, duration_s=24.0)
+    result = diagnose(train, [record(2, "relaxation", noise=0.002, duration_s=24.0, name="t")])
+    assert result["effect"] == "relaxation"
+    assert result["runner_up"] not in (None, "relaxation")

@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 
 from bushenv.diagnose.regimes import (
     held_after_step_mask,
@@ -53,3 +54,16 @@ def test_coherence_separates_a_linear_residual_from_independent_noise():
     _, _, coh_noise = residual_spectrum(rng.normal(size=x.size), x, dt)
     assert np.median(coh_linear) > 0.95
     assert np.median(coh_noise) < 0.2
+
+
+def test_noise_floor_cut_off_is_the_same_for_a_record_read_backwards():
+    from bushenv.diagnose.design import noise_band_edge
+
+    dt = 1 / 1024
+    t = np.arange(int(50 / dt)) * dt
+    # a sweep running low to high: its top lies in the last samples of the record
+    x = 2e-3 * np.sin(2 * np.pi * (0.5 * t + (30.0 - 0.5) * t**2 / (2 * t[-1])))
+    x = x + 1e-9 * np.random.default_rng(0).normal(size=t.size)
+    forward, backward = noise_band_edge(x, dt), noise_band_edge(x[::-1], dt)
+    assert forward is not None and forward == pytest.approx(backward, rel=1e-9)
+    assert forward > 30.0  # the whole band is kept, up to the sweep's top

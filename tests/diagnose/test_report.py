@@ -37,7 +37,7 @@ def test_diagnose_command_writes_the_contract_files(case):
     )
     assert [r["effect"] for r in report["ranking"]][0] == "friction"
     assert sorted(r["effect"] for r in report["ranking"]) == sorted(effect_names())
-    assert report["mode"] == "held_out"
+    assert report["mode"] == "cross"  # every record is used by default
     assert 0 <= report["unexplained"]["unexplained_share"] <= 1
     for r in report["ranking"]:
         assert {"effect", "gap_before", "gap_after", "shrink"} <= set(r)
@@ -149,3 +149,11 @@ def test_unavailable_baseline_is_a_clear_error(tmp_path, capsys, monkeypatch):
     )
     assert code == 2
     assert "fit_model" in capsys.readouterr().err
+
+
+def test_quiet_writes_nothing_on_stderr(tmp_path, capsys):
+    train = write_csv(tmp_path / "train.csv", record(61, "relaxation", duration_s=8.0))
+    test = write_csv(tmp_path / "test.csv", record(62, "relaxation", duration_s=8.0))
+    out = tmp_path / "out"
+    assert main(["diagnose", str(train), str(test), "--out", str(out), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""

@@ -76,6 +76,10 @@ class Hardening(Effect):
         "0, 25, 50, 80 % of the range + (x/x80)^2, (x/x80)^4, + a constant per side"
     )
     weights = "tangent stiffnesses >= 0 (N/m): monotone, softening or stiffening"
+    telling_test = (
+        "a slow ramp to beyond the largest deflection so far (a force not proportional to "
+        "deflection, without a loop)"
+    )
     replaces_spring = True
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:

@@ -111,15 +111,18 @@ class Effect:
 
     Class attributes (they also make the effects table of docs/diagnose.md):
     ``name`` (registry name), ``form`` (the force it adds), ``weights`` (their bounds),
-    ``shape_text`` (the shape settings tried). ``replaces_spring``: the columns replace the
-    linear spring ``k x`` (a backbone of its own); ``continuous_shape``: the best grid shape
-    is refined by a 1-D search on the fitting error.
+    ``shape_text`` (the shape settings tried), ``telling_test`` (a programme that shows what
+    only this effect does, offered when an answer cannot tell two effects apart).
+    ``replaces_spring``: the columns replace the linear spring ``k x`` (a backbone of its
+    own); ``continuous_shape``: the best grid shape is refined by a 1-D search on the fitting
+    error.
     """
 
     name: ClassVar[str] = ""
     form: ClassVar[str] = ""
     weights: ClassVar[str] = ""
     shape_text: ClassVar[str] = "none"
+    telling_test: ClassVar[str] = "a programme that excites it alone"
     replaces_spring: ClassVar[bool] = False
     continuous_shape: ClassVar[bool] = False
 

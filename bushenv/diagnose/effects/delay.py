@@ -54,6 +54,10 @@ class Delay(Effect):
     name = "delay"
     form = "the whole predicted force at t - d"
     weights = "none"
+    telling_test = (
+        "a broadband random or a sweep to the highest frequency the machine drives (a "
+        "phase lag growing linearly with frequency at unchanged gain)"
+    )
     shape_text = "d on 25 values 0.25..40 ms, refined by a bounded 1-D search"
     continuous_shape = True
 

@@ -59,6 +59,10 @@ class Friction(Effect):
         "- sum_m q_m x A_m / sigma_x, A_m = envelope of abs(x) (2 s, 20 s)"
     )
     weights = "F_j >= 0 (N), q_m >= 0 (N/m)"
+    telling_test = (
+        "sines at one amplitude and rates a decade apart (a loop that does not change "
+        "with rate) and at several amplitudes"
+    )
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         xs = DAHL_FRACTIONS * scales.sigma_x

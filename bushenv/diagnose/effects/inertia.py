@@ -15,6 +15,10 @@ class Inertia(Effect):
     name = "inertia"
     form = "m a, a = d2x/dt2"
     weights = "m >= 0 (kg)"
+    telling_test = (
+        "a small-amplitude sweep to high frequency (a force growing with the square of "
+        "frequency, in phase with the deflection)"
+    )
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         return s.a[:, None].copy()

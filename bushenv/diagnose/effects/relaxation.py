@@ -47,6 +47,9 @@ class Relaxation(Effect):
         "to 2 x the longest record"
     )
     weights = "k_i >= 0 (N/m)"
+    telling_test = (
+        "a step held for longer than its time scale (the force decays at constant deflection)"
+    )
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         return np.stack([maxwell_state(s.x, s.dt, t) for t in tau_grid_s(scales)], axis=1)

@@ -37,6 +37,10 @@ class Thermal(Effect):
     name = "thermal"
     form = "-theta (b_k x + b_c v), theta' = P - theta / tau_th, P = v^2 or abs(v) v_rms"
     weights = "b_k, b_c >= 0"
+    telling_test = (
+        "a long constant-amplitude sine with rests (a stiffness that falls while it runs "
+        "and recovers in the rests)"
+    )
     shape_text = "tau_th in {10, 30, 100, 300, inf} s x heating {viscous, hysteretic}"
 
     def shapes(self, scales: Scales) -> list:
