@@ -26,11 +26,11 @@ COMMANDS = {
     "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
     "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
     "measure": ("bushenv.commands.measure", "run a test programme on a model; write CSV records"),
-    "fit": ("bushenv.identify.command", "identify a model from measured records, with a card"),
-    "import-nn": ("bushenv.identify.import_command", "a torch NARX network to a model file"),
-    "card": ("bushenv.identify.card_command", "show a model card; check its model and records"),
+    "fit": ("bushenv.commands.fit", "identify a model from measured records, with a card"),
+    "import-nn": ("bushenv.commands.import_nn", "a torch NARX network to a model file"),
+    "card": ("bushenv.commands.card", "show a model card; check its model and records"),
     "certify": ("bushenv.commands.certify", "hold-stability and passivity certificates of a NARX"),
-    "zoo": ("bushenv.zoo.command", "population study: how often NARX models fail, by recipe"),
+    "zoo": ("bushenv.commands.zoo", "population study: how often NARX models fail, by recipe"),
     "export": ("bushenv.commands.export", "a model as an FMU (FMI 2.0 / 3.0, compiled C)"),
 }
 

@@ -9,12 +9,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "bushenv"
 NOT_YET_MOVED = {
     "diagnose/report.py",
     "diagnose/validate.py",
-    "identify/command.py",
-    "identify/import_command.py",
-    "identify/card_command.py",
-    "zoo/command.py",
     "reference/calibration.py",
-    "record_rates.py",
 }
 
 

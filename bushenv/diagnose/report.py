@@ -31,11 +31,12 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.commands.options import add_resample_option
 from bushenv.diagnose.candidates import effect_names
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import baseline_names, diagnose
 from bushenv.diagnose.plots import make_plots
-from bushenv.record_rates import add_resample_option, one_rate
+from bushenv.record_rates import one_rate
 
 EXAMPLE = (
     "bushenv diagnose train.csv test_random.csv test_steps.csv --out diag/ "

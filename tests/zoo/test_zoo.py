@@ -8,7 +8,7 @@ from bushenv.execution import LocalBackend
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
 from bushenv.zoo.cell import run_cell
-from bushenv.zoo.command import CELL_KEYS, RESULT_KEYS, ZooConfig, ZooError
+from bushenv.zoo.study import CELL_KEYS, RESULT_KEYS, ZooConfig, ZooError
 from bushenv.zoo.summary import summarise, wilson
 
 QUICK = {"teacher_steps": 150}  # a small one-step-ahead training: seconds, not minutes
@@ -61,8 +61,8 @@ def test_a_small_population_trains_judges_summarises_and_resumes(tmp_path):
 def test_certified_flag_reaches_the_training_the_file_names_and_the_summary_label():
     import argparse
 
+    from bushenv.commands.zoo import add_arguments, config_from
     from bushenv.zoo.cell import cell_name
-    from bushenv.zoo.command import add_arguments, config_from
     from bushenv.zoo.summary import recipe_label
 
     p = argparse.ArgumentParser()

@@ -15,9 +15,10 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
+from bushenv.commands.options import add_resample_option
 from bushenv.identify import fittable_models, options_class
 from bushenv.identify.options import describe, flag_of, option_fields
-from bushenv.record_rates import add_resample_option, one_rate
+from bushenv.record_rates import one_rate
 
 EXAMPLE = "bushenv fit train1.csv train2.csv --model hybrid --validate held.csv --out my_hybrid.npz"
 DEST = "option_"  # argparse dest prefix of the model options

@@ -1,0 +1,70 @@
+"""``bushenv zoo``: argparse in, a ``ZooConfig`` out, the population study (``zoo/study.py``)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from bushenv.execution import get_backend
+from bushenv.progress import Progress
+from bushenv.search.matrix import parse_seeds
+from bushenv.zoo.study import ZooConfig, run_study
+
+EXAMPLE = (
+    "bushenv zoo --recipes teacher-forcing,free-run --models nn,hybrid --seeds 0-9 "
+    "--axes axial,radial --out runs/zoo"
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    d = ZooConfig()
+    p.add_argument("--recipes", default=",".join(d.recipes), help="training recipes")
+    p.add_argument("--models", default=",".join(d.models), help="NARX models to train")
+    p.add_argument("--axes", default=",".join(d.axes), help="bushing axes")
+    p.add_argument("--seeds", default="0-9", help="training and record seeds, e.g. 0-9 or 1,4")
+    p.add_argument("--searchers", default=",".join(d.searchers), help="searchers per model")
+    p.add_argument("--budget", type=int, default=d.budget, help="evaluations per search")
+    p.add_argument(
+        "--certified",
+        choices=("off", "on"),
+        default="off",
+        help="train every model with the certified-holds loss term (bushenv fit --certified on)",
+    )
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--resume", action="store_true", help="continue an interrupted study")
+    p.add_argument("--workers", type=int, default=None, help="local worker processes")
+    p.add_argument("--ray", action="store_true", help="run on Ray (a local instance)")
+    p.add_argument("--ray-address", default=None, help="run on an existing Ray cluster")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+
+
+def _names(text: str) -> tuple[str, ...]:
+    return tuple(n.strip() for n in text.split(",") if n.strip())
+
+
+def config_from(args: argparse.Namespace) -> ZooConfig:
+    """The study the arguments describe (checked)."""
+    return ZooConfig(
+        recipes=_names(args.recipes),
+        models=_names(args.models),
+        axes=_names(args.axes),
+        seeds=tuple(parse_seeds(args.seeds)),
+        searchers=_names(args.searchers),
+        budget=args.budget,
+        out=Path(args.out),
+        resume=args.resume,
+        train_options={"certified": "on"} if args.certified == "on" else {},
+    ).checked()
+
+
+def run(args: argparse.Namespace) -> int:
+    config = config_from(args)
+    backend = get_backend(
+        "ray" if (args.ray or args.ray_address) else "local",
+        workers=args.workers,
+        address=args.ray_address,
+    )
+    run_study(config, backend, Progress(quiet=args.quiet))
+    print((config.out / "summary.md").read_text())
+    print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md, accuracy_vs_robustness.png")
+    return 0
