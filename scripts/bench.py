@@ -183,7 +183,7 @@ def bench_float32_error(fig: Figures, model, T: int) -> None:
 def bench_boucwen_accuracy(fig: Figures, model, T: int) -> None:
     """What the Bouc-Wen throughput buys: error against a converged run, steps per sample."""
     from bushenv.excitation import random_rpc
-    from bushenv.models.boucwen_accuracy import error_against_converged
+    from bushenv.models.boucwen.accuracy import error_against_converged
 
     x = random_rpc(1.0, T * model.dt, model.dt, seed=0)
     err_of_peak, _, steps = error_against_converged(model.vector(), x, model.rtol, model.dt)
@@ -191,7 +191,7 @@ def bench_boucwen_accuracy(fig: Figures, model, T: int) -> None:
         "free_run.boucwen.error_vs_converged",
         err_of_peak,
         "of peak",
-        2e-3,  # the accuracy the model states (bushenv/models/boucwen.py)
+        2e-3,  # the accuracy the model states (bushenv/models/boucwen/model.py)
         better="lower",
         note=f"rtol {model.rtol:g}; vs RK4 with 512 sub-steps/sample (docs/boucwen-integration.md)",
     )

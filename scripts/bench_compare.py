@@ -70,7 +70,7 @@ def bench_scipy(fig, quick: bool) -> None:
     """Bouc-Wen: solve_ivp at bushenv's accuracy, steps/s, as ratios."""
     from bushenv.excitation import random_rpc
     from bushenv.models import get_model
-    from bushenv.models.boucwen_accuracy import converged
+    from bushenv.models.boucwen.accuracy import converged
 
     print("\n== Bouc-Wen beside scipy's solve_ivp at the same accuracy (one profile, one thread)")
     model = get_model("boucwen", axis="axial")

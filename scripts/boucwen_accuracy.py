@@ -3,7 +3,7 @@
 For every pair: the worst force error of the production kernel (ROS34PW2 with error control)
 relative to the peak and to F_REF (the scale the tolerance refers to), against fixed-step RK4
 with 512 sub-steps per sample, and the trial steps per sample it took (both blocks, rejected
-ones included). The cases: ``bushenv.models.boucwen_accuracy``.
+ones included). The cases: ``bushenv.models.boucwen.accuracy``.
 
     python scripts/boucwen_accuracy.py                 # default rtol
     python scripts/boucwen_accuracy.py --rtol 1e-7 --md table.md
@@ -14,8 +14,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from bushenv.models.boucwen_accuracy import INPUTS, error_against_converged, parameter_sets
-from bushenv.models.boucwen_kernels import BW_RTOL
+from bushenv.models.boucwen.accuracy import INPUTS, error_against_converged, parameter_sets
+from bushenv.models.boucwen.kernels import BW_RTOL
 
 
 def main(argv: list[str] | None = None) -> int:

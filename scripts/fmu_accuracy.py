@@ -22,7 +22,7 @@ from bushenv.export import export_fmu
 from bushenv.export.fmpy_master import derivatives_then_step, set_then_read
 from bushenv.models import PAPER_DT, get_model
 from bushenv.models.boucwen import BoucWenBushing
-from bushenv.models.boucwen_accuracy import converged
+from bushenv.models.boucwen.accuracy import converged
 
 DT = PAPER_DT
 AXIS = {"linear": "axial", "nn": "axial", "hybrid": "axial", "boucwen": "radial"}

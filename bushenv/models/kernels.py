@@ -135,13 +135,13 @@ def narx_kernel(  # pragma: no cover - compiled
 
 
 # ----- Bouc-Wen (seed 002 eqs. 1-5): in boucwen_kernels.py, re-exported here ---------------
-from bushenv.models.boucwen_kernels import (  # noqa: E402, F401
+from bushenv.models.boucwen.kernels import (  # noqa: E402, F401
     BW_MAX_SUBSTEPS,
     BW_N_STATE,
     boucwen_kernel,
 )
-from bushenv.models.boucwen_reference import boucwen_fixed_step  # noqa: E402, F401
-from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare  # noqa: E402, F401
+from bushenv.models.boucwen.reference import boucwen_fixed_step  # noqa: E402, F401
+from bushenv.models.boucwen.tables import BW_ORDER, BW_RTOL, prepare  # noqa: E402, F401
 
 
 def warm_up() -> None:

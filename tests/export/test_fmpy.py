@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from bushenv.models import PAPER_DT, get_model
-from bushenv.models.boucwen_accuracy import converged
+from bushenv.models.boucwen.accuracy import converged
 
 from .fmu_masters import AXIS, inputs, set_then_read
 

@@ -8,19 +8,19 @@ import pytest
 from bushenv import excitation as ex
 from bushenv.models import PAPER_DT, get_model
 from bushenv.models.boucwen import BoucWenBushing, BoucWenError, simulate_population
-from bushenv.models.boucwen_accuracy import (
+from bushenv.models.boucwen.accuracy import (
     INPUTS,
     converged,
     force_scale,
     parameter_sets,
 )
-from bushenv.models.boucwen_kernels import (
+from bushenv.models.boucwen.kernels import (
     BW_MAX_SUBSTEPS,
     BW_N_STATE,
     BW_TILE,
     boucwen_kernel,
 )
-from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare
+from bushenv.models.boucwen.tables import BW_ORDER, BW_RTOL, prepare
 
 DT = PAPER_DT
 ACCURACY = 2e-3  # of max(peak force, F_REF), at the default rtol (module docstring)

@@ -46,7 +46,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from bushenv.models.boucwen_pass import (  # noqa: F401  (row offsets: the scratch layout)
+from bushenv.models.boucwen.passes import (  # noqa: F401  (row offsets: the scratch layout)
     _AAW,
     _ACT,
     _AW,
@@ -102,14 +102,14 @@ from bushenv.models.boucwen_pass import (  # noqa: F401  (row offsets: the scrat
     JIT,
     _pass,
 )
-from bushenv.models.boucwen_step import (
+from bushenv.models.boucwen.step import (
     hermite,
     inverse,
     locate,
     locate_tolerance,
     locate_zero_crossing,
 )
-from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, V_REF_M_PER_S, X_REF_M
+from bushenv.models.boucwen.tables import BW_ORDER, BW_RTOL, V_REF_M_PER_S, X_REF_M
 
 # State rows: y, w, z1, z2 (z: written for inspection, not read), x_prev, v_prev, trial steps in
 # the last sample (both blocks, diagnostic), next step size of block 1 and 2 (s; 0 = one step

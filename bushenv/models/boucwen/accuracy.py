@@ -15,8 +15,8 @@ import numpy as np
 from bushenv import excitation as ex
 from bushenv.models.base import PAPER_DT
 from bushenv.models.boucwen import BoucWenBushing
-from bushenv.models.boucwen_reference import boucwen_fixed_step
-from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, V_REF_M_PER_S, X_REF_M
+from bushenv.models.boucwen.reference import boucwen_fixed_step
+from bushenv.models.boucwen.tables import BW_ORDER, BW_RTOL, V_REF_M_PER_S, X_REF_M
 
 REFERENCE_SUBSTEPS = 512  # converged to ~6e-7 of the peak on the cases below
 

@@ -35,7 +35,7 @@ import math
 import numba as nb
 import numpy as np
 
-from bushenv.models.boucwen_step import hermite_solve
+from bushenv.models.boucwen.step import hermite_solve
 
 # Parameter rows of a parameter vector (16,), SI.
 BW_ORDER = (

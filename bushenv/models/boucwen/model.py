@@ -45,8 +45,8 @@ import numpy as np
 
 from bushenv.errors import ModelRefused
 from bushenv.models.base import PAPER_DT, BushingModel, ModelError
-from bushenv.models.boucwen_kernels import BW_MAX_SUBSTEPS, BW_N_STATE, boucwen_kernel
-from bushenv.models.boucwen_tables import BW_ORDER, BW_RTOL, prepare
+from bushenv.models.boucwen.kernels import BW_MAX_SUBSTEPS, BW_N_STATE, boucwen_kernel
+from bushenv.models.boucwen.tables import BW_ORDER, BW_RTOL, prepare
 
 MM_PER_M = 1000.0
 

@@ -14,13 +14,13 @@ import math
 
 import numba as nb
 
-from bushenv.models.boucwen_step import (
+from bushenv.models.boucwen.step import (
     SMALL_Z,
     hermite_values,
     phis_half_and_full,
     segment_index,
 )
-from bushenv.models.boucwen_tables import BC_ROWS
+from bushenv.models.boucwen.tables import BC_ROWS
 
 # error_model="numpy": no zero-division guard branches, so the loops over lanes vectorise.
 JIT = dict(cache=True, fastmath=False, nogil=True, error_model="numpy")
