@@ -10,7 +10,8 @@ python3 -m venv "$venv"
 {
   echo "# Every dependency's version as tested (Python 3.11, x86_64, CPU). Used as pip constraints by the"
   echo "# README's commands and .ci/run. Refresh: bash scripts/lock.sh (docs/contributing.md)."
-  "$venv/bin/pip" freeze --exclude bushenv | sed 's/^torch==\([0-9.]*\)+cpu/torch==\1/'
+  "$venv/bin/pip" freeze --all --exclude bushenv --exclude pip --exclude wheel \
+    | sed 's/^torch==\([0-9.]*\)+cpu/torch==\1/'
 } > constraints.txt
 rm -rf "$(dirname "$venv")"
-echo "constraints.txt refreshed; now: pip install -c constraints.txt '.[test,ray,fmi]' && pytest -m 'not slow' -q" >&2
+echo "constraints.txt refreshed; now, in a fresh venv, the README's test command" >&2
