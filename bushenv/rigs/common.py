@@ -20,13 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.errors import DIVERGENCE_RAISES, BadInput
+from bushenv.errors import DIVERGENCE_RAISES
 from bushenv.models import MODELS, BushingModel, get_model
-
-
-class RigError(BadInput):
-    """A rig argument, spec file or excitation is wrong; the message names it and the value."""
-
+from bushenv.rigs.errors import RigError
 
 # What a model's step may raise that ends its episode as a divergence: its own state ran away
 # (Bouc-Wen's guard) or 1/0, overflow (``bushenv.errors``). Anything else the model raises is a

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.rigs.common import RigError
+from bushenv.rigs.errors import RigError
 
 SPEC_PACKAGE = "bushenv.envs"
 SOURCE_SPEC_DIR = Path(__file__).resolve().parents[2] / "envs"
