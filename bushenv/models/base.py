@@ -36,7 +36,52 @@ class ModelError(BadInput):
     """A model file or a model argument is wrong; the message names the file and the problem."""
 
 
-class BushingModel:
+class SavedParameters:
+    """What every model kind shares: its parameters in one ``.npz`` file (no pickle; the
+    kind's ``FILE_FORMAT`` tag in the ``__meta__`` entry) and a fresh copy from them.
+
+    A subclass sets ``name``, ``param_names``, ``dt`` and a ``params`` dict, and takes its
+    parameters (and ``extra_meta()``) as keyword arguments of its constructor."""
+
+    FILE_FORMAT: ClassVar[str] = "bushenv-model"
+
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write the model to one ``.npz`` file atomically (temp file, then rename)."""
+        path = Path(path)
+        arrays = {k: np.asarray(v, dtype=np.float64) for k, v in self.params.items()}
+        meta = {
+            "format": self.FILE_FORMAT,
+            "version": FORMAT_VERSION,
+            "model": self.name,
+            "dt": self.dt,
+            "shapes": {k: list(a.shape) for k, a in arrays.items()},
+            "extra": self.extra_meta(),
+        }
+        payload = {"__meta__": np.array(json.dumps(meta)), **arrays}
+        atomic_write(path, lambda fh: np.savez(fh, **payload))
+        return path
+
+    def extra_meta(self) -> dict[str, Any]:
+        """Non-array settings a subclass needs to rebuild itself (plain JSON values)."""
+        return {}
+
+    @classmethod
+    def from_params(cls, params: dict[str, np.ndarray], dt: float, extra: dict[str, Any]):
+        return cls(dt=dt, **{k: params[k] for k in cls.param_names}, **extra)
+
+    def copy(self):
+        """A fresh model with the same parameters (own state, at rest)."""
+        return type(self).from_params(
+            {k: np.array(v, dtype=np.float64) for k, v in self.params.items()},
+            self.dt,
+            self.extra_meta(),
+        )
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(dt={self.dt:.6g})"
+
+
+class BushingModel(SavedParameters):
     """Base class: state handling, step/simulate over one kernel, parameters, save/load.
 
     Subclasses set ``name``, ``param_names`` (the arrays that define the model; floats are
@@ -163,42 +208,6 @@ class BushingModel:
         return np.ascontiguousarray(x2, dtype), np.ascontiguousarray(v2, dtype), one_d
 
     # ----- files -------------------------------------------------------------------------
-    def save(self, path: str | os.PathLike) -> Path:
-        """Write the model to one ``.npz`` file atomically (temp file, then rename)."""
-        path = Path(path)
-        arrays = {k: np.asarray(v, dtype=np.float64) for k, v in self.params.items()}
-        meta = {
-            "format": "bushenv-model",
-            "version": FORMAT_VERSION,
-            "model": self.name,
-            "dt": self.dt,
-            "shapes": {k: list(a.shape) for k, a in arrays.items()},
-            "extra": self.extra_meta(),
-        }
-        payload = {"__meta__": np.array(json.dumps(meta)), **arrays}
-        atomic_write(path, lambda fh: np.savez(fh, **payload))
-        return path
-
-    def extra_meta(self) -> dict[str, Any]:
-        """Non-array settings a subclass needs to rebuild itself (plain JSON values)."""
-        return {}
-
-    @classmethod
-    def from_params(
-        cls, params: dict[str, np.ndarray], dt: float, extra: dict[str, Any]
-    ) -> BushingModel:
-        return cls(dt=dt, **{k: params[k] for k in cls.param_names}, **extra)
-
-    def copy(self) -> BushingModel:
-        """A fresh model with the same parameters (own state)."""
-        return type(self).from_params(
-            {k: np.array(v, dtype=np.float64) for k, v in self.params.items()},
-            self.dt,
-            self.extra_meta(),
-        )
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}(dt={self.dt:.6g})"
 
 
 def velocity_of(x: np.ndarray, dt: float) -> np.ndarray:

@@ -17,16 +17,12 @@ mistaken for a one-axis one and the other way round.
 
 from __future__ import annotations
 
-import json
-import os
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
 from bushenv.errors import BadInput, BushenvError, ModelRaised
-from bushenv.models.base import PAPER_DT, velocity_of
-from bushenv.persist import atomic_write
+from bushenv.models.base import PAPER_DT, SavedParameters, velocity_of
 
 COORDS = ("axial", "radial", "rotation")
 UNITS = ("m", "m", "rad")
@@ -39,13 +35,15 @@ class PlanarModelError(BadInput):
     """A planar model file or argument is wrong; the message names the file and the problem."""
 
 
-class PlanarModel:
+class PlanarModel(SavedParameters):
     """Base class: state, step/simulate over one ``_advance``, parameters, save/load.
 
     Subclasses set ``name`` and ``param_names`` (arrays that define the model, kept as
     attributes), give ``n_state`` and implement ``_advance``; settings that are not arrays go
     through ``extra_meta`` and back into the constructor.
     """
+
+    FILE_FORMAT: ClassVar[str] = FORMAT  # its own tag: a one-axis loader refuses the file
 
     name: ClassVar[str] = ""
     param_names: ClassVar[tuple[str, ...]] = ()
@@ -72,10 +70,6 @@ class PlanarModel:
     @property
     def params(self) -> dict[str, Any]:
         return {k: getattr(self, k) for k in self.param_names}
-
-    def extra_meta(self) -> dict[str, Any]:
-        """Non-array settings a subclass needs to rebuild itself (plain JSON values)."""
-        return {}
 
     # ----- the protocol ------------------------------------------------------------------
     def reset(self, batch_size: int = 1) -> None:
@@ -141,38 +135,6 @@ class PlanarModel:
         return out[:, 0, :] if two_d else out
 
     # ----- files -------------------------------------------------------------------------
-    def save(self, path: str | os.PathLike) -> Path:
-        """Write the model to one ``.npz`` file atomically (temp file, then rename)."""
-        path = Path(path)
-        arrays = {k: np.asarray(v, dtype=np.float64) for k, v in self.params.items()}
-        meta = {
-            "format": FORMAT,
-            "version": FORMAT_VERSION,
-            "model": self.name,
-            "dt": self.dt,
-            "shapes": {k: list(a.shape) for k, a in arrays.items()},
-            "extra": self.extra_meta(),
-        }
-        payload = {"__meta__": np.array(json.dumps(meta)), **arrays}
-        atomic_write(path, lambda fh: np.savez(fh, **payload))
-        return path
-
-    @classmethod
-    def from_params(
-        cls, params: dict[str, np.ndarray], dt: float, extra: dict[str, Any]
-    ) -> PlanarModel:
-        return cls(dt=dt, **{k: params[k] for k in cls.param_names}, **extra)
-
-    def copy(self) -> PlanarModel:
-        """A fresh model with the same parameters (own state, at rest)."""
-        return type(self).from_params(
-            {k: np.array(v, dtype=np.float64) for k, v in self.params.items()},
-            self.dt,
-            self.extra_meta(),
-        )
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}(dt={self.dt:.6g})"
 
 
 def as_matrix(name: str, value: Any, shape: tuple[int, ...] = (3, 3)) -> np.ndarray:
