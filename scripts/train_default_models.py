@@ -37,7 +37,7 @@ from bushenv.reference.rubber import RubberBushing
 
 IDENT_SEED = 0
 VERIFY_SEED = 1
-MODELS = ("nn", "hybrid", "boucwen", "nn-paper", "hybrid-paper")
+MODELS = tuple(n for n in REGISTRY.names() if REGISTRY[n].shipped)  # the files the package ships
 # The papers' models as the seeds made them: teacher forcing (one step ahead only, seed 000
 # §4.2), five past displacements and forces into one hidden layer of nine tanh units (seed 000
 # §4.2, the paper whose NN departs after the 4 mm step), no certified-hold term.
