@@ -1,17 +1,28 @@
 """What every searcher shares: the interface, the result and its book-keeping.
 
-Every searcher is ``searcher.run(evaluator, budget, seed) -> SearchResult``. The budget counts
-model evaluations (profiles simulated, ``BatchEvaluator.n_evaluations``), the same unit for
-every searcher; the result records how many evaluations and seconds it took to the first
-failure, the worst profile found (lowest STL robustness, see ``bushenv/divergence.py``) and
-every failing profile (up to ``MAX_KEPT_FAILURES``). Given the seed, a run is deterministic.
+Callers run a searcher with ``searcher.run(evaluator, budget, seed) -> SearchResult``. A
+searcher implements one hook, ``search(ctx)``: ``ctx`` is a ``SearchContext`` holding the
+evaluator, the budget, the run's random generator (seeded by ``run``), the recorder, the seed
+and a progress callback. The hook proposes profiles, judges them with
+``ctx.evaluator.evaluate(profiles)``, books every one with ``ctx.recorder.record(batch,
+families, params)`` and stops when ``ctx.budget`` evaluations are booked. ``run`` builds the
+context, calls the hook and returns the result. ``bushenv/search/checks.py`` holds the contract
+as checks every ``SEARCHERS`` entry passes.
+
+The budget counts model evaluations (profiles simulated, ``BatchEvaluator.n_evaluations``), the
+same unit for every searcher; the result records how many evaluations and seconds it took to
+the first failure, the worst profile found (lowest STL robustness, see
+``bushenv/divergence.py``) and every failing profile (up to ``MAX_KEPT_FAILURES``). Given the
+seed, a run is deterministic.
 """
 
 from __future__ import annotations
 
 import time
+from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -186,28 +197,75 @@ def _check_budget(budget: int) -> int:
     return budget
 
 
-class Searcher:
-    """Base: subclasses implement ``_search(evaluator, budget, rng, recorder)``."""
+class Evaluator(Protocol):
+    """What a searcher may use of its evaluator (``bushenv.search.evaluate.BatchEvaluator``)."""
+
+    target: Any  # bushenv.search.targets.Target: families, limits, RL env
+    model: Any  # the BushingModel under attack
+    reference: Any  # the BushingModel it is judged against, or None
+    dt: float  # s
+    axis: str
+    scales: Any  # bushenv.scales.BushingScales: stroke, velocity, force floor
+    n_evaluations: int
+
+    def evaluate(self, profiles: list[np.ndarray]) -> Any: ...  # a BatchResult
+
+
+@dataclass(frozen=True)
+class SearchContext:
+    """Everything one search run gets, fixed for the run (``Searcher.search``'s argument)."""
+
+    evaluator: Evaluator
+    budget: int  # evaluations (episodes for RL agents) to book, exactly
+    rng: np.random.Generator  # seeded from (seed, searcher name): the run's only randomness
+    recorder: Recorder  # book every evaluation here
+    seed: int  # for libraries that take a seed of their own (SB3, CMA-ES)
+    progress: ProgressFn  # one line of progress; never None
+
+
+class Searcher(ABC):
+    """Base of every searcher: subclasses set ``name`` (their ``SEARCHERS`` name) and
+    implement ``search(ctx)``; callers use ``run``."""
 
     name = ""
 
+    def __init_subclass__(cls, **kwargs) -> None:
+        super().__init_subclass__(**kwargs)
+        # The hook searchers had before ``search(ctx)``: still run, through the context.
+        legacy = cls.__dict__.get("_search")
+        if legacy is not None and "search" not in cls.__dict__:
+
+            def search(self, ctx: SearchContext, _legacy=legacy) -> None:
+                c = ctx
+                _legacy(self, c.evaluator, c.budget, c.rng, c.recorder, c.seed, c.progress)
+
+            cls.search = search
+
     def run(
         self,
-        evaluator,
+        evaluator: Evaluator,
         budget: int,
         seed: int = 0,
         progress: ProgressFn | None = None,
     ) -> SearchResult:
+        """Search ``evaluator``'s model for at most ``budget`` evaluations, seeded by ``seed``."""
         budget = _check_budget(budget)
         result = SearchResult(self.name, int(seed), budget, evaluator.target.name)
         recorder = Recorder(result, evaluator)
         rng = np.random.default_rng([int(seed), _stable_id(self.name)])
-        self._search(evaluator, budget, rng, recorder, seed, progress or (lambda s: None))
+        ctx = SearchContext(evaluator, budget, rng, recorder, int(seed), progress or _silent)
+        self.search(ctx)
         result.seconds = time.perf_counter() - recorder.t0
         return result
 
-    def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
-        raise NotImplementedError
+    @abstractmethod
+    def search(self, ctx: SearchContext) -> None:
+        """Propose profiles, ``ctx.evaluator.evaluate`` them, ``ctx.recorder.record`` every
+        evaluation, stop once ``ctx.budget`` are booked; draw randomness from ``ctx.rng``."""
+
+
+def _silent(line: str) -> None:
+    pass
 
 
 def _stable_id(name: str) -> int:

@@ -27,7 +27,7 @@ from bushenv.certify import CertifyError, narx_net
 from bushenv.certify.certificate import non_passive_bands, stability_margin
 from bushenv.certify.fixed_points import fixed_points
 from bushenv.divergence import static_curve, static_margin
-from bushenv.search.base import Searcher, SearchError
+from bushenv.search.base import SearchContext, Searcher, SearchError
 
 HOLD_GRID = 81  # held displacements the certificate reads over the stroke
 SINE_AMPLITUDES_M = (0.25e-3, 0.5e-3, 1e-3, 2e-3)
@@ -68,7 +68,8 @@ class CertificateSearch(Searcher):
     def __init__(self, batch_size: int = 32) -> None:
         self.batch_size = int(batch_size)
 
-    def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
+    def search(self, ctx: SearchContext) -> None:
+        evaluator, budget, rng, recorder = ctx.evaluator, ctx.budget, ctx.rng, ctx.recorder
         target = evaluator.target
         if not {"step", "sine"} <= set(target.family_names()):
             raise SearchError(
@@ -96,7 +97,7 @@ class CertificateSearch(Searcher):
             best = sorted(best + list(zip(rob.tolist(), batch, strict=True)), key=lambda t: t[0])
             best = best[: self.batch_size]
             done += n
-            progress(f"certificate {done}/{budget} evals, best robustness {recorder.best:.3g}")
+            ctx.progress(f"certificate {done}/{budget} evals, best robustness {recorder.best:.3g}")
 
     def proposals(self, evaluator) -> list[tuple[str, np.ndarray]]:
         """(family, unit-cube point) in the order they are tried."""

@@ -20,7 +20,7 @@ for random search. Seeded (SB3's seed, one torch thread): the same episodes for 
 
 from __future__ import annotations
 
-from bushenv.search.base import Searcher, SearchError
+from bushenv.search.base import SearchContext, Searcher, SearchError
 
 # Road agents: QuarterCar-v0's full action (50 mm per 4.9 ms step, 10 m/s) on a random policy
 # throws the twin car against its bump stops within 0.1-0.3 s, after which nothing can be
@@ -72,7 +72,8 @@ class RLSearch(Searcher):
         self.n_envs = int(n_envs)
         self.episode_s = float(episode_s)
 
-    def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
+    def search(self, ctx: SearchContext) -> None:
+        evaluator, budget, recorder, seed = ctx.evaluator, ctx.budget, ctx.recorder, ctx.seed
         import torch
         from stable_baselines3 import PPO, SAC
         from stable_baselines3.common.callbacks import BaseCallback
@@ -90,7 +91,7 @@ class RLSearch(Searcher):
                 return
             state["episodes"] += min(k, room)
             recorder.record(batch, [f"agent-{self.name}"] * k, [None] * k, limit=room)
-            progress(
+            ctx.progress(
                 f"{self.name} {state['episodes']}/{budget} episodes, "
                 f"best robustness {recorder.best:.3g}"
             )

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bushenv.registry import Registry, load_entry_point
-from bushenv.search.base import Searcher, SearchError
+from bushenv.search.base import SearchContext, Searcher, SearchError
 
 
 class RandomSearch(Searcher):
@@ -36,7 +36,8 @@ class RandomSearch(Searcher):
         self.families = families
         self.batch_size = int(batch_size)
 
-    def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
+    def search(self, ctx: SearchContext) -> None:
+        evaluator, budget, rng, recorder = ctx.evaluator, ctx.budget, ctx.rng, ctx.recorder
         target = evaluator.target
         names = self.families or target.random_families()
         fams = [target.family(n) for n in names]
@@ -52,7 +53,7 @@ class RandomSearch(Searcher):
             batch = evaluator.evaluate(profiles)
             recorder.record(batch, [fams[i].name for i in picks], [u.tolist() for u in us])
             done += n
-            progress(f"random {done}/{budget} evals, best robustness {recorder.best:.3g}")
+            ctx.progress(f"random {done}/{budget} evals, best robustness {recorder.best:.3g}")
 
 
 class CMASearch(Searcher):
@@ -65,7 +66,8 @@ class CMASearch(Searcher):
         self.popsize = int(popsize)
         self.sigma0 = float(sigma0)
 
-    def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
+    def search(self, ctx: SearchContext) -> None:
+        evaluator, budget, rng, recorder = ctx.evaluator, ctx.budget, ctx.rng, ctx.recorder
         import cma
 
         fam = evaluator.target.family(self.family or evaluator.target.cma_family)
@@ -93,7 +95,7 @@ class CMASearch(Searcher):
                 if n < len(xs):
                     break
                 es.tell(xs, [float(r) for r in batch.verdict.robustness])
-                progress(
+                ctx.progress(
                     f"cma {done}/{budget} evals (restart {restart}), "
                     f"best robustness {recorder.best:.3g}"
                 )
@@ -115,6 +117,9 @@ class SearcherEntry:
     summary: str
     episodes: bool = False  # RL agents: the budget counts episodes, capped by --rl-budget
     cost: float = 1.0  # wall time per evaluation relative to a batched search (progress only)
+    # the budget the contract checks (``checks.py``) run it at: small, yet past any proposals
+    # it makes before it draws on its seed
+    check_budget: int = 13
 
     def make(self, **kwargs) -> Searcher:
         f = self.factory
@@ -129,15 +134,20 @@ SEARCHERS.add(
     SearcherEntry(
         "bushenv.search.guided:CertificateSearch",
         "steps to the holds and sines in the bands the model's certificates find weakest",
+        check_budget=64,  # its sweep (57 profiles for a model it cannot read) comes first
     ),
 )
 SEARCHERS.add(
     "ppo",
-    SearcherEntry("bushenv.search.rl:PPOSearch", "PPO agent (SB3)", episodes=True, cost=8.0),
+    SearcherEntry(
+        "bushenv.search.rl:PPOSearch", "PPO agent (SB3)", episodes=True, cost=8.0, check_budget=3
+    ),
 )
 SEARCHERS.add(
     "sac",
-    SearcherEntry("bushenv.search.rl:SACSearch", "SAC agent (SB3)", episodes=True, cost=8.0),
+    SearcherEntry(
+        "bushenv.search.rl:SACSearch", "SAC agent (SB3)", episodes=True, cost=8.0, check_budget=3
+    ),
 )
 
 

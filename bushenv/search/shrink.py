@@ -142,15 +142,21 @@ def _default_rule(row: dict) -> Callable[[dict], bool]:
     return still_fails
 
 
+def moves(x: np.ndarray, dt: float, target, limits) -> list[np.ndarray]:
+    """Every candidate one round of shrinking tries from ``x`` (the moves of the module doc),
+    each started at rest and kept within ``target``'s limits (``Target.finish``)."""
+
+    def finish(c: np.ndarray, dt: float) -> np.ndarray:
+        return target.finish(c, dt, limits)
+
+    return _candidates(x, dt, finish, limits.velocity_m_per_s * SPEED_MARGIN)
+
+
 def _simplest_failing(x, evaluator, still_fails, room: int):
     """One round: the simplest candidate simpler than ``x`` that still fails (None if none
     does), its verdict row, and whether there was any candidate to try."""
-    lim, dt = evaluator.scales, evaluator.dt
-
-    def finish(c: np.ndarray, dt: float) -> np.ndarray:
-        return evaluator.target.finish(c, dt, lim)
-
-    cands = _candidates(x, dt, finish, lim.velocity_m_per_s * SPEED_MARGIN)
+    dt = evaluator.dt
+    cands = moves(x, dt, evaluator.target, evaluator.scales)
     cands = [c for c in cands if complexity(c) < complexity(x)][:room]
     if not cands:
         return None, None, False

@@ -2,9 +2,10 @@
 
 A target owns everything env-specific a search touches: its excitation families (``FAMILIES``
 entries name their target), the batched simulation that turns a batch of profiles into a
-verdict's inputs, the vector env RL agents act in, and how a profile is kept within the env's
-limits. Searchers, the evaluator, shrinking, campaigns and the corpus ask the target; none of
-them compares env names.
+verdict's inputs, the vector env RL agents act in, the env's limits on a profile
+(``profile_bounds``) and how a profile is kept within them (``finish``). Searchers, the
+evaluator, shrinking, campaigns and the corpus ask the target; none of them compares env names.
+``bushenv/search/checks.py`` holds the contract as checks every ``TARGETS`` entry passes.
 
 | name       | profile                          | simulation                                       |
 |------------|----------------------------------|--------------------------------------------------|
@@ -74,6 +75,11 @@ class Target:
         """``x`` kept within the env's limits (a shrinking move may step outside them)."""
         return x
 
+    def profile_bounds(self, limits=MACHINE) -> tuple[float, float]:
+        """The largest |profile| (m) and |rate| (m/s) the env takes: every family's profile
+        and every shrinking move stays within them (``bushenv/search/checks.py``)."""
+        raise NotImplementedError
+
     def responses(
         self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
     ) -> Responses:
@@ -98,6 +104,9 @@ class RigTarget(Target):
 
     def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
         return ex.clip_to_limits(x, dt, limits.stroke_m, limits.velocity_m_per_s)
+
+    def profile_bounds(self, limits=MACHINE) -> tuple[float, float]:
+        return limits.stroke_m, limits.velocity_m_per_s
 
     def responses(
         self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
@@ -127,6 +136,13 @@ class QuarterCarTarget(Target):
     profile_label = "road [mm]"
     cma_family = "bump"
     default_searchers = ("random", "cma")
+
+    def profile_bounds(self, limits=MACHINE) -> tuple[float, float]:
+        """The env's road limits (its spec): height, and one road step per sample."""
+        from bushenv.rigs.specs import load_spec
+
+        kw = load_spec(self.env_id)["kwargs"]
+        return kw["max_road_height_m"], kw["max_road_step_m"] / kw["dt_s"]
 
     def responses(
         self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
