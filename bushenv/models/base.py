@@ -7,7 +7,8 @@ states) lives in ``self.state``, an array of shape (n_state, B) for B independen
 Every model implements ``_advance(x, v, out)`` on arrays of shape (T, B): it runs its compiled
 kernel over T samples, updating ``self.state`` in place. ``step`` (one sample, scalar or (B,))
 and ``simulate`` (a whole (T,) or (T, B) profile, free run from reset) both call it, so looped
-and batched results agree to the last bit.
+and batched results agree to the last bit. A model registered without shipped files also gives
+``preset(axis, dt)``: the parameters ``get_model(name)`` builds it with.
 
 Model files are ``.npz`` archives read with ``allow_pickle=False`` (loading never runs code):
 one array per parameter plus ``__meta__``, a JSON string with the registry name, the format
@@ -119,6 +120,16 @@ class BushingModel(SavedParameters):
     @property
     def params(self) -> dict[str, Any]:
         return {k: getattr(self, k) for k in self.param_names}
+
+    @classmethod
+    def preset(cls, axis: str = "axial", dt: float = PAPER_DT, **options: Any) -> BushingModel:
+        """A ready model of this kind for ``axis`` at ``dt``: what ``get_model(name)`` builds for
+        a registered model that ships no trained files (``ModelEntry.shipped``); ``options``
+        are the entry's ``reference_preset`` keywords. Kinds that ship files need none."""
+        raise ModelError(
+            f"model {cls.name or cls.__name__!r} has no preset: give it a preset(axis, dt) "
+            "classmethod or register it with shipped=True and its trained files"
+        )
 
     # ----- the protocol ------------------------------------------------------------------
     def reset(self, batch_size: int = 1) -> None:

@@ -1,28 +1,57 @@
 """Every registered model, every axis, through every check of the model contract
 (``bushenv.models.checks``): registering a model is the one step that tests it."""
 
+import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bushenv.models import AXES, MODELS, get_model, get_reference
-from bushenv.models.checks import CHECKS
+from bushenv.models.checks import CHECKS, drive
 
 ENTRIES = [(name, axis) for name in MODELS.names() for axis in AXES]
+
+
+def checked_model(name, axis="axial"):
+    # a model with a reference preset is checked as it judges (the rubber without its
+    # measurement chain's noise, whose stream is per batch)
+    if MODELS[name].reference_preset:
+        return get_reference(name, axis=axis)
+    return get_model(name, axis=axis)
 
 
 @pytest.mark.parametrize("check", sorted(CHECKS))
 @pytest.mark.parametrize(("name", "axis"), ENTRIES, ids=[f"{n}-{a}" for n, a in ENTRIES])
 def test_every_registered_model_keeps_the_contract(name, axis, check):
-    # a model with a reference preset is checked as it judges (the rubber without its
-    # measurement chain's noise, whose stream is per batch)
-    if MODELS[name].reference_preset:
-        CHECKS[check](lambda: get_reference(name, axis=axis))
-    else:
-        CHECKS[check](lambda: get_model(name, axis=axis))
+    CHECKS[check](lambda: checked_model(name, axis))
+
+
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 10_000), batch=st.integers(1, 5), name=st.sampled_from(MODELS.names()))
+def test_any_batch_equals_its_columns_run_alone(seed, batch, name):
+    m = checked_model(name)
+    x, v = drive(40, batch, seed, m.dt)
+    batched = m.simulate(x, v)
+    for b in range(batch):
+        assert np.array_equal(batched[:, b], m.simulate(x[:, b], v[:, b])), name
+
+
+def test_a_model_without_files_or_preset_is_refused_with_the_fix():
+    from bushenv.models import ModelEntry, ModelError
+    from bushenv.models.base import BushingModel
+
+    class Bare(BushingModel):
+        name = "bare"
+
+        def _advance(self, x, v, out):
+            out[:] = 0.0
+
+    with MODELS.temporarily("bare", ModelEntry(Bare, "test")):
+        with pytest.raises(ModelError, match="'bare' has no preset: give it a preset"):
+            get_model("bare")
 
 
 def test_a_model_registered_at_run_time_is_checked_too():
-    import numpy as np
-
     from bushenv.models import ModelEntry
     from bushenv.models.base import BushingModel
 
