@@ -146,13 +146,15 @@ def reproduce(
     verif_s: float,
     shipped: bool,
     progress: Progress | None = None,
+    models: tuple[str, ...] | None = None,
 ) -> dict[str, Any]:
-    """Identify (or load) every model per axis, judge it on the unseen records and the step;
-    writes ``out/report.json``, ``report.md`` and the plots; returns the report."""
+    """Identify (or load) every model per axis (``models``, default every identified one),
+    judge it on the unseen records and the step; writes ``out/report.json``, ``report.md`` and
+    the plots; returns the report."""
     import torch
 
     progress = progress or Progress(quiet=True)
-    names = identified_models()
+    names = identified_models() if models is None else tuple(models)
     progress.total = len(axes) * sum(EFFORT.get(n, 10.0) for n in names)
     _say = progress.say
     torch.manual_seed(seed)

@@ -4,6 +4,9 @@ Recorded once before the architecture refactor (``python -m tests.golden.runs --
 compared by ``tests/golden/test_golden.py`` ever since: the refactor must not change what
 ``bushenv attack``, ``bushenv reproduce``, ``bushenv diagnose`` and the corpus replay say.
 Where behaviour changes on purpose later, rerun ``--write`` and say why in the commit.
+
+Each golden names the registry entries it was recorded on (models, effects, searchers), so
+registering a new one changes no golden file.
 """
 
 from __future__ import annotations
@@ -32,6 +35,13 @@ VOLATILE = {
 }
 
 
+# The entries the goldens were recorded on; registering another must not change them.
+ATTACK_SEARCHERS = "random,cma"
+RL_SEARCHERS = "ppo,sac"
+REPRODUCE_MODELS = ("linear", "nn", "hybrid", "boucwen")
+DIAGNOSE_EFFECTS = ("relaxation", "friction", "hardening", "thermal", "delay", "inertia")
+
+
 def strip(obj: Any) -> Any:
     """``obj`` without volatile keys (timings, paths), recursively."""
     if isinstance(obj, dict):
@@ -56,42 +66,38 @@ def _attack(out: Path, name: str, extra: list[str]) -> dict[str, Any]:
 
 def attack_run(out: Path) -> dict[str, Any]:
     """A short default-like attack: random and CMA-ES on the NN, the hybrid and the control."""
-    extra = ["--budget", "48", "--searchers", "random,cma", "--max-shrink", "1"]
+    extra = ["--budget", "48", "--searchers", ATTACK_SEARCHERS, "--max-shrink", "1"]
     return _attack(out, "attack", extra + ["--shrink-budget", "40"])
 
 
 def attack_rl_run(out: Path) -> dict[str, Any]:
     """PPO and SAC through the vector env, a few episodes each."""
-    extra = ["--budget", "12", "--rl-budget", "12", "--searchers", "ppo,sac"]
+    extra = ["--budget", "12", "--rl-budget", "12", "--searchers", RL_SEARCHERS]
     return _attack(out, "attack_rl", extra + ["--max-shrink", "1", "--shrink-budget", "20"])
 
 
 def attack_road_run(out: Path) -> dict[str, Any]:
     """Road searches through the batched quarter car."""
-    extra = ["--env", "quartercar", "--budget", "16", "--searchers", "random,cma"]
+    extra = ["--env", "quartercar", "--budget", "16", "--searchers", ATTACK_SEARCHERS]
     return _attack(out, "attack_road", extra + ["--max-shrink", "1", "--shrink-budget", "20"])
 
 
 def reproduce_run(out: Path) -> dict[str, Any]:
     """``bushenv reproduce`` on the shipped models (radial), short records."""
-    from bushenv.cli import main
+    from bushenv.progress import Progress
+    from bushenv.reproduce import reproduce
 
-    code = main(
-        [
-            "reproduce",
-            "--out",
-            str(out / "reproduce"),
-            "--axes",
-            "radial",
-            "--shipped",
-            "--identification-s",
-            "6.44",
-            "--verification-s",
-            "6.44",
-        ]
+    (out / "reproduce").mkdir(parents=True)
+    reproduce(
+        out / "reproduce",
+        ["radial"],
+        seed=0,
+        ident_s=6.44,
+        verif_s=6.44,
+        shipped=True,
+        progress=Progress(quiet=True),
+        models=REPRODUCE_MODELS,
     )
-    if code != 0:
-        raise RuntimeError(f"reproduce exited {code}")
     return strip(json.loads((out / "reproduce" / "report.json").read_text()))
 
 
@@ -106,7 +112,10 @@ def diagnose_run(out: Path) -> dict[str, Any]:
     for seed, name in ((1, "train"), (2, "test")):
         rec = random_test(RubberBushing.preset("axial", seed=seed), 1.0, duration_s=20.0, seed=seed)
         paths.append(str(save_csv(rec, out / f"{name}.csv")))
-    code = main(["diagnose", *paths, "--out", str(out / "diagnose"), "--quiet"])
+    effects = ",".join(DIAGNOSE_EFFECTS)
+    code = main(
+        ["diagnose", *paths, "--effects", effects, "--out", str(out / "diagnose"), "--quiet"]
+    )
     if code != 0:
         raise RuntimeError(f"diagnose exited {code}")
     return strip(json.loads((out / "diagnose" / "report.json").read_text()))
