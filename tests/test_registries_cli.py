@@ -30,7 +30,7 @@ class Steps(RandomSearch):
 
 def test_the_docs_page_is_what_the_registries_hold():
     assert DOCS.read_text() == markdown(), (
-        "rerun: python -m bushenv.registries > docs/registries.md"
+        "rerun: python scripts/gen_docs.py"
     )
 
 
