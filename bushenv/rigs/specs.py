@@ -4,13 +4,18 @@ Shipped in the wheel as the resource package ``bushenv.envs``; in a source check
 ``envs/`` beside the package. A spec's top level mirrors Gymnasium's ``EnvSpec`` (``id``,
 ``entry_point``, ``vector_entry_point``, ``max_episode_steps``); ``[kwargs]`` holds every
 default an environment takes, and the constructors refuse keys it does not name.
+
+A spec is parsed once per id and kept frozen (``_frozen_spec``); every caller gets its own
+plain copy, so an env that edits its kwargs cannot change the next one's.
 """
 
 from __future__ import annotations
 
 import tomllib
+from functools import cache
 from importlib import resources
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -72,12 +77,39 @@ def read_spec(source: Any) -> dict[str, Any]:
     return spec
 
 
-def load_spec(env_id: str) -> dict[str, Any]:
-    """The parsed spec of ``env_id`` (e.g. ``"BushRig-v0"``)."""
+def _freeze(value: Any) -> Any:
+    if isinstance(value, dict):
+        return MappingProxyType({k: _freeze(v) for k, v in value.items()})
+    if isinstance(value, list):
+        return tuple(_freeze(v) for v in value)
+    return value
+
+
+def _thaw(value: Any) -> Any:
+    if isinstance(value, MappingProxyType):
+        return {k: _thaw(v) for k, v in value.items()}
+    if isinstance(value, tuple):
+        return [_thaw(v) for v in value]
+    return value
+
+
+@cache
+def _frozen_spec(env_id: str) -> MappingProxyType:
+    """The spec of ``env_id``, parsed on first use and kept read-only."""
     for f in spec_files():
         if f.name == f"{env_id}.toml":
-            return read_spec(f)
+            return _freeze(read_spec(f))
     raise RigError(f"no spec file {env_id}.toml in {spec_directory()}")
+
+
+def load_spec(env_id: str) -> dict[str, Any]:
+    """The parsed spec of ``env_id`` (e.g. ``"BushRig-v0"``): a fresh plain copy of the one
+    parse per id (``clear_spec_cache`` forgets them, for specs edited while running)."""
+    return _thaw(_frozen_spec(env_id))
+
+
+def clear_spec_cache() -> None:
+    _frozen_spec.cache_clear()
 
 
 def spec_kwargs(env_id: str, overrides: dict[str, Any]) -> dict[str, Any]:

@@ -176,3 +176,31 @@ def test_built_wheel_contains_the_env_specs(tmp_path):
     for env_id in SPEC_IDS:
         assert f"bushenv/envs/{env_id}.toml" in names
     assert "bushenv/rigs/registration.py" in names
+
+
+def test_a_spec_is_parsed_once_per_id_however_many_envs_are_made(monkeypatch):
+    from bushenv.rigs import specs
+
+    parsed = []
+
+    def counting(source):
+        parsed.append(source.name)
+        return read_spec(source)
+
+    monkeypatch.setattr(specs, "read_spec", counting)
+    specs.clear_spec_cache()
+    for _ in range(3):
+        gym.make("BushRig-v0", model="linear").close()
+        gym.make("bushenv/BushRig-v0", model="linear", physics_substeps=4).close()
+    gym.make("QuarterCar-v0").close()
+    assert sorted(parsed) == ["BushRig-v0.toml", "QuarterCar-v0.toml"]
+
+
+def test_an_env_editing_its_kwargs_leaves_the_next_ones_spec_alone():
+    from bushenv.rigs.specs import load_spec, spec_kwargs
+
+    kw = spec_kwargs("QuarterCar-v0", {})
+    kw["model"] = "edited"
+    load_spec("QuarterCar-v0")["kwargs"]["reference"] = "edited"
+    again = load_spec("QuarterCar-v0")["kwargs"]
+    assert again["model"] == "linear" and again["reference"] == "rubber"
