@@ -29,9 +29,7 @@ class Steps(RandomSearch):
 
 
 def test_the_docs_page_is_what_the_registries_hold():
-    assert DOCS.read_text() == markdown(), (
-        "rerun: python scripts/gen_docs.py"
-    )
+    assert DOCS.read_text() == markdown(), "rerun: python scripts/gen_docs.py"
 
 
 def test_a_searcher_and_a_model_registered_at_run_time_are_accepted_by_attack(tmp_path, capsys):
