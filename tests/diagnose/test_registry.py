@@ -29,11 +29,11 @@ class Hum(Effect):
         t = np.arange(s.x.size) * s.dt
         return np.stack([np.sin(2 * np.pi * HUM_HZ * t), np.cos(2 * np.pi * HUM_HZ * t)], axis=1)
 
-    def columns_count(self, shape, scales):
-        return 2
-
     def lower(self, shape, scales):
         return np.full(2, -np.inf)
+
+    def example(self, scales, k_n_per_m):
+        return None, np.array([0.1 * k_n_per_m * scales.sigma_x, 0.0])
 
 
 def hum_record(seed, name=""):
