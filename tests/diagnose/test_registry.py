@@ -77,9 +77,17 @@ def test_an_unknown_effect_on_the_command_line_names_the_known_ones(tmp_path, ca
     code = None
     with pytest.raises(SystemExit) as exc:
         main(
-            ["diagnose", str(train), str(train), "--out", str(tmp_path / "o"), "--effects", "creep"]
+            [
+                "diagnose",
+                str(train),
+                str(train),
+                "--out",
+                str(tmp_path / "o"),
+                "--effects",
+                "nosuch",
+            ]
         )
     code = exc.value.code
     assert code == 2
     err = capsys.readouterr().err
-    assert "creep" in err and ", ".join(candidates.effect_names()) in err
+    assert "nosuch" in err and ", ".join(candidates.effect_names()) in err
