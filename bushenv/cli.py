@@ -23,8 +23,11 @@ COMMANDS = {
     "attack": ("bushenv.commands.attack", "adversarial campaign: excitations that break a model"),
     "campaign": ("bushenv.commands.campaign", "campaign matrix: models x axes x searchers x seeds"),
     "replay": ("bushenv.commands.replay", "replay a regression corpus; name every changed verdict"),
-    "diagnose": ("bushenv.diagnose.report", "sim-to-real gap: where, which effect, how far"),
-    "diagnose-validate": ("bushenv.diagnose.validate", "blind validation of the gap diagnosis"),
+    "diagnose": ("bushenv.commands.diagnose", "sim-to-real gap: where, which effect, how far"),
+    "diagnose-validate": (
+        "bushenv.commands.diagnose_validate",
+        "blind validation of the gap diagnosis",
+    ),
     "measure": ("bushenv.commands.measure", "run a test programme on a model; write CSV records"),
     "fit": ("bushenv.commands.fit", "identify a model from measured records, with a card"),
     "import-nn": ("bushenv.commands.import_nn", "a torch NARX network to a model file"),

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -58,6 +59,22 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
 def save_figure(fig: Any, path: str | os.PathLike, dpi: int = 110) -> Path:
     """Write a matplotlib figure as PNG, atomically (a reader never sees half a picture)."""
     return atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=dpi))
+
+
+def write_figure(fig: Any, path: str | os.PathLike, dpi: int = 110) -> Path:
+    """``save_figure``, then close the figure (a report draws dozens; pyplot keeps them all)."""
+    try:
+        return save_figure(fig, path, dpi)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+
+
+def copy_file(source: str | os.PathLike, path: str | os.PathLike) -> Path:
+    """A copy of ``source`` at ``path``, written atomically."""
+    with open(source, "rb") as src:
+        return atomic_write(path, lambda fh: shutil.copyfileobj(src, fh))
 
 
 def json_default(o: Any) -> Any:

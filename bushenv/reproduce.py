@@ -40,7 +40,7 @@ import numpy as np
 
 from bushenv import metrics
 from bushenv.models import AXES, MODELS, get_model
-from bushenv.persist import json_text, write_text
+from bushenv.persist import json_text, write_figure, write_text
 from bushenv.progress import Progress
 
 # Identification time relative to the linear least squares, for the time-left estimate only.
@@ -252,8 +252,7 @@ def _plot(out: Path, plots: dict[str, Any]) -> list[str]:
         ax[1].legend(ncol=5, fontsize=8)
         fig.suptitle(f"{axis}: unseen n = 1.5 record (first 5 s)")
         names.append(f"{axis}_force_vs_time.png")
-        fig.savefig(out / names[-1], dpi=110)
-        plt.close(fig)
+        write_figure(fig, out / names[-1], dpi=110)
 
         fig, axs = plt.subplots(1, len(models), figsize=(14, 3.6), sharey=True, squeeze=False)
         axs = axs[0]
@@ -267,8 +266,7 @@ def _plot(out: Path, plots: dict[str, Any]) -> list[str]:
         fig.suptitle(f"{axis}: force-displacement loops, n = 1.5")
         names.append(f"{axis}_loops.png")
         fig.tight_layout()
-        fig.savefig(out / names[-1], dpi=110)
-        plt.close(fig)
+        write_figure(fig, out / names[-1], dpi=110)
 
         ts = np.arange(len(step["reference"])) * test.dt
         fig, ax = plt.subplots(figsize=(10, 4))
@@ -280,8 +278,7 @@ def _plot(out: Path, plots: dict[str, Any]) -> list[str]:
         ax.set_title(f"{axis}: 4 mm step at 1 s, held 10 s (seed 000 Fig. 14)")
         ax.legend(ncol=5, fontsize=8)
         names.append(f"{axis}_step.png")
-        fig.savefig(out / names[-1], dpi=110)
-        plt.close(fig)
+        write_figure(fig, out / names[-1], dpi=110)
     return names
 
 

@@ -1,7 +1,10 @@
 """The registry of candidate effects: the one list the diagnosis, the CLI and the docs use.
 
 A new candidate = one ``Effect`` subclass (in ``effects/``) + one line in ``EFFECTS``. The
-diagnosis tries every registered effect alone and every pair of them, composed with ``+``
+registry takes an effect under the name its class declares and only when the class keeps
+what can be told of the contract without data (``effects.base.contract_problem``); the rest
+is ``bushenv.diagnose.checks``, run over every entry by the tests. The diagnosis tries every
+registered effect alone and every pair of them, composed with ``+``
 (``Relaxation() + Friction()``); ``bushenv diagnose --effects`` chooses among the names, and
 the effects table of docs/diagnose.md is ``effects_table()``.
 """
@@ -11,7 +14,7 @@ from __future__ import annotations
 from itertools import combinations
 
 from bushenv.diagnose.effects.backbone import Hardening
-from bushenv.diagnose.effects.base import NULL, Combination, Effect
+from bushenv.diagnose.effects.base import NULL, Combination, Effect, contract_problem
 from bushenv.diagnose.effects.delay import Delay
 from bushenv.diagnose.effects.friction import Friction
 from bushenv.diagnose.effects.inertia import Inertia
@@ -25,7 +28,21 @@ class UnknownEffectError(BadInput):
     """An effect name that is not in the registry; the message lists the known names."""
 
 
-EFFECTS: Registry[type[Effect]] = Registry("candidate effect", UnknownEffectError)
+class EffectContractError(TypeError):
+    """An effect class that cannot be registered as given (a bug in the effect, not input)."""
+
+
+class EffectRegistry(Registry[type[Effect]]):
+    """``Registry`` that refuses an effect breaking its contract, or under another name."""
+
+    def add(self, name: str, entry: type[Effect], *, replace: bool = False) -> type[Effect]:
+        problem = contract_problem(name, entry)
+        if problem:
+            raise EffectContractError(problem)
+        return super().add(name, entry, replace=replace)
+
+
+EFFECTS = EffectRegistry("candidate effect", UnknownEffectError)
 for _cls in (Relaxation, Friction, Hardening, Thermal, Delay, Inertia):
     EFFECTS.add(_cls.name, _cls)
 

@@ -3,7 +3,7 @@ records made ready for fitting (smoothed displacement, derivatives, baseline for
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -14,10 +14,10 @@ from bushenv.diagnose.effects.base import STENCILS, Signals
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fitting import Fold
 from bushenv.models.base import DT_TOLERANCE
+from bushenv.progress import Progress  # any callable of a line will do; fit.py types with it
 
 MIN_SAMPLES = 64
 LINEAR = "linear"
-Progress = Callable[[str], None]
 
 
 def baseline_names() -> list[str]:

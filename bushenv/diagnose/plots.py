@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.diagnose.regimes import residual_spectrum
+from bushenv.persist import write_figure
 
 MAX_POINTS = 3000  # points per curve drawn (records are decimated for the figure only)
 
@@ -24,8 +25,7 @@ def _plt():
 
 def _save(fig, out: Path, name: str, names: list[str]) -> None:
     fig.tight_layout()
-    fig.savefig(out / name, dpi=100)
-    _plt().close(fig)
+    write_figure(fig, out / name, dpi=100)
     names.append(name)
 
 

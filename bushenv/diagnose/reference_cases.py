@@ -22,7 +22,9 @@ a TRAIN record and two TEST records.
 
 The case mix: three cases in four are single-class (cycling through ``none`` and the effects
 that have a draw here), one in four a random pair. ``DRAWS`` holds one parameter draw per
-effect, keyed by the reference's effect names (``bushenv.reference.rubber.REFERENCE_EFFECTS``).
+effect, keyed by the candidates' names (declared on their classes); each draw sets the
+parameters of the reference's effect of that name (``bushenv.reference.rubber.REFERENCE_EFFECTS``,
+the specimen's own list: a test holds the two together).
 """
 
 from __future__ import annotations
@@ -34,6 +36,12 @@ from typing import Any
 import numpy as np
 
 from bushenv.diagnose.candidates import effect_names
+from bushenv.diagnose.effects.backbone import Hardening
+from bushenv.diagnose.effects.delay import Delay
+from bushenv.diagnose.effects.friction import Friction
+from bushenv.diagnose.effects.inertia import Inertia
+from bushenv.diagnose.effects.relaxation import Relaxation
+from bushenv.diagnose.effects.thermal import Thermal
 
 RATES_HZ = (204.8, 512.0, 1024.0)
 
@@ -120,12 +128,12 @@ def _thermal(d: Draw) -> dict[str, Any]:
 
 # One draw per effect, in the order the draws consume random numbers.
 DRAWS: dict[str, Callable[[Draw], dict[str, Any]]] = {
-    "relaxation": _relaxation,
-    "friction": _friction,
-    "hardening": _hardening,
-    "delay": _delay,
-    "inertia": _inertia,
-    "thermal": _thermal,
+    Relaxation.name: _relaxation,
+    Friction.name: _friction,
+    Hardening.name: _hardening,
+    Delay.name: _delay,
+    Inertia.name: _inertia,
+    Thermal.name: _thermal,
 }
 
 

@@ -28,7 +28,7 @@ linear baseline a bench engineer would identify from the measured TRAIN record.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -38,6 +38,7 @@ import bushenv  # noqa: F401  (registers the envs)
 from bushenv.diagnose.fit import DiagnoseError, diagnose
 from bushenv.metrics import rms_ratio
 from bushenv.models.linear import LinearBushing
+from bushenv.progress import Progress
 from bushenv.records import Record
 
 RIG_IDS = ("BushRig-v0", "QuarterCar-v0")
@@ -62,8 +63,6 @@ QUARTERCAR_CHANNELS: dict[str, tuple[str, str]] = {
 }
 DERIVED = "chassis_acceleration_m_per_s2"  # gradient of chassis_vy_m_per_s
 BUSHRIG_CHANNELS: dict[str, tuple[str, str]] = {"force": ("force_model_n", "force_reference_n")}
-
-Progress = Callable[[str], None]
 
 
 class RigDiagnoseError(DiagnoseError):

@@ -1,7 +1,8 @@
 """Specimens for the widened validation: each effect in forms the candidates do not assume.
 
 The diagnosis must not win by knowing how its test data were made, so this module shares no
-code with ``candidates.py`` nor with ``bushenv.reference``. Every form maps a fine-grid motion
+forms with the candidates nor with ``bushenv.reference``; it reads only their names (declared
+on the effect classes) from them. Every form maps a fine-grid motion
 (``x``, ``v``, ``a``: (T,) arrays in m, m/s, m/s^2, sample time ``dt`` s) to the force it adds
 (N). Records are simulated on a grid 4-8 times finer than the one they are sampled at, so the
 specimen is a continuous-time system seen through a sampler, as on a test machine.
@@ -23,7 +24,12 @@ import numba as nb
 import numpy as np
 from scipy import signal
 
-from bushenv.diagnose.effects.friction import amplitude_envelope
+from bushenv.diagnose.effects.backbone import Hardening
+from bushenv.diagnose.effects.delay import Delay
+from bushenv.diagnose.effects.friction import Friction, amplitude_envelope
+from bushenv.diagnose.effects.inertia import Inertia
+from bushenv.diagnose.effects.relaxation import Relaxation
+from bushenv.diagnose.effects.thermal import Thermal
 
 Params = dict[str, Any]
 
@@ -211,7 +217,7 @@ def _draw_hardening(form: str, rng, x_peak: float) -> Params:
 def hardening_is_monotone(p: Params, form: str, k: float, x_peak: float) -> bool:
     """Tangent of k x + the form's force stays > 0 within 2 x_peak (checked on a grid)."""
     xs = np.linspace(-2 * x_peak, 2 * x_peak, 4001)
-    f = k * xs + form_force("hardening", form, p, xs, None, None, 1.0)
+    f = k * xs + form_force(Hardening.name, form, p, xs, None, None, 1.0)
     return bool(np.all(np.diff(f) > 0))
 
 
@@ -286,7 +292,7 @@ class TruthEffect:
 
 
 TRUTH_EFFECTS: dict[str, TruthEffect] = {
-    "relaxation": TruthEffect(
+    Relaxation.name: TruthEffect(
         "specimen",
         {
             "power_law": _relax_power_law,
@@ -296,7 +302,7 @@ TRUTH_EFFECTS: dict[str, TruthEffect] = {
         },
         lambda f, rng, sc: _draw_relaxation(f, rng, sc.x_peak, sc.quasi_static),
     ),
-    "friction": TruthEffect(
+    Friction.name: TruthEffect(
         "specimen",
         {
             "bouc_wen": _fric_bouc_wen,
@@ -306,7 +312,7 @@ TRUTH_EFFECTS: dict[str, TruthEffect] = {
         },
         lambda f, rng, sc: _draw_friction(f, rng, sc.x_peak, sc.v_rms),
     ),
-    "hardening": TruthEffect(
+    Hardening.name: TruthEffect(
         "specimen",
         {
             "poly_asym": _hard_poly_asym,
@@ -317,15 +323,15 @@ TRUTH_EFFECTS: dict[str, TruthEffect] = {
         },
         lambda f, rng, sc: _draw_hardening(f, rng, sc.x_peak),
     ),
-    "thermal": TruthEffect(
+    Thermal.name: TruthEffect(
         "thermal", {"power_heating": None}, lambda f, rng, sc: _draw_thermal(f, rng)
     ),
-    "delay": TruthEffect(
+    Delay.name: TruthEffect(
         "channel",
         {"pure": None, "bessel": None},
         lambda f, rng, sc: _draw_delay(f, rng, sc.band_hz),
     ),
-    "inertia": TruthEffect(
+    Inertia.name: TruthEffect(
         "cell",
         {"rigid": None, "compliant_cell": None},
         lambda f, rng, sc: _draw_inertia(f, rng, sc.band_hz),

@@ -1,6 +1,5 @@
-"""``bushenv diagnose-validate``: blind validation of the gap diagnosis.
-
-    bushenv diagnose-validate --set reference|widened --cases N --seed S --out DIR
+"""Blind validation of the gap diagnosis (``bushenv diagnose-validate``,
+``bushenv/commands/diagnose_validate.py``, gives a ``ValidationConfig``).
 
 Each case (``SETS``) draws, from ``(seed, case index)``, a specimen with a hidden label --
 ``none``, one effect or two -- and records; the records alone go to ``diagnose`` (linear
@@ -22,11 +21,10 @@ rates and noise the candidates do not assume (``widened_cases.py``).
 
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -36,14 +34,44 @@ from bushenv.diagnose.candidates import effect_names
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import diagnose
 from bushenv.diagnose.reference_cases import Case, make_case
+from bushenv.diagnose.report import check_out_dir
 from bushenv.diagnose.rule import AMBIGUOUS, OUTSIDE
 from bushenv.diagnose.widened_cases import make_widened_case
+from bushenv.persist import write_text
+from bushenv.progress import Progress, ProgressSpec
 
 SETS: dict[str, Callable[[int, int], Case]] = {
     "reference": make_case,
     "widened": make_widened_case,
 }
-EXAMPLE = "bushenv diagnose-validate --set widened --cases 60 --seed 0 --out validation/"
+
+
+@dataclass(frozen=True)
+class ValidationConfig:
+    """A validation run: ``cases`` cases of ``case_set`` from index ``start``, drawn from
+    ``seed``, written to ``out`` (refused if it exists, unless ``force``)."""
+
+    out: Path
+    case_set: str = "reference"
+    cases: int = 70
+    seed: int = 0
+    start: int = 0
+    force: bool = False
+
+    def checked(self) -> ValidationConfig:
+        if self.cases < 1:
+            raise DiagnoseError(f"--cases must be >= 1, got {self.cases}")
+        if self.case_set not in SETS:
+            raise DiagnoseError(f"unknown case set {self.case_set!r}; known: {', '.join(SETS)}")
+        return self
+
+    @property
+    def command(self) -> str:
+        """The command line that repeats this run."""
+        return (
+            f"bushenv diagnose-validate --set {self.case_set} --cases {self.cases} "
+            f"--seed {self.seed} --start {self.start} --out {self.out}"
+        )
 
 
 def recomputed_shrink(result: dict[str, Any]) -> float:
@@ -132,13 +160,18 @@ def confusion_table(summary: dict[str, Any]) -> str:
 
 
 def run_validation(
-    n_cases: int, seed: int, progress=None, start: int = 0, case_set: str = "reference"
+    n_cases: int,
+    seed: int,
+    progress: ProgressSpec = False,
+    start: int = 0,
+    case_set: str = "reference",
 ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """Draw, diagnose and judge ``n_cases`` cases; returns per-case rows and the summary."""
-    say = progress or (lambda msg: None)
+    """Draw, diagnose and judge ``n_cases`` cases; returns per-case rows and the summary.
+
+    ``progress``: a line per case on stderr (True), none (False), or to a callable."""
+    say = Progress.of(progress, total=n_cases)
     make = SETS[case_set]
     rows: list[dict[str, Any]] = []
-    t_start = time.monotonic()
     for i in range(start, start + n_cases):
         t0 = time.monotonic()
         case = make(seed, i)
@@ -148,11 +181,12 @@ def run_validation(
         row["seconds"] = round(time.monotonic() - t0, 2)
         rows.append(row)
         done = i + 1 - start
-        left = (time.monotonic() - t_start) / done * (n_cases - done)
-        say(
+        say.update(
+            done,
             f"case {done}/{n_cases}: label {row['label']:<22} named {row['named']:<22} "
             f"{'right' if row['right'] else 'WRONG'}  shrink {100 * row['shrink']:5.1f} %  "
-            f"({row['seconds']:.1f} s; about {left:.0f} s left)"
+            f"({row['seconds']:.1f} s)",
+            force=True,
         )
     return rows, summarise(rows)
 
@@ -186,45 +220,18 @@ def report_text(summary: dict[str, Any], seed: int, case_set: str) -> str:
     )
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--set",
-        dest="case_set",
-        default="reference",
-        choices=list(SETS),
-        help="reference: the forms the candidates assume; widened: other forms, strengths, "
-        "rates and noise (docs/diagnose.md)",
+def write_validation(config: ValidationConfig, progress: ProgressSpec = False) -> str:
+    """Run ``config``; write ``validation.json`` and ``validation.md`` under ``config.out``;
+    returns the report's text."""
+    config = config.checked()
+    out = Path(config.out)
+    check_out_dir(out, config.force)
+    rows, summary = run_validation(
+        config.cases, config.seed, progress, config.start, config.case_set
     )
-    parser.add_argument("--cases", type=int, default=70, help="number of blind cases")
-    parser.add_argument("--seed", type=int, default=0, help="validation seed")
-    parser.add_argument("--start", type=int, default=0, help="first case index")
-    parser.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    parser.add_argument("--force", action="store_true", help="write into an existing DIR")
-    parser.add_argument("--quiet", action="store_true", help="no progress lines")
-
-
-def run(args: argparse.Namespace) -> int:
-    from bushenv.diagnose.report import atomic_write, check_out_dir
-
-    if args.cases < 1:
-        raise DiagnoseError(f"--cases must be >= 1, got {args.cases}")
-    out = Path(args.out)
-    check_out_dir(out, args.force)
-    start = time.monotonic()
-
-    def progress(msg: str) -> None:
-        if not args.quiet:
-            print(f"[{time.monotonic() - start:7.1f} s] {msg}", file=sys.stderr, flush=True)
-
-    rows, summary = run_validation(args.cases, args.seed, progress, args.start, args.case_set)
     out.mkdir(parents=True, exist_ok=True)
-    text = report_text(summary, args.seed, args.case_set)
-    command = (
-        f"bushenv diagnose-validate --set {args.case_set} --cases {args.cases} "
-        f"--seed {args.seed} --start {args.start} --out {out}"
-    )
-    data = {"command": command, "summary": summary, "cases": rows}
-    atomic_write(out / "validation.json", json.dumps(data, indent=2, default=str) + "\n")
-    atomic_write(out / "validation.md", f"`{command}`\n\n{text}")
-    print(text)
-    return 0
+    text = report_text(summary, config.seed, config.case_set)
+    data = {"command": config.command, "summary": summary, "cases": rows}
+    write_text(out / "validation.json", json.dumps(data, indent=2, default=str) + "\n")
+    write_text(out / "validation.md", f"`{config.command}`\n\n{text}")
+    return text

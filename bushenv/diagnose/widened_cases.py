@@ -21,6 +21,12 @@ from typing import Any
 import numpy as np
 
 from bushenv.diagnose import truth_forms as tf
+from bushenv.diagnose.effects.backbone import Hardening
+from bushenv.diagnose.effects.delay import Delay
+from bushenv.diagnose.effects.friction import Friction
+from bushenv.diagnose.effects.inertia import Inertia
+from bushenv.diagnose.effects.relaxation import Relaxation
+from bushenv.diagnose.effects.thermal import Thermal
 from bushenv.diagnose.reference_cases import Case
 from bushenv.diagnose.widened_programmes import (
     bushing_programmes,
@@ -60,23 +66,23 @@ class Specimen:
             if tf.TRUTH_EFFECTS[name].stage != "specimen":
                 continue
             f = tf.form_force(name, form, p, x, v, a, dt)
-            if name == "hardening":
+            if name == Hardening.name:
                 elastic = elastic + f
             else:
                 extra = extra + f
         viscous = self.c_ns_per_m * v
-        if "thermal" in self.effects:
-            p = self.effects["thermal"][1]
+        if Thermal.name in self.effects:
+            p = self.effects[Thermal.name][1]
             power = self.c_ns_per_m * v * v + np.abs(extra * v)
             fac = tf.thermal_factor(p, power, dt)
             out = fac * (elastic + extra) + fac ** p["viscous_ratio"] * viscous
         else:
             out = elastic + extra + viscous
-        if "inertia" in self.effects:
-            form, p = self.effects["inertia"]
+        if Inertia.name in self.effects:
+            form, p = self.effects[Inertia.name]
             out = out + tf.inertia_force(a, p, dt, form)
-        if "delay" in self.effects:
-            form, p = self.effects["delay"]
+        if Delay.name in self.effects:
+            form, p = self.effects[Delay.name]
             out = tf.delayed(out, p, dt, form)
         return out
 
@@ -103,11 +109,11 @@ def visible_gap(forces: list[np.ndarray], progs: list[Programme], judged: list[b
 
 def _initial_scale(name: str, k: float, x_peak: float, band_hz: float) -> float:
     return {
-        "relaxation": k,
-        "friction": 0.1 * k * x_peak,
-        "hardening": k,
-        "thermal": 1e-3,
-        "inertia": 0.1 * k / (2 * np.pi * band_hz) ** 2,
+        Relaxation.name: k,
+        Friction.name: 0.1 * k * x_peak,
+        Hardening.name: k,
+        Thermal.name: 1e-3,
+        Inertia.name: 0.1 * k / (2 * np.pi * band_hz) ** 2,
     }.get(name, 1.0)
 
 
@@ -122,15 +128,15 @@ def calibrate(
     """
     alone = Specimen(specimen.k_n_per_m, specimen.c_ns_per_m, {name: specimen.effects[name]})
     form, p = specimen.effects[name]
-    key = "delay_s" if name == "delay" else "scale"
+    key = "delay_s" if name == Delay.name else "scale"
     for _ in range(3):
         gap = visible_gap(_sampled(alone, progs), progs, [True] * len(progs))
         if gap <= 0:
             return gap
         p[key] *= target / gap
-        if name == "delay":  # a lag of 0.1 ms up to the form's limit, whatever the target asks
+        if name == Delay.name:  # a lag of 0.1 ms up to the form's limit, whatever the target asks
             p[key] = float(np.clip(p[key], 1e-4, p["max_delay_s"]))
-    if name == "thermal":  # a specimen that loses more than MAX_THERMAL_DROP is not a bushing
+    if name == Thermal.name:  # a specimen that loses more than MAX_THERMAL_DROP is not a bushing
         power = [specimen.c_ns_per_m * np.gradient(x, dt) ** 2 for x, dt in progs]
         low = min(
             float(np.min(tf.thermal_factor(p, pw, dt)))
@@ -138,7 +144,7 @@ def calibrate(
         )
         if low < 1.0 - MAX_THERMAL_DROP:
             p["scale"] *= np.log(1.0 - MAX_THERMAL_DROP) / np.log(low)
-    if name == "hardening":
+    if name == Hardening.name:
         x_peak = max(float(np.max(np.abs(x))) for x, _ in progs)
         while not tf.hardening_is_monotone(p, form, specimen.k_n_per_m, x_peak):
             p["scale"] *= 0.7
@@ -169,10 +175,9 @@ def case_label_widened(index: int, rng) -> tuple[tuple[str, ...], bool]:
     and three in ten are pairs of any two effects."""
     effects = tuple(tf.TRUTH_EFFECTS)
     if index % 5 == 4:
-        qs = ("relaxation", "none", "hardening", "relaxation+hardening", "friction")
-        qs += ("relaxation+friction",)
-        pick = qs[(index // 5) % len(qs)]
-        return (() if pick == "none" else tuple(pick.split("+"))), True
+        relax, hard, fric = Relaxation.name, Hardening.name, Friction.name
+        qs = ((relax,), (), (hard,), (relax, hard), (fric,), (relax, fric))
+        return qs[(index // 5) % len(qs)], True
     j = index - (index + 1) // 5  # dynamic cases before this one
     if j % 10 >= 7:
         pair = rng.choice(len(effects), size=2, replace=False)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv.divergence import cumulative_work
-from bushenv.persist import load_profiles
+from bushenv.persist import load_profiles, write_figure
 from bushenv.search.corpus import load_case
 
 REF_COLOUR, MODEL_COLOUR, FAIL_COLOUR = "tab:blue", "tab:red", "tab:purple"
@@ -89,8 +89,7 @@ def plot_worst(campaign, plt, plot_dir) -> list[str]:
             a.set_xlabel("time [s]")
         fig.tight_layout()
         names.append(f"worst-{key}.png")
-        fig.savefig(plot_dir / names[-1], dpi=90)
-        plt.close(fig)
+        write_figure(fig, plot_dir / names[-1], dpi=90)
     return names
 
 
@@ -115,8 +114,7 @@ def plot_shrunk(campaign, plt, plot_dir) -> list[str]:
             a.set_xlabel("time [s]")
         fig.tight_layout()
         names.append(f"shrunk-{i}.png")
-        fig.savefig(plot_dir / names[-1], dpi=90)
-        plt.close(fig)
+        write_figure(fig, plot_dir / names[-1], dpi=90)
     return names
 
 

@@ -21,11 +21,11 @@ and the replay says so.
 from __future__ import annotations
 
 import os
-import shutil
 from pathlib import Path
 
 from bushenv.errors import BadInput
 from bushenv.models import MODELS, file_hash
+from bushenv.persist import copy_file
 
 KEPT_DIR = "models"
 
@@ -48,21 +48,10 @@ def keep(source: Path, directory: Path, sha: str) -> dict[str, str]:
     kept = directory / KEPT_DIR / sha[:16] / source.name
     for src, dst in zip((source, *card_paths(source)), (kept, *card_paths(kept)), strict=True):
         if src.is_file() and not dst.is_file():
-            _copy(src, dst)
+            copy_file(src, dst)
     if file_hash(kept) != sha:  # a half-copied or altered earlier copy: never trust it silently
-        _copy(source, kept)
+        copy_file(source, kept)
     return {"source": _relative(source, directory), "kept": kept.relative_to(directory).as_posix()}
-
-
-def _copy(src: Path, dst: Path) -> None:
-    """Copy atomically (temp file in the target folder, then rename)."""
-    dst.parent.mkdir(parents=True, exist_ok=True)
-    tmp = dst.with_name(f".{dst.name}.{os.getpid()}.tmp")
-    try:
-        shutil.copyfile(src, tmp)
-        os.replace(tmp, dst)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 def _relative(path: Path, directory: Path) -> str:

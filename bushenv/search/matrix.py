@@ -30,7 +30,7 @@ import numpy as np
 from bushenv.errors import BadInput
 from bushenv.judge import build_judge
 from bushenv.models import MODELS, ModelError, check_axis, get_model
-from bushenv.persist import write_json, write_text
+from bushenv.persist import write_figure, write_json, write_text
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
 from bushenv.search.evaluate import BatchEvaluator
@@ -250,8 +250,7 @@ def write_summary(out: Path, summary: dict[str, Any]) -> None:
     fig.colorbar(im, ax=ax, label="divergence rate")
     ax.set_title("campaign matrix")
     fig.tight_layout()
-    fig.savefig(out / "summary.png", dpi=110)
-    plt.close(fig)
+    write_figure(fig, out / "summary.png", dpi=110)
 
 
 @dataclass

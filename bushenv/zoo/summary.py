@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.persist import write_json, write_text
+from bushenv.persist import write_figure, write_json, write_text
 
 Z95 = 1.959963984540054
 STEP_AT_S = 1.0  # the papers' step starts 1 s into its profile (cell.py)
@@ -188,8 +188,7 @@ def plot(rows: list[dict], path: Path) -> Path:
     ax.set_title("accuracy against robustness, per recipe")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    write_figure(fig, path, dpi=110)
     return path
 
 

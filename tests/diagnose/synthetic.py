@@ -1,13 +1,19 @@
-"""Small synthetic bushing records for the diagnosis tests (own forms, independent of the
-candidates' generic forms where possible: an elasto-plastic Jenkins friction element, Maxwell
-branches off the candidates' tau grid, a stiffness that softens with dissipated energy)."""
+"""Small synthetic bushing records for the diagnosis tests: a spring and damper plus one
+registered effect, made by the effect's own forward form at its typical instance
+(``Effect.forward``, ``Effect.example``), so every registered effect has records without an
+entry here. Forms the candidates do not assume are the widened validation's
+(``bushenv/diagnose/truth_forms.py``)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 from scipy import signal
+
+from bushenv.diagnose.candidates import get_effect
+from bushenv.diagnose.effects.base import Scales, Signals
 
 K = 380e3  # N/m
 C = 4.4e3  # N s/m
@@ -49,35 +55,22 @@ def motion(
     return x
 
 
-def force(x: np.ndarray, dt: float, effect: str = "none", strength: float = 1.0) -> np.ndarray:
-    v = np.gradient(x, dt)
-    f = K * x + C * v
-    if effect == "relaxation":
-        for k, tau in ((0.5 * K, 0.07), (0.3 * K, 1.3)):
-            a = np.exp(-dt / tau)
-            h = signal.lfilter([1.0], [1.0, -a], v * dt)  # h' = v - h/tau
-            f = f + strength * k * h
-    elif effect == "friction":
-        fmax, kf = 0.15 * K * np.std(x) * 3, 20 * K
-        z = np.zeros_like(x)
-        for t in range(1, x.size):
-            z[t] = np.clip(z[t - 1] + kf * (x[t] - x[t - 1]), -fmax, fmax)
-        f = f + strength * z
-    elif effect == "hardening":
-        s = np.std(x)
-        f = f + strength * 0.08 * K * s * (x / s) ** 3
-    elif effect == "thermal":
-        e = np.cumsum(C * v * v) * dt  # dissipated energy, J
-        f = f * (1 - strength * 0.3 * e / e[-1])
-    elif effect == "delay":
-        d = strength * 0.006
-        t = np.arange(x.size) * dt
-        f = np.interp(t - d, t, f, left=0.0)
-    elif effect == "inertia":
-        f = f + strength * 40.0 * np.gradient(v, dt)
-    elif effect != "none":
-        raise ValueError(effect)
-    return f
+@cache
+def specimen_scales() -> Scales:
+    """What the synthetic specimen's effects are sized by: one default motion's scales, the
+    same for every record (one specimen, as on a test machine)."""
+    return Scales.of([Signals(motion(0), 1 / 204.8)])
+
+
+def force(x: np.ndarray, dt: float, effect: str = "none") -> np.ndarray:
+    """Force (N) of the spring K, damper C and ``effect`` (a registered name) under ``x``."""
+    s = Signals(x, dt)
+    if effect == "none":
+        return K * x + C * s.v
+    eff = get_effect(effect)
+    shape, w = eff.example(specimen_scales(), K)
+    own = C * s.v if eff.replaces_spring else K * x + C * s.v
+    return eff.forward(s, own, shape, w, specimen_scales())
 
 
 def record(

@@ -85,10 +85,10 @@ def test_candidate_columns_have_one_weight_bound_each():
 
 
 def test_unknown_candidate_is_a_clear_error_listing_the_registry():
-    with pytest.raises(UnknownEffectError, match="unknown candidate effect 'creep'; known: "):
-        get_effect("creep")
+    with pytest.raises(UnknownEffectError, match="unknown candidate effect 'nosuch'; known: "):
+        get_effect("nosuch")
     with pytest.raises(ValueError, match=", ".join(effect_names())):
-        get_effect("creep")
+        get_effect("nosuch")
 
 
 def test_effects_compose_with_plus_and_refuse_a_duplicate():

@@ -29,11 +29,11 @@ class Hum(Effect):
         t = np.arange(s.x.size) * s.dt
         return np.stack([np.sin(2 * np.pi * HUM_HZ * t), np.cos(2 * np.pi * HUM_HZ * t)], axis=1)
 
-    def columns_count(self, shape, scales):
-        return 2
-
     def lower(self, shape, scales):
         return np.full(2, -np.inf)
+
+    def example(self, scales, k_n_per_m):
+        return None, np.array([0.1 * k_n_per_m * scales.sigma_x, 0.0])
 
 
 def hum_record(seed, name=""):
@@ -77,9 +77,17 @@ def test_an_unknown_effect_on_the_command_line_names_the_known_ones(tmp_path, ca
     code = None
     with pytest.raises(SystemExit) as exc:
         main(
-            ["diagnose", str(train), str(train), "--out", str(tmp_path / "o"), "--effects", "creep"]
+            [
+                "diagnose",
+                str(train),
+                str(train),
+                "--out",
+                str(tmp_path / "o"),
+                "--effects",
+                "nosuch",
+            ]
         )
     code = exc.value.code
     assert code == 2
     err = capsys.readouterr().err
-    assert "creep" in err and ", ".join(candidates.effect_names()) in err
+    assert "nosuch" in err and ", ".join(candidates.effect_names()) in err

@@ -71,3 +71,19 @@ def test_widened_quasi_static_cases_are_50_hz_pulls_and_holds_of_metres_scale_ju
     peak = max(float(np.max(r.displacement)) for r in case.train + case.tests)
     assert 0.04 <= peak <= 0.17
     assert min(float(np.min(r.displacement)) for r in case.train) > -1e-3  # pulls only
+
+
+def test_each_reference_draw_switches_on_the_reference_effect_named_by_its_label():
+    # the reference's effect switches are its own list (it sits below the diagnosis): the
+    # labels of the reference set name candidates, and each draw must set exactly the
+    # reference effect of that name, or the scoring would judge against a wrong label
+    from bushenv.diagnose.candidates import effect_names
+    from bushenv.diagnose.reference_cases import DRAWS, Draw
+    from bushenv.reference.rubber import RubberBushing
+
+    assert set(DRAWS) <= set(effect_names())
+    x = 2e-3 * np.sin(np.linspace(0, 60, 4000))
+    for name, draw in DRAWS.items():
+        params = draw(Draw(np.random.default_rng(0), 4e5, 4e3, 3e-3, x, 1 / 204.8))
+        model = RubberBushing(dt=1 / 204.8, k_n_per_m=4e5, c_ns_per_m=4e3, **params)
+        assert model.active_effects == (name,), (name, model.active_effects)

@@ -10,6 +10,7 @@ from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 KNOTS = (0.25, 0.5, 0.8)  # fractions of the largest deflection
 GRID = 4001  # points of the tangent's integral table
+EXAMPLE_GROWTH = 1.5  # tangent 2.5 k at the last knot: about 78 % more force at the top
 
 
 def _knots(scales: Scales) -> tuple[float, float, float]:
@@ -91,8 +92,13 @@ class Hardening(Effect):
             )
         return cols
 
-    def columns_count(self, shape: Any, scales: Scales) -> int:
-        return 6 + 2 * _two_sided(scales)
+    def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
+        """The spring k (the hats and the plateau sum to a constant tangent) plus a
+        quadratic growth of the tangent: a cubic hardening, alike on both sides."""
+        w = np.zeros(6 + 2 * _two_sided(scales))
+        w[:4] = k_n_per_m
+        w[4] = EXAMPLE_GROWTH * k_n_per_m
+        return None, w
 
     def parameters(self, shape: Any, scales: Scales, w: np.ndarray) -> dict[str, Any]:
         u1, u2, u3 = _knots(scales)

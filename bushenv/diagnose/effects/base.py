@@ -1,5 +1,6 @@
 """What every candidate effect shares: the record's signals, TRAIN's scales, the Effect base
-class and the composition of effects (``Relaxation() + Friction()``).
+class (the whole contract of an effect) and the composition of effects
+(``Relaxation() + Friction()``).
 
 An effect turns a record's prescribed motion into regressor columns (its added force is a
 weighted sum of them, weights by bounded least squares) for each of a few shape settings,
@@ -10,7 +11,10 @@ at another.
 
 from __future__ import annotations
 
+import inspect
+from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any, ClassVar
 
 import numpy as np
@@ -106,16 +110,24 @@ class Scales:
         )
 
 
-class Effect:
-    """One candidate effect. Subclasses set the class attributes and override ``columns``.
+class Effect(ABC):
+    """One candidate effect: the whole contract, checked over every registered effect by
+    ``bushenv.diagnose.checks``.
 
-    Class attributes (they also make the effects table of docs/diagnose.md):
-    ``name`` (registry name), ``form`` (the force it adds), ``weights`` (their bounds),
-    ``shape_text`` (the shape settings tried), ``telling_test`` (a programme that shows what
-    only this effect does, offered when an answer cannot tell two effects apart).
-    ``replaces_spring``: the columns replace the linear spring ``k x`` (a backbone of its
-    own); ``continuous_shape``: the best grid shape is refined by a 1-D search on the fitting
-    error.
+    Declared once, on the class (the docs table is made of them): ``name`` (the registry
+    name; every other list of effects reads it from here), ``form`` (the force it adds),
+    ``weights`` (their bounds, in words), ``shape_text`` (the shape settings tried),
+    ``telling_test`` (a programme that shows what only this effect does, offered when an
+    answer cannot tell two effects apart). ``replaces_spring``: the columns replace the
+    linear spring ``k x`` (a backbone of its own); ``continuous_shape``: the best grid shape
+    is refined by a 1-D search on the fitting error.
+
+    Implemented by each effect: ``columns`` (its regressors) and ``example`` (a typical
+    instance: what synthetic records and the checks are made of). ``lower`` (the weights'
+    admissible bounds), ``shapes``, ``delay_s``, ``describe`` and ``parameters`` where the
+    defaults do not fit. Derived, never kept by hand: ``columns_count`` (from ``columns``)
+    and ``forward`` (the force the effect adds, from the same regressors and delay the
+    diagnosis predicts with).
     """
 
     name: ClassVar[str] = ""
@@ -130,20 +142,45 @@ class Effect:
         """The shape settings to try (hashable values; ``[None]`` if none)."""
         return [None]
 
+    @abstractmethod
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
-        """(T, p) regressors of the added force for one record."""
-        return np.zeros((s.x.size, 0))
+        """(T, p) regressors of the added force for one record; p depends on ``shape`` and
+        ``scales`` only (``np.zeros((T, 0))`` for an effect without weights)."""
+
+    @abstractmethod
+    def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
+        """A typical instance ``(shape, weights)`` on a bushing of stiffness ``k_n_per_m``
+        whose records have ``scales``: clearly visible, physically admissible (weights within
+        ``lower``). A ``replaces_spring`` effect's weights include that stiffness."""
 
     def lower(self, shape: Any, scales: Scales) -> np.ndarray:
         """(p,) lower bounds of the weights (0 where the physics fixes a sign)."""
         return np.zeros(self.columns_count(shape, scales))
 
     def columns_count(self, shape: Any, scales: Scales) -> int:
-        return 0
+        """p of ``columns``, read off them on a short probe motion (so it cannot disagree)."""
+        try:
+            return _probed_count(type(self), shape, scales)
+        except TypeError:  # an unhashable shape: probe without the cache
+            return _probed_count.__wrapped__(type(self), shape, scales)
 
     def delay_s(self, shape: Any) -> float:
         """Time shift of the whole predicted force (only the delay has one)."""
         return 0.0
+
+    def forward(
+        self, s: Signals, force: np.ndarray, shape: Any, w: np.ndarray, scales: Scales
+    ) -> np.ndarray:
+        """The force measured when this effect (``shape``, weights ``w``) acts on a specimen
+        whose own force is ``force`` (T,), N: the regressors' weighted sum added, the whole
+        seen through the delay -- the diagnosis's own prediction (``fitting.predict``)."""
+        from bushenv.diagnose.effects.delay import shift_columns
+
+        total = np.asarray(force, dtype=np.float64)
+        cols = self.columns(s, shape, scales)
+        if cols.shape[1]:
+            total = total + cols @ np.asarray(w, dtype=np.float64)
+        return shift_columns(total, self.delay_s(shape), s.dt)
 
     def describe(self, shape: Any) -> str:
         return self.name
@@ -157,6 +194,41 @@ class Effect:
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
+
+
+PROBE_SAMPLES = 16
+
+
+@lru_cache(maxsize=4096)
+def _probed_count(cls: type[Effect], shape: Any, scales: Scales) -> int:
+    x = scales.sigma_x * np.sin(np.linspace(0.0, 3.0, PROBE_SAMPLES))
+    return int(cls().columns(Signals(x, scales.dt), shape, scales).shape[1])
+
+
+RESERVED_NAMES = ("none",)  # the answer "no effect"; "+" joins the names of a pair
+
+
+def contract_problem(name: str, cls: Any) -> str | None:
+    """Why ``cls`` cannot be registered as effect ``name`` (None: it can).
+
+    What can be told without data; ``bushenv.diagnose.checks`` runs the rest.
+    """
+    if not (isinstance(cls, type) and issubclass(cls, Effect)):
+        return f"effect {name!r}: {cls!r} is not an Effect subclass"
+    if name != cls.name:
+        return (
+            f"effect {name!r}: the class declares name {cls.name!r}; an effect's name is "
+            "declared once, on its class (register it under that name)"
+        )
+    if not name or name != name.lower() or "+" in name or name in RESERVED_NAMES:
+        return f"effect {name!r}: names are lowercase, without '+', and not 'none'"
+    if inspect.isabstract(cls):
+        missing = ", ".join(sorted(cls.__abstractmethods__))
+        return f"effect {name!r}: {cls.__name__} does not implement {missing}"
+    for attr in ("form", "weights"):
+        if not getattr(cls, attr):
+            return f"effect {name!r}: {cls.__name__}.{attr} is empty (the docs table shows it)"
+    return None
 
 
 @dataclass(frozen=True)

@@ -6,9 +6,10 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose.effects.base import Effect, Scales
+from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 DELAY_GRID_S = tuple(float(d) for d in 1e-3 * np.geomspace(0.25, 40.0, 25))
+EXAMPLE_DELAY_S = 6e-3  # between grid values: the shape search must refine it
 
 
 TAPS = 8  # points of the Lagrange interpolation (7th order)
@@ -63,6 +64,12 @@ class Delay(Effect):
 
     def shapes(self, scales: Scales) -> list:
         return list(DELAY_GRID_S)
+
+    def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        return np.zeros((s.x.size, 0))  # no weights: the shift is all of it
+
+    def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
+        return EXAMPLE_DELAY_S, np.zeros(0)
 
     def delay_s(self, shape: Any) -> float:
         return float(shape or 0.0)

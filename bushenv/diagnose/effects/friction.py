@@ -11,6 +11,7 @@ from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 DAHL_FRACTIONS = np.array([0.003, 0.01, 0.03, 0.1, 0.3, 1.0])  # x_j / sigma_x
 PAYNE_MEMORY_S = (2.0, 20.0)  # decay times of the amplitude envelope
+EXAMPLE_SLIP = (0.03, 0.45)  # slip length / sigma_x, slip force / (k sigma_x)
 
 
 @nb.njit(cache=True, nogil=True)
@@ -75,8 +76,13 @@ class Friction(Effect):
             out[:, xs.size + m] = -s.x * env / scales.sigma_x
         return out
 
-    def columns_count(self, shape: Any, scales: Scales) -> int:
-        return int(DAHL_FRACTIONS.size + len(PAYNE_MEMORY_S))
+    def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
+        """One stiff element (slip at 3 % of sigma_x, slip force 0.45 k sigma_x): nearly a
+        Jenkins element, a loop with sharp corners; no amplitude softening."""
+        w = np.zeros(DAHL_FRACTIONS.size + len(PAYNE_MEMORY_S))
+        fraction, force = EXAMPLE_SLIP
+        w[int(np.argmin(np.abs(DAHL_FRACTIONS - fraction)))] = force * k_n_per_m * scales.sigma_x
+        return None, w
 
     def parameters(self, shape: Any, scales: Scales, w: np.ndarray) -> dict[str, Any]:
         xs = DAHL_FRACTIONS * scales.sigma_x

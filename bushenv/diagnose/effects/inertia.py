@@ -8,6 +8,8 @@ import numpy as np
 
 from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
+EXAMPLE_RESONANCE_HZ = 16.0
+
 
 class Inertia(Effect):
     """``m a``: the load cell also carries a fixture mass."""
@@ -23,8 +25,9 @@ class Inertia(Effect):
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         return s.a[:, None].copy()
 
-    def columns_count(self, shape: Any, scales: Scales) -> int:
-        return 1
+    def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
+        """A fixture that would resonate with the bushing's spring at 16 Hz."""
+        return None, np.array([k_n_per_m / (2 * np.pi * EXAMPLE_RESONANCE_HZ) ** 2])
 
     def parameters(self, shape: Any, scales: Scales, w: np.ndarray) -> dict[str, Any]:
         return {"mass_kg": float(w[0])}

@@ -12,6 +12,7 @@ from bushenv.diagnose.effects.base import Effect, Scales, Signals
 PER_DECADE = 3  # Maxwell branches per decade of relaxation time
 TAU_MIN_S = 1e-2  # shorter times look like damping and a negative mass (a delay)
 TAU_MAX_S = 1e4
+EXAMPLE_BRANCHES = ((0.1, 0.5), (1.0, 0.3))  # (tau_s, k_i / k) of a typical rubber
 
 
 def maxwell_state(x: np.ndarray, dt: float, tau: float) -> np.ndarray:
@@ -54,8 +55,13 @@ class Relaxation(Effect):
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         return np.stack([maxwell_state(s.x, s.dt, t) for t in tau_grid_s(scales)], axis=1)
 
-    def columns_count(self, shape: Any, scales: Scales) -> int:
-        return int(tau_grid_s(scales).size)
+    def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
+        """Two branches, k_i = 0.5 k and 0.3 k, at the grid's times nearest 0.1 s and 1 s."""
+        taus = tau_grid_s(scales)
+        w = np.zeros(taus.size)
+        for tau, share in EXAMPLE_BRANCHES:
+            w[np.argmin(np.abs(np.log(taus / tau)))] += share * k_n_per_m
+        return None, w
 
     def parameters(self, shape: Any, scales: Scales, w: np.ndarray) -> dict[str, Any]:
         taus = tau_grid_s(scales)

@@ -11,6 +11,8 @@ from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 TIME_CONSTANTS_S = (10.0, 30.0, 100.0, 300.0, np.inf)
 HEATING = ("viscous", "hysteretic")  # heat input ~ v^2 (a damper) or ~ |v| (friction)
+EXAMPLE_LOSS = 0.3  # stiffness lost by the end of the longest record
+EXAMPLE_DAMPING_S = 0.01  # the damping lost with it, as for c = k x 10 ms
 
 
 def heating_state(v: np.ndarray, dt: float, tau: float, heating: str, v_rms: float) -> np.ndarray:
@@ -51,8 +53,12 @@ class Thermal(Effect):
         theta = heating_state(s.v, s.dt, tau, heating, scales.v_rms)
         return np.stack([-theta * s.x, -theta * s.v], axis=1)
 
-    def columns_count(self, shape: Any, scales: Scales) -> int:
-        return 2
+    def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
+        """Viscous heating without a leak: 30 % of the stiffness (and of a damping of
+        k x 10 ms) lost by the end of the longest record at its RMS velocity."""
+        heat = scales.v_rms**2 * scales.duration_s  # theta at the end, m^2/s
+        b_k = EXAMPLE_LOSS * k_n_per_m / heat
+        return ("viscous", np.inf), np.array([b_k, EXAMPLE_DAMPING_S * b_k])
 
     def describe(self, shape: Any) -> str:
         return f"thermal ({shape[0]} heating, tau_th={shape[1]:g} s)"
