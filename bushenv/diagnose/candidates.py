@@ -20,7 +20,7 @@ from bushenv.diagnose.effects.friction import Friction
 from bushenv.diagnose.effects.inertia import Inertia
 from bushenv.diagnose.effects.relaxation import Relaxation
 from bushenv.diagnose.effects.thermal import Thermal
-from bushenv.errors import BadInput
+from bushenv.errors import BadInput, BushenvError
 from bushenv.registry import Registry
 
 
@@ -28,7 +28,7 @@ class UnknownEffectError(BadInput):
     """An effect name that is not in the registry; the message lists the known names."""
 
 
-class EffectContractError(TypeError):
+class EffectContractError(BushenvError):
     """An effect class that cannot be registered as given (a bug in the effect, not input)."""
 
 
