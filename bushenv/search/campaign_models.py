@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv.identify.linear import CONTROL_RECORD_S, fitted_linear  # noqa: F401 (re-export)
-from bushenv.judge import card_of
 from bushenv.models import MODELS
+from bushenv.resolved import ResolvedModel
 
 FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
 
@@ -55,20 +55,22 @@ def roles(config, judge, notes: list[str]) -> list[tuple[str, str]]:
     return out
 
 
-def card_displacements(spec: str | None) -> list[np.ndarray] | None:
-    """The displacement of the training records a reference file's card names, when they are
-    all still there (checked against the card's hashes), else None."""
-    card = card_of(spec)
-    if card is None:
+def card_displacements(reference: ResolvedModel | None) -> list[np.ndarray] | None:
+    """The displacement of the training records the reference's card names, when they are
+    all still there (checked against the card's hashes, with the card read once, at
+    resolving), else None."""
+    if reference is None or reference.card is None:
         return None
-    from bushenv.identify.card import card_paths, load_card
+    from bushenv.identify.card import ModelCard
     from bushenv.records import load_csv
 
     # record files are relative to the card (older cards: absolute)
-    here = card_paths(spec)[0].parent
-    paths = [here / r["file"] for r in card["records"] if r.get("role") == "train" and r["file"]]
+    card = ModelCard(reference.card_file, reference.card)
+    here = card.path.parent
+    records = card.records
+    paths = [here / r["file"] for r in records if r.get("role") == "train" and r["file"]]
     if not paths or not all(p.is_file() for p in paths):
         return None
 
-    load_card(spec, records=paths)  # CardError naming a record that changed since
+    card.verify_records(paths)  # CardError naming a record that changed since
     return [load_csv(p).displacement for p in paths]
