@@ -34,17 +34,9 @@ class ResolvedModel:
     model: BushingModel = field(repr=False, compare=False)
     file: Path | None  # the file behind it (a shipped default or the file given); else None
     sha256: str | None  # of that file's bytes
-    card: dict | None = field(default=None, repr=False, compare=False)  # see ``card_of``
+    card: dict | None = field(default=None, repr=False, compare=False)  # see ``read_card``
+    card_file: Path | None = None  # where the card was read (``MODEL.card.json``)
     registered: bool = False  # given by a name in ``MODELS``
-
-    @property
-    def card_file(self) -> Path | None:
-        """Where the card is (``MODEL.card.json``), when there is one."""
-        if self.card is None or self.file is None:
-            return None
-        from bushenv.identify.card import card_paths
-
-        return card_paths(self.file)[0]
 
 
 def is_file_spec(spec: Any) -> bool:
@@ -67,16 +59,16 @@ def report_key(spec: Any) -> str:
     return Path(text).stem if text.endswith((".npz", ".fmu")) else text
 
 
-def card_of(spec: Any) -> dict | None:
-    """The model card beside a model file (checked against the file), or None: read from disk
-    here and nowhere else (``resolve_model(..., card=True)``)."""
+def read_card(spec: Any):
+    """The ``ModelCard`` beside a model file (checked against the file), or None: read from
+    disk here and nowhere else in an attack (``resolve_model(..., card=True)``)."""
     if not is_file_spec(spec) or not Path(spec).is_file():
         return None
     from bushenv.identify.card import card_paths, load_card
 
     if not card_paths(spec)[0].is_file():
         return None
-    return load_card(spec).data
+    return load_card(spec)
 
 
 def resolved(
@@ -92,13 +84,15 @@ def resolved(
     path = None if isinstance(spec, BushingModel) else model_file(spec, axis)
     if path is not None and not path.is_file():
         path = None
+    model_card = read_card(spec) if card else None
     return ResolvedModel(
         key=report_key(spec) if key is None else key,
         spec=spec_label(spec),
         model=model,
         file=path,
         sha256=file_hash(path) if path is not None else None,
-        card=card_of(spec) if card else None,
+        card=None if model_card is None else model_card.data,
+        card_file=None if model_card is None else model_card.path,
         registered=isinstance(spec, str) and spec in MODELS,
     )
 
