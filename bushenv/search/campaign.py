@@ -28,7 +28,6 @@ from typing import Any
 from bushenv.execution import local_cores
 from bushenv.persist import write_json, write_text
 from bushenv.progress import Progress
-from bushenv.resolved import report_key
 from bushenv.search.campaign_cases import Shrunk, shrink_failures
 from bushenv.search.campaign_config import CampaignConfig, CampaignError
 from bushenv.search.campaign_holds import hold_stage
@@ -44,12 +43,7 @@ from bushenv.search.campaign_resolve import Resolved, resolve
 from bushenv.search.campaign_search import search
 from bushenv.search.searchers import SEARCHERS
 
-__all__ = ["Attacked", "CampaignConfig", "CampaignError", "label", "run_attack"]
-
-
-def label(spec: str) -> str:
-    """The key a model goes by in the report: a name, or a model file's stem."""
-    return report_key(spec)
+__all__ = ["Attacked", "CampaignConfig", "CampaignError", "run_attack"]
 
 
 @dataclass(frozen=True)

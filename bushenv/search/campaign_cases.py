@@ -92,6 +92,7 @@ def _case(resolved: Resolved, config: CampaignConfig, profile, family, params, f
         static=judge.static,
         judge=judge.describe(),
         shas={m.spec: m.sha256 for m in resolved.models.values()},
+        reference_record=resolved.reference_identity(),
         **extra,
     )
 

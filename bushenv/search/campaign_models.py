@@ -13,13 +13,15 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv.identify.linear import CONTROL_RECORD_S, fitted_linear  # noqa: F401 (re-export)
+from bushenv.judge import Judge
 from bushenv.models import MODELS
 from bushenv.resolved import ResolvedModel
+from bushenv.search.campaign_config import CampaignConfig
 
 FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
 
 
-def roles(config, judge, notes: list[str]) -> list[tuple[str, str]]:
+def roles(config: CampaignConfig, judge: Judge, notes: list[str]) -> list[tuple[str, str]]:
     """(role, spec) for the target, the hybrid (when there is one), the control and, for a
     target whose registry entry names them, the models rechecked beside it (``also``)."""
     builtin = judge.builtin

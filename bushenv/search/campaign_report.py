@@ -44,18 +44,6 @@ def model_identity(model: ResolvedModel) -> dict[str, Any]:
     }
 
 
-def reference_json(resolved: Resolved) -> dict[str, Any]:
-    """What the report records of its reference (as a corpus case does)."""
-    ref = resolved.reference
-    if ref is None:
-        return {"spec": None, "file_sha256": None, "params_sha256": None}
-    return {
-        "spec": resolved.judge.reference_spec,
-        "file_sha256": ref.sha256,
-        "params_sha256": params_sha(ref.model),
-    }
-
-
 def criteria_json(resolved: Resolved) -> dict[str, Any]:
     """Which criteria the verdicts used, and why some did not run (the judge's)."""
     judge = resolved.judge
@@ -72,7 +60,7 @@ def fresh_report(resolved: Resolved, config: CampaignConfig) -> dict[str, Any]:
         "version": REPORT_VERSION,
         "arguments": config.arguments(),
         "searchers": list(config.searchers),
-        "reference": reference_json(resolved),
+        "reference": resolved.reference_identity(),
         "scales": resolved.judge.scales.to_json(),
         "judge": resolved.judge.describe(),
         "criteria": criteria_json(resolved),

@@ -20,6 +20,7 @@ from bushenv.judge import (
     judge_of,
     reference_spec_for,
 )
+from bushenv.models import params_sha
 from bushenv.resolved import ResolvedModel, report_key, resolve_model, resolved
 from bushenv.scales import stiffness_mismatch
 from bushenv.search.campaign_config import CampaignConfig
@@ -72,6 +73,18 @@ class Resolved:
     def searched_keys(self) -> list[str]:
         """The models searched (every role but ``also``: those are rechecked only)."""
         return [k for k in self.models if self.roles[k] != "also"]
+
+    def reference_identity(self) -> dict[str, Any]:
+        """What reports and cases record of the reference: the spec it was given by, its
+        file's and its parameters' sha256 (all None: judged without one)."""
+        ref = self.reference
+        if ref is None:
+            return {"spec": None, "file_sha256": None, "params_sha256": None}
+        return {
+            "spec": self.judge.reference_spec,
+            "file_sha256": ref.sha256,
+            "params_sha256": params_sha(ref.model),
+        }
 
     def evaluator(self, key: str, threads: int = 1) -> BatchEvaluator:
         """A fresh evaluator of model ``key`` against the reference, as the judge says."""

@@ -146,9 +146,12 @@ def make_case(
     shrink: dict[str, Any] | None = None,
     notes: str = "",
     judge: dict[str, Any] | None = None,
+    reference_record: dict[str, Any] | None = None,
 ) -> Case:
     """A case whose ``expect`` holds what each model does on the decoded profile now, against
-    ``reference`` (given by ``reference_spec``; None: judged without one) at ``scales``."""
+    ``reference`` (given by ``reference_spec``; None: judged without one) at ``scales``.
+    ``reference_record``: what the case records of a reference resolved already (default:
+    ``reference_identity``, which hashes its file)."""
     x = decode_profile(encode_profile(profile))
     rows = judge_profile(x, models, env, axis, reference, scales, static)
     shas = shas or {}
@@ -173,7 +176,7 @@ def make_case(
         params=params,
         found_by=found_by,
         expect=expect,
-        reference=reference_identity(reference_spec, reference, axis),
+        reference=reference_record or reference_identity(reference_spec, reference, axis),
         shrink=shrink,
         notes=notes,
         scales=scales,
