@@ -107,3 +107,19 @@ def test_report_cases_and_plots_take_typed_results_not_a_campaign(name):
             assert "Campaign" not in str(hints[param]).replace("CampaignConfig", ""), (
                 f"{name}.{fname}({param}: {hints[param]})"
             )
+
+
+def _imported_names(path: Path) -> set[str]:
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            names |= {a.name for a in node.names}
+    return names
+
+
+@pytest.mark.parametrize("name", ["search/matrix", "zoo/cell"])
+def test_a_campaign_cell_and_a_zoo_member_compose_the_stages_not_a_run_of_their_own(name):
+    names = _imported_names(PACKAGE / f"{name}.py")
+    assert {"resolve_target", "run_search"} <= names
+    # judging and searching are the stages' (no judge, evaluator or searcher built here)
+    assert not names & {"build_judge", "judge_of", "BatchEvaluator", "get_searcher"}, names
