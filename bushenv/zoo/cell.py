@@ -147,8 +147,7 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
         "certificate": _certificate(model, reference),
         "step": _steps(resolved),
         "attacks": {
-            s: _attack(resolved, s, int(cell["budget"]), seed)
-            for s in cell["searchers"].split(",")
+            s: _attack(resolved, s, int(cell["budget"]), seed) for s in cell["searchers"].split(",")
         },
     }
     row["judge_s"] = time.perf_counter() - t1
