@@ -214,7 +214,8 @@ def build_judge(
     ref = None if spec is None else resolve_model(spec, axis, dt, reference=True, card=True)
     subject = None
     if model_object is not None:
-        subject = resolved(model, model_object, axis, card=True)
+        given = model_object if model is None else model
+        subject = resolved(given, model_object, axis, card=True)
     elif model is not None:
         subject = resolve_model(model, axis, card=True)
     return judge_of(
