@@ -21,14 +21,13 @@ inputs give the same judge everywhere:
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Any
 
 from bushenv.divergence import CRITERIA, NEEDS_REFERENCE
 from bushenv.errors import BadInput
-from bushenv.models import MODELS, BushingModel, get_reference
+from bushenv.models import MODELS, BushingModel
+from bushenv.resolved import ResolvedModel, resolve_model, resolved
 from bushenv.scales import (
     BushingScales,
     ScaleError,
@@ -132,10 +131,6 @@ class Judge:
         }
 
 
-def is_file_spec(spec: Any) -> bool:
-    return isinstance(spec, str | os.PathLike) and str(spec) not in MODELS
-
-
 def reference_spec_for(model: Any, reference: Any) -> Any:
     """The reference a verdict on ``model`` is judged against (see the module doc)."""
     if reference is None:
@@ -146,15 +141,13 @@ def reference_spec_for(model: Any, reference: Any) -> Any:
     return reference
 
 
-def card_of(spec: Any) -> dict | None:
-    """The model card beside a model file (checked against the file), or None."""
-    if not is_file_spec(spec) or not Path(spec).is_file():
-        return None
-    from bushenv.identify.card import card_paths, load_card
-
-    if not card_paths(spec)[0].is_file():
-        return None
-    return load_card(spec).data
+def check_reference_needed(spec: Any, target: Any) -> None:
+    """Refuse to judge without a reference where ``target`` cannot (``JudgeError``)."""
+    if spec is None and not target.reference_free:
+        raise JudgeError(
+            f"the {target.name} target needs a reference (its twin runs on it); pass "
+            "--reference NAME|FILE"
+        )
 
 
 def judging_scales(
@@ -211,23 +204,49 @@ def build_judge(
     vet: bool = True,
     model_object: BushingModel | None = None,
 ) -> Judge:
-    """The judge of verdicts on ``model`` (a name, file or object) against ``reference``.
+    """The judge of verdicts on ``model`` (a name, file or object) against ``reference``:
+    both resolved here (``bushenv.resolved``), then ``judge_of``.
 
-    ``target``: where the verdicts are made (``Where``, or a search ``Target``).
     ``model_object`` is the resolved model under test (its responses enter the compatibility
-    check of the vetting). Raises ``JudgeError`` when the reference fails its vetting and
-    ``trust_reference`` is not set."""
-    tgt = target  # a ``Where`` or a search ``Target``
+    check of the vetting); without it the model's card still counts, its responses do not."""
     spec = reference_spec_for(model, reference)
-    if spec is None and not tgt.reference_free:
-        raise JudgeError(
-            f"the {tgt.name} target needs a reference (its twin runs on it); pass "
-            "--reference NAME|FILE"
-        )
-    ref = None if spec is None else get_reference(spec, axis=axis, dt=dt)
-    builtin = isinstance(spec, str) and spec == BUILTIN_REFERENCE
-    ref_card = card_of(spec) if ref is not None else None
-    card = ref_card if ref is not None else card_of(model)
+    check_reference_needed(spec, target)
+    ref = None if spec is None else resolve_model(spec, axis, dt, reference=True, card=True)
+    subject = None
+    if model_object is not None:
+        given = model_object if model is None else model
+        subject = resolved(given, model_object, axis, card=True)
+    elif model is not None:
+        subject = resolve_model(model, axis, card=True)
+    return judge_of(
+        subject, ref, target=target, flags=flags, trust_reference=trust_reference, vet=vet,
+        compare=model_object is not None,
+    )  # fmt: skip
+
+
+def judge_of(
+    model: ResolvedModel | None,
+    reference: ResolvedModel | None,
+    *,
+    target: Any = RIG,
+    flags: ScaleFlags = ScaleFlags(),
+    trust_reference: bool = False,
+    vet: bool = True,
+    compare: bool = True,
+) -> Judge:
+    """The judge of verdicts on ``model`` against ``reference``, both resolved already.
+
+    ``target``: where the verdicts are made (``Where``, or a search ``Target``). ``compare``:
+    the model's responses enter the compatibility check of the vetting (its card always
+    does). Raises ``JudgeError`` when the reference fails its vetting and ``trust_reference``
+    is not set."""
+    tgt = target  # a ``Where`` or a search ``Target``
+    check_reference_needed(reference, tgt)
+    ref = None if reference is None else reference.model
+    builtin = reference is not None and reference.registered and reference.spec == BUILTIN_REFERENCE
+    ref_card = None if reference is None else reference.card
+    model_card = None if model is None else model.card
+    card = ref_card if ref is not None else model_card
     scale_problem = None
     try:
         scales = judging_scales(ref, builtin, card, flags)
@@ -236,14 +255,15 @@ def build_judge(
         scales = judging_scales(None, builtin, card, flags)
     static = ref is not None and (ref_card is None or static_identified(ref_card))
     criteria, why = criteria_of(ref, static, tgt)
-    label = _label(spec)
+    label = None if reference is None else reference.spec
     vetting = None
     if ref is not None and vet:
         from bushenv.vetting import vet_reference
 
         vetting = vet_reference(
-            ref, label, scales, card=ref_card, card_file=spec, model=model_object,
-            model_card=card_of(model), model_file=model,
+            ref, label, scales, card=ref_card, card_file=reference.file,
+            model=model.model if model is not None and compare else None,
+            model_card=model_card, model_file=None if model is None else model.file,
         )  # fmt: skip
         if scale_problem is not None:
             from bushenv.vetting import Check, Vetting
@@ -258,7 +278,7 @@ def build_judge(
                 "then marked as judged by an unvetted reference)"
             )
     return Judge(
-        reference_spec=None if spec is None else _recorded(spec),
+        reference_spec=label,
         builtin=builtin,
         scales=scales,
         static=static and "static" in criteria,
@@ -281,13 +301,3 @@ def envelope_of(card: dict | None, scales: BushingScales) -> tuple[float, float,
             "the reference's card's training records",
         )
     return scales.stroke_m, scales.velocity_m_per_s, "the judged stroke and velocity"
-
-
-def _label(spec: Any) -> str:
-    if isinstance(spec, BushingModel):
-        return f"<{spec.name or type(spec).__name__} object>"
-    return str(spec)
-
-
-def _recorded(spec: Any) -> str:
-    return _label(spec) if isinstance(spec, BushingModel) else os.fspath(spec)

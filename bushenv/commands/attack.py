@@ -16,7 +16,7 @@ from pathlib import Path
 
 from bushenv.models import AXES
 from bushenv.progress import Progress
-from bushenv.search.campaign import Campaign, CampaignConfig
+from bushenv.search.campaign import CampaignConfig, run_attack
 from bushenv.search.campaign_report import format_table
 from bushenv.search.corpus import DEFAULT_CORPUS
 from bushenv.search.searchers import SEARCHERS
@@ -138,13 +138,13 @@ def run(args: argparse.Namespace) -> int:
 
     torch.set_num_threads(1)
     progress = Progress(quiet=args.quiet)
-    campaign = Campaign(config_from(args), progress)
-    report = campaign.run()
-    print(format_table(report, campaign.target_key))
-    print(f"\nreport: {campaign.report_path}  ({report['seconds']:.1f} s in total)")
-    if campaign.control_flagged():
+    attacked = run_attack(config_from(args), progress)
+    report = attacked.report
+    print(format_table(report, attacked.target_key))
+    print(f"\nreport: {attacked.report_path}  ({report['seconds']:.1f} s in total)")
+    if attacked.control_flagged:
         progress.say(
-            f"WARNING: the control ({campaign.control_key}) was flagged: the divergence criteria "
+            f"WARNING: the control ({attacked.control_key}) was flagged: the divergence criteria "
             "or the coupling are at fault, not only the model under attack"
         )
     return 0

@@ -229,18 +229,6 @@ class Searcher(ABC):
 
     name = ""
 
-    def __init_subclass__(cls, **kwargs) -> None:
-        super().__init_subclass__(**kwargs)
-        # The hook searchers had before ``search(ctx)``: still run, through the context.
-        legacy = cls.__dict__.get("_search")
-        if legacy is not None and "search" not in cls.__dict__:
-
-            def search(self, ctx: SearchContext, _legacy=legacy) -> None:
-                c = ctx
-                _legacy(self, c.evaluator, c.budget, c.rng, c.recorder, c.seed, c.progress)
-
-            cls.search = search
-
     def run(
         self,
         evaluator: Evaluator,

@@ -1,4 +1,4 @@
-"""A campaign's failures, shrunk and kept: which to shrink, shrinking, the regression cases.
+"""Stage 4 of an attack, shrink: a campaign's failures, shrunk and kept as regression cases.
 
 The worst failure per family of the target (up to ``max_shrink``) and, always, any failure of
 the hybrid or the control are shrunk (``shrink.py``) to the simplest profile that still fails,
@@ -8,13 +8,29 @@ judged on every model of the campaign and written as corpus cases (``corpus.py``
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from bushenv import excitation as ex
-from bushenv.search.corpus import Case, make_case, model_sha, save_case
+from bushenv.progress import Progress
+from bushenv.search.campaign_config import CampaignConfig
+from bushenv.search.campaign_recheck import Rechecked
+from bushenv.search.campaign_resolve import Resolved
+from bushenv.search.campaign_search import Searched
+from bushenv.search.corpus import Case, make_case, save_case
 from bushenv.search.shrink import shrink
+
+
+@dataclass(frozen=True)
+class Shrunk:
+    """The shrunk failures as the report lists them (``shrunk``) and the corpus files added
+    (``corpus``: those of a resumed report first)."""
+
+    entries: tuple[Mapping[str, Any], ...]
+    corpus: tuple[str, ...] = ()
 
 
 def near(a: np.ndarray, b: np.ndarray) -> bool:
@@ -31,156 +47,184 @@ def _verdicts(case: Case) -> str:
     )
 
 
-def shrink_choices(campaign) -> list[tuple[str, np.ndarray, dict]]:
+def shrink_choices(
+    resolved: Resolved, searched: Searched, rechecked: Rechecked, max_shrink: int
+) -> list[tuple[str, np.ndarray, dict]]:
     """Worst failure per family of the target (up to max_shrink) + any hybrid/control."""
-    target = campaign.target_key
-    profiles, meta = campaign.failures_of(target)
+    target = resolved.target_key
+    profiles, meta = searched.failures(target)
     best: dict[str, int] = {}
     for i, m in enumerate(meta):
         fam = m["family"]
         if fam not in best or m["verdict"]["robustness"] < meta[best[fam]]["verdict"]["robustness"]:
             best[fam] = i
     order = sorted(best.values(), key=lambda i: meta[i]["verdict"]["robustness"])
-    picks = [(target, profiles[i], meta[i]) for i in order[: campaign.config.max_shrink]]
-    for key in campaign.models:
+    picks = [(target, profiles[i], meta[i]) for i in order[:max_shrink]]
+    for key in resolved.models:
         if key == target:
             continue
-        ps, ms = campaign.failures_of(key)
+        ps, ms = searched.failures(key)
         if ps:  # honesty: a hybrid or control failure is always shrunk and reported
             i = int(np.argmin([m["verdict"]["robustness"] for m in ms]))
             picks.append((key, ps[i], ms[i]))
-        rc = campaign.report["recheck"].get(key, {})
+        rc = rechecked.models.get(key, {})
         if rc.get("failures"):
             j = rc["failures"][0]["index"]
             picks.append((key, profiles[j], {**meta[j], "found_on": target}))
     return picks
 
 
-def _case(campaign, profile, family, params, found_by, **extra) -> Case:
+def _case(resolved: Resolved, config: CampaignConfig, profile, family, params, found_by,
+          **extra) -> Case:  # fmt: skip
     """``profile`` judged on every model of the campaign, as a corpus case."""
-    c = campaign.config
-    shas = {k: model_sha(campaign.specs[k], c.axis) for k in campaign.models}
+    judge = resolved.judge
     return make_case(
         profile,
-        env=c.target,
-        axis=c.axis,
+        env=config.target,
+        axis=config.axis,
         family=family,
         params=params,
         found_by=found_by,
-        models={campaign.specs[k]: m for k, m in campaign.models.items()},
-        reference=campaign.reference,
-        reference_spec=campaign.reference_spec,
-        scales=campaign.scales,
-        static=campaign.static,
-        judge=campaign.judge.describe(),
-        shas={campaign.specs[k]: shas[k] for k in campaign.models},
+        models={m.spec: m.model for m in resolved.models.values()},
+        reference=judge.reference,
+        reference_spec=judge.reference_spec,
+        scales=judge.scales,
+        static=judge.static,
+        judge=judge.describe(),
+        shas={m.spec: m.sha256 for m in resolved.models.values()},
+        reference_record=resolved.reference_identity(),
         **extra,
     )
 
 
-def _keep(campaign, case: Case, failed_key: str | None) -> None:
-    """Add ``case`` to the regression corpus when the campaign saves (and it still fails)."""
-    c = campaign.config
-    say = campaign.progress.say
-    if not c.save:
-        return
-    if failed_key is not None and not case.expect[campaign.specs[failed_key]]["diverged"]:
-        say(f"corpus: {case.name} not saved: {failed_key} no longer fails once stored")
-        return
-    saved = save_case(case, c.corpus, force=c.force)
-    if saved is None:
-        if failed_key is not None:
-            say(f"corpus: {case.name} already there (kept; --force to overwrite)")
-        return
-    say(f"corpus: added {saved}")
-    campaign.report["corpus"].append(str(saved))
+class _Keeper:
+    """Adds cases to the regression corpus when the campaign saves; lists what it added."""
+
+    def __init__(self, config: CampaignConfig, say, before: tuple[str, ...]) -> None:
+        self.config = config
+        self.say = say
+        self.added: list[str] = list(before)
+
+    def keep(self, case: Case, failed_spec: str | None) -> None:
+        """Add ``case`` to the corpus (when saving, and while it still fails)."""
+        c, say = self.config, self.say
+        if not c.save:
+            return
+        if failed_spec is not None and not case.expect[failed_spec]["diverged"]:
+            say(f"corpus: {case.name} not saved: {failed_spec} no longer fails once stored")
+            return
+        saved = save_case(case, c.corpus, force=c.force)
+        if saved is None:
+            if failed_spec is not None:
+                say(f"corpus: {case.name} already there (kept; --force to overwrite)")
+            return
+        say(f"corpus: added {saved}")
+        self.added.append(str(saved))
 
 
-def _shrunk_case(campaign, key: str, profile, meta: dict, seen: list) -> dict | None:
-    c = campaign.config
-    say = campaign.progress.say
-    start = campaign.progress.done
-    with campaign.evaluator(key) as ev:
+def _shrunk_case(
+    resolved: Resolved,
+    config: CampaignConfig,
+    threads: int,
+    progress: Progress,
+    keeper: _Keeper,
+    key: str,
+    profile,
+    meta: dict,
+    seen: list,
+) -> dict | None:
+    c, say, out = config, progress.say, config.out
+    start = progress.done
+    with resolved.evaluator(key, threads) as ev:
         try:
             res = shrink(profile, ev, budget=c.shrink_budget)
         except ValueError as exc:
             say(f"shrink: {key}/{meta['family']}: {exc}")
             return None
-    campaign.progress.update(start + res.evaluations, f"shrink: {key}/{meta['family']}")
+    progress.update(start + res.evaluations, f"shrink: {key}/{meta['family']}")
     if any(near(res.profile, other) for other in seen):
         # two failures shrank to (nearly) the same simplest profile: keep one
         say(f"shrink: {key}/{meta['family']} shrank to a profile already kept")
         return None
     seen.append(res.profile)
+    model = resolved.models[key]
     found_by = {
         "searcher": meta.get("searcher"),
         "seed": c.seed,
-        "model": campaign.specs[key],
-        "model_sha256": model_sha(campaign.specs[key], c.axis),
+        "model": model.spec,
+        "model_sha256": model.sha256,
         "campaign_budget": c.budget,
     }
     case = _case(
-        campaign, res.profile, meta["family"], meta.get("params"), found_by, shrink=res.summary()
-    )
-    path = save_case(case, campaign.out / "cases", force=True)
+        resolved, c, res.profile, meta["family"], meta.get("params"), found_by,
+        shrink=res.summary(),
+    )  # fmt: skip
+    path = save_case(case, out / "cases", force=True)
     say(
         f"shrink: {key}/{meta['family']} {res.original} -> {res.final} "
         f"(segments, samples, peak um) in {res.evaluations} evaluations: {_verdicts(case)}"
     )
-    _keep(campaign, case, key)
+    keeper.keep(case, model.spec)
     return {
         "failed_model": key,
         "family": meta["family"],
         "searcher": meta.get("searcher"),
         "shrink": res.summary(),
         "verdicts": case.expect,
-        "case_file": str(path.relative_to(campaign.out)),
+        "case_file": str(path.relative_to(out)),
         "name": case.name,
     }
 
 
-def paper_step_case(campaign) -> dict[str, Any]:
+def paper_step_case(
+    resolved: Resolved, config: CampaignConfig, progress: Progress, keeper: _Keeper
+) -> dict[str, Any]:
     """The papers' own case: a 4 mm step held 10 s, NN said to diverge after 7.3 s."""
-    c = campaign.config
-    x = ex.step_hold(4e-3, 10.0, campaign.dt, pre_s=0.5)
+    x = ex.step_hold(4e-3, 10.0, resolved.dt, pre_s=0.5)
+    target = resolved.models[resolved.target_key]
     found_by = {
         "searcher": "paper (seed 000 §5.2)",
         "seed": None,
-        "model": campaign.specs[campaign.target_key],
-        "model_sha256": model_sha(campaign.specs[campaign.target_key], c.axis),
+        "model": target.spec,
+        "model_sha256": target.sha256,
     }
     params = {"size_m": 4e-3, "hold_s": 10.0, "pre_s": 0.5, "rise_s": 0.0}
     notes = (
         "seed 000 §5.2: the papers' NN diverges after 7.3 s of this step; the "
         "verdicts recorded here are what the shipped models do"
     )
-    case = _case(campaign, x, "step", params, found_by, notes=notes)
-    path = save_case(case, campaign.out / "cases", force=True)
-    campaign.progress.say(f"paper step (4 mm, 10 s hold): {_verdicts(case)}")
-    _keep(campaign, case, None)
+    case = _case(resolved, config, x, "step", params, found_by, notes=notes)
+    path = save_case(case, config.out / "cases", force=True)
+    progress.say(f"paper step (4 mm, 10 s hold): {_verdicts(case)}")
+    keeper.keep(case, None)
     return {
         "failed_model": None,
         "family": "step",
         "searcher": "paper",
         "shrink": None,
         "verdicts": case.expect,
-        "case_file": str(path.relative_to(campaign.out)),
+        "case_file": str(path.relative_to(config.out)),
         "name": case.name,
     }
 
 
-def shrink_and_save(campaign) -> None:
+def shrink_failures(
+    resolved: Resolved,
+    searched: Searched,
+    rechecked: Rechecked,
+    config: CampaignConfig,
+    threads: int,
+    progress: Progress,
+    corpus_before: tuple[str, ...] = (),
+) -> Shrunk:
     """Shrink the chosen failures, write their cases; the papers' step when asked for."""
-    if campaign.report["shrunk"]:
-        campaign.progress.say("shrink: done earlier (resumed)")
-        return
+    keeper = _Keeper(config, progress.say, corpus_before)
     shrunk: list[dict] = []
     seen: list[np.ndarray] = []
-    for key, profile, meta in shrink_choices(campaign):
-        entry = _shrunk_case(campaign, key, profile, meta, seen)
+    for key, profile, meta in shrink_choices(resolved, searched, rechecked, config.max_shrink):
+        entry = _shrunk_case(resolved, config, threads, progress, keeper, key, profile, meta, seen)
         if entry is not None:
             shrunk.append(entry)
-    if campaign.config.paper_step and campaign.target.paper_step:
-        shrunk.append(paper_step_case(campaign))
-    campaign.report["shrunk"] = shrunk
-    campaign.save()
+    if config.paper_step and resolved.target.paper_step:
+        shrunk.append(paper_step_case(resolved, config, progress, keeper))
+    return Shrunk(tuple(shrunk), tuple(keeper.added))

@@ -16,10 +16,18 @@ stroke).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
 from bushenv.certify import CertifyError, CertifyOptions, certify
-from bushenv.search.base import Searcher
+from bushenv.progress import Progress
+from bushenv.search.base import SearchContext, Searcher
+from bushenv.search.campaign_config import CampaignConfig
+from bushenv.search.campaign_resolve import Resolved
+from bushenv.search.campaign_search import Searched, search_one
 
 NAME = "cert-holds"
 HOLD_PROFILE_S = 10.0
@@ -60,9 +68,10 @@ class CertificateHolds(Searcher):
         self.holds = holds
         self.verdicts: list[dict] = []
 
-    def _search(self, evaluator, budget, rng, recorder, seed, progress) -> None:
+    def search(self, ctx: SearchContext) -> None:
         if not self.holds:
             return
+        evaluator, recorder, progress = ctx.evaluator, ctx.recorder, ctx.progress
         dt, vmax = evaluator.dt, evaluator.scales.velocity_m_per_s
         profiles = [step_and_hold(h["x_m"], vmax, dt) for h in self.holds]
         batch = evaluator.evaluate(profiles)
@@ -81,3 +90,48 @@ class CertificateHolds(Searcher):
             f"{sum(x['confirmed'] for x in self.verdicts)} of {len(self.holds)} listed holds "
             "confirmed by the judge"
         )
+
+
+@dataclass(frozen=True)
+class HoldStage:
+    """The stage's outcome: the search summary filed under ``NAME`` beside the target's
+    searches (None: no search ran) and the report's ``hold_stage`` entry (None: resumed)."""
+
+    summary: Mapping[str, Any] | None = None
+    entry: Mapping[str, Any] | None = None
+
+    def searched(self, resolved: Resolved, out) -> Searched:
+        """The stage's search as a ``Searched`` (to merge with the target's searches)."""
+        runs = {resolved.target_key: {NAME: self.summary}} if self.summary else {}
+        return Searched(out, runs)
+
+
+def hold_stage(
+    resolved: Resolved,
+    config: CampaignConfig,
+    threads: int,
+    progress: Progress,
+    searched: Searched,
+) -> HoldStage:
+    """Simulate every hold the target's certificate lists as failing (a resumed report that
+    holds the stage's search is left as it is)."""
+    key = resolved.target_key
+    if NAME in searched.of(key):
+        progress.say(f"[{key}] {NAME}: done earlier (resumed)")
+        return HoldStage()
+    model = resolved.models[key].model
+    holds = listed_holds(model, resolved.judge.reference, resolved.judge.scales.stroke_m)
+    if holds is None:
+        return HoldStage(entry={"run": False, "why": "not a NARX network (no certificate)"})
+    if not holds:
+        progress.say(f"[{key}] {NAME}: the certificate lists none")
+        return HoldStage(entry={"run": True, "listed": 0, "confirmed": 0, "holds": []})
+    stage = CertificateHolds(holds)
+    summary = search_one(resolved, key, NAME, config, threads, progress, stage, len(holds))
+    entry = {
+        "run": True,
+        "listed": len(holds),
+        "confirmed": sum(v["confirmed"] for v in stage.verdicts),
+        "holds": stage.verdicts,
+    }
+    return HoldStage(summary, entry)

@@ -13,13 +13,15 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv.identify.linear import CONTROL_RECORD_S, fitted_linear  # noqa: F401 (re-export)
-from bushenv.judge import card_of
+from bushenv.judge import Judge
 from bushenv.models import MODELS
+from bushenv.resolved import ResolvedModel
+from bushenv.search.campaign_config import CampaignConfig
 
 FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
 
 
-def roles(config, judge, notes: list[str]) -> list[tuple[str, str]]:
+def roles(config: CampaignConfig, judge: Judge, notes: list[str]) -> list[tuple[str, str]]:
     """(role, spec) for the target, the hybrid (when there is one), the control and, for a
     target whose registry entry names them, the models rechecked beside it (``also``)."""
     builtin = judge.builtin
@@ -55,20 +57,22 @@ def roles(config, judge, notes: list[str]) -> list[tuple[str, str]]:
     return out
 
 
-def card_displacements(spec: str | None) -> list[np.ndarray] | None:
-    """The displacement of the training records a reference file's card names, when they are
-    all still there (checked against the card's hashes), else None."""
-    card = card_of(spec)
-    if card is None:
+def card_displacements(reference: ResolvedModel | None) -> list[np.ndarray] | None:
+    """The displacement of the training records the reference's card names, when they are
+    all still there (checked against the card's hashes, with the card read once, at
+    resolving), else None."""
+    if reference is None or reference.card is None:
         return None
-    from bushenv.identify.card import card_paths, load_card
+    from bushenv.identify.card import ModelCard
     from bushenv.records import load_csv
 
     # record files are relative to the card (older cards: absolute)
-    here = card_paths(spec)[0].parent
-    paths = [here / r["file"] for r in card["records"] if r.get("role") == "train" and r["file"]]
+    card = ModelCard(reference.card_file, reference.card)
+    here = card.path.parent
+    records = card.records
+    paths = [here / r["file"] for r in records if r.get("role") == "train" and r["file"]]
     if not paths or not all(p.is_file() for p in paths):
         return None
 
-    load_card(spec, records=paths)  # CardError naming a record that changed since
+    card.verify_records(paths)  # CardError naming a record that changed since
     return [load_csv(p).displacement for p in paths]

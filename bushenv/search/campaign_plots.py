@@ -9,10 +9,16 @@ that gives back more than it took generates energy, which a bounded-looking forc
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import numpy as np
 
 from bushenv.divergence import cumulative_work
-from bushenv.persist import load_profiles, write_figure
+from bushenv.persist import write_figure
+from bushenv.search.campaign_cases import Shrunk
+from bushenv.search.campaign_resolve import Resolved
+from bushenv.search.campaign_search import Searched
 from bushenv.search.corpus import load_case
 
 REF_COLOUR, MODEL_COLOUR, FAIL_COLOUR = "tab:blue", "tab:red", "tab:purple"
@@ -47,32 +53,22 @@ def _row(axes, t, profile, x, fm, fr, verdict: dict, key: str, profile_label: st
     ax_l.legend(fontsize=7, loc="upper left")
 
 
-def _worst_rows(campaign, key: str) -> list[tuple[str, np.ndarray, dict]]:
-    rows = []
-    for name, summary in campaign.report["models"][key]["searchers"].items():
-        f = summary.get("profiles_file")
-        if f:
-            ps, ms = load_profiles(campaign.out / f)
-            worst = [(p, m) for p, m in zip(ps, ms, strict=True) if m.get("worst")]
-            if worst:
-                rows.append((name, *worst[0]))
-    return rows
-
-
 def _figure(plt, n_rows: int):
     return plt.subplots(n_rows, 3, figsize=(15, 2.8 * n_rows), squeeze=False)
 
 
-def plot_worst(campaign, plt, plot_dir) -> list[str]:
+def plot_worst(
+    resolved: Resolved, searched: Searched, threads: int, plt: Any, plot_dir: Path
+) -> list[str]:
     """``plots/worst-<model>.png``: each search's worst profile on that model."""
-    dt, label = campaign.dt, campaign.target.profile_label
+    dt, label = resolved.dt, resolved.target.profile_label
     names = []
-    for key in campaign.models:
-        rows = _worst_rows(campaign, key)
+    for key in resolved.models:
+        rows = searched.worst(key)
         if not rows:
             continue
         fig, axes = _figure(plt, len(rows))
-        with campaign.evaluator(key) as ev:
+        with resolved.evaluator(key, threads) as ev:
             batch = ev.evaluate([p for _, p, _ in rows])
         for r, (name, p, m) in enumerate(rows):
             n, v = p.size, m["verdict"]
@@ -93,17 +89,19 @@ def plot_worst(campaign, plt, plot_dir) -> list[str]:
     return names
 
 
-def plot_shrunk(campaign, plt, plot_dir) -> list[str]:
+def plot_shrunk(
+    resolved: Resolved, shrunk: Shrunk, out: Path, threads: int, plt: Any, plot_dir: Path
+) -> list[str]:
     """``plots/shrunk-<i>.png``: each shrunk failure on every model of the campaign."""
-    dt, label = campaign.dt, campaign.target.profile_label
+    dt, label = resolved.dt, resolved.target.profile_label
     names = []
-    for i, entry in enumerate(campaign.report["shrunk"]):
-        case = load_case(campaign.out / entry["case_file"])
+    for i, entry in enumerate(shrunk.entries):
+        case = load_case(out / entry["case_file"])
         p = case.profile
         t = np.arange(p.size) * dt
-        fig, axes = _figure(plt, len(campaign.models))
-        for r, key in enumerate(campaign.models):
-            with campaign.evaluator(key) as ev:
+        fig, axes = _figure(plt, len(resolved.models))
+        for r, key in enumerate(resolved.models):
+            with resolved.evaluator(key, threads) as ev:
                 b = ev.evaluate([p])
             row = b.verdict.row(0)
             fr = None if b.f_ref is None else b.f_ref[:, 0]
@@ -118,13 +116,16 @@ def plot_shrunk(campaign, plt, plot_dir) -> list[str]:
     return names
 
 
-def plot_campaign(campaign) -> list[str]:
-    """Every plot of the campaign in ``DIR/plots``; returns their file names."""
+def plot_campaign(
+    resolved: Resolved, searched: Searched, shrunk: Shrunk, out: Path, threads: int = 1
+) -> list[str]:
+    """Every plot of the campaign in ``out/plots``; returns their file names."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    plot_dir = campaign.out / "plots"
+    plot_dir = out / "plots"
     plot_dir.mkdir(parents=True, exist_ok=True)
-    return plot_worst(campaign, plt, plot_dir) + plot_shrunk(campaign, plt, plot_dir)
+    worst = plot_worst(resolved, searched, threads, plt, plot_dir)
+    return worst + plot_shrunk(resolved, shrunk, out, threads, plt, plot_dir)

@@ -20,8 +20,10 @@ from pathlib import Path
 from typing import Any
 
 from bushenv.errors import BadInput
-from bushenv.models import file_hash, model_file, params_sha
-from bushenv.search.corpus import reference_identity
+from bushenv.models import params_sha
+from bushenv.resolved import ResolvedModel
+from bushenv.search.campaign_config import CampaignConfig
+from bushenv.search.campaign_resolve import Resolved
 
 REPORT_FORMAT = "bushenv-attack-report"
 REPORT_VERSION = 1
@@ -31,40 +33,41 @@ class ReportError(BadInput):
     """A report that cannot be resumed; the message says why and what to do."""
 
 
-def model_identity(spec: str, model, axis: str) -> dict[str, Any]:
+def model_identity(model: ResolvedModel) -> dict[str, Any]:
     """Which model a report row is: its spec, class, file and hashes."""
-    path = model_file(spec, axis)
-    if path is not None and not path.is_file():
-        path = None
     return {
-        "spec": spec,
-        "class": type(model).__name__,
-        "file": str(path) if path else None,
-        "sha256": file_hash(path) if path else None,
-        "params_sha256": params_sha(model),
+        "spec": model.spec,
+        "class": type(model.model).__name__,
+        "file": str(model.file) if model.file else None,
+        "sha256": model.sha256,
+        "params_sha256": params_sha(model.model),
     }
 
 
-def fresh_report(campaign) -> dict[str, Any]:
+def criteria_json(resolved: Resolved) -> dict[str, Any]:
+    """Which criteria the verdicts used, and why some did not run (the judge's)."""
+    judge = resolved.judge
+    why = judge.why
+    if judge.reference is not None:
+        why = f"{why} {judge.reference_spec!r}"
+    return {"run": list(judge.criteria), "why": why}
+
+
+def fresh_report(resolved: Resolved, config: CampaignConfig) -> dict[str, Any]:
     """The report of a campaign that has run nothing yet."""
-    c = campaign.config
     return {
         "format": REPORT_FORMAT,
         "version": REPORT_VERSION,
-        "arguments": c.arguments(),
-        "searchers": list(c.searchers),
-        "reference": reference_identity(campaign.reference_spec, campaign.reference, c.axis),
-        "scales": campaign.scales.to_json(),
-        "judge": campaign.judge.describe(),
-        "criteria": campaign.criteria(),
-        "notes": list(campaign.notes),
+        "arguments": config.arguments(),
+        "searchers": list(config.searchers),
+        "reference": resolved.reference_identity(),
+        "scales": resolved.judge.scales.to_json(),
+        "judge": resolved.judge.describe(),
+        "criteria": criteria_json(resolved),
+        "notes": list(resolved.notes),
         "models": {
-            key: {
-                "role": campaign.roles[key],
-                **model_identity(campaign.specs[key], m, c.axis),
-                "searchers": {},
-            }
-            for key, m in campaign.models.items()
+            key: {"role": resolved.roles[key], **model_identity(m), "searchers": {}}
+            for key, m in resolved.models.items()
         },
         "recheck": {},
         "shrunk": [],
@@ -72,6 +75,12 @@ def fresh_report(campaign) -> dict[str, Any]:
         "complete": False,
         "seconds": 0.0,
     }
+
+
+def control_flagged(report: dict[str, Any], control_key: str | None) -> bool:
+    """Whether any search made the control diverge (the criteria are then at fault)."""
+    control = report["models"].get(control_key, {}).get("searchers", {})
+    return any(s["diverged"] for s in control.values())
 
 
 def resumed_report(path: Path, fresh: dict[str, Any]) -> dict[str, Any]:

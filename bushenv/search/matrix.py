@@ -3,9 +3,10 @@
     bushenv campaign --models nn,hybrid,boucwen --axes axial,radial \\
         --searchers random,cma,ppo --seeds 0-9 --budget 256 --out runs/matrix [--ray]
 
-Each cell is one search run (``run_cell``): the model (a name's default for the axis, or a
-file) against ``--reference`` (default the rubber; a name, a file, or none), one searcher, one
-seed, ``budget`` model evaluations. Cells are pure
+Each cell is one search run (``run_cell``), the attack's own stages for one model (resolve,
+then search: ``campaign_resolve``, ``campaign_search``): the model (a name's default for the
+axis, or a file) against ``--reference`` (default the rubber; a name, a file, or none), one
+searcher, one seed, ``budget`` model evaluations. Cells are pure
 functions of their description, so the local process pool and a Ray cluster give the same
 results for the same seeds (wall-clock fields aside: ``seconds``, ``seconds_to_failure``).
 
@@ -20,7 +21,7 @@ the divergence rate and the median evaluations to failure.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from itertools import product
 from pathlib import Path
 from typing import Any
@@ -28,13 +29,14 @@ from typing import Any
 import numpy as np
 
 from bushenv.errors import BadInput
-from bushenv.judge import build_judge
-from bushenv.models import MODELS, ModelError, check_axis, get_model
+from bushenv.models import MODELS, ModelError, check_axis
 from bushenv.persist import write_figure, write_json, write_text
 from bushenv.progress import Progress
+from bushenv.resolved import resolve_model
 from bushenv.runlog import RunLog, run_cells
-from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.searchers import SEARCHERS, get_searcher
+from bushenv.search.campaign_resolve import resolve_target
+from bushenv.search.campaign_search import run_search
+from bushenv.search.searchers import SEARCHERS
 from bushenv.search.targets import TARGETS
 
 WALL_CLOCK_FIELDS = ("seconds", "seconds_to_failure", "wall_s", "worker_backend")
@@ -106,28 +108,23 @@ def make_cells(
 
 
 def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
-    """One search run; a pure function of ``cell`` (module-level, so any backend can ship it)."""
+    """One search run; a pure function of ``cell`` (module-level, so any backend can ship it):
+    the attack's stages for one model, resolve then search (``campaign_resolve``,
+    ``campaign_search``)."""
     import torch
 
     torch.set_num_threads(1)
-    axis = cell["axis"]
-    model = get_model(cell["model"], axis=axis)
-    judge = build_judge(
+    resolved = resolve_target(
         cell["model"],
         cell.get("reference", "rubber"),
-        axis=axis,
-        dt=model.dt,
-        target=TARGETS[cell["env"]],
+        axis=cell["axis"],
+        target=cell["env"],
         trust_reference=bool(cell.get("trust_reference", False)),
-        model_object=model,
     )
     t0 = time.perf_counter()
-    evaluator = BatchEvaluator(
-        model, judge.reference, cell["env"], 1, axis, scales=judge.scales, static=judge.static
-    )
-    with evaluator as ev:
-        result = get_searcher(cell["searcher"]).run(ev, cell["budget"], seed=cell["seed"])
-    out = {**cell, **result.summary(), "judge": judge.describe()}
+    key = resolved.target_key
+    result = run_search(resolved, key, cell["searcher"], cell["budget"], cell["seed"])
+    out = {**cell, **result.summary(), "judge": resolved.judge.describe()}
     out["wall_s"] = time.perf_counter() - t0
     return out
 
@@ -253,7 +250,7 @@ def write_summary(out: Path, summary: dict[str, Any]) -> None:
     write_figure(fig, out / "summary.png", dpi=110)
 
 
-@dataclass
+@dataclass(frozen=True)
 class MatrixConfig:
     """A campaign matrix; ``bushenv campaign`` translates its arguments into this."""
 
@@ -289,18 +286,17 @@ class MatrixConfig:
         for m, a in product(self.models, self.axes):
             check_axis(a)
             try:
-                model = get_model(m, axis=a)
+                model = resolve_model(m, a, card=True)
             except ModelError as exc:
                 raise MatrixError(f"model {m!r} ({a}): {exc}") from None
             try:  # the judge every cell of this model and axis gets, vetted before any runs
-                build_judge(m, self.reference, axis=a, dt=model.dt, target=TARGETS[self.target],
-                            model_object=model)  # fmt: skip
+                resolve_target(model, self.reference, axis=a, target=self.target)
             except ModelError as exc:
                 raise MatrixError(f"--reference {self.reference!r} ({a}): {exc}") from None
-        self.out = Path(self.out)
-        if self.out.exists() and not self.out.is_dir():
-            raise MatrixError(f"--out {self.out}: exists and is not a folder")
-        return self
+        out = Path(self.out)
+        if out.exists() and not out.is_dir():
+            raise MatrixError(f"--out {out}: exists and is not a folder")
+        return replace(self, out=out)
 
     def cells(self) -> list[dict[str, Any]]:
         return make_cells(

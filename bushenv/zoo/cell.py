@@ -27,11 +27,11 @@ from bushenv import excitation as ex
 from bushenv import metrics
 from bushenv.certify import CertifyOptions, certify
 from bushenv.identify import fit_model
-from bushenv.judge import build_judge
 from bushenv.machine import random_test
 from bushenv.reference.rubber import RubberBushing
-from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.searchers import get_searcher
+from bushenv.resolved import resolved as resolved_as
+from bushenv.search.campaign_resolve import Resolved, resolve_target
+from bushenv.search.campaign_search import run_search
 
 STEP_M = 4e-3  # the papers' step (seed 000 §5.2)
 STEP_HOLD_S = 10.0
@@ -75,14 +75,12 @@ def _certificate(model, reference) -> dict[str, Any]:
     return {k: s[k] for k in keep}
 
 
-def _steps(model, judge) -> dict[str, Any]:
+def _steps(resolved: Resolved) -> dict[str, Any]:
     """The papers' step both ways: verdict, departure time, held force beside the reference's."""
-    dt = model.dt
+    dt = resolved.dt
     out = {}
     profiles = [ex.step_hold(s * STEP_M, STEP_HOLD_S, dt, pre_s=1.0) for s in (1, -1)]
-    with BatchEvaluator(
-        model, judge.reference, "rig", scales=judge.scales, static=judge.static
-    ) as ev:
+    with resolved.evaluator(resolved.target_key) as ev:
         batch = ev.evaluate(profiles)
     departure = batch.verdict.criterion_first_s["self_sustained"]
     for b, name in enumerate(("+4mm", "-4mm")):
@@ -100,11 +98,9 @@ def _steps(model, judge) -> dict[str, Any]:
     return out
 
 
-def _attack(model, judge, searcher: str, budget: int, seed: int) -> dict[str, Any]:
-    with BatchEvaluator(
-        model, judge.reference, "rig", scales=judge.scales, static=judge.static
-    ) as ev:
-        res = get_searcher(searcher).run(ev, budget, seed=seed)
+def _attack(resolved: Resolved, searcher: str, budget: int, seed: int) -> dict[str, Any]:
+    """One search of the attack's (``campaign_search.run_search``) on the member."""
+    res = run_search(resolved, resolved.target_key, searcher, budget, seed)
     ff = res.first_failure
     return {
         "diverged": res.diverged,
@@ -139,8 +135,9 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     )
     train_s = time.perf_counter() - t0
     path = model.save(Path(cell["out"]) / "models" / f"{cell_name(cell)}.npz")
-    judge = build_judge(model, "rubber", axis=axis, dt=model.dt, model_object=model)
-    reference = judge.reference
+    # the attack's resolve stage, on the member as trained (its file hashed, no card read)
+    resolved = resolve_target(resolved_as(path, model, axis), "rubber", axis=axis)
+    reference = resolved.judge.reference
     t1 = time.perf_counter()
     row = {
         **cell,
@@ -148,10 +145,9 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
         "train_s": train_s,
         "accuracy": _accuracy(model, seen, beyond),
         "certificate": _certificate(model, reference),
-        "step": _steps(model, judge),
+        "step": _steps(resolved),
         "attacks": {
-            s: _attack(model, judge, s, int(cell["budget"]), seed)
-            for s in cell["searchers"].split(",")
+            s: _attack(resolved, s, int(cell["budget"]), seed) for s in cell["searchers"].split(",")
         },
     }
     row["judge_s"] = time.perf_counter() - t1

@@ -11,7 +11,7 @@ when every cell is done, ``DIR/summary.json``, ``summary.md`` and
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import product
 from pathlib import Path
 from typing import Any
@@ -37,7 +37,7 @@ class ZooError(BadInput):
     """Bad population-study settings or results file; the message says which."""
 
 
-@dataclass
+@dataclass(frozen=True)
 class ZooConfig:
     recipes: tuple[str, ...] = RECIPES
     models: tuple[str, ...] = NARX_MODELS
@@ -62,8 +62,7 @@ class ZooConfig:
             check_axis(a)
         if self.budget < 1:
             raise ZooError(f"--budget must be >= 1 evaluation, got {self.budget}")
-        self.out = Path(self.out)
-        return self
+        return replace(self, out=Path(self.out))
 
     def cells(self) -> list[dict[str, Any]]:
         return [

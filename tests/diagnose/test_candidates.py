@@ -148,8 +148,8 @@ def test_other_baselines_refuse_a_test_at_another_rate_and_the_cross_mode(monkey
 def test_a_test_equal_to_train_is_flagged_as_not_held_out():
     train = record(10, "none", duration_s=8.0)
     result = diagnose(train, [train], test_names=["same"])
-    assert "TEST same is the TRAIN record rec10 itself: its gap is not held out." in (
-        result["notes"]
+    assert (
+        "TEST same is the TRAIN record rec10 itself: its gap is not held out." in (result["notes"])
     )
 
 

@@ -93,18 +93,3 @@ def test_a_searcher_without_the_hook_cannot_be_made():
 
     with pytest.raises(TypeError, match="search"):
         NoHook()
-
-
-def test_a_searcher_written_for_the_old_hook_still_runs(linear_axial, reference_axial):
-    from bushenv.search.evaluate import BatchEvaluator
-
-    class OldHook(Searcher):
-        name = "old_hook"
-
-        def _search(self, evaluator, budget, rng, recorder, seed, progress):
-            fam = evaluator.target.family("step")
-            profiles = [fam.profile(rng.random(fam.dim), evaluator.dt) for _ in range(budget)]
-            recorder.record(evaluator.evaluate(profiles), ["step"] * budget, [None] * budget)
-
-    res = OldHook().run(BatchEvaluator(linear_axial, reference_axial), 3, seed=0)
-    assert res.evaluations == 3 and res.searcher == "old_hook"
