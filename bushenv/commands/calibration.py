@@ -1,4 +1,4 @@
-"""``python -m bushenv.reference.calibration``: the reference bushing measured against the
+"""``python -m bushenv.commands.calibration``: the reference bushing measured against the
 papers (``bushenv/reference/calibration.py``), printed as the tables of docs/reference.md."""
 
 from __future__ import annotations

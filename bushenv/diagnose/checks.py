@@ -20,7 +20,7 @@ from scipy.optimize import lsq_linear
 
 from bushenv.diagnose.candidates import EFFECTS, get_effect
 from bushenv.diagnose.effects.base import Effect, Scales, Signals, contract_problem
-from bushenv.diagnose.effects.delay import shift_columns
+from bushenv.diagnose.effects.timeshift import shift_columns
 
 K_N_PER_M = 380e3  # the probe bushing: seed 000's axial Table 1
 C_NS_PER_M = 4.4e3

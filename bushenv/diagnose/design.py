@@ -19,7 +19,7 @@ from scipy import signal
 
 from bushenv.diagnose.candidates import get_effect
 from bushenv.diagnose.effects.base import Scales, Signals
-from bushenv.diagnose.effects.delay import shift_columns
+from bushenv.diagnose.effects.timeshift import shift_columns
 
 _UIDS = count()
 SPRING = ("spring", "x,v")  # the linear spring and damper block (or the baseline's correction)

@@ -18,7 +18,7 @@ from scipy.optimize import lsq_linear, minimize_scalar
 
 from bushenv.diagnose.design import DAMPER, SPRING, Block, ColumnStore, Prepared
 from bushenv.diagnose.effects.base import Combination
-from bushenv.diagnose.effects.delay import shift_columns
+from bushenv.diagnose.effects.timeshift import shift_columns
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,12 @@ from pathlib import Path
 from bushenv.models.base import AXES, DT_TOLERANCE, PAPER_DT, BushingModel, ModelError
 from bushenv.models.files import file_hash, load_model, params_sha
 from bushenv.models.registry import MODELS, ModelEntry
+from bushenv.registry import Registry, load_entry_point
+
+# Model files other than bushenv's own .npz, by suffix: a loader living above the models (the
+# FMU's, in bushenv.export) is named by its "module:attribute" and imported on first use.
+MODEL_FILES: Registry = Registry("model file type", ModelError)
+MODEL_FILES.add(".fmu", "bushenv.export.fmu_model:load_fmu")
 
 ModelSpec = str | os.PathLike | BushingModel
 
@@ -90,10 +96,10 @@ def get_model(
                 )
             return load_model(path, dt=dt)
         return entry.model_class().preset(axis=axis, dt=dt or PAPER_DT, **(preset or {}))
-    if text.endswith(".fmu"):  # an FMU through FMPy (bushenv.export.fmu_model)
-        from bushenv.export.fmu_model import load_fmu
-
-        return load_fmu(text, dt=dt)
+    suffix = Path(text).suffix.lower()
+    if suffix in MODEL_FILES:  # e.g. an FMU, run through FMPy
+        loader = MODEL_FILES[suffix]
+        return (load_entry_point(loader) if isinstance(loader, str) else loader)(text, dt=dt)
     if text.endswith(".npz") or Path(text).exists():
         return load_model(text, dt=dt)
     raise ModelError(f"{MODELS.unknown_message(text)} or a .npz model file")

@@ -1,3 +1,3 @@
 """The reference ("real") rubber bushing: ``rubber.py`` (the model, registered as ``rubber``),
 ``kernel.py`` (its one compiled kernel), ``calibration.py`` (how it is measured against the
-papers: ``python -m bushenv.reference.calibration --behaviour``). See docs/reference.md."""
+papers: ``python -m bushenv.commands.calibration --behaviour``). See docs/reference.md."""

@@ -9,9 +9,8 @@ axial, 11.9 % radial). ``calibration_numbers(axis)`` repeats that on the referen
    squares (``linear_fit``), as ``bushenv.machine.papers_programme`` records it;
 2. run that linear model on the unseen n = 1.5 record (20 s, next seed); ``rms_ratio``.
 
-Run ``python -m bushenv.reference.calibration`` to print the numbers for both axes (they are
-recorded in ``rubber.py`` and docs/reference.md); the printing is
-``bushenv/commands/calibration.py``.
+Run ``python -m bushenv.commands.calibration`` to print the numbers for both axes (they are
+recorded in ``rubber.py`` and docs/reference.md).
 """
 
 from __future__ import annotations
@@ -120,9 +119,3 @@ def behaviour_numbers(axis: str, dt: float = PAPER_DT) -> dict[str, object]:
         "kdyn_n_per_mm": kdyn,
         "loop_energy_j": energy,
     }
-
-
-if __name__ == "__main__":  # python -m bushenv.reference.calibration: the printing command
-    from bushenv.commands.calibration import main
-
-    raise SystemExit(main())

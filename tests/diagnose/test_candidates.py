@@ -9,9 +9,9 @@ from bushenv.diagnose.candidates import (
     get_effect,
 )
 from bushenv.diagnose.effects.base import NULL, Scales, Signals
-from bushenv.diagnose.effects.delay import shift_columns
 from bushenv.diagnose.effects.friction import Friction, dahl_states
 from bushenv.diagnose.effects.relaxation import Relaxation, maxwell_state
+from bushenv.diagnose.effects.timeshift import shift_columns
 from bushenv.diagnose.fit import diagnose
 
 from .synthetic import record

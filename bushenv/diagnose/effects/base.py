@@ -19,6 +19,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from bushenv.diagnose.effects.timeshift import shift_columns
 from bushenv.models.base import velocity_of
 
 STENCILS = ("central", "five_point")
@@ -174,8 +175,6 @@ class Effect(ABC):
         """The force measured when this effect (``shape``, weights ``w``) acts on a specimen
         whose own force is ``force`` (T,), N: the regressors' weighted sum added, the whole
         seen through the delay -- the diagnosis's own prediction (``fitting.predict``)."""
-        from bushenv.diagnose.effects.delay import shift_columns
-
         total = np.asarray(force, dtype=np.float64)
         cols = self.columns(s, shape, scales)
         if cols.shape[1]:
