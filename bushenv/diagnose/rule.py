@@ -108,10 +108,10 @@ def mark_passes(rows: list[dict[str, Any]], ctx: Context) -> None:
         r["z_vs_null"] = float(cut_z(ctx.force, ctx.null_pred, r["_pred"], ctx.edges))
         r["closes_excess"] = ctx.closes(r["gap_after"], ctx.gap_null)
         r["significant"] = bool(r["z_vs_null"] >= Z_NAME or r["closes_excess"] >= CLEAR_CUT)
-        r["passes_unless_lag"] = bool(
+        r["_passes_unless_lag"] = bool(
             not r["failed_to_fit"] and r["significant"] and r["closes_excess"] >= SHRINK_MIN
         )
-        r["passes"] = bool(r["passes_unless_lag"] and _lag_ok(r, ctx))
+        r["passes"] = bool(r["_passes_unless_lag"] and _lag_ok(r, ctx))
 
 
 def mark_pairs(singles: list[dict], pairs: list[dict], ctx: Context) -> None:
@@ -130,7 +130,7 @@ def mark_pairs(singles: list[dict], pairs: list[dict], ctx: Context) -> None:
         r["members_add"] = bool(all(adds))
         closes = r["gap_after"] <= (1.0 - PAIR_GAIN_MIN) * best_gap
         pair_ok = open_for_pairs and r["members_add"] and closes
-        r["passes_unless_lag"] = bool(pair_ok and r["passes_unless_lag"])
+        r["_passes_unless_lag"] = bool(pair_ok and r["_passes_unless_lag"])
         r["passes"] = bool(pair_ok and r["passes"])
 
 
@@ -187,7 +187,7 @@ def _unseen_delay_rival(rows: list[dict], chosen: dict, ctx: Context) -> dict | 
     if ctx.lag.seen or "delay" in chosen["members"]:
         return None
     for r in rows:
-        if "delay" in r["members"] and r.get("passes_unless_lag"):
+        if "delay" in r["members"] and r.get("_passes_unless_lag"):
             if r["gap_after"] <= (1.0 + TIE_GAP) * chosen["gap_after"]:
                 return r
     return None

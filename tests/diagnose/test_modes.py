@@ -222,13 +222,13 @@ def test_a_delay_that_fits_better_but_whose_lag_is_not_seen_leaves_the_answer_am
     rows = [a, delay]
     rule.mark_failed(rows, ctx)
     rule.mark_passes(rows, ctx)
-    assert a["passes"] and not delay["passes"] and delay["passes_unless_lag"]
+    assert a["passes"] and not delay["passes"] and delay["_passes_unless_lag"]
     ans = rule.answer(rule.rank(rows, ["delay", "relaxation"], ctx), [], ctx)
     assert ans.effect == rule.AMBIGUOUS and set(ans.between) == {"relaxation", "delay"}
     # a delay that fits clearly worse leaves the relaxation named
     weak = row("delay", ["delay"], 0.5 * r1, 1)
     rule.mark_failed([weak], ctx)
     rule.mark_passes([weak], ctx)
-    assert weak["passes_unless_lag"]
+    assert weak["_passes_unless_lag"]
     ans = rule.answer(rule.rank([a, weak], ["relaxation", "delay"], ctx), [], ctx)
     assert ans.effect == "relaxation"
