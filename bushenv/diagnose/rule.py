@@ -218,8 +218,9 @@ def answer(singles: list[dict], pairs: list[dict], ctx: Context) -> Answer:
     if winners:
         best = winners[0]
         rival = _unseen_delay_rival(pairs, best, ctx)
-        if rival is not None:
-            between = [best["effect"], rival["effect"]]
+        if rival is not None:  # the effects the two pairs do not share
+            between = [m for m in best["members"] if m not in rival["members"]]
+            between += [m for m in rival["members"] if m not in best["members"]]
             return Answer(AMBIGUOUS, best, list(best["members"]), between)
         return Answer(best["effect"], best, list(best["members"]), [])
     passing = [r for r in ok if r["passes"]]

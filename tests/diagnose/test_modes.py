@@ -232,3 +232,20 @@ def test_a_delay_that_fits_better_but_whose_lag_is_not_seen_leaves_the_answer_am
     assert weak["_passes_unless_lag"]
     ans = rule.answer(rule.rank([a, weak], ["relaxation", "delay"], ctx), [], ctx)
     assert ans.effect == "relaxation"
+
+
+def test_a_pair_with_an_unseen_delay_that_fits_better_leaves_the_pair_answer_ambiguous():
+    ctx, a, b, row, r1, r2 = _rows_for_pair_rule()
+    b2 = row("friction", ["friction"], r2, 8)
+    d = row("delay", ["delay"], 0.2 * r2, 1)
+    named = row("relaxation+friction", ["relaxation", "friction"], r1 + 0.9 * r2, 20)
+    lagged = row("relaxation+delay", ["relaxation", "delay"], r1 + r2, 13)
+    singles, pairs = [a, b2, d], [named, lagged]
+    rule.mark_failed(singles + pairs, ctx)
+    rule.mark_passes(singles + pairs, ctx)
+    singles = rule.rank(singles, ["relaxation", "friction", "delay"], ctx)
+    rule.mark_pairs(singles, pairs, ctx)
+    assert named["passes"] and not lagged["passes"]
+    ans = rule.answer(singles, rule.rank(pairs, ["relaxation", "friction", "delay"], ctx), ctx)
+    assert ans.effect == rule.AMBIGUOUS and ans.between == ["friction", "delay"]
+    assert ans.top_two == ["relaxation", "friction"]
