@@ -211,3 +211,41 @@ def test_a_softening_backbone_is_named_hardening_with_a_monotone_falling_tangent
         k = [p["tangent_stiffness_n_per_m"] for p in back[side]]
         assert min(k) >= 0 and k[0] > k[3]
     assert back["positive_side"][0]["tangent_stiffness_n_per_m"] == pytest.approx(K, rel=0.15)
+
+
+def test_a_delay_that_fits_better_but_whose_lag_is_not_seen_leaves_the_answer_ambiguous():
+    """A short delay shows almost no phase: the lag test cannot see it, so it is not named,
+    but neither is the relaxation fitted in its place when the delay fits as well."""
+    ctx, a, _, row, r1, r2 = _rows_for_pair_rule()
+    assert not ctx.lag.seen
+    delay = row("delay", ["delay"], r1 + 0.5 * r2, 1)
+    rows = [a, delay]
+    rule.mark_failed(rows, ctx)
+    rule.mark_passes(rows, ctx)
+    assert a["passes"] and not delay["passes"] and delay["_passes_unless_lag"]
+    ans = rule.answer(rule.rank(rows, ["delay", "relaxation"], ctx), [], ctx)
+    assert ans.effect == rule.AMBIGUOUS and set(ans.between) == {"relaxation", "delay"}
+    # a delay that fits clearly worse leaves the relaxation named
+    weak = row("delay", ["delay"], 0.5 * r1, 1)
+    rule.mark_failed([weak], ctx)
+    rule.mark_passes([weak], ctx)
+    assert weak["_passes_unless_lag"]
+    ans = rule.answer(rule.rank([a, weak], ["relaxation", "delay"], ctx), [], ctx)
+    assert ans.effect == "relaxation"
+
+
+def test_a_pair_with_an_unseen_delay_that_fits_better_leaves_the_pair_answer_ambiguous():
+    ctx, a, b, row, r1, r2 = _rows_for_pair_rule()
+    b2 = row("friction", ["friction"], r2, 8)
+    d = row("delay", ["delay"], 0.2 * r2, 1)
+    named = row("relaxation+friction", ["relaxation", "friction"], r1 + 0.9 * r2, 20)
+    lagged = row("relaxation+delay", ["relaxation", "delay"], r1 + r2, 13)
+    singles, pairs = [a, b2, d], [named, lagged]
+    rule.mark_failed(singles + pairs, ctx)
+    rule.mark_passes(singles + pairs, ctx)
+    singles = rule.rank(singles, ["relaxation", "friction", "delay"], ctx)
+    rule.mark_pairs(singles, pairs, ctx)
+    assert named["passes"] and not lagged["passes"]
+    ans = rule.answer(singles, rule.rank(pairs, ["relaxation", "friction", "delay"], ctx), ctx)
+    assert ans.effect == rule.AMBIGUOUS and ans.between == ["friction", "delay"]
+    assert ans.top_two == ["relaxation", "friction"]
