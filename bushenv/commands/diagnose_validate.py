@@ -23,7 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="reference",
         choices=list(SETS),
         help="reference: the forms the candidates assume; widened: other forms, strengths, "
-        "rates and noise (docs/diagnose.md)",
+        "rates and noise; outside: effects none of the candidates models (docs/diagnose.md)",
     )
     parser.add_argument("--cases", type=int, default=70, help="number of blind cases")
     parser.add_argument("--seed", type=int, default=0, help="validation seed")

@@ -33,6 +33,7 @@ import numpy as np
 from bushenv.diagnose.candidates import effect_names
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import diagnose
+from bushenv.diagnose.outside_cases import make_outside_case
 from bushenv.diagnose.reference_cases import Case, make_case
 from bushenv.diagnose.report import check_out_dir
 from bushenv.diagnose.rule import AMBIGUOUS, OUTSIDE
@@ -43,6 +44,7 @@ from bushenv.progress import Progress, ProgressSpec
 SETS: dict[str, Callable[[int, int], Case]] = {
     "reference": make_case,
     "widened": make_widened_case,
+    "outside": make_outside_case,
 }
 
 
