@@ -1,0 +1,37 @@
+"""bushenv reproduce --planar: the 3-axis table beside seed 000 Table 3, apart from report.json."""
+
+import json
+
+import numpy as np
+
+import bushenv.planar.reproduce3 as r3
+from bushenv.cli import main
+from bushenv.metrics import rms_ratio
+from bushenv.models.base import PAPER_DT
+from bushenv.planar.fitting import fit_planar
+from bushenv.planar.programme import random_independent
+from bushenv.planar.reference import PlanarRubber
+
+
+def test_planar_only_writes_its_own_report_and_the_table_beside_table3(
+    tmp_path, monkeypatch, capsys
+):
+    monkeypatch.setattr(r3, "MODELS", ("linear",))
+    args = ["reproduce", "--planar", "only", "--identification-s", "8", "--verification-s", "7"]
+    assert main([*args, "--out", str(tmp_path), "--quiet"]) == 0
+    assert not (tmp_path / "report.json").exists()  # the papers' report (and its golden) untouched
+    report = json.loads((tmp_path / "planar.json").read_text())
+    assert list(report["records"]) == list(r3.unseen_records(PAPER_DT, 0, 7.0))
+    row = report["records"]["random correlated n=1"]["linear"]
+    assert set(row) == {"axial", "radial", "rotation"}
+    assert report["records"]["radial preload + rotation sweep"]["linear"]["axial"]["at_rest"]
+    out = capsys.readouterr().out
+    assert "seed 000 Table 3                 axial               10.9 / 24.9" in out
+    # the JSON is what the models do: recompute linear's radial RMS ratio on one record
+    q = random_independent(1.0, 8.0, PAPER_DT, 0)
+    lin = fit_planar([(q, PlanarRubber.preset(seed=0).simulate(q))], "linear", None, PAPER_DT)
+    qt = r3.unseen_records(PAPER_DT, 0, 7.0)["random correlated n=1"]
+    ft = PlanarRubber.preset(seed=101).simulate(qt)
+    want = rms_ratio(ft[:, 1], lin.model.simulate(qt)[:, 1])
+    assert np.isclose(row["radial"]["rms_ratio"], want, rtol=1e-12)
+    assert main([*args, "--out", str(tmp_path), "--quiet"]) == 2  # planar.json exists, no --force
