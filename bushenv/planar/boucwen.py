@@ -1,6 +1,8 @@
 """Vector Bouc-Wen bushing: one hysteretic state on the deflection vector, plus 3x3 K and C.
 
-    f = K q + C v + h (.) z                    (N, N, N m; ``h`` one force scale per axis)
+    f = K q + C v + h (.) z + G3(q)            (N, N, N m; ``h`` one force scale per axis)
+    G3(q)_i = sum_j G_ij q_i q_j^2             (cubic stiffness: hardening on the diagonal,
+                                                stiffening of axis i by a deflection in j off it)
     u = q / d                                  (scaled deflection, d = yield deflection m, m, rad)
     dz = du - |z|^(eta - 2) z [beta |z . du| + gamma (z . du)]
 
@@ -53,7 +55,7 @@ def _dz(z0, z1, z2, d0, d1, d2, beta, gamma, eta, out):
 
 
 @nb.njit(cache=True)
-def vector_boucwen_kernel(q, v, state, k, c, h, d, beta, gamma, eta, out):
+def vector_boucwen_kernel(q, v, state, k, c, g, h, d, beta, gamma, eta, out):
     """(T, B, 3) q, v -> out; state rows: z (3), previous q (3)."""
     T, B, _ = q.shape
     k1 = np.empty(3)
@@ -101,6 +103,7 @@ def vector_boucwen_kernel(q, v, state, k, c, h, d, beta, gamma, eta, out):
                 acc = h[i] * state[i, b]
                 for j in range(3):
                     acc += k[i, j] * q[t, b, j] + c[i, j] * v[t, b, j]
+                    acc += g[i, j] * q[t, b, i] * q[t, b, j] * q[t, b, j]
                 out[t, b, i] = acc
 
 
@@ -108,7 +111,7 @@ class PlanarBoucWen(PlanarModel):
     """Vector Bouc-Wen + 3x3 linear stiffness and damping; see the module docstring."""
 
     name = "boucwen"
-    param_names = ("k_matrix", "c_matrix", "h_force", "d_yield", "shape")
+    param_names = ("k_matrix", "c_matrix", "h_force", "d_yield", "shape", "g_cubic")
 
     def __init__(
         self,
@@ -117,6 +120,7 @@ class PlanarBoucWen(PlanarModel):
         h_force: Any,
         d_yield: Any,
         shape: Any = (0.5, 0.5, 2.0),
+        g_cubic: Any = None,
         dt: float = PAPER_DT,
     ) -> None:
         self.k_matrix = as_matrix("boucwen: k_matrix", k_matrix)
@@ -124,6 +128,8 @@ class PlanarBoucWen(PlanarModel):
         self.h_force = as_matrix("boucwen: h_force", h_force, (3,))
         self.d_yield = as_matrix("boucwen: d_yield", d_yield, (3,))
         self.shape = as_matrix("boucwen: shape", shape, (3,))
+        g = np.zeros((3, 3)) if g_cubic is None else g_cubic
+        self.g_cubic = as_matrix("boucwen: g_cubic", g)
         beta, gamma, eta = self.shape
         if np.any(self.d_yield <= 0):
             raise PlanarModelError(f"boucwen: d_yield must be > 0 (m, m, rad), got {self.d_yield}")
@@ -164,7 +170,8 @@ class PlanarBoucWen(PlanarModel):
             )
         beta, gamma, eta = (float(x) for x in self.shape)
         vector_boucwen_kernel(
-            q, v, self.state, self.k_matrix, self.c_matrix, self.h_force, self.d_yield,
+            q, v, self.state, self.k_matrix, self.c_matrix, self.g_cubic, self.h_force,
+            self.d_yield,
             beta, gamma, eta, out,
         )  # fmt: skip
 

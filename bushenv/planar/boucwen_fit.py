@@ -3,7 +3,8 @@
 The force is linear in K, C and h once the hysteretic shape (d, beta, eta) is fixed, so the
 search runs over those five numbers only (variable projection): for each trial shape, z is
 run along every record from rest and K, C, h follow by least squares, one force row at a time
-(row i: f_i ~ K_i q + C_i v + h_i z_i). The score is the sum over the axes of the free-run RMS
+(row i: f_i ~ K_i q + C_i v + G_i (q_i q^2) + h_i z_i; G per row, so not constrained to derive
+from one strain energy). The score is the sum over the axes of the free-run RMS
 ratio (seed 000 eq. 8): the model has no force feedback, so the least-squares residual is its
 free-run error. Search: a grid of 8 start shapes (the first always runs), then bounded Powell
 (scipy). Deterministic: budgets are evaluations; ``time_limit_s`` only seconds them (a stop by
@@ -80,7 +81,9 @@ def fit_planar_boucwen(
     peak = np.maximum(np.abs(q_all).max(axis=0), 1e-12)
     f_norm = np.maximum(np.sqrt(np.sum(f_all**2, axis=0)), 1e-300)
     lin = np.hstack([q_all, v_all])
+    cubic = [q_all[:, i : i + 1] * q_all**2 for i in range(3)]  # row i: q_i q_j^2, j = 0..2
     col = np.maximum(np.abs(lin).max(axis=0), 1e-300)
+    cub_col = [np.maximum(np.abs(c).max(axis=0), 1e-300) for c in cubic]
     lo = np.concatenate([np.log(peak * SEARCH_D_SHARE[0]), [SEARCH_BETA[0], SEARCH_ETA[0]]])
     hi = np.concatenate([np.log(peak * SEARCH_D_SHARE[1]), [SEARCH_BETA[1], SEARCH_ETA[1]]])
     t0 = time.perf_counter()
@@ -92,14 +95,14 @@ def fit_planar_boucwen(
         unit = PlanarBoucWen(np.zeros((3, 3)), np.zeros((3, 3)), np.ones(3), d,
                              (beta, 1.0 - beta, eta), dt=dt)  # fmt: skip
         z = np.vstack([unit.hysteretic_state(q) for q in qs])
-        coef = np.zeros((3, 7))
+        coef = np.zeros((3, 10))  # row i: K_i (3), C_i (3), G_i (3), h_i
         score = 0.0
         for i in range(3):
-            a = np.hstack([lin / col, z[:, i : i + 1]])
+            a = np.hstack([lin / col, cubic[i] / cub_col[i], z[:, i : i + 1]])
             c, *_ = np.linalg.lstsq(a, f_all[:, i], rcond=None)
-            if c[6] < 0:  # a hysteresis giving energy: refit without it
-                c = np.append(np.linalg.lstsq(a[:, :6], f_all[:, i], rcond=None)[0], 0.0)
-            coef[i] = np.append(c[:6] / col, c[6])
+            if c[9] < 0:  # a hysteresis giving energy: refit without it
+                c = np.append(np.linalg.lstsq(a[:, :9], f_all[:, i], rcond=None)[0], 0.0)
+            coef[i] = np.concatenate([c[:6] / col, c[6:9] / cub_col[i], c[9:]])
             score += float(np.linalg.norm(a @ c - f_all[:, i]) / f_norm[i])
         return score, coef
 
@@ -134,8 +137,8 @@ def fit_planar_boucwen(
     except _OutOfTime:
         stopped = True
     p, coef = best["p"], best["coef"]
-    model = PlanarBoucWen(coef[:, :3], coef[:, 3:6], coef[:, 6], np.exp(p[:3]),
-                          (p[3], 1.0 - p[3], p[4]), dt=dt)  # fmt: skip
+    model = PlanarBoucWen(coef[:, :3], coef[:, 3:6], coef[:, 9], np.exp(p[:3]),
+                          (p[3], 1.0 - p[3], p[4]), coef[:, 6:9], dt=dt)  # fmt: skip
     info = {
         "evaluations": count[0],
         "score_sum_rms_ratio": best["score"],

@@ -11,7 +11,8 @@ one; records are ``(q (T, 3), f (T, 3))`` pairs at one sample time.
 | nn        | the MIMO NARX network, ``train.fit_planar_network``                 |
 | nn-axis   | three single-axis networks (seed 000 §4.2's kind), the same training |
 | hybrid    | least-squares 3x3 backbone, then the MIMO network on the residual   |
-| boucwen   | variable projection: bounded Powell on the shape, least squares K, C, h |
+| boucwen   | variable projection: bounded Powell on the shape, least squares K, C, G, h |
+| hybrid-bw | the boucwen fit as backbone, then the MIMO network on its residual  |
 
 The networks train on one history: several records are joined end to end (the joint is a
 jump the training sees once per record; the card says so).
@@ -64,7 +65,21 @@ class PlanarNetworkOptions:
     def train_options(self) -> Any:
         from bushenv.planar.train import TrainOptions
 
-        return TrainOptions(**{k: getattr(self, k) for k in self.__dataclass_fields__})
+        return TrainOptions(
+            **{k: getattr(self, k) for k in PlanarNetworkOptions.__dataclass_fields__}
+        )
+
+
+@dataclass(frozen=True)
+class PlanarHybridBWOptions(PlanarNetworkOptions):
+    """The network's options and the backbone's search (``boucwen_fit``)."""
+
+    evaluations: int = option(200, "shape evaluations of the bounded Powell search (after 8)")
+    time_limit_s: float = option(120.0, "wall-time limit of the backbone's search, s (0: none)")
+
+    def check(self) -> None:
+        super().check()
+        PlanarBoucWenOptions(self.evaluations, self.time_limit_s).check()
 
 
 @dataclass(frozen=True)
@@ -116,6 +131,25 @@ PLANAR_FITS.add("linear", PlanarFit(NoOptions, _linear))
 for _kind in ("nn", "nn-axis", "hybrid"):
     PLANAR_FITS.add(_kind, PlanarFit(PlanarNetworkOptions, _network(_kind)))
 PLANAR_FITS.add("boucwen", PlanarFit(PlanarBoucWenOptions, _boucwen))
+
+
+def _hybrid_bw(histories, dt, opts, seed, say):
+    from bushenv.planar.hybrid_bw import compose
+    from bushenv.planar.train import fit_planar_network
+
+    backbone, info = fit_planar_boucwen(
+        histories, dt, PlanarBoucWenOptions(opts.evaluations, opts.time_limit_s), say=say
+    )
+    q = np.vstack([h[0] for h in histories])
+    residual = np.vstack([h[1] - backbone.simulate(h[0]) for h in histories])
+    net = fit_planar_network(q, residual, dt, "nn", opts.train_options(), seed, quiet=say is None)
+    info = {f"backbone {k}": v for k, v in info.items()}
+    if len(histories) > 1:
+        info["note"] = "the network's records joined end to end"
+    return compose(backbone, net), info
+
+
+PLANAR_FITS.add("hybrid-bw", PlanarFit(PlanarHybridBWOptions, _hybrid_bw))
 
 
 def fit_planar(

@@ -92,3 +92,27 @@ def test_the_clock_stops_the_search_and_says_so():
     )
     assert info["time_limited"] and info["evaluations"] == 1
     assert np.all(np.isfinite(model.simulate(q)))
+
+
+def test_hybrid_bw_is_its_backbone_plus_its_network():
+    from bushenv.planar.hybrid_bw import PlanarBoucWenHybrid
+    from bushenv.planar.narx import PlanarNarx
+
+    model = PlanarBoucWenHybrid.untrained(seed=3)
+    net = PlanarNarx(**{k: model.params[k] for k in PlanarNarx.param_names})
+    q = random_independent(1.0, 3.0, PAPER_DT, 2)
+    f = model.simulate(q)
+    assert np.array_equal(f, model.backbone.simulate(q) + net.simulate(q))
+    assert np.all(np.abs(f - model.backbone.simulate(q)) <= model.nn_bound())
+
+
+def test_hybrid_bw_fit_runs_backbone_then_network():
+    from bushenv.planar.fitting import fit_planar
+
+    q = random_independent(1.0, 6.5, PAPER_DT, 4)
+    f = _truth().simulate(q)
+    opts = {"evaluations": 1, "teacher_steps": 20, "free_run_steps": 0}
+    result = fit_planar([(q, f)], "hybrid-bw", opts, PAPER_DT, seed=0)
+    assert result.model.name == "hybrid-bw" and result.info["backbone evaluations"] >= 8
+    err = result.model.simulate(q) - f
+    assert np.all(np.sqrt(np.mean(err**2, axis=0) / np.mean(f**2, axis=0)) < 0.05)

@@ -9,7 +9,6 @@ from bushenv.cli import main
 from bushenv.metrics import rms_ratio
 from bushenv.models.base import PAPER_DT
 from bushenv.planar.fitting import fit_planar
-from bushenv.planar.programme import random_independent
 from bushenv.planar.reference import PlanarRubber
 
 
@@ -28,8 +27,7 @@ def test_planar_only_writes_its_own_report_and_the_table_beside_table3(
     out = capsys.readouterr().out
     assert "seed 000 Table 3                 axial               10.9 / 24.9" in out
     # the JSON is what the models do: recompute linear's radial RMS ratio on one record
-    q = random_independent(1.0, 8.0, PAPER_DT, 0)
-    lin = fit_planar([(q, PlanarRubber.preset(seed=0).simulate(q))], "linear", None, PAPER_DT)
+    lin = fit_planar(r3.identification_records(PAPER_DT, 0, 8.0), "linear", None, PAPER_DT)
     qt = r3.unseen_records(PAPER_DT, 0, 7.0)["random correlated n=1"]
     ft = PlanarRubber.preset(seed=101).simulate(qt)
     want = rms_ratio(ft[:, 1], lin.model.simulate(qt)[:, 1])
