@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 import bushenv.planar.reproduce3 as r3
 from bushenv.cli import main
@@ -33,3 +34,13 @@ def test_planar_only_writes_its_own_report_and_the_table_beside_table3(
     want = rms_ratio(ft[:, 1], lin.model.simulate(qt)[:, 1])
     assert np.isclose(row["radial"]["rms_ratio"], want, rtol=1e-12)
     assert main([*args, "--out", str(tmp_path), "--quiet"]) == 2  # planar.json exists, no --force
+
+
+@pytest.mark.slow
+def test_hybrid_bw_meets_the_target_on_unseen_random_coupled_records():
+    # docs/planar.md, "The 3-axis table in bushenv reproduce": seed 0, default options (~2.5 min)
+    report = r3.planar_table(0, 40.0, 20.0, PAPER_DT, models=("hybrid-bw",))
+    for rec, row in report["records"].items():
+        if rec.startswith("random"):
+            for axis, m in row["hybrid-bw"].items():
+                assert m["rms_ratio"] <= 0.03 and m["max_error_ratio"] <= 0.06, (rec, axis, m)
