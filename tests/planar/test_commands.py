@@ -120,3 +120,16 @@ def test_every_planar_fit_flag_is_explained_in_docs_fit(name):
         if f"`{flag_of(f.name)}`" not in DOC
     ]
     assert not missing, f"docs/fit.md does not explain {missing} of the 3-axis {name}"
+
+
+def test_3_axis_records_at_two_rates_are_refused_naming_both(records, tmp_path, capsys):
+    from bushenv.planar.records import save_planar_csv
+
+    rec = load_planar_csv(records[0][0])
+    fast = save_planar_csv(tmp_path / "fast.csv", rec.time / 2, rec.q, rec.f)
+    args = ["fit", str(records[0][0]), str(fast), "--model", "linear"]
+    line = _fails([*args, "--out", str(tmp_path / "x.npz")], capsys)
+    assert "fast.csv is sampled at 409.6 Hz" in line and "204.8 Hz" in line
+    line = _fails([*args[:2], "--model", "linear", "--resample", "204.8", "--out",
+                   str(tmp_path / "x.npz")], capsys)  # fmt: skip
+    assert "--resample is for one-axis records" in line

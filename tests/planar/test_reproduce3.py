@@ -38,7 +38,7 @@ def test_planar_only_writes_its_own_report_and_the_table_beside_table3(
 
 @pytest.mark.slow
 def test_hybrid_bw_meets_the_target_on_unseen_random_coupled_records():
-    # docs/planar.md, "The 3-axis table in bushenv reproduce": seed 0, default options (~2.5 min)
+    # docs/planar.md, "The 3-axis table in bushenv reproduce": seed 0, default options (30-150 s)
     report = r3.planar_table(0, 40.0, 20.0, PAPER_DT, models=("hybrid-bw",))
     for rec, row in report["records"].items():
         if rec.startswith("random"):
