@@ -24,6 +24,10 @@ substeps (shorter ones where eta (beta + |gamma|) > 5, for stability; at most
 ``MAX_SUBSTEPS``). The linear part is summed in the same compiled kernel, so a loop of
 ``step`` equals a batched ``simulate`` bit for bit.
 
+``yield_surface="axis"`` runs the classical law on each coordinate alone (three independent
+Bouc-Wen elements, a box of yield limits, no shared surface): the per-axis kind of the same
+model, for measuring what the shared surface is worth.
+
 State (6, B): z (3) and the previous deflection (3), at rest zero.
 """
 
@@ -40,10 +44,24 @@ from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
 SUBSTEP = 0.1  # path length of one RK4 substep in scaled deflection (accurate: |h lambda| < 0.5)
 MAX_SUBSTEPS = 2000
 ETA_RANGE = (1.0, 8.0)
+YIELD_SURFACES = ("vector", "axis")
 
 
 @nb.njit(cache=True)
-def _dz(z0, z1, z2, d0, d1, d2, beta, gamma, eta, out):
+def _scalar(z, d, beta, gamma, eta):
+    """The classical one-coordinate law (the "axis" yield surface)."""
+    if z == 0.0:
+        return d
+    return d - abs(z) ** (eta - 2.0) * (beta * abs(z * d) + gamma * z * d) * z
+
+
+@nb.njit(cache=True)
+def _dz(z0, z1, z2, d0, d1, d2, beta, gamma, eta, vector, out):
+    if not vector:
+        out[0] = _scalar(z0, d0, beta, gamma, eta)
+        out[1] = _scalar(z1, d1, beta, gamma, eta)
+        out[2] = _scalar(z2, d2, beta, gamma, eta)
+        return
     nz = np.sqrt(z0 * z0 + z1 * z1 + z2 * z2)
     zd = z0 * d0 + z1 * d1 + z2 * d2
     g = 0.0
@@ -55,7 +73,7 @@ def _dz(z0, z1, z2, d0, d1, d2, beta, gamma, eta, out):
 
 
 @nb.njit(cache=True)
-def vector_boucwen_kernel(q, v, state, k, c, g, h, d, beta, gamma, eta, out):
+def vector_boucwen_kernel(q, v, state, k, c, g, h, d, beta, gamma, eta, vector, out):
     """(T, B, 3) q, v -> out; state rows: z (3), previous q (3)."""
     T, B, _ = q.shape
     k1 = np.empty(3)
@@ -81,16 +99,17 @@ def vector_boucwen_kernel(q, v, state, k, c, g, h, d, beta, gamma, eta, out):
             z1 = state[1, b]
             z2 = state[2, b]
             for _ in range(m):
-                _dz(z0, z1, z2, s0, s1, s2, beta, gamma, eta, k1)
+                _dz(z0, z1, z2, s0, s1, s2, beta, gamma, eta, vector, k1)
                 _dz(
                     z0 + 0.5 * k1[0], z1 + 0.5 * k1[1], z2 + 0.5 * k1[2],
-                    s0, s1, s2, beta, gamma, eta, k2,
+                    s0, s1, s2, beta, gamma, eta, vector, k2,
                 )  # fmt: skip
                 _dz(
                     z0 + 0.5 * k2[0], z1 + 0.5 * k2[1], z2 + 0.5 * k2[2],
-                    s0, s1, s2, beta, gamma, eta, k3,
+                    s0, s1, s2, beta, gamma, eta, vector, k3,
                 )  # fmt: skip
-                _dz(z0 + k3[0], z1 + k3[1], z2 + k3[2], s0, s1, s2, beta, gamma, eta, k4)
+                _dz(z0 + k3[0], z1 + k3[1], z2 + k3[2], s0, s1, s2, beta, gamma, eta, vector,
+                    k4)  # fmt: skip
                 z0 += (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]) / 6.0
                 z1 += (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]) / 6.0
                 z2 += (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2]) / 6.0
@@ -121,8 +140,14 @@ class PlanarBoucWen(PlanarModel):
         d_yield: Any,
         shape: Any = (0.5, 0.5, 2.0),
         g_cubic: Any = None,
+        yield_surface: str = "vector",
         dt: float = PAPER_DT,
     ) -> None:
+        if yield_surface not in YIELD_SURFACES:
+            raise PlanarModelError(
+                f"boucwen: yield_surface {yield_surface!r}; known: {list(YIELD_SURFACES)}"
+            )
+        self.yield_surface = yield_surface
         self.k_matrix = as_matrix("boucwen: k_matrix", k_matrix)
         self.c_matrix = as_matrix("boucwen: c_matrix", c_matrix)
         self.h_force = as_matrix("boucwen: h_force", h_force, (3,))
@@ -163,6 +188,9 @@ class PlanarBoucWen(PlanarModel):
     def n_state(self) -> int:
         return 6
 
+    def extra_meta(self) -> dict[str, Any]:
+        return {"yield_surface": self.yield_surface}
+
     def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         if self.state.shape[1] != q.shape[1]:
             raise PlanarModelError(
@@ -172,11 +200,11 @@ class PlanarBoucWen(PlanarModel):
         vector_boucwen_kernel(
             q, v, self.state, self.k_matrix, self.c_matrix, self.g_cubic, self.h_force,
             self.d_yield,
-            beta, gamma, eta, out,
+            beta, gamma, eta, self.yield_surface == "vector", out,
         )  # fmt: skip
 
     def hysteretic_state(self, q: np.ndarray) -> np.ndarray:
         """z along ``q`` ((T, 3) -> (T, 3)) from rest: the run with K = C = 0 and h = 1."""
         unit = type(self)(np.zeros((3, 3)), np.zeros((3, 3)), np.ones(3), self.d_yield,
-                          self.shape, dt=self.dt)  # fmt: skip
+                          self.shape, yield_surface=self.yield_surface, dt=self.dt)  # fmt: skip
         return unit.simulate(q, np.zeros_like(q))

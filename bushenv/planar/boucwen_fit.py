@@ -37,6 +37,11 @@ class PlanarBoucWenOptions:
     """Options of the vector Bouc-Wen identification; each is a flag of ``bushenv fit``."""
 
     evaluations: int = option(200, "shape evaluations of the bounded Powell search (after 8)")
+    yield_surface: str = option(
+        "vector",
+        "vector: one yield surface on the deflection vector; axis: each coordinate its own",
+        choices=("vector", "axis"),
+    )
     time_limit_s: float = option(
         120.0,
         "wall-time limit of the search, s (0: none); evaluations decide below it, so a seed "
@@ -93,7 +98,8 @@ def fit_planar_boucwen(
     def solve(p: np.ndarray) -> tuple[float, np.ndarray]:
         d, beta, eta = np.exp(p[:3]), float(p[3]), float(p[4])
         unit = PlanarBoucWen(np.zeros((3, 3)), np.zeros((3, 3)), np.ones(3), d,
-                             (beta, 1.0 - beta, eta), dt=dt)  # fmt: skip
+                             (beta, 1.0 - beta, eta), yield_surface=opt.yield_surface,
+                             dt=dt)  # fmt: skip
         z = np.vstack([unit.hysteretic_state(q) for q in qs])
         coef = np.zeros((3, 10))  # row i: K_i (3), C_i (3), G_i (3), h_i
         score = 0.0
@@ -138,7 +144,8 @@ def fit_planar_boucwen(
         stopped = True
     p, coef = best["p"], best["coef"]
     model = PlanarBoucWen(coef[:, :3], coef[:, 3:6], coef[:, 9], np.exp(p[:3]),
-                          (p[3], 1.0 - p[3], p[4]), coef[:, 6:9], dt=dt)  # fmt: skip
+                          (p[3], 1.0 - p[3], p[4]), coef[:, 6:9], opt.yield_surface,
+                          dt=dt)  # fmt: skip
     info = {
         "evaluations": count[0],
         "score_sum_rms_ratio": best["score"],

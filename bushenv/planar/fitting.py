@@ -79,7 +79,10 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
 
     def check(self) -> None:
         super().check()
-        PlanarBoucWenOptions(self.evaluations, self.time_limit_s).check()
+        self.backbone_options().check()
+
+    def backbone_options(self) -> PlanarBoucWenOptions:
+        return PlanarBoucWenOptions(self.evaluations, time_limit_s=self.time_limit_s)
 
 
 @dataclass(frozen=True)
@@ -137,9 +140,7 @@ def _hybrid_bw(histories, dt, opts, seed, say):
     from bushenv.planar.hybrid_bw import compose
     from bushenv.planar.train import fit_planar_network
 
-    backbone, info = fit_planar_boucwen(
-        histories, dt, PlanarBoucWenOptions(opts.evaluations, opts.time_limit_s), say=say
-    )
+    backbone, info = fit_planar_boucwen(histories, dt, opts.backbone_options(), say=say)
     q = np.vstack([h[0] for h in histories])
     residual = np.vstack([h[1] - backbone.simulate(h[0]) for h in histories])
     net = fit_planar_network(q, residual, dt, "nn", opts.train_options(), seed, quiet=say is None)

@@ -35,7 +35,8 @@ class PlanarBoucWenHybrid(PlanarNarx):
     def __init__(self, **params: Any) -> None:  # noqa: D107
         dt = params.get("dt", PAPER_DT)
         backbone = {k: params.pop(k) for k in BACKBONE_PARAMS if k in params}
-        self.backbone = PlanarBoucWen(**backbone, dt=dt)
+        surface = params.pop("yield_surface", "vector")
+        self.backbone = PlanarBoucWen(**backbone, yield_surface=surface, dt=dt)
         for k in BACKBONE_PARAMS:
             setattr(self, k, getattr(self.backbone, k))
         super().__init__(**params)
@@ -46,6 +47,9 @@ class PlanarBoucWenHybrid(PlanarNarx):
         net = PlanarNarx.untrained(seed=seed, dt=dt)
         bw = PlanarBoucWen.preset(dt=dt)
         return cls(**bw.params, **net.params, dt=dt)
+
+    def extra_meta(self) -> dict[str, Any]:
+        return self.backbone.extra_meta()
 
     def reset(self, batch_size: int = 1) -> None:
         super().reset(batch_size)
@@ -60,4 +64,6 @@ class PlanarBoucWenHybrid(PlanarNarx):
 
 def compose(backbone: PlanarBoucWen, network: PlanarNarx) -> PlanarBoucWenHybrid:
     """The hybrid of a fitted backbone and a network trained on its residual."""
-    return PlanarBoucWenHybrid(**backbone.params, **network.params, dt=backbone.dt)
+    return PlanarBoucWenHybrid(
+        **backbone.params, **network.params, **backbone.extra_meta(), dt=backbone.dt
+    )

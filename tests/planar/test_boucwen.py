@@ -116,3 +116,23 @@ def test_hybrid_bw_fit_runs_backbone_then_network():
     assert result.model.name == "hybrid-bw" and result.info["backbone evaluations"] >= 8
     err = result.model.simulate(q) - f
     assert np.all(np.sqrt(np.mean(err**2, axis=0) / np.mean(f**2, axis=0)) < 0.05)
+
+
+def test_axis_yield_surface_keeps_each_coordinate_to_itself(tmp_path):
+    T = 200
+    q = np.zeros((T, 3))
+    q[:, 1] = np.minimum(np.arange(T), 50) / 50 * 10 * D[1]
+    q[100:, 0] = np.arange(T - 100) / 100 * 10 * D[0]
+    axis = PlanarBoucWen(np.zeros((3, 3)), np.zeros((3, 3)), np.ones(3), D, (0.5, 0.5, 2.0),
+                         yield_surface="axis")  # fmt: skip
+    z = axis.hysteretic_state(q)
+    assert z[-1, 1] == z[99, 1] > 0.99 and z[-1, 0] > 0.95
+    one = np.zeros((T, 3))
+    one[:, 1] = q[:, 1]
+    assert np.array_equal(axis.hysteretic_state(one)[:, 1], z[:, 1])
+    from bushenv.planar import load_planar_model
+
+    back = load_planar_model(axis.save(tmp_path / "axis.npz"))
+    assert back.yield_surface == "axis" and np.array_equal(back.hysteretic_state(q), z)
+    with pytest.raises(PlanarModelError, match="yield_surface 'box'"):
+        PlanarBoucWen(np.zeros((3, 3)), np.zeros((3, 3)), np.ones(3), D, yield_surface="box")
