@@ -1,4 +1,4 @@
-"""Vector Bouc-Wen bushing: one hysteretic state on the deflection vector, plus 3x3 K and C.
+"""Vector Bouc-Wen bushing: one hysteretic state on the deflection vector, 3x3 K, C and G.
 
     f = K q + C v + h (.) z + G3(q)            (N, N, N m; ``h`` one force scale per axis)
     G3(q)_i = sum_j G_ij q_i q_j^2             (cubic stiffness: hardening on the diagonal,
@@ -127,7 +127,7 @@ def vector_boucwen_kernel(q, v, state, k, c, g, h, d, beta, gamma, eta, vector, 
 
 
 class PlanarBoucWen(PlanarModel):
-    """Vector Bouc-Wen + 3x3 linear stiffness and damping; see the module docstring."""
+    """Vector Bouc-Wen + 3x3 stiffness, damping and cubic stiffness; see the module docstring."""
 
     name = "boucwen"
     param_names = ("k_matrix", "c_matrix", "h_force", "d_yield", "shape", "g_cubic")
