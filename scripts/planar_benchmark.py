@@ -4,10 +4,11 @@
 
 For each seed: the planar reference (with load-cell noise, its own noise seed) is driven by
 60 s of independent random motion at n = 1 on all axes; linear (3x3 K, C by least squares),
-the per-axis networks (seed 000 §4.2's kind), the MIMO network and the MIMO hybrid are
-identified from it; each is run free on the unseen records of ``bushenv.planar.programme``
-(n = 1.5) against the reference. Prints RMS ratio and MAX error (% of max |f|, as seed 000
-Table 3) per axis, beside Table 3, and writes the numbers as JSON.
+the per-axis networks (seed 000 §4.2's kind), the MIMO network, the MIMO hybrid, the vector
+Bouc-Wen and the hybrid on it (``hybrid-bw``; default options) are identified from it; each
+is run free on the unseen records of ``bushenv.planar.programme`` (n = 1.5) against the
+reference. Prints RMS ratio and MAX error
+(% of max |f|, as seed 000 Table 3) per axis, beside Table 3, and writes the numbers as JSON.
 """
 
 from __future__ import annotations
@@ -22,13 +23,15 @@ import numpy as np
 from bushenv.metrics import max_error_ratio, rms_ratio
 from bushenv.models.base import PAPER_DT, velocity_of
 from bushenv.planar.base import COORDS
+from bushenv.planar.boucwen_fit import fit_planar_boucwen
+from bushenv.planar.hybrid_bw import compose
 from bushenv.planar.linear import fit_linear
 from bushenv.planar.programme import programme, random_independent
 from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.train import TrainOptions, fit_planar_network
 from bushenv.progress import Progress
 
-MODELS = ("linear", "nn-axis", "nn", "hybrid")
+MODELS = ("linear", "nn-axis", "nn", "hybrid", "boucwen", "hybrid-bw")
 TABLE3 = {  # seed 000 Table 3, RMS ratio / MAX in %, linear / NN / hybrid
     "axial": {"rms": (10.9, 5.2, 5.1), "max": (24.9, 9.3, 8.4)},
     "radial": {"rms": (5.1, 3.0, 3.0), "max": (20.7, 8.3, 7.8)},
@@ -66,11 +69,21 @@ def run_seed(
     q = random_independent(1.0, 60.0, dt, seed)
     f = reference(uncoupled, seed).simulate(q)
     models = {"linear": fit_linear(q, velocity_of(q, dt), f, dt)}
-    for kind in MODELS[1:]:
+    for kind in MODELS[1:4]:
         t0 = time.perf_counter()
         models[kind] = fit_planar_network(q, f, dt, kind=kind, seed=seed, options=options)
         done[0] += 1
         progress.update(done[0], f"seed {seed}: {kind} trained in {time.perf_counter() - t0:.0f} s")
+    t0 = time.perf_counter()
+    models["boucwen"] = fit_planar_boucwen([(q, f)], dt)[0]
+    done[0] += 1
+    progress.update(done[0], f"seed {seed}: boucwen fitted in {time.perf_counter() - t0:.0f} s")
+    t0 = time.perf_counter()  # hybrid-bw: that Bouc-Wen as backbone, the MIMO net on its residual
+    residual = f - models["boucwen"].simulate(q)
+    net = fit_planar_network(q, residual, dt, kind="nn", seed=seed, options=options)
+    models["hybrid-bw"] = compose(models["boucwen"], net)
+    done[0] += 1
+    progress.update(done[0], f"seed {seed}: hybrid-bw trained in {time.perf_counter() - t0:.0f} s")
     out = {}
     for name, qt in programme(dt, seed).items():
         ft = reference(uncoupled, seed + 100).simulate(qt)
@@ -148,6 +161,8 @@ def table(results: dict[int, dict]) -> str:
             "-",
             f"{t['rms'][1]} / {t['max'][1]}",
             f"{t['rms'][2]} / {t['max'][2]}",
+            "-",
+            "-",
         ]
         lines.append(f"| seed 000 Table 3 | {c} | " + " | ".join(cells) + " | - |")
     return "\n".join(lines)
@@ -165,7 +180,7 @@ def main() -> None:
     )
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args()
-    progress = Progress(3 * len(args.seeds), quiet=args.quiet, label="planar benchmark")
+    progress = Progress(5 * len(args.seeds), quiet=args.quiet, label="planar benchmark")
     done = [0]
     try:
         opts = parse_options(args.options)

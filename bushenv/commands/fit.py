@@ -25,12 +25,27 @@ DEST = "option_"  # argparse dest prefix of the model options
 
 
 def model_options() -> dict[str, list[tuple[str, Any]]]:
-    """Option name -> [(model, dataclass field)] for every model with an identification."""
+    """Option name -> [(model, dataclass field)] for every model with an identification; the
+    planar (3-axis) models' owners read "NAME (3-axis)"."""
+    from bushenv.commands.fit_planar import PLANAR_LABEL
+    from bushenv.planar.fitting import PLANAR_FITS
+
     table: dict[str, list[tuple[str, Any]]] = defaultdict(list)
     for name in fittable_models():
         for f in option_fields(options_class(name)):
             table[f.name].append((name, f))
+    for name, entry in PLANAR_FITS.items():
+        for f in option_fields(entry.options):
+            table[f.name].append((name + PLANAR_LABEL, f))
     return dict(table)
+
+
+def model_choices() -> list[str]:
+    """``--model``: the one-axis fittable models, then the planar ones not named alike."""
+    from bushenv.planar.fitting import PLANAR_FITS
+
+    one = fittable_models()
+    return one + [n for n in PLANAR_FITS.names() if n not in one]
 
 
 def _option_help(owners: list[tuple[str, Any]]) -> str:
@@ -57,7 +72,10 @@ def _metavar(f: Any) -> str:
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("train", nargs="*", metavar="TRAIN.csv", help="training record files")
     p.add_argument(
-        "--model", required=True, choices=fittable_models(), help="model to identify (required)"
+        "--model",
+        required=True,
+        choices=model_choices(),
+        help="model to identify (required); on 3-axis records a planar model (PLANAR_MODELS)",
     )
     p.add_argument("--out", required=True, metavar="MODEL.npz", help="model file to write")
     p.add_argument(
@@ -127,12 +145,23 @@ def _check_paths(args: argparse.Namespace) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
+    from bushenv.cli import CliError
+    from bushenv.commands.fit_planar import planar_records, run_planar
     from bushenv.identify import fit
     from bushenv.identify.card import save_fit
     from bushenv.identify.data import check_model_rate, check_same_rate
+    from bushenv.planar.records import HEADER_TEXT
     from bushenv.records import load_csv
 
     out = _check_paths(args)
+    if planar_records(args):
+        given = {k[len(DEST) :]: v for k, v in vars(args).items() if k.startswith(DEST)}
+        return run_planar(args, out, given)
+    if args.model not in fittable_models():
+        raise CliError(
+            f"model {args.model} is a 3-axis model: its records have the header "
+            f"'{HEADER_TEXT}'; for one-axis records choose one of {', '.join(fittable_models())}"
+        )
     given = chosen_options(args)
     train = [load_csv(p) for p in args.train]
     held = [load_csv(p) for p in args.validate or []]

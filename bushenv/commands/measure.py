@@ -40,6 +40,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--axis", default="axial", choices=("axial", "radial"))
     parser.add_argument(
+        "--axes",
+        type=int,
+        default=1,
+        choices=(1, 3),
+        help="3: the 3-axis programme on a planar model (--model: the planar reference by "
+        "default, a planar preset or .npz), 3-axis CSV records (default: 1)",
+    )
+    parser.add_argument(
         "--programme",
         default="papers",
         choices=PROGRAMMES,
@@ -92,6 +100,10 @@ def cli_run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise MachineError(f"--out {out}: exists and is not a folder")
+    if args.axes == 3:
+        from bushenv.commands.measure_planar import run_planar
+
+        return run_planar(args)
     model = get_model(args.model, axis=args.axis, dt=1.0 / args.rate)
     items = programme_items(args, model.dt)
     paths = [out / f"{item.name}.csv" for item in items]

@@ -28,6 +28,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="use the trained models shipped in the package instead of identifying anew",
     )
+    p.add_argument(
+        "--planar",
+        choices=("off", "add", "only"),
+        default="off",
+        help="the 3-axis table beside seed 000 Table 3 (planar models on unseen coupled "
+        "records, DIR/planar.json and planar.md): add it to the papers' tables, or run only it",
+    )
     p.add_argument("--force", action="store_true", help="overwrite an existing report in --out")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
 
@@ -36,8 +43,11 @@ def run(args: argparse.Namespace) -> int:
     from bushenv.cli import CliError
 
     out = Path(args.out)
-    if (out / "report.json").exists() and not args.force:
-        raise CliError(f"{out}/report.json exists; pass --force to overwrite it")
+    written = ["report.json"] if args.planar != "only" else []
+    written += ["planar.json"] if args.planar != "off" else []
+    for name in written:
+        if (out / name).exists() and not args.force:
+            raise CliError(f"{out}/{name} exists; pass --force to overwrite it")
     if args.seed < 0:
         raise CliError(f"--seed must be >= 0, got {args.seed}")
     for name in ("identification_s", "verification_s"):
@@ -50,9 +60,25 @@ def run(args: argparse.Namespace) -> int:
             raise CliError(f"unknown axis {a!r}; choose from {list(AXES)}")
     out.mkdir(parents=True, exist_ok=True)
     progress = Progress(quiet=args.quiet)
-    report = reproduce(
-        out, axes, args.seed, args.identification_s, args.verification_s, args.shipped, progress
-    )
-    print(format_tables(report))
-    print(f"\nwrote {out / 'report.json'}, {out / 'report.md'} and plots")
+    if args.planar != "only":
+        report = reproduce(
+            out, axes, args.seed, args.identification_s, args.verification_s, args.shipped, progress
+        )
+        print(format_tables(report))
+        print(f"\nwrote {out / 'report.json'}, {out / 'report.md'} and plots")
+    if args.planar != "off":
+        _planar(out, args, progress)
     return 0
+
+
+def _planar(out: Path, args: argparse.Namespace, progress: Progress) -> None:
+    from bushenv.models.base import PAPER_DT
+    from bushenv.persist import json_text, write_text
+    from bushenv.planar.reproduce3 import format_planar, planar_table
+
+    report = planar_table(args.seed, args.identification_s, args.verification_s, PAPER_DT, progress)
+    text = format_planar(report)
+    write_text(out / "planar.json", json_text(report, indent=2))
+    write_text(out / "planar.md", "# The 3-axis table\n\n```\n" + text + "\n```\n")
+    print(("\n" if args.planar == "add" else "") + text)
+    print(f"\nwrote {out / 'planar.json'}, {out / 'planar.md'}")

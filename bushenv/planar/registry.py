@@ -23,6 +23,8 @@ PLANAR_MODELS.add("linear", "bushenv.planar.linear:PlanarLinear")
 PLANAR_MODELS.add("nn", "bushenv.planar.narx:PlanarNarx")
 PLANAR_MODELS.add("nn-axis", "bushenv.planar.narx:PlanarNarxPerAxis")
 PLANAR_MODELS.add("hybrid", "bushenv.planar.narx:PlanarHybrid")
+PLANAR_MODELS.add("boucwen", "bushenv.planar.boucwen:PlanarBoucWen")
+PLANAR_MODELS.add("hybrid-bw", "bushenv.planar.hybrid_bw:PlanarBoucWenHybrid")
 
 
 def model_class(name: str) -> type:

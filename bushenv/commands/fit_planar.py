@@ -1,0 +1,136 @@
+"""``bushenv fit`` on 3-axis records: the records' header decides, the planar models fit.
+
+A record whose header names the planar columns (``bushenv.planar.records.HEADER``) is a 3-axis
+record; ``bushenv fit`` then takes ``--model`` from ``PLANAR_FITS`` and writes the planar model
+file and its per-axis card (``bushenv.planar.card``). Training and held-out records must all
+be of one kind.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+from typing import Any
+
+from bushenv.planar.records import HEADER, HEADER_TEXT
+from bushenv.records import _NAME_UNIT
+
+PLANAR_LABEL = " (3-axis)"  # how the planar models own their flags in ``bushenv fit --help``
+
+
+def is_planar_csv(path: str) -> bool:
+    """Whether the file's first line is a planar record header (units in brackets allowed);
+    an unreadable file is not (the one-axis loader then names its problem)."""
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as fh:
+            first = next(csv.reader(fh), [])
+    except (OSError, UnicodeDecodeError, csv.Error):
+        return False
+    names = []
+    for text in first:
+        m = _NAME_UNIT.match(text)
+        names.append((m.group(1) if m else text).strip())
+    return tuple(names) == HEADER
+
+
+def planar_records(args: argparse.Namespace) -> bool:
+    """True when every record given is 3-axis, False when none is; refuses a mix (CliError)."""
+    from bushenv.cli import CliError
+
+    paths = [*args.train, *(args.validate or [])]
+    kinds = {p: is_planar_csv(p) for p in paths}
+    planar = [p for p, k in kinds.items() if k]
+    if not planar:
+        return False
+    single = [p for p, k in kinds.items() if not k]
+    if single:
+        raise CliError(
+            f"{planar[0]} is a 3-axis record but {single[0]} is not ({len(planar)} 3-axis, "
+            f"{len(single)} other): give records of one kind to one fit, the 3-axis ones with "
+            f"the header '{HEADER_TEXT}'"
+        )
+    return True
+
+
+def planar_options(args: argparse.Namespace, given: dict[str, str]) -> dict[str, str]:
+    """The given options, checked against the planar model's own (CliError naming the flag)."""
+    from bushenv.cli import CliError
+    from bushenv.identify.options import flag_of, option_fields
+    from bushenv.planar.fitting import PLANAR_FITS
+
+    own = [f.name for f in option_fields(PLANAR_FITS[args.model].options)]
+    for name in given:
+        if name not in own:
+            raise CliError(
+                f"{flag_of(name)} is not an option of the 3-axis model {args.model}; it takes: "
+                f"{', '.join(flag_of(n) for n in own) or 'no options'}"
+            )
+    return given
+
+
+def run_planar(args: argparse.Namespace, out: Path, given: dict[str, Any]) -> int:
+    """Load the 3-axis records, identify, write the model and its card, print the summary."""
+    from bushenv.cli import CliError
+    from bushenv.planar.card import save_planar_fit
+    from bushenv.planar.fitting import PLANAR_FITS, fit_planar
+    from bushenv.planar.records import load_planar_csv
+    from bushenv.records import STEP_RTOL
+
+    if args.model not in PLANAR_FITS:
+        raise CliError(
+            f"model {args.model} has no 3-axis identification; for 3-axis records choose "
+            f"one of: {', '.join(PLANAR_FITS.names())}"
+        )
+    if args.resample is not None:
+        raise CliError("--resample is for one-axis records; give 3-axis records at one rate")
+    given = planar_options(args, given)
+    train = [load_planar_csv(p) for p in args.train]
+    held = [load_planar_csv(p) for p in args.validate or []]
+    dt = train[0].dt
+    for rec in train[1:] + held:
+        if abs(rec.dt - dt) > STEP_RTOL * dt:
+            raise CliError(
+                f"{rec.source} is sampled at {1 / rec.dt:.6g} Hz, {train[0].source} at "
+                f"{1 / dt:.6g} Hz: give 3-axis records at one rate (resample them first)"
+            )
+    say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+    if say:
+        seconds = sum(r.time.size * dt for r in train)
+        say(f"fit {args.model} (3-axis) on {len(train)} record(s), {seconds:.1f} s at "
+            f"{1 / dt:.6g} Hz")  # fmt: skip
+    result = fit_planar([(r.q, r.f) for r in train], args.model, given, dt, args.seed, say)
+    card = save_planar_fit(result, out, train, held)
+    print(summary(card, out))
+    return 0
+
+
+def summary(card: dict[str, Any], out: Path) -> str:
+    """What ``bushenv fit`` prints for a 3-axis fit: files and per-axis metrics."""
+    from bushenv.identify.card import card_paths
+    from bushenv.planar.base import COORDS
+
+    json_path, md_path = card_paths(out)
+    src = card["source"]
+    lines = [
+        f"model {card['model']} (3-axis) -> {out} (card {json_path.name}, {md_path.name})",
+        f"identified in {src['wall_time_s']:.1f} s, seed {src['seed']}",
+    ]
+    lines += [f"{k}: {v}" for k, v in src["info"].items()]
+    names = [r["file"] or r["name"] for r in card["records"]]
+    width = max(30, *(len(n) for n in names))
+    lines += ["", f"{'record':{width}s} {'role':9s} {'axis':9s} {'RMS ratio %':>12s} "
+              f"{'ESR %':>8s} {'MAX %':>8s}"]  # fmt: skip
+    for name, r in zip(names, card["records"], strict=True):
+        for c in COORDS:
+            m = r["metrics"][c]
+            cells = [
+                "-" if m[k] is None else f"{100 * m[k]:.2f}"
+                for k in ("rms_ratio", "esr", "max_error_ratio")
+            ]
+            lines.append(
+                f"{name:{width}s} {r['role']:9s} {c:9s} {cells[0]:>12s} {cells[1]:>8s} "
+                f"{cells[2]:>8s}"
+            )
+    return "\n".join(lines)

@@ -1,0 +1,132 @@
+"""Model cards of planar fits: what a 3-axis model was made from and how well it does, per axis.
+
+``MODEL.npz`` gets ``MODEL.card.json`` and ``MODEL.card.md`` beside it (the one-axis names,
+``bushenv.identify.card.card_paths``), under the format tag ``bushenv-planar-model-card``:
+
+- ``model`` (a ``PLANAR_MODELS`` name), ``model_file``, ``model_sha256``, ``dt_s``;
+- ``source``: ``kind`` "fit", ``seed``, ``wall_time_s``, ``options`` (every option and its
+  value), ``info`` (the identification's own summary: evaluations, a stop by the clock, notes);
+- ``records``: each record with ``role`` ("train" or "held-out"), ``file`` (relative to the
+  card), ``sha256`` of its bytes, ``samples``, ``sample_rate_hz``, ``duration_s``, and
+  ``metrics`` per axis (``axial``, ``radial``, ``rotation``) of the model's free run from rest:
+  ``bushenv.metrics.all_metrics`` (RMS ratio and ESR of seed 000 eqs 8-9, MAX as max error
+  over max |f| as in Table 3, max error in N or N m; fractions). An axis whose measured force
+  is zero throughout has null ratios there.
+"""
+
+from __future__ import annotations
+
+import datetime
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bushenv.identify.card import card_paths, sha256_file
+from bushenv.identify.options import as_dict
+from bushenv.metrics import all_metrics
+from bushenv.persist import plain, write_json, write_text
+from bushenv.planar.base import COORDS, FORCE_UNITS
+
+CARD_FORMAT = "bushenv-planar-model-card"
+CARD_VERSION = 1
+
+
+def axis_metrics(f_exp: np.ndarray, f_pre: np.ndarray) -> dict[str, dict[str, float | None]]:
+    """Per axis, every metric of ``bushenv.metrics`` ((T, 3) arrays); non-finite ratios None."""
+    out = {}
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for i, c in enumerate(COORDS):
+            m = all_metrics(f_exp[:, i], f_pre[:, i])
+            out[c] = {k: (float(v) if np.isfinite(v) else None) for k, v in m.items()}
+    return out
+
+
+def record_entry(record: Any, role: str, model: Any, card_dir: Path) -> dict[str, Any]:
+    """A card's description of a ``PlanarRecord`` and the model's per-axis metrics on it."""
+    path = Path(record.source) if record.source else None
+    entry = {
+        "role": role,
+        "name": path.stem if path else "",
+        "file": os.path.relpath(path, card_dir) if path else None,
+        "sha256": sha256_file(path) if path and path.is_file() else None,
+        "samples": int(record.time.size),
+        "sample_rate_hz": 1.0 / record.dt,
+        "duration_s": float(record.time[-1] - record.time[0] + record.dt),
+        "max_abs": {c: float(np.abs(record.f[:, i]).max()) for i, c in enumerate(COORDS)},
+    }
+    entry["metrics"] = axis_metrics(record.f, model.simulate(record.q))
+    return entry
+
+
+def save_planar_fit(result: Any, model_path: Path, train: list, held_out: list) -> dict[str, Any]:
+    """Write the model file, then its card (JSON + markdown); returns the card."""
+    from bushenv import __version__
+
+    model = result.model
+    model.save(model_path)
+    here = model_path.parent
+    card = {
+        "format": CARD_FORMAT,
+        "version": CARD_VERSION,
+        "bushenv_version": __version__,
+        "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "model": model.name,
+        "model_file": model_path.name,
+        "model_sha256": sha256_file(model_path),
+        "dt_s": model.dt,
+        "sample_rate_hz": 1.0 / model.dt,
+        "source": {
+            "kind": "fit",
+            "seed": result.seed,
+            "wall_time_s": result.seconds,
+            "options": as_dict(result.options),
+            "info": result.info,
+        },
+        "records": [record_entry(r, "train", model, here) for r in train]
+        + [record_entry(r, "held-out", model, here) for r in held_out],
+    }
+    card = plain(card)
+    json_path, md_path = card_paths(model_path)
+    write_json(json_path, card, indent=1)
+    write_text(md_path, card_markdown(card))
+    return card
+
+
+def _pct(v: float | None) -> str:
+    return "-" if v is None else f"{100 * v:.2f}"
+
+
+def card_markdown(card: dict[str, Any]) -> str:
+    """The card for people: per record and axis, RMS ratio, ESR, MAX and max error."""
+    src = card["source"]
+    lines = [
+        f"# Model card: {card['model_file']} (3-axis)",
+        "",
+        f"- model: **{card['model']}** (planar), {card['sample_rate_hz']:.6g} Hz; sha256 "
+        f"`{card['model_sha256']}`",
+        f"- made by: fit with bushenv {card['bushenv_version']} on {card['created']}; seed "
+        f"{src['seed']}, wall time {src['wall_time_s']:.1f} s",
+    ]
+    lines += [f"- {k}: {v}" for k, v in src["info"].items()]
+    lines += [
+        "",
+        "## Free run from rest, per axis",
+        "",
+        "| record | role | axis | RMS ratio % | ESR % | MAX % | max error |",
+        "|---|---|---|---:|---:|---:|---:|",
+    ]
+    for r in card["records"]:
+        for c, unit in zip(COORDS, FORCE_UNITS, strict=True):
+            m = r["metrics"][c]
+            lines.append(
+                f"| {r['file'] or r['name']} | {r['role']} | {c} | {_pct(m['rms_ratio'])} | "
+                f"{_pct(m['esr'])} | {_pct(m['max_error_ratio'])} | {m['max_error']:.4g} {unit} |"
+            )
+    lines += ["", "## Options", "", "| option | value |", "|---|---|"]
+    lines += [f"| {k} | {v} |" for k, v in src["options"].items()]
+    return "\n".join(lines) + "\n"
+
+
+__all__ = ["CARD_FORMAT", "axis_metrics", "card_markdown", "card_paths", "save_planar_fit"]

@@ -1,0 +1,173 @@
+"""Identifying planar models from 3-axis records: which models can be fitted, with what options.
+
+``PLANAR_FITS`` names the identification of each fittable ``PLANAR_MODELS`` entry (the same
+names) and its options dataclass, whose fields are flags of ``bushenv fit`` as the one-axis
+options are (``bushenv.identify.options``). ``fit_planar(records, name, options, seed)`` runs
+one; records are ``(q (T, 3), f (T, 3))`` pairs at one sample time.
+
+| name      | identification                                                      |
+|-----------|---------------------------------------------------------------------|
+| linear    | least squares of f on [q, v] (3x3 K and C)                          |
+| nn        | the MIMO NARX network, ``train.fit_planar_network``                 |
+| nn-axis   | three single-axis networks (seed 000 §4.2's kind), the same training |
+| hybrid    | least-squares 3x3 backbone, then the MIMO network on the residual   |
+| boucwen   | variable projection: bounded Powell on the shape, least squares K, C, G, h |
+| hybrid-bw | the boucwen fit as backbone, then the MIMO network on its residual  |
+
+The networks train on one history: several records are joined end to end (the joint is a
+jump the training sees once per record; the card says so).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from bushenv.identify.options import NoOptions, option, options_of
+from bushenv.planar.base import PlanarModel, PlanarModelError
+from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
+from bushenv.planar.registry import PLANAR_MODELS
+from bushenv.registry import Registry
+
+History = tuple[np.ndarray, np.ndarray]
+
+
+@dataclass(frozen=True)
+class PlanarNetworkOptions:
+    """Options of the planar network training (``train.TrainOptions``); flags of ``bushenv fit``."""
+
+    hidden: int = option(27, "hidden tanh units (the per-axis kind: a third per axis)")
+    teacher_steps: int = option(400, "full-batch Adam steps one step ahead")
+    teacher_lr: float = option(1e-2, "learning rate one step ahead (cosine decay to 0)")
+    free_run_steps: int = option(200, "Adam steps on free-run windows")
+    free_run_lr: float = option(2e-3, "free-run learning rate")
+    window: int = option(64, "samples per free-run window")
+    windows: int = option(32, "free-run windows per step")
+    val_fraction: float = option(0.2, "last part of the training history kept for validation")
+    eval_every: int = option(25, "free-run steps between two validations")
+
+    def check(self) -> None:
+        small = [n for n in ("hidden", "teacher_steps", "window", "windows", "eval_every")
+                 if getattr(self, n) < 1]  # fmt: skip
+        if small or self.free_run_steps < 0 or not 0 < self.val_fraction < 0.9:
+            raise PlanarModelError(
+                f"planar network options: {small or 'free_run_steps / val_fraction'} out of "
+                "range (counts >= 1, free_run_steps >= 0, 0 < val_fraction < 0.9)"
+            )
+        if self.hidden % 3:
+            raise PlanarModelError(f"hidden must be a multiple of 3 (one group per axis), got "
+                                   f"{self.hidden}")  # fmt: skip
+
+    def train_options(self) -> Any:
+        from bushenv.planar.train import TrainOptions
+
+        return TrainOptions(
+            **{k: getattr(self, k) for k in PlanarNetworkOptions.__dataclass_fields__}
+        )
+
+
+@dataclass(frozen=True)
+class PlanarHybridBWOptions(PlanarNetworkOptions):
+    """The network's options and the backbone's search (``boucwen_fit``)."""
+
+    evaluations: int = option(200, "shape evaluations of the bounded Powell search (after 8)")
+    time_limit_s: float = option(120.0, "wall-time limit of the backbone's search, s (0: none)")
+
+    def check(self) -> None:
+        super().check()
+        self.backbone_options().check()
+
+    def backbone_options(self) -> PlanarBoucWenOptions:
+        return PlanarBoucWenOptions(self.evaluations, time_limit_s=self.time_limit_s)
+
+
+@dataclass(frozen=True)
+class PlanarFit:
+    """One identification: its options class and ``fit(histories, dt, opts, seed, say)``."""
+
+    options: type
+    fit: Callable[..., tuple[PlanarModel, dict[str, Any]]]
+
+
+@dataclass
+class PlanarFitResult:
+    model: PlanarModel
+    name: str
+    options: Any
+    seed: int
+    seconds: float
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+def _linear(histories, dt, opts, seed, say):
+    from bushenv.models.base import velocity_of
+    from bushenv.planar.linear import fit_linear
+
+    q = np.vstack([h[0] for h in histories])
+    v = np.vstack([velocity_of(h[0], dt) for h in histories])
+    return fit_linear(q, v, np.vstack([h[1] for h in histories]), dt), {}
+
+
+def _network(kind: str):
+    def fit(histories, dt, opts, seed, say):
+        from bushenv.planar.train import fit_planar_network
+
+        q = np.vstack([h[0] for h in histories])
+        f = np.vstack([h[1] for h in histories])
+        model = fit_planar_network(q, f, dt, kind, opts.train_options(), seed, quiet=say is None)
+        info = {"note": "records joined end to end"} if len(histories) > 1 else {}
+        return model, info
+
+    return fit
+
+
+def _boucwen(histories, dt, opts, seed, say):
+    return fit_planar_boucwen(histories, dt, opts, say=say)
+
+
+PLANAR_FITS: Registry[PlanarFit] = Registry("fittable planar model", PlanarModelError)
+PLANAR_FITS.add("linear", PlanarFit(NoOptions, _linear))
+for _kind in ("nn", "nn-axis", "hybrid"):
+    PLANAR_FITS.add(_kind, PlanarFit(PlanarNetworkOptions, _network(_kind)))
+PLANAR_FITS.add("boucwen", PlanarFit(PlanarBoucWenOptions, _boucwen))
+
+
+def _hybrid_bw(histories, dt, opts, seed, say):
+    from bushenv.planar.hybrid_bw import compose
+    from bushenv.planar.train import fit_planar_network
+
+    backbone, info = fit_planar_boucwen(histories, dt, opts.backbone_options(), say=say)
+    q = np.vstack([h[0] for h in histories])
+    residual = np.vstack([h[1] - backbone.simulate(h[0]) for h in histories])
+    net = fit_planar_network(q, residual, dt, "nn", opts.train_options(), seed, quiet=say is None)
+    info = {f"backbone {k}": v for k, v in info.items()}
+    if len(histories) > 1:
+        info["note"] = "the network's records joined end to end"
+    return compose(backbone, net), info
+
+
+PLANAR_FITS.add("hybrid-bw", PlanarFit(PlanarHybridBWOptions, _hybrid_bw))
+
+
+def fit_planar(
+    histories: Sequence[History],
+    name: str,
+    options: Any = None,
+    dt: float | None = None,
+    seed: int = 0,
+    say: Callable[[str], None] | None = None,
+) -> PlanarFitResult:
+    """Identify the planar model ``name`` from ``histories`` at sample time ``dt``."""
+    entry = PLANAR_FITS[name]
+    if name not in PLANAR_MODELS:
+        raise PlanarModelError(f"{name!r} has an identification but no PLANAR_MODELS entry")
+    if dt is None or not dt > 0:
+        raise PlanarModelError(f"fit_planar: dt must be a positive number of seconds, got {dt!r}")
+    opts = options_of(entry.options, options, name)
+    t0 = time.perf_counter()
+    model, info = entry.fit(list(histories), dt, opts, seed, say)
+    return PlanarFitResult(model, name, opts, seed, time.perf_counter() - t0, info)
