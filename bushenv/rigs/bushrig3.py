@@ -28,15 +28,16 @@ COORDS = ("axial", "radial", "rotation")
 MODEL_ERRORS = (BadInput, ModelRaised, ArithmeticError)
 
 
-def resolve_planar(value: Any, dt: float, what: str) -> PlanarModel:
-    """A planar model from a registered name (its ``preset``), an ``.npz`` file or an object."""
+def resolve_planar(value: Any, dt: float, what: str, env_id: str = ENV_ID) -> PlanarModel:
+    """A planar model from a registered name (its ``preset``), an ``.npz`` file or an object;
+    errors name ``env_id`` and the argument ``what``."""
     if isinstance(value, PlanarModel):
         return value.copy()
     if isinstance(value, str) and value in PLANAR_MODELS:
         cls = model_class(value)
         if not hasattr(cls, "preset"):
             raise RigError(
-                f"{ENV_ID}: {what} {value!r} has no preset (a network must be trained): pass "
+                f"{env_id}: {what} {value!r} has no preset (a network must be trained): pass "
                 "its .npz file from fit_planar_network(...).save(path)"
             )
         kwargs = {"measurement": False} if value == "reference" else {}
@@ -44,7 +45,7 @@ def resolve_planar(value: Any, dt: float, what: str) -> PlanarModel:
     if isinstance(value, str | Path) and str(value).endswith(".npz"):
         return load_planar_model(value, dt=dt)
     raise RigError(
-        f"{ENV_ID}: {what} {value!r}: {PLANAR_MODELS.unknown_message(value)}, "
+        f"{env_id}: {what} {value!r}: {PLANAR_MODELS.unknown_message(value)}, "
         "or a .npz planar model file"
     )
 
