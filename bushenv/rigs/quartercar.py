@@ -158,6 +158,13 @@ class QuarterCarEnv(gym.Env):
 
         env = gym.make("QuarterCar-v0", model="hybrid")
         env = gym.make("QuarterCar-v0", model={"radial": "r.npz", "axial": "a.npz"})
+        env = gym.make("QuarterCar-v0", arm_bushing="planar.npz")  # one planar model
+
+    ``arm_bushing`` (a ``bushenv.planar.PLANAR_MODELS`` name, a planar ``.npz`` file or a
+    planar model) replaces the two one-axis models by one three-axis bushing that also carries
+    the arm's rotation (a moment, judged by ``arm_moment_limit_nm``; the twin's is
+    ``arm_bushing_reference``); info then adds ``arm_rotation_rad``, ``moment_model_nm``,
+    ``moment_reference_nm``. docs/planar.md gives its coupling and range.
         obs, info = env.reset(options={"excitation": road})  # replay road heights exactly
 
     ## Vectorized environment
@@ -189,7 +196,8 @@ class QuarterCarEnv(gym.Env):
 
     ## Version History
 
-    - v0: the car of ``envs/QuarterCar-v0.toml``. Since: the episode length is the spec's
+    - v0: the car of ``envs/QuarterCar-v0.toml`` (``arm_bushing`` added, default off: the
+      car is unchanged). Since: the episode length is the spec's
       ``max_episode_steps`` (Gymnasium's ``TimeLimit``; the kwarg ``episode_steps`` is gone),
       ``render_fps`` is 1 / ``dt_s``, the env pickles and deep-copies, a vector entry point
       exists, and the id is also registered as ``bushenv/QuarterCar-v0``. The dynamics and
