@@ -18,7 +18,7 @@ from bushenv.models.kernels import JIT
 TILE = 128  # histories per tile (z, h: 61 KB, in L2); measured best of 32-256
 
 
-@nb.njit(**JIT)
+@nb.njit(**{**JIT, "fastmath": {"contract"}})
 def planar_narx_kernel(  # pragma: no cover - compiled
     q, v, state, q_offset, q_scale, f_offset, f_scale, w1, b1, w_out, b_out, k, c, out
 ):
@@ -91,3 +91,16 @@ def planar_narx_kernel(  # pragma: no cover - compiled
                 for b in range(n):
                     state[i, lo + b] = z[i, b]
                     state[nq + i, lo + b] = y[i, b]
+
+
+@nb.njit(**JIT)
+def planar_linear_kernel(q, v, k, c, out):  # pragma: no cover - compiled
+    """out = K q + C v per sample and history; ``q``, ``v``, ``out`` (T, B, 3)."""
+    T, B, _ = q.shape
+    for t in range(T):
+        for b in range(B):
+            for i in range(3):
+                f = 0.0
+                for j in range(3):
+                    f += k[i, j] * q[t, b, j] + c[i, j] * v[t, b, j]
+                out[t, b, i] = f
