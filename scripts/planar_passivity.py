@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from bushenv.models.base import PAPER_DT, velocity_of
-from bushenv.planar import PLANAR_MODELS, load_planar_model, model_class
+from bushenv.planar import PLANAR_MODELS, PlanarModelError, load_planar_model, model_class
 from bushenv.planar.fixed_points import fixed_points, fold_crossings, grid
 from bushenv.planar.linear import fit_linear
 from bushenv.planar.narx import PlanarNarx
@@ -61,9 +61,9 @@ def build_models(names: list[str], seed: int, progress: Progress) -> dict:
 
             models[name] = fit_planar_network(q, f, dt, kind=name, seed=seed)
         else:
-            raise SystemExit(
-                f"planar_passivity.py: --models {name!r}: {PLANAR_MODELS.unknown_message(name)}, "
-                "linear-preset, or a .npz planar model file"
+            raise PlanarModelError(
+                f"--models {name!r}: {PLANAR_MODELS.unknown_message(name)}, linear-preset, or "
+                "a .npz planar model file"
             )
         progress.update(k + 1, f"{name} ready")
     return models
@@ -109,7 +109,7 @@ def certificate_table(models: dict) -> str:
             continue
         t0 = time.perf_counter()
         fp = fixed_points(m, grid(*CERT_AXES))
-        folds = fold_crossings(m, *CERT_AXES, fp=fp)
+        folds = fold_crossings(m, *CERT_AXES, fp=fp, refine=False)  # counted, not located
         n = fp.count
         un = int(fp.unresolved.sum())
         rows.append(
@@ -158,7 +158,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--quiet", action="store_true")
     args = p.parse_args(argv)
     progress = Progress(len(args.models) * 2, quiet=args.quiet, label="planar passivity")
-    models = build_models(args.models, args.seed, progress)
+    try:
+        models = build_models(args.models, args.seed, progress)
+    except PlanarModelError as exc:  # a bad name or file: one line, exit 2
+        print(f"planar_passivity.py: {exc}", file=sys.stderr)
+        return 2
     reports = {}
     for k, (name, m) in enumerate(models.items()):
         reports[name] = passivity(m, HOLDS, FREQ_HZ)

@@ -101,3 +101,25 @@ def test_network_report_names_holds_without_a_stable_fixed_point():
     assert len(rep.no_stable) == 3 and rep.eig.shape == (0, 2, 3)
     held = model.simulate(np.tile([0.0, 2e-3, 0.0], (2000, 1)))[-200:, 1]
     assert held.max() - held.min() > 10.0  # N: no steady state, it keeps oscillating
+
+
+def test_script_prints_both_tables_and_refuses_an_unknown_name(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[2] / "scripts" / "planar_passivity.py"
+    net = str(PlanarNarx.untrained(seed=0).save(tmp_path / "net.npz"))
+    run = subprocess.run(
+        [sys.executable, str(script), "--models", "linear-preset", net, "--quiet",
+         "--png", str(tmp_path / "p.png")],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert "| linear-preset | analytic |" in run.stdout and "| net.npz | linearised |" in run.stdout
+    assert "| net.npz | 125 |" in run.stdout and (tmp_path / "p.png").stat().st_size > 0
+    bad = subprocess.run(
+        [sys.executable, str(script), "--models", "nope"], capture_output=True, text=True
+    )
+    assert bad.returncode == 2 and "unknown planar model 'nope'" in bad.stderr
+    assert "Traceback" not in bad.stderr
