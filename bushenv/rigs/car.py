@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 import os
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -148,19 +147,9 @@ class CarParameters:
         self.moment_limit = g("arm_moment_limit_nm", kwargs.get("arm_moment_limit_nm", 2500.0))
         self.rotation_in: dict[str, tuple[float, float]] = {}  # car role -> (k_in, c_in)
         if resolve_models and self.planar:
-            from bushenv.rigs.bushrig3 import resolve_planar
+            from bushenv.rigs.car_planar import resolve_arm
 
-            arm = resolve_planar(self.arm_bushing, self.dt, "arm_bushing", env_id=CAR.name)
-            twin = resolve_planar(
-                kwargs.get("arm_bushing_reference", "reference"), self.dt,
-                "arm_bushing_reference", env_id=CAR.name,
-            )  # fmt: skip
-            self.models, self.references = {"arm": arm}, {"arm": twin}
-            self.rotation_in = {"model": rotation_split(arm), "reference": rotation_split(twin)}
-            label = self.arm_bushing
-            self.model_name = label if isinstance(label, str) else arm.name
-            self.model_name = f"planar {Path(str(self.model_name)).name}"
-            self.reference_name = f"planar {twin.name}"
+            resolve_arm(self, kwargs)
         elif resolve_models:
             self.models = axis_models(kwargs["model"], self.dt, reference=False)
             self.references = axis_models(
@@ -171,25 +160,6 @@ class CarParameters:
             )
             self.model_name = axis_label(self.models, kwargs["model"])
             self.reference_name = axis_label(self.references, kwargs["reference"])
-
-
-ROTATION_K_IN_FLOOR = 1e-3  # N m/rad: a rotary spring needs a stiffness; this one is nil
-
-
-def rotation_split(model) -> tuple[float, float]:
-    """(k_in N m/rad, c_in N m s/rad) of a planar bushing's rotation inside the sub-steps: what
-    the model states (a linear model's K_tt, C_tt; a hybrid's backbone), else the planar
-    linear preset's (the reference's tangent at rest, 3000 N m/rad). Matching the model makes
-    its held remainder small: a linear model's is exactly zero, as in the one-axis split.
-    Held explicitly, even 3000 N m/rad on the arm (about 1.1 kg m^2 about its centre of mass)
-    is omega dt = 0.26: the rotation is not where the coupling trap lies; accuracy is."""
-    from bushenv.planar.linear import PlanarLinear
-
-    k = getattr(model, "k_matrix", None)
-    if k is None:
-        lin = PlanarLinear.preset(dt=model.dt)
-        return float(lin.k_matrix[2, 2]), float(lin.c_matrix[2, 2])
-    return max(float(k[2, 2]), ROTATION_K_IN_FLOOR), max(float(model.c_matrix[2, 2]), 0.0)
 
 
 class Car:
@@ -389,7 +359,9 @@ class CarPair:
         car.update_damping()
         motion = car.bushing_motion()
         if "arm" in models:
-            return motion, *self._sample_planar(car, models["arm"], motion)
+            from bushenv.rigs.car_planar import sample_planar
+
+            return motion, *sample_planar(self.p, car, models["arm"], motion)
         xr, vr, xa, va = motion
         try:
             forces = (models["radial"].step(xr, vr), models["axial"].step(xa, va))
@@ -402,31 +374,6 @@ class CarPair:
             car.radial.hold(forces[0], xr, vr)
             car.axial.hold(forces[1], xa, va)
         return motion, forces, why
-
-    def _sample_planar(self, car: Car, model, motion):
-        """(forces, why) of a planar arm bushing: (radial N, axial N, moment N m), judged and
-        held as ``sample`` does, the moment by its own limit ``arm_moment_limit_nm``."""
-        xr, vr, xa, va = motion
-        theta, omega = car.bushing_rotation()
-        try:
-            f = model.step(np.array([xa, xr, theta]), np.array([va, vr, omega]))
-            forces = (float(f[1]), float(f[0]), float(f[2]))
-        except MODEL_ERRORS as exc:
-            return (math.nan,) * 3, f"model raised {type(exc).__name__}: {exc}"
-        except Exception as exc:
-            return (math.nan,) * 3, MODEL_ERROR_PREFIX + model_error_text(exc)
-        why = force_reason(*forces[:2], self.p.force_limit)
-        if not why and not math.isfinite(forces[2]):
-            why = f"bushing moment {forces[2]!r} N m is not finite"
-        elif not why and abs(forces[2]) > self.p.moment_limit:
-            why = (
-                f"|bushing moment| = {abs(forces[2]):.6g} N m exceeds {self.p.moment_limit:.6g} N m"
-            )
-        if not why:
-            car.radial.hold(forces[0], xr, vr)
-            car.axial.hold(forces[1], xa, va)
-            car.rotation.hold(forces[2], theta, omega)
-        return forces, why
 
     def integrate(self, h0: float, h: float) -> None:
         """Both cars through ``physics_substeps`` pymunk steps, the road moving h0 -> h."""
