@@ -782,6 +782,80 @@ def bench_diagnose(fig: Figures, quick: bool) -> None:
     )
 
 
+def _env_steps_per_s(env, n: int) -> float:
+    """Single-env steps per second over ``n`` steps of random actions drawn in bulk."""
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    actions = np.stack([env.action_space.sample() for _ in range(256)])
+    t0 = time.perf_counter()
+    for i in range(n):
+        _, _, term, trunc, _ = env.step(actions[i % 256])
+        if term or trunc:
+            env.reset()
+    return n / (time.perf_counter() - t0)
+
+
+def bench_planar(fig: Figures, quick: bool) -> None:
+    """Issue 25 item 8: a BushRig3-v0 step within 3x a BushRig-v0 step, and the MIMO network's
+    batched free run per axis at least a third of the one-axis network's."""
+    import tempfile
+
+    import gymnasium as gym
+
+    import bushenv  # noqa: F401  registers the envs
+    from bushenv.excitation import random_rpc
+    from bushenv.models import get_model
+    from bushenv.planar.narx import PlanarNarx
+
+    print("\n== planar: BushRig3-v0 beside BushRig-v0, MIMO free run beside one axis (same run)")
+    n = 2000 if quick else 20000
+    with tempfile.TemporaryDirectory() as tmp:
+        net_file = str(PlanarNarx.untrained(seed=0).save(Path(tmp) / "nn.npz"))
+        for label, one, three in (("linear", "linear", "linear"), ("nn", "nn", net_file)):
+            env1 = gym.make("BushRig-v0", model=one).unwrapped
+            env3 = gym.make("BushRig3-v0", model=three).unwrapped
+            # interleaved, best of two each: the shared machine's load shifts within seconds
+            r1 = max(_env_steps_per_s(env1, n) for _ in range(2))
+            r3 = max(_env_steps_per_s(env3, n) for _ in range(2))
+            fig.add(f"planar.BushRig-v0.{label}.single", r1, "steps/s")
+            fig.add(f"planar.BushRig3-v0.{label}.single", r3, "steps/s")
+            fig.add(
+                f"planar.BushRig3-v0.{label}.step_time_over_bushrig",
+                r1 / r3,
+                "ratio",
+                None if quick else 3.0,
+                better="lower",
+                note="nn: a planar MIMO network file (33-27-3) beside the one-axis nn preset",
+            )
+    T, B = (512 if quick else 4096), 1024
+    min_time = 0.05 if quick else 0.5
+    dt = 1 / 204.8
+    peaks = (2e-3, 2e-3, 0.05)
+    q = np.stack(
+        [
+            np.stack([random_rpc(1.0, T * dt, dt, seed=3 * b + i, peak_m_at_n1=peaks[i])
+                      for i in range(3)], 1)
+            for b in range(B)
+        ],
+        1,
+    )  # fmt: skip
+    v = np.gradient(q, dt, axis=0)
+    mimo = PlanarNarx.untrained(seed=0)
+    one = get_model("nn", axis="axial")
+    x, vx = np.ascontiguousarray(q[:, :, 0]), np.ascontiguousarray(v[:, :, 0])
+    s_m = _time_per_call(lambda: mimo.simulate(q, v), min_time)
+    s_1 = _time_per_call(lambda: one.simulate(x, vx), min_time)
+    fig.add("planar.free_run.nn.B1024", T * B / s_m, "steps/s", note="3 forces per step")
+    fig.add(
+        "planar.free_run.nn.B1024.per_axis_over_one_axis",
+        3 * s_1 / s_m,
+        "ratio",
+        None if quick else 1 / 3,
+        note="3 x MIMO steps/s over the one-axis nn's steps/s; the MIMO step has 9x the "
+        "multiply-adds (33 x 27 + 27 x 3 against 11 x 9 + 9)",
+    )
+
+
 SECTIONS = {
     "models": bench_models,
     "scipy": bench_compare.bench_scipy,
@@ -797,6 +871,7 @@ SECTIONS = {
     "records": bench_records,
     "diagnose": bench_diagnose,
     "fmu": bench_fmu.bench_fmu,
+    "planar": bench_planar,
 }
 
 

@@ -75,6 +75,17 @@ EXPECTED = [
     "memory.batch_B1024_T512.peak",
     "records.load_csv_20k_over_loadtxt",
     "diagnose.cross.4_records.seconds",
+    *(
+        f"planar.{f}"
+        for f in (
+            "BushRig-v0.linear.single",
+            "BushRig3-v0.linear.single",
+            "BushRig3-v0.linear.step_time_over_bushrig",
+            "BushRig3-v0.nn.step_time_over_bushrig",
+            "free_run.nn.B1024",
+            "free_run.nn.B1024.per_axis_over_one_axis",
+        )
+    ),
 ]
 
 

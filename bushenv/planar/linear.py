@@ -15,6 +15,7 @@ import numpy as np
 
 from bushenv.models.base import PAPER_DT
 from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
+from bushenv.planar.kernels import planar_linear_kernel
 from bushenv.planar.reference import ROTATION_K_NM_PER_RAD
 
 
@@ -39,8 +40,8 @@ class PlanarLinear(PlanarModel):
         return cls(k, c, dt=dt)
 
     def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        np.matmul(q, self.k_matrix.T, out=out)
-        out += v @ self.c_matrix.T
+        # compiled: at one sample the two numpy products cost more than the arithmetic
+        planar_linear_kernel(q, v, self.k_matrix, self.c_matrix, out)
 
 
 def fit_linear(q: np.ndarray, v: np.ndarray, f: np.ndarray, dt: float = PAPER_DT) -> PlanarLinear:

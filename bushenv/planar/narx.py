@@ -26,6 +26,7 @@ import numpy as np
 
 from bushenv.models.base import PAPER_DT
 from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
+from bushenv.planar.kernels import planar_narx_kernel
 
 N_PAST_Q = 5  # seed 000 §4.2
 N_PAST_F = 5
@@ -142,22 +143,18 @@ class PlanarNarx(PlanarModel):
         )
 
     def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        nq = 3 * N_PAST_Q
-        z = np.empty((q.shape[1], N_IN))
-        state = self.state  # (30, B): past qs lags 1..5, past ys lags 1..5
-        for t in range(q.shape[0]):
-            z[:, :3] = (q[t] - self.q_offset) / self.q_scale
-            z[:, 3:] = state.T
-            y = np.tanh(z @ self.w1.T + self.b1) @ self.w_out.T + self.b_out
-            out[t] = self.f_offset + self.f_scale * y
-            state[3:nq] = state[: nq - 3]
-            state[:3] = z[:, :3].T
-            state[nq + 3 :] = state[nq:-3]
-            state[nq : nq + 3] = y.T
-        self._backbone(q, v, out)
+        k, c = self._backbone_matrices()
+        planar_narx_kernel(
+            q, v, self.state, self.q_offset, self.q_scale, self.f_offset, self.f_scale,
+            self.w1, self.b1, self.w_out, self.b_out, k, c, out,
+        )  # fmt: skip
 
-    def _backbone(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        """The pure network has none."""
+    def _backbone_matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """(K, C) of the linear backbone; the pure network has none."""
+        return _NO_BACKBONE, _NO_BACKBONE
+
+
+_NO_BACKBONE = np.zeros((3, 3))
 
 
 class PlanarNarxPerAxis(PlanarNarx):
@@ -185,5 +182,5 @@ class PlanarHybrid(PlanarNarx):
         self.c_matrix = as_matrix("hybrid: c_matrix", c_matrix)
         super().__init__(**network)
 
-    def _backbone(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        out += q @ self.k_matrix.T + v @ self.c_matrix.T
+    def _backbone_matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.k_matrix, self.c_matrix

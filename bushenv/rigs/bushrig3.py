@@ -18,6 +18,7 @@ from gymnasium import spaces
 from bushenv.divergence import force_termination
 from bushenv.errors import BadInput, ModelRaised
 from bushenv.planar import PLANAR_MODELS, PlanarModel, load_planar_model, model_class
+from bushenv.rigs.bushrig3_kernels import rig3_motion, rig3_outcome
 from bushenv.rigs.common import RigError, positive, positive_int
 from bushenv.rigs.specs import spec_kwargs
 from bushenv.rigs.vector_base import ArrayVectorEnv
@@ -27,15 +28,16 @@ COORDS = ("axial", "radial", "rotation")
 MODEL_ERRORS = (BadInput, ModelRaised, ArithmeticError)
 
 
-def resolve_planar(value: Any, dt: float, what: str) -> PlanarModel:
-    """A planar model from a registered name (its ``preset``), an ``.npz`` file or an object."""
+def resolve_planar(value: Any, dt: float, what: str, env_id: str = ENV_ID) -> PlanarModel:
+    """A planar model from a registered name (its ``preset``), an ``.npz`` file or an object;
+    errors name ``env_id`` and the argument ``what``."""
     if isinstance(value, PlanarModel):
         return value.copy()
     if isinstance(value, str) and value in PLANAR_MODELS:
         cls = model_class(value)
         if not hasattr(cls, "preset"):
             raise RigError(
-                f"{ENV_ID}: {what} {value!r} has no preset (a network must be trained): pass "
+                f"{env_id}: {what} {value!r} has no preset (a network must be trained): pass "
                 "its .npz file from fit_planar_network(...).save(path)"
             )
         kwargs = {"measurement": False} if value == "reference" else {}
@@ -43,7 +45,7 @@ def resolve_planar(value: Any, dt: float, what: str) -> PlanarModel:
     if isinstance(value, str | Path) and str(value).endswith(".npz"):
         return load_planar_model(value, dt=dt)
     raise RigError(
-        f"{ENV_ID}: {what} {value!r}: {PLANAR_MODELS.unknown_message(value)}, "
+        f"{env_id}: {what} {value!r}: {PLANAR_MODELS.unknown_message(value)}, "
         "or a .npz planar model file"
     )
 
@@ -62,6 +64,7 @@ class Rig3Core:
         self.history = positive_int("history", kwargs["history"])
         self.limit = _per_coord("stroke", kwargs["stroke"])
         self.rate = _per_coord("rate", kwargs["rate"])
+        self._rate_dt = self.rate * self.dt
         self.force_limit = _per_coord("force_limit", kwargs["force_limit"])
         self.force_scale = _per_coord("force_scale", kwargs["force_scale"])
         self.reward_cap = positive("reward_cap", kwargs["reward_cap"])
@@ -76,6 +79,10 @@ class Rig3Core:
             self.obs = np.zeros((self.batch, 3, 3, self.history), dtype=np.float32)
             self.model.reset(self.batch)
             self.reference.reset(self.batch)
+            # (1, B, 3) buffers the models' _advance runs on: the step skips the checks of
+            # PlanarModel.step (shapes are right by construction), a third of its cost
+            self._q1, self._v1 = np.zeros((1, self.batch, 3)), np.zeros((1, self.batch, 3))
+            self._fm1, self._fr1 = np.zeros((1, self.batch, 3)), np.zeros((1, self.batch, 3))
         for m in (self.model, self.reference):
             m.state[:, mask] = m.initial_state(self.batch)[:, mask]
         self.q[mask] = 0.0
@@ -83,32 +90,34 @@ class Rig3Core:
 
     def step(self, action: np.ndarray) -> dict[str, np.ndarray]:
         """action (B, 3) in [-1, 1] (NaN as 0) -> the step's arrays."""
-        a = np.clip(np.nan_to_num(np.asarray(action, dtype=np.float64), nan=0.0), -1.0, 1.0)
-        q_new = np.clip(self.q + a * self.rate * self.dt, -self.limit, self.limit)
-        v = (q_new - self.q) / self.dt
-        self.q = q_new
+        a = np.ascontiguousarray(action, dtype=np.float64)
+        rig3_motion(a, self.q, self._rate_dt, self.limit, self.dt, self._q1, self._v1)
         try:
-            f_model = self.model.step(q_new, v)
-            raised = ""
+            self.model._guarded(self._q1, self._v1, self._fm1)
+            f_model, raised = self._fm1[0], ""
         except MODEL_ERRORS as exc:
             f_model, raised = np.full((self.batch, 3), np.nan), str(exc)
-        f_ref = self.reference.step(q_new, v)
-        non_finite, model_over, ref_over = force_termination(f_model, f_ref, self.force_limit)
-        err = np.abs(f_model - f_ref) / self.force_scale
-        reward = np.minimum(np.nan_to_num(err.sum(axis=1), nan=np.inf), self.reward_cap)
-        self.obs[:, :, :, 1:] = self.obs[:, :, :, :-1]
-        for j, f in enumerate(
-            (q_new / self.limit, f_model / self.force_limit, f_ref / self.force_limit)
-        ):
-            self.obs[:, j, :, 0] = np.clip(np.nan_to_num(f, nan=0.0), -1.0, 1.0)
+        self.reference._guarded(self._q1, self._v1, self._fr1)
+        f_ref = self._fr1[0]
+        reward = np.empty(self.batch)
+        calm = rig3_outcome(
+            self.q, f_model, f_ref, self.limit, self.force_limit, self.force_scale,
+            self.reward_cap, self.obs, reward,
+        )  # fmt: skip
+        if calm:  # all finite and within every limit: force_termination cannot fire
+            terminated = truncated = np.zeros(self.batch, dtype=bool)
+        else:
+            non_finite, model_over, ref_over = force_termination(f_model, f_ref, self.force_limit)
+            terminated = non_finite.any(axis=1) | model_over.any(axis=1)
+            truncated = ref_over.any(axis=1)
         return {
-            "q": q_new,
-            "v": v,
-            "f_model": f_model,
-            "f_ref": f_ref,
+            "q": self.q.copy(),
+            "v": self._v1[0].copy(),
+            "f_model": f_model.copy(),
+            "f_ref": f_ref.copy(),
             "reward": reward,
-            "terminated": non_finite.any(axis=1) | model_over.any(axis=1),
-            "truncated": ref_over.any(axis=1),
+            "terminated": terminated,
+            "truncated": truncated,
             "raised": raised,
         }
 
@@ -119,13 +128,19 @@ class Rig3Core:
         )
 
 
+_INFO_KEYS = tuple(
+    f"{kind}_{c}" for kind in ("q", "force_model", "force_reference") for c in COORDS
+)
+
+
 def _info(s: dict[str, Any], i: int, t: int, dt: float) -> dict[str, Any]:
+    # tolist(): one call for three Python floats (float() per element costs 3x the step's
+    # model time at B = 1)
+    values = s["q"][i].tolist() + s["f_model"][i].tolist() + s["f_ref"][i].tolist()
     return {
         "time_s": t * dt,
         "step": t,
-        **{f"q_{c}": float(s["q"][i, k]) for k, c in enumerate(COORDS)},
-        **{f"force_model_{c}": float(s["f_model"][i, k]) for k, c in enumerate(COORDS)},
-        **{f"force_reference_{c}": float(s["f_ref"][i, k]) for k, c in enumerate(COORDS)},
+        **dict(zip(_INFO_KEYS, values, strict=True)),
         "diverged": bool(s["terminated"][i]),
         "machine_limit": bool(s["truncated"][i]),
         "model_error": s["raised"],

@@ -34,6 +34,7 @@ from bushenv.rigs.common import (
 from bushenv.rigs.coupling import (
     LONG_ARM_M,
     SplitBushing,
+    SplitRotation,
     implicit_euler_damping,
     inverse_mass_along,
     space_stepper,
@@ -140,7 +141,16 @@ class CarParameters:
         # the split coupling's in-sub-step linear part: the Table-1 Kelvin-Voigt bushing
         self.k_in = {a: TABLE1[a]["k_n_per_m"] for a in AXES}
         self.c_in = {a: TABLE1[a]["c_ns_per_m"] for a in AXES}
-        if resolve_models:
+        # a planar arm bushing: one three-axis model for axial, radial and the arm's rotation
+        self.arm_bushing = kwargs.get("arm_bushing", "")
+        self.planar = not (isinstance(self.arm_bushing, str) and self.arm_bushing == "")
+        self.moment_limit = g("arm_moment_limit_nm", kwargs.get("arm_moment_limit_nm", 2500.0))
+        self.rotation_in: dict[str, tuple[float, float]] = {}  # car role -> (k_in, c_in)
+        if resolve_models and self.planar:
+            from bushenv.rigs.car_planar import resolve_arm
+
+            resolve_arm(self, kwargs)
+        elif resolve_models:
             self.models = axis_models(kwargs["model"], self.dt, reference=False)
             self.references = axis_models(
                 kwargs["reference"],
@@ -167,8 +177,11 @@ class Car:
     (``implicit_euler_damping``).
     """
 
-    def __init__(self, p: CarParameters, space: pymunk.Space | None = None) -> None:
+    def __init__(
+        self, p: CarParameters, space: pymunk.Space | None = None, role: str = "model"
+    ) -> None:
         self.p = p
+        self.role = role  # "model" or "reference": which bushing's rotation split it uses
         self.space = space = space if space is not None else pymunk.Space()
         ground = space.static_body
         L = p.L
@@ -204,6 +217,10 @@ class Car:
             space, self.chassis, self.unsprung, (0.0, 0.0), self.arm_inner, (1.0, 0.0),
             p.k_in["axial"], p.c_in["axial"], p.h,
         )  # fmt: skip
+        self.rotation = None
+        if p.planar:  # the bushing also carries the arm's rotation (a moment)
+            k_in, c_in = p.rotation_in[role]
+            self.rotation = SplitRotation(space, self.chassis, self.unsprung, k_in, c_in, p.h)
         self.reset()
 
     def reset(self) -> None:
@@ -221,6 +238,8 @@ class Car:
             body.angular_velocity = 0.0
         self.radial.release()
         self.axial.release()
+        if self.rotation is not None:
+            self.rotation.release()
         self._damping_angle = 0.0
         self.update_damping(force=True)
 
@@ -252,6 +271,11 @@ class Car:
         vb = self.unsprung.velocity_at_local_point(self.arm_inner)
         return pb.y - cp.y, vb.y - cv.y, pb.x - cp.x, vb.x - cv.x
 
+    def bushing_rotation(self) -> tuple[float, float]:
+        """(theta, omega): the arm's rotation relative to the chassis, rad and rad/s."""
+        u, c = self.unsprung, self.chassis
+        return u.angle - c.angle, u.angular_velocity - c.angular_velocity
+
     def body_state(self) -> tuple[float, float, float, float]:
         """(chassis y, chassis vy, wheel centre y, wheel centre vy) from ride height."""
         w = self.unsprung.local_to_world(self.wheel_centre)
@@ -274,6 +298,11 @@ class Car:
             "springs": {k: (s.rest_length, s.damping) for k, s in self._springs().items()},
             "held_n": (self.radial.held_n, self.axial.held_n),
             "damping_angle": self._damping_angle,
+            **(
+                {}
+                if self.rotation is None
+                else {"rotation": (self.rotation.spring.rest_angle, self.rotation.held_nm)}
+            ),
         }
 
     def restore(self, snapshot: dict[str, Any]) -> None:
@@ -287,13 +316,15 @@ class Car:
             spring.rest_length, spring.damping = rest_length, damping
         self.radial.held_n, self.axial.held_n = snapshot["held_n"]
         self._damping_angle = snapshot["damping_angle"]
+        if "rotation" in snapshot:
+            self.rotation.spring.rest_angle, self.rotation.held_nm = snapshot["rotation"]
 
     def __getstate__(self) -> dict[str, Any]:
         # pymunk drops a spring's force_func when pickling (the unilateral tyre): rebuild instead
-        return {"p": self.p, "snapshot": self.snapshot()}
+        return {"p": self.p, "snapshot": self.snapshot(), "role": self.role}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__init__(state["p"])
+        self.__init__(state["p"], role=state.get("role", "model"))
         self.restore(state["snapshot"])
 
 
@@ -306,7 +337,7 @@ class CarPair:
     def __init__(self, p: CarParameters) -> None:
         self.p = p
         self.car = Car(p, pymunk.Space())
-        self.twin = Car(p, pymunk.Space())
+        self.twin = Car(p, pymunk.Space(), "reference")
         self._connect()
 
     def _connect(self) -> None:
@@ -327,6 +358,10 @@ class CarPair:
         the remainders are held for the coming step."""
         car.update_damping()
         motion = car.bushing_motion()
+        if "arm" in models:
+            from bushenv.rigs.car_planar import sample_planar
+
+            return motion, *sample_planar(self.p, car, models["arm"], motion)
         xr, vr, xa, va = motion
         try:
             forces = (models["radial"].step(xr, vr), models["axial"].step(xa, va))
@@ -382,12 +417,17 @@ def beyond_bounds(p: CarParameters, yc, yw, xr, xa):
 def car_verdict(p: CarParameters, forces_model, forces_reference, bounds_model, bounds_reference):
     """(terminated, truncated) of the model car beside its twin.
 
-    ``forces_*``: (2,) or (2, N) radial and axial bushing forces, N; ``bounds_*``: the cars'
-    ``beyond_bounds``. The force criteria are ``divergence.force_termination``'s (not finite, or
-    beyond ``force_limit_n`` while the twin's is within); the twin beyond its own bounds or
-    force limit truncates (the road is too harsh to judge), and that comes first."""
+    ``forces_*``: (2,) or (2, N) radial and axial bushing forces, N (with a planar arm bushing
+    (3,) or (3, N), the moment last, N m, judged by ``arm_moment_limit_nm``); ``bounds_*``: the
+    cars' ``beyond_bounds``. The force criteria are ``divergence.force_termination``'s (not
+    finite, or beyond ``force_limit_n`` while the twin's is within); the twin beyond its own
+    bounds or force limit truncates (the road is too harsh to judge), and that comes first."""
+    limit = p.force_limit
+    if len(forces_model) == 3:  # a planar arm bushing: radial, axial, moment
+        limit = np.array([p.force_limit, p.force_limit, p.moment_limit])
+        limit = limit[:, None] if np.ndim(forces_model) == 2 else limit
     non_finite, model_over, reference_over = force_termination(
-        forces_model, forces_reference, p.force_limit
+        forces_model, forces_reference, limit
     )
     twin_out = reference_over.any(axis=0) | bounds_reference
     model_out = non_finite.any(axis=0) | model_over.any(axis=0) | bounds_model

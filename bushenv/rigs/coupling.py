@@ -153,3 +153,39 @@ def velocity_setter(body):
             body.velocity = (vx, vy)
 
         return set_velocity
+
+
+class SplitRotation:
+    """The rotational coordinate of a planar bushing between bodies ``a`` (the bushing frame; it
+    must not rotate) and ``b``: ``SplitBushing``'s scheme for a moment. A pymunk
+    DampedRotarySpring applies k_in theta + c_in omega inside every sub-step (its damper made
+    implicit Euler about ``b``'s inertia); ``hold(M, theta, omega)`` holds the remainder
+    H = M - (k_in theta + c_in omega) by the spring's rest angle (chipmunk's rotary spring acts
+    on b with -k (theta + rest_angle)), so ``b`` feels -(k_in theta(t) + c_in omega(t) + H)."""
+
+    def __init__(self, space, a, b, k_in, c_in, h) -> None:
+        import pymunk
+
+        self.a, self.b = a, b
+        self.h = positive("sub-step", h)
+        self.k_in = positive("k_in", k_in)
+        self.c_in = float(c_in)
+        self.spring = pymunk.DampedRotarySpring(a, b, 0.0, self.k_in, self.c_in)
+        space.add(self.spring)
+        self.held_nm = 0.0
+        self.update_damping()
+
+    def update_damping(self) -> None:
+        k = sum(1.0 / x.moment for x in (self.a, self.b) if math.isfinite(x.moment))
+        self.spring.damping = implicit_euler_damping(self.c_in, self.h, k)
+
+    def hold(self, moment_nm: float, theta: float, omega: float) -> float:
+        """Hold the remainder of the sampled model moment ``moment_nm`` at (theta, omega)."""
+        held = moment_nm - (self.k_in * theta + self.c_in * omega)
+        self.held_nm = held
+        self.spring.rest_angle = held / self.k_in
+        return held
+
+    def release(self) -> None:
+        self.held_nm = 0.0
+        self.spring.rest_angle = 0.0

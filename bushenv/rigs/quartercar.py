@@ -158,6 +158,13 @@ class QuarterCarEnv(gym.Env):
 
         env = gym.make("QuarterCar-v0", model="hybrid")
         env = gym.make("QuarterCar-v0", model={"radial": "r.npz", "axial": "a.npz"})
+        env = gym.make("QuarterCar-v0", arm_bushing="planar.npz")  # one planar model
+
+    ``arm_bushing`` (a ``bushenv.planar.PLANAR_MODELS`` name, a planar ``.npz`` file or a
+    planar model) replaces the two one-axis models by one three-axis bushing that also carries
+    the arm's rotation (a moment, judged by ``arm_moment_limit_nm``; the twin's is
+    ``arm_bushing_reference``); info then adds ``arm_rotation_rad``, ``moment_model_nm``,
+    ``moment_reference_nm``. docs/planar.md gives its coupling and range.
         obs, info = env.reset(options={"excitation": road})  # replay road heights exactly
 
     ## Vectorized environment
@@ -189,7 +196,8 @@ class QuarterCarEnv(gym.Env):
 
     ## Version History
 
-    - v0: the car of ``envs/QuarterCar-v0.toml``. Since: the episode length is the spec's
+    - v0: the car of ``envs/QuarterCar-v0.toml`` (``arm_bushing`` added, default off: the
+      car is unchanged). Since: the episode length is the spec's
       ``max_episode_steps`` (Gymnasium's ``TimeLimit``; the kwarg ``episode_steps`` is gone),
       ``render_fps`` is 1 / ``dt_s``, the env pickles and deep-copies, a vector entry point
       exists, and the id is also registered as ``bushenv/QuarterCar-v0``. The dynamics and
@@ -256,7 +264,8 @@ class QuarterCarEnv(gym.Env):
         if self._trace is not None:
             self._trace.clear()
         zero = (0.0,) * 4
-        info = self._info(zero, zero, zero, zero, zero, zero, "", "", "")
+        forces = (0.0,) * (3 if p.planar else 2)
+        info = self._info(zero, forces, zero, zero, forces, zero, "", "", "")
         self._info_last = info
         if self.render_mode == "human":
             self.render()
@@ -297,8 +306,12 @@ class QuarterCarEnv(gym.Env):
         ]
         terminated, truncated = car_verdict(p, np.array(force_m), np.array(force_r), *bounds)
         terminated, truncated = bool(terminated), bool(truncated)
-        why_m = why_m or out_of_bounds(p, body_m[0], body_m[2], motion_m[0], motion_m[2], *force_m)
-        why_r = why_r or out_of_bounds(p, body_r[0], body_r[2], motion_r[0], motion_r[2], *force_r)
+        why_m = why_m or out_of_bounds(
+            p, body_m[0], body_m[2], motion_m[0], motion_m[2], *force_m[:2]
+        )
+        why_r = why_r or out_of_bounds(
+            p, body_r[0], body_r[2], motion_r[0], motion_r[2], *force_r[:2]
+        )
         info = self._info(
             motion_m, force_m, body_m, motion_r, force_r, body_r, why_m, why_r,
             why_m if terminated else "",
@@ -364,6 +377,16 @@ class QuarterCarEnv(gym.Env):
             "physical_limit": bool(why_r),
             "divergence_reason": reason,
             "model_error": "",
+            **(self._planar_info(force_m, force_r) if p.planar else {}),
+        }
+
+    def _planar_info(self, force_m, force_r) -> dict[str, float]:
+        """The arm's rotation and the planar bushing's moments (``arm_bushing`` set)."""
+        return {
+            "arm_rotation_rad": self.car.bushing_rotation()[0],
+            "reference_arm_rotation_rad": self.twin.bushing_rotation()[0],
+            "moment_model_nm": force_m[2],
+            "moment_reference_nm": force_r[2],
         }
 
     # ----- drawing ---------------------------------------------------------------------------

@@ -192,7 +192,14 @@ class QuarterCarBatch:
         self.num_cars = positive_int("num_cars", num_cars)
         if episode_steps is not None:  # taken for the callers that pass it; a road sets length
             positive_int("episode_steps", episode_steps)
-        self.params = p = CarParameters(spec_kwargs(ENV_ID, spec_overrides))
+        kwargs = spec_kwargs(ENV_ID, spec_overrides)
+        if kwargs.get("arm_bushing", "") != "":
+            raise RigError(
+                f"{ENV_ID}: arm_bushing (a planar arm bushing) runs in the pymunk env only, not in "
+                "this array integrator: use gym.make(...) or make_vec(..., "
+                "vectorization_mode='sync')"
+            )
+        self.params = p = CarParameters(kwargs)
         self.models = p.models
         self.references = p.references if with_reference else None
         self._prm = parameter_vector(p)
