@@ -17,10 +17,10 @@ import numpy as np
 import pymunk
 
 from bushenv.divergence import force_termination
-from bushenv.judge import Where
 from bushenv.models import BushingModel
 from bushenv.models.linear import TABLE1
 from bushenv.rigs.actions import check_profile
+from bushenv.rigs.car_verdict import CAR, MODEL_ERROR_PREFIX, force_reason  # noqa: F401
 from bushenv.rigs.common import (
     MODEL_ERRORS,
     RigError,
@@ -43,9 +43,6 @@ from bushenv.rigs.coupling import (
 AXES = ("radial", "axial")  # radial: vertical at the arm's inner end; axial: along the arm
 DAMPING_ANGLE_STEP = 0.005  # rad; see Car.update_damping
 BODIES = ("chassis", "unsprung", "road")
-
-
-CAR = Where("QuarterCar-v0", reference_free=False, judges_static=False)  # for the judge
 
 
 def axis_models(
@@ -91,9 +88,6 @@ def check_road(profile: Any, max_height_m: float, max_step_m: float) -> np.ndarr
         "a change of {value:.6g} m exceeds max_road_step_m "
         + f"{max_step_m:.6g} m (the road starts at 0)",
     )
-
-
-MODEL_ERROR_PREFIX = "model error: "  # a sample whose model raised (not a divergence)
 
 
 class CarParameters:
@@ -388,17 +382,6 @@ class CarPair:
         for car in (self.car, self.twin):  # exact road position, no drift from integrating
             car.road.position = (p.L, h)
             car.road.velocity = (0.0, 0.0)
-
-
-def force_reason(fr: float, fa: float, limit_n: float) -> str:
-    """Why a car's sampled bushing forces cannot be applied ("" if they can): the first axis
-    whose force is not finite or beyond ``limit_n``."""
-    for axis, f in (("radial", fr), ("axial", fa)):
-        if not math.isfinite(f):
-            return f"{axis} bushing force {f!r} N is not finite"
-        if abs(f) > limit_n:
-            return f"|{axis} bushing force| = {abs(f):.6g} N exceeds {limit_n:.6g} N"
-    return ""
 
 
 def beyond_bounds(p: CarParameters, yc, yw, xr, xa):

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.rigs.car import CAR, MODEL_ERROR_PREFIX, force_reason
+from bushenv.rigs.car_verdict import CAR, MODEL_ERROR_PREFIX, force_reason
 from bushenv.rigs.common import MODEL_ERRORS, model_error_text
 
 ROTATION_K_IN_FLOOR = 1e-3  # N m/rad: a rotary spring needs a stiffness; this one is nil
