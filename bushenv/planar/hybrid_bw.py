@@ -56,7 +56,8 @@ class PlanarBoucWenHybrid(PlanarNarx):
         if hasattr(self, "backbone"):
             self.backbone.reset(batch_size)
 
-    def _backbone(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        super()._advance(q, v, out)  # the network alone (no linear backbone)
         f_bw = np.empty_like(out)
         self.backbone._advance(q, v, f_bw)
         out += f_bw
