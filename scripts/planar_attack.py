@@ -68,12 +68,13 @@ def main() -> None:
             shrink_budget=100,
             threads=1,
         )
-        rows[kind] = run_planar_attack(config, progress).report
+        one = Progress(quiet=args.quiet, label=kind)
+        rows[kind] = run_planar_attack(config, one).report
     print(
-        "| model | searcher | failures / evals | evals to 1st failure | 1st: family (axis) |"
-        " failures by family | by axis | control flagged |"
+        "| model | searcher | failures / evals | in an axis at rest | evals to 1st failure |"
+        " 1st: family (axis) | failures by family | by axis | control flagged |"
     )
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     for kind, rep in rows.items():
         ctrl = rep["recheck"]["control"]
         for s in rep["searchers"]:
@@ -81,6 +82,7 @@ def main() -> None:
             first = f"{ff['family']} ({ff['axis']}, {ff['first_criterion']})" if ff else "-"
             print(
                 f"| {kind} | {s['searcher']} | {s['n_failures']} / {s['evaluations']} | "
+                f"{s['failures']['in_a_coordinate_at_rest']} | "
                 f"{s['evaluations_to_failure'] or '-'} | {first} | "
                 f"{json.dumps(s['failures']['by_family'])} | "
                 f"{json.dumps(s['failures']['by_axis'])} | "

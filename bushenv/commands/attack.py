@@ -32,7 +32,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--model",
         default=d.model,
         help="model under attack: name or .npz file (default: nn-paper, the papers' NARX "
-        "network as seed 000 trained it; nn is the certified one)",
+        "network as seed 000 trained it; nn is the certified one; with --env rig3 a planar "
+        "model: a PLANAR_MODELS name with a preset or a planar .npz file)",
     )
     p.add_argument("--budget", type=int, default=d.budget, help="model evaluations per search")
     p.add_argument("--rl-budget", type=int, default=d.rl_budget, help="cap on RL episodes")

@@ -70,7 +70,15 @@ def _tally(failures) -> dict:
     axis = Counter(str(c.verdict.get("axis")) for c in failures)
     crit = Counter(str(c.verdict.get("first_criterion")) for c in failures)
     pairs = Counter(f"{c.family}/{c.verdict.get('axis')}" for c in failures)
+    coords = TARGETS["rig3"].coords
+    at_rest = sum(  # failed in a coordinate the profile never moved: a cross-axis failure
+        1
+        for c in failures
+        if c.verdict.get("axis") in coords
+        and not np.any(c.profile[:, coords.index(c.verdict["axis"])])
+    )
     return {
+        "in_a_coordinate_at_rest": at_rest,
         "by_family": dict(fam.most_common()),
         "by_axis": dict(axis.most_common()),
         "by_criterion": dict(crit.most_common()),

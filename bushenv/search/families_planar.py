@@ -18,6 +18,9 @@ random search and CMA-ES draw them like any other parameter.
 |                |    | radial and rotation lag behind axial 0-1 period of the band's centre,    |
 |                |    | seed 0-9999, 1-8 s; one common drive, phase-shifted, then a hold         |
 | any3           | 10 | u[0] picks one of the above, u[1:] its parameters (CMA-ES over families) |
+| one_axis       | 9  | u[0] picks a coordinate, u[1:] the one-axis ``any`` family's parameters  |
+|                |    | (scaled to that coordinate's stroke): a single-axis test, not drawn by   |
+|                |    | random search over the planar families                                   |
 """
 
 from __future__ import annotations
@@ -213,6 +216,19 @@ def _random3(u, dt, max_s, lim):
     return _join(cols), params
 
 
+def _one_axis(u, dt, max_s, lim):
+    """A one-axis rig profile (the ``any`` family: steps, ramps, pulses, sines, chirps,
+    random) in one coordinate, the others at rest: what a single-axis test drives. Built on
+    the axial stroke and rate and scaled to the chosen coordinate's (the rate limits are in
+    the same ratio as the strokes, so the scaled profile keeps both)."""
+    stroke = rig3_limits()[0]
+    i = _pick(u[0], 3)
+    x = FAMILIES["any"].profile(u[1:], dt, max_s) * (stroke[i] / stroke[0])
+    q = np.zeros((x.size, 3))
+    q[:, i] = x
+    return q, {"axis": COORDS[i], **FAMILIES["any"].describe(u[1:], dt, max_s)}
+
+
 _BUILDERS = {
     "preload_step": (6, _preload_step),
     "rotation_sweep": (6, _rotation_sweep),
@@ -233,3 +249,7 @@ def _any3(u, dt, max_s, lim):
 for _name, (_d, _b) in _BUILDERS.items():
     FAMILIES.add(_name, Family(_name, _d, TARGET, _b, finish=finish3))
 FAMILIES.add("any3", Family("any3", _ANY_DIM, TARGET, _any3, random=False, finish=finish3))
+ONE_AXIS_DIM = 1 + FAMILIES["any"].dim
+FAMILIES.add(
+    "one_axis", Family("one_axis", ONE_AXIS_DIM, TARGET, _one_axis, random=False, finish=finish3)
+)

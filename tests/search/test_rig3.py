@@ -23,10 +23,24 @@ def _only_axis_active(i: int) -> PlanarLinear:
 
 
 def test_planar_families_are_the_rig3_targets_and_not_the_rigs():
-    planar = {"preload_step", "rotation_sweep", "orbit", "random3", "any3"}
+    planar = {"preload_step", "rotation_sweep", "orbit", "random3", "any3", "one_axis"}
     assert set(TARGETS["rig3"].family_names()) == planar
     assert not planar & set(TARGETS["rig"].family_names())
-    assert "any3" not in TARGETS["rig3"].random_families()
+    assert set(TARGETS["rig3"].random_families()) == planar - {"any3", "one_axis"}
+
+
+def test_one_axis_moves_one_coordinate_only_as_a_single_axis_test_does():
+    fam = FAMILIES["one_axis"]
+    rng = np.random.default_rng(5)
+    seen = set()
+    for _ in range(30):
+        u = rng.random(fam.dim)
+        q = fam.profile(u, DT)
+        moving = [COORDS[i] for i in range(3) if np.any(q[:, i] != 0)]
+        assert len(moving) <= 1
+        assert moving in ([], [fam.describe(u, DT)["axis"]])
+        seen |= set(moving)
+    assert seen == set(COORDS)
 
 
 @pytest.mark.parametrize("name", ["preload_step", "rotation_sweep", "orbit", "random3"])
@@ -134,3 +148,22 @@ def test_shrinking_puts_the_axes_that_do_not_matter_at_rest():
     assert np.all(small.profile[:, :2] == 0), "the axial and radial motion should be gone"
     assert np.any(small.profile[:, 2] != 0)
     assert small.final < small.original
+
+
+def test_the_controls_are_never_flagged_against_the_coupled_reference():
+    """The planar Table-1 linear model and the measured reference (load-cell noise) against
+    the coupled reference: no planar family's corners, centre or random points flag them."""
+    from bushenv.planar.reference import PlanarRubber
+    from bushenv.search.checks import family_profiles
+
+    target = TARGETS["rig3"]
+    profiles = [x for _, x in family_profiles(target)]
+    rng = np.random.default_rng(11)
+    for name in target.family_names():
+        fam = FAMILIES[name]
+        profiles += [fam.profile(rng.random(fam.dim), DT) for _ in range(6)]
+    ref = PlanarRubber.preset(measurement=False)
+    for control in (PlanarLinear.preset(), PlanarRubber.preset(measurement=True)):
+        with BatchEvaluator(control, ref, "rig3") as ev:
+            v = ev.evaluate(profiles).verdict
+        assert not v.diverged.any(), [v.row(b) for b in np.flatnonzero(v.diverged)][:2]
