@@ -188,10 +188,3 @@ class Rig3Target(Target):
 
     def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
         raise SearchError("the rig3 target has no RL env for the search yet")
-
-
-def describe_row(row: dict) -> str:
-    """A verdict row's failure in words, with its coordinate."""
-    if not row.get("diverged"):
-        return "held"
-    return f"{row['first_criterion']} ({row.get('axis')}) at {row['first_time_s']:.2f} s"

@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from bushenv.cli import main
 from bushenv.planar.linear import PlanarLinear
@@ -63,3 +64,10 @@ def test_a_one_axis_model_name_on_rig3_is_refused_in_one_line(tmp_path, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "nn-paper" in err[0] and "planar model" in err[0]
+
+
+def test_the_matrix_refuses_a_planar_target_pointing_at_the_attack(tmp_path):
+    from bushenv.search.matrix import MatrixConfig, MatrixError
+
+    with pytest.raises(MatrixError, match="bushenv attack --env rig3"):
+        MatrixConfig(target="rig3", out=tmp_path).checked()
