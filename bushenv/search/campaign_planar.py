@@ -101,6 +101,8 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     target = TARGETS[c.target]
     out = Path(c.out)
     report_path = out / "report.json"
+    if c.resume:
+        raise SearchError("--resume: a planar attack is not resumable yet; run it with --force")
     if report_path.exists() and not c.force:
         raise SearchError(f"{report_path} exists: pass --force to overwrite it")
     for s in c.searchers:

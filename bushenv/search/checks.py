@@ -157,9 +157,9 @@ def check_different_seeds_differ(trial: SearcherTrial) -> None:
     )
 
 
-def _check_candidate(c: Candidate, n: int, where: str) -> None:
+def _check_candidate(c: Candidate, n: int, where: str, ndim: int = 1) -> None:
     p = c.profile
-    assert isinstance(p, np.ndarray) and p.ndim in (1, 2) and p.size >= 1, f"{where}: profile {p!r}"
+    assert isinstance(p, np.ndarray) and p.ndim == ndim and p.size >= 1, f"{where}: profile {p!r}"
     assert np.all(np.isfinite(p)), f"{where}: profile not finite"
     assert isinstance(c.family, str) and c.family, f"{where}: family {c.family!r}"
     assert 1 <= c.evaluation <= n, f"{where}: evaluation {c.evaluation} outside 1..{n}"
@@ -180,10 +180,11 @@ def check_returns_a_valid_result(trial: SearcherTrial) -> None:
     assert got == want, f"{w}: result names (searcher, seed, budget, env) {got}, want {want}"
     assert res.worst is not None, f"{w}: no worst profile"
     n = res.evaluations
-    _check_candidate(res.worst, n, f"{w}: worst")
+    ndim = 2 if TARGETS[trial.target].coords else 1  # (T, k) profiles on a planar target
+    _check_candidate(res.worst, n, f"{w}: worst", ndim)
     for c in [res.first_failure, *res.failures]:
         if c is not None:
-            _check_candidate(c, n, f"{w}: failure {c.evaluation}")
+            _check_candidate(c, n, f"{w}: failure {c.evaluation}", ndim)
             assert c.diverged, f"{w}: kept failure {c.evaluation} did not diverge"
     assert res.n_failures >= len(res.failures), f"{w}: more kept failures than counted"
     evals = [e for e, _ in res.history]

@@ -167,3 +167,19 @@ def test_the_controls_are_never_flagged_against_the_coupled_reference():
         with BatchEvaluator(control, ref, "rig3") as ev:
             v = ev.evaluate(profiles).verdict
         assert not v.diverged.any(), [v.row(b) for b in np.flatnonzero(v.diverged)][:2]
+
+
+def test_two_threads_give_the_verdicts_and_axes_of_one():
+    ref = PlanarLinear.preset()
+    rng = np.random.default_rng(2)
+    profiles = []
+    for name in TARGETS["rig3"].random_families():
+        fam = FAMILIES[name]
+        profiles += [fam.profile(rng.random(fam.dim), DT) for _ in range(2)]
+    rows = []
+    for threads in (1, 2):
+        with BatchEvaluator(_only_axis_active(1), ref, "rig3", threads=threads) as ev:
+            v = ev.evaluate(profiles).verdict
+        rows.append([v.row(b) for b in range(len(profiles))])
+    assert rows[0] == rows[1]
+    assert any(r["diverged"] for r in rows[0]) and {r["axis"] for r in rows[0]} >= {"radial"}
