@@ -1,6 +1,7 @@
 """``bushenv attack``: the command; argparse in, a ``CampaignConfig`` out, the table printed.
 
     bushenv attack --model nn --budget 256 [--axis axial] [--env rig|quartercar]
+    bushenv attack --env rig3 --model PLANAR.npz|linear   (planar: ``campaign_planar.py``)
                    [--searchers random,cma,ppo,sac] [--seed S] [--out DIR] [--save]
 
 Outputs in ``DIR`` (default ``runs/attack``): ``report.json`` (see ``campaign_report.py``),
@@ -31,7 +32,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--model",
         default=d.model,
         help="model under attack: name or .npz file (default: nn-paper, the papers' NARX "
-        "network as seed 000 trained it; nn is the certified one)",
+        "network as seed 000 trained it; nn is the certified one; with --env rig3 a planar "
+        "model: a PLANAR_MODELS name with a preset or a planar .npz file)",
     )
     p.add_argument("--budget", type=int, default=d.budget, help="model evaluations per search")
     p.add_argument("--rl-budget", type=int, default=d.rl_budget, help="cap on RL episodes")
@@ -138,6 +140,15 @@ def run(args: argparse.Namespace) -> int:
 
     torch.set_num_threads(1)
     progress = Progress(quiet=args.quiet)
+    if TARGETS[args.env].coords:  # planar profiles: the planar attack
+        from bushenv.search.campaign_planar import format_planar_table, run_planar_attack
+
+        planar = run_planar_attack(config_from(args), progress)
+        print(format_planar_table(planar.report))
+        print(f"\nreport: {planar.report_path}  ({planar.report['seconds']:.1f} s in total)")
+        if planar.control_flagged:
+            progress.say("WARNING: the planar control (linear) was flagged on a failing profile")
+        return 0
     attacked = run_attack(config_from(args), progress)
     report = attacked.report
     print(format_table(report, attacked.target_key))

@@ -173,11 +173,14 @@ class Recorder:
         res.seconds = now
 
     def _cover(self, batch, families: list[str], n: int) -> None:
-        """Add the first ``n`` profiles' peak deflection and rate to the coverage."""
+        """Add the first ``n`` profiles' peak deflection and rate to the coverage (of a
+        (T, B, k) batch: the largest over its coordinates, m or rad)."""
         x = batch.x[:, :n]
         peak = np.max(np.abs(x), axis=0)
         dt = float(getattr(self.evaluator, "dt", 1.0))
         rate = np.max(np.abs(np.diff(x, axis=0)), axis=0) / dt if x.shape[0] > 1 else peak * 0
+        if x.ndim == 3:
+            peak, rate = peak.max(axis=-1), rate.max(axis=-1)
         cov = self.result.coverage
         for b in range(n):
             c = cov.setdefault(families[b], [0, np.inf, 0.0, 0.0])

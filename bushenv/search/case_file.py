@@ -10,7 +10,9 @@ A case file (``tests/regressions/corpus/<name>.json``) holds:
 |               | height), the bushing axis, the sample time in s                             |
 | profile       | ``{"encoding": "f32-diff-zlib-b64", "n_samples": T, "data": ...}``: the     |
 |               | sample-to-sample differences as float32, zlib-compressed, base64; decoded   |
-|               | by a float64 cumulative sum from 0 (holds stay exactly constant)            |
+|               | by a float64 cumulative sum from 0 (holds stay exactly constant). A (T, k)  |
+|               | profile (``rig3``) adds ``"shape": [T, k]``, its columns one after another, |
+|               | each from 0; n_samples is then T k                                          |
 | family, params| the excitation family and its physical parameters (or the agent's name)     |
 | found_by      | searcher, seed, model name and the sha256 of the model file it was found on |
 | expect        | per model spec: ``diverged`` (bool), the ``criterion`` it fired (or null),  |
@@ -63,10 +65,21 @@ class CorpusError(BadInput):
 
 # ----- profile encoding --------------------------------------------------------------------------
 def encode_profile(x: np.ndarray) -> dict[str, Any]:
-    x = np.asarray(x, dtype=np.float64).reshape(-1)
-    diffs = np.diff(np.r_[0.0, x]).astype(np.float32)
+    """A (T,) profile as before; a (T, k) one column after column, with ``"shape": [T, k]``."""
+    x = np.asarray(x, dtype=np.float64)
+    shape = list(x.shape) if x.ndim == 2 else None
+    if shape:  # each column's differences from rest, the columns one after another
+        diffs = np.diff(np.concatenate([np.zeros((1, shape[1])), x]), axis=0).T.reshape(-1)
+        x = x.T.reshape(-1)
+    else:
+        x = x.reshape(-1)
+        diffs = np.diff(np.r_[0.0, x])
+    diffs = diffs.astype(np.float32)
     data = base64.b64encode(zlib.compress(diffs.tobytes(), 9)).decode("ascii")
-    return {"encoding": ENCODING, "n_samples": int(x.size), "data": data}
+    out = {"encoding": ENCODING, "n_samples": int(x.size), "data": data}
+    if shape:
+        out["shape"] = shape
+    return out
 
 
 def decode_profile(d: dict[str, Any], where: str = "profile") -> np.ndarray:
@@ -81,7 +94,20 @@ def decode_profile(d: dict[str, Any], where: str = "profile") -> np.ndarray:
         raise CorpusError(
             f"{where}: profile has {diffs.size} samples, header says {d.get('n_samples')}"
         )
-    x = np.cumsum(diffs.astype(np.float64))
+    shape = d.get("shape")
+    if shape is None:
+        x = np.cumsum(diffs.astype(np.float64))
+    else:
+        if (
+            not isinstance(shape, list)
+            or len(shape) != 2
+            or not all(isinstance(n, int) and n > 0 for n in shape)
+            or shape[0] * shape[1] != diffs.size
+        ):
+            raise CorpusError(
+                f"{where}: profile shape {shape!r} does not hold its {diffs.size} samples"
+            )
+        x = np.cumsum(diffs.astype(np.float64).reshape(shape[1], shape[0]), axis=1).T.copy()
     if not np.all(np.isfinite(x)):
         raise CorpusError(f"{where}: profile holds NaN or inf")
     return x

@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
-from bushenv.models.linear import LinearBushing
 from bushenv.scales import MACHINE
 from bushenv.search.base import MAX_KEPT_FAILURES, Candidate, SearchError, SearchResult
 from bushenv.search.evaluate import BatchEvaluator
@@ -37,18 +36,6 @@ FAMILY_POINTS = 6  # unit-cube points per family: both corners, the centre, 3 se
 
 class NotApplicable(Exception):
     """The searcher refuses the target (it said why with a ``SearchError``)."""
-
-
-def active_pair(axis: str = "axial") -> tuple[LinearBushing, LinearBushing]:
-    """(model, reference) the searcher checks run: negative damping vs Table 1."""
-    ref = LinearBushing.preset(axis)
-    return LinearBushing(ref.k_n_per_m, -0.5 * ref.c_ns_per_m, ref.dt), ref
-
-
-def passive_pair(axis: str = "axial") -> tuple[LinearBushing, LinearBushing]:
-    """(model, reference) the target checks run: a softer spring vs Table 1."""
-    ref = LinearBushing.preset(axis)
-    return LinearBushing(0.8 * ref.k_n_per_m, ref.c_ns_per_m, ref.dt), ref
 
 
 # ----- searchers ---------------------------------------------------------------------------------
@@ -99,7 +86,7 @@ class SearcherTrial:
     def run(self, seed: int = 0, fresh: bool = False) -> Run:
         if seed in self._kept and not fresh:
             return self._kept[seed]
-        model, reference = active_pair()
+        model, reference = TARGETS[self.target].check_models("active")
         with LoggingEvaluator(model, reference, self.target) as ev:
             try:
                 result = self.entry.make().run(ev, self.budget, seed=seed)
@@ -170,9 +157,9 @@ def check_different_seeds_differ(trial: SearcherTrial) -> None:
     )
 
 
-def _check_candidate(c: Candidate, n: int, where: str) -> None:
+def _check_candidate(c: Candidate, n: int, where: str, ndim: int = 1) -> None:
     p = c.profile
-    assert isinstance(p, np.ndarray) and p.ndim == 1 and p.size >= 1, f"{where}: profile {p!r}"
+    assert isinstance(p, np.ndarray) and p.ndim == ndim and p.size >= 1, f"{where}: profile {p!r}"
     assert np.all(np.isfinite(p)), f"{where}: profile not finite"
     assert isinstance(c.family, str) and c.family, f"{where}: family {c.family!r}"
     assert 1 <= c.evaluation <= n, f"{where}: evaluation {c.evaluation} outside 1..{n}"
@@ -193,10 +180,11 @@ def check_returns_a_valid_result(trial: SearcherTrial) -> None:
     assert got == want, f"{w}: result names (searcher, seed, budget, env) {got}, want {want}"
     assert res.worst is not None, f"{w}: no worst profile"
     n = res.evaluations
-    _check_candidate(res.worst, n, f"{w}: worst")
+    ndim = 2 if TARGETS[trial.target].coords else 1  # (T, k) profiles on a planar target
+    _check_candidate(res.worst, n, f"{w}: worst", ndim)
     for c in [res.first_failure, *res.failures]:
         if c is not None:
-            _check_candidate(c, n, f"{w}: failure {c.evaluation}")
+            _check_candidate(c, n, f"{w}: failure {c.evaluation}", ndim)
             assert c.diverged, f"{w}: kept failure {c.evaluation} did not diverge"
     assert res.n_failures >= len(res.failures), f"{w}: more kept failures than counted"
     evals = [e for e, _ in res.history]
@@ -236,14 +224,19 @@ def family_profiles(target: Target, dt: float = PAPER_DT) -> list[tuple[str, np.
 
 
 def _assert_within(target: Target, x: np.ndarray, dt: float, where: str) -> None:
-    height, rate = target.profile_bounds(MACHINE)
-    assert x.ndim == 1 and x.size >= 2, f"{where}: profile of shape {x.shape}"
+    height, rate = target.profile_bounds(MACHINE)  # floats, or one per coordinate
+    shape = (x.shape[0], len(target.coords)) if target.coords else x.shape[:1]
+    assert x.shape == shape and x.shape[0] >= 2, f"{where}: profile of shape {x.shape}"
     assert np.all(np.isfinite(x)), f"{where}: profile not finite"
-    assert x[0] == 0.0, f"{where}: starts at {x[0]!r}, not at rest"
-    peak = float(np.max(np.abs(x)))
-    assert peak <= height * (1 + LIMIT_RTOL), f"{where}: |x| reaches {peak:.6g} > {height:.6g}"
-    fastest = float(np.max(np.abs(np.diff(x)))) / dt
-    assert fastest <= rate * (1 + LIMIT_RTOL), f"{where}: rate {fastest:.6g} > {rate:.6g} m/s"
+    assert np.all(x[0] == 0.0), f"{where}: starts at {x[0]!r}, not at rest"
+    peak = np.max(np.abs(x), axis=0)
+    assert np.all(peak <= np.multiply(height, 1 + LIMIT_RTOL)), (
+        f"{where}: |x| reaches {np.round(peak, 9)} > {height}"
+    )
+    fastest = np.max(np.abs(np.diff(x, axis=0)), axis=0) / dt
+    assert np.all(fastest <= np.multiply(rate, 1 + LIMIT_RTOL)), (
+        f"{where}: rate {np.round(fastest, 6)} > {rate} m/s"
+    )
 
 
 def check_families_keep_the_env_limits(target: Target) -> None:
@@ -267,7 +260,7 @@ def check_shrink_moves_keep_profiles_valid(target: Target) -> None:
 
 
 def _judged(target: Target, profiles: list[np.ndarray]):
-    model, reference = passive_pair()
+    model, reference = target.check_models("passive")
     with BatchEvaluator(model, reference, target) as ev:
         return ev.evaluate(profiles)
 
@@ -277,7 +270,7 @@ def check_batched_equals_looped(target: Target) -> None:
     batch = _judged(target, profiles)
     for b, p in enumerate(profiles):
         one = _judged(target, [p])
-        n = p.size
+        n = p.shape[0]
         for what in ("x", "f_model", "f_ref"):
             together, alone = getattr(batch, what)[:n, b], getattr(one, what)[:n, 0]
             assert np.array_equal(together, alone, equal_nan=True), (
@@ -293,7 +286,7 @@ def check_verdict_inputs_are_finite(target: Target) -> None:
     profiles = family_profiles(target)
     batch = _judged(target, [x for _, x in profiles])
     for b, (where, x) in enumerate(profiles):
-        n = x.size
+        n = x.shape[0]
         for what in ("x", "f_model", "f_ref"):
             col = getattr(batch, what)[:n, b]
             assert np.all(np.isfinite(col)), f"{where}: {what} not finite for a passive model"

@@ -39,6 +39,7 @@ from bushenv.search.case_file import (  # noqa: F401 (the case file, as corpus g
 )
 from bushenv.search.corpus_files import KeptFileError, locate
 from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.targets import TARGETS
 
 
 # ----- model and reference identity -------------------------------------------------------------
@@ -87,7 +88,7 @@ def resolved_reference(case: Case, notes: list[str] | None = None) -> ResolvedMo
         notes.append(note)
     given = spec if path is None else str(path)
     try:
-        return resolve_model(given, axis=case.axis, dt=case.dt, reference=True)
+        return _resolve(case, given, reference=True)
     except ValueError as exc:
         raise CorpusError(
             f"case {case.name}: its reference {spec!r} cannot be loaded ({exc}); restore the "
@@ -96,6 +97,16 @@ def resolved_reference(case: Case, notes: list[str] | None = None) -> ResolvedMo
 
 
 Resolver = Callable[[str, str, float], BushingModel]
+
+
+def _resolve(case: Case, spec: str, reference: bool = False) -> ResolvedModel:
+    """A model a case names, resolved for its target: a planar model (``PLANAR_MODELS`` name
+    or file) on a target whose profiles have coordinates, a one-axis model otherwise."""
+    if not TARGETS[case.env].coords:
+        return resolve_model(spec, axis=case.axis, dt=case.dt, reference=reference)
+    from bushenv.search.campaign_planar import resolved_planar
+
+    return resolved_planar(spec, case.dt, "reference" if reference else "model")
 
 
 def model_spec(case: Case, spec: str, notes: list[str] | None = None) -> str:
@@ -230,7 +241,7 @@ def resolve_case(
     try:
         for name, spec in specs.items():
             if resolve is None:
-                given = resolve_model(spec, axis=case.axis, dt=case.dt)
+                given = _resolve(case, spec)
                 models[name], shas[name] = given.model, given.sha256
             else:
                 models[name], shas[name] = resolve(spec, case.axis, case.dt), None

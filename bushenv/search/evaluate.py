@@ -212,7 +212,9 @@ def _merge_verdicts(parts: list[Verdict]) -> Verdict:
     if len(parts) == 1:
         return parts[0]
     cat = np.concatenate
-    return Verdict(
+    merged_extra = getattr(parts[0], "merged_extra", None)  # a target's own verdict fields
+    extra = merged_extra(parts) if merged_extra else {}
+    return type(parts[0])(
         diverged=cat([p.diverged for p in parts]),
         flags={k: cat([p.flags[k] for p in parts]) for k in parts[0].flags},
         first_time_s=cat([p.first_time_s for p in parts]),
@@ -229,4 +231,5 @@ def _merge_verdicts(parts: list[Verdict]) -> Verdict:
         criterion_first_s={
             k: cat([p.criterion_first_s[k] for p in parts]) for k in parts[0].criterion_first_s
         },
+        **extra,
     )

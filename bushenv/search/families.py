@@ -359,7 +359,8 @@ def get_family(name: str) -> Family:
 
 
 def pad_batch(profiles: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Stack (T_i,) profiles into a (T, B) array, each padded by holding its last value.
+    """Stack (T_i,) profiles into a (T, B) array (or (T_i, k) ones into (T, B, k)), each padded
+    by holding its last value.
 
     Returns (x, lengths). Models are causal, so the first T_i samples of column i are exactly
     what profile i alone would give; ``divergence.judge(..., lengths=lengths)`` ignores the rest.
@@ -370,7 +371,7 @@ def pad_batch(profiles: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     if np.any(lengths < 1):
         raise FamilyError("pad_batch: empty profile")
     T = int(lengths.max())
-    x = np.empty((T, len(profiles)))
+    x = np.empty((T, len(profiles), *np.shape(profiles[0])[1:]))  # (T, B, 3) for planar
     for i, p in enumerate(profiles):
         x[: len(p), i] = p
         x[len(p) :, i] = p[-1]

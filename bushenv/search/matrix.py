@@ -271,6 +271,11 @@ class MatrixConfig:
             raise MatrixError(
                 f"--budget must be a positive number of evaluations, got {self.budget}"
             )
+        if self.target in TARGETS and TARGETS[self.target].coords:
+            raise MatrixError(
+                f"--env {self.target}: the matrix runs one-axis models; attack a planar model "
+                f"with: bushenv attack --env {self.target} --model PLANAR_MODEL"
+            )
         for what, names, registry in (
             ("--models", self.models, MODELS),
             ("--searchers", self.searchers, SEARCHERS),

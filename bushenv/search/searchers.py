@@ -103,8 +103,9 @@ class CMASearch(Searcher):
 
 
 def _family_label(fam, u) -> str:
-    """'any' profiles are labelled with the family their first coordinate picked."""
-    if fam.name == "any":
+    """Meta-family profiles ('any', 'any3') are labelled with the family their first
+    coordinate picked."""
+    if not fam.random:
         return fam.describe(u)["family"]
     return fam.name
 

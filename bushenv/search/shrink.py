@@ -56,8 +56,14 @@ def n_segments(x: np.ndarray) -> int:
 
 
 def complexity(x: np.ndarray) -> tuple[int, int, int]:
-    """(segments, length, peak in micrometres): smaller is simpler, compared in order."""
+    """(segments, length, peak in micrometres): smaller is simpler, compared in order. A
+    (T, k) profile counts the segments of its moving coordinates (a coordinate at rest counts
+    none), its samples and its largest |x| in micro-units (um, urad)."""
     x = np.asarray(x)
+    if x.ndim == 2:
+        moving = [x[:, i] for i in range(x.shape[1]) if np.any(x[:, i] != 0.0)]
+        segments = sum(n_segments(c) for c in moving)
+        return (segments, int(x.shape[0]), int(round(float(np.max(np.abs(x))) * 1e6)))
     return (n_segments(x), int(x.size), int(round(float(np.max(np.abs(x))) * 1e6)))
 
 
@@ -149,7 +155,37 @@ def moves(x: np.ndarray, dt: float, target, limits) -> list[np.ndarray]:
     def finish(c: np.ndarray, dt: float) -> np.ndarray:
         return target.finish(c, dt, limits)
 
+    if np.ndim(x) == 2:
+        return _axis_candidates(np.asarray(x), dt, finish)
     return _candidates(x, dt, finish, limits.velocity_m_per_s * SPEED_MARGIN)
+
+
+def _axis_candidates(x: np.ndarray, dt: float, finish) -> list[np.ndarray]:
+    """Moves for a (T, k) profile, one coordinate at a time: put a coordinate at rest, scale
+    one down; then all together: hold everything from 1/8, 2/8, ... of the profile on, and
+    scale the whole (each kept within the limits by ``finish``)."""
+    T, k = x.shape
+    out: list[np.ndarray] = []
+    for i in range(k):
+        if np.any(x[:, i] != 0.0):
+            zeroed = x.copy()
+            zeroed[:, i] = 0.0
+            out.append(zeroed)
+            for s in (0.5, 0.85):
+                scaled = x.copy()
+                scaled[:, i] *= s
+                out.append(scaled)
+    for j in range(1, 8):
+        a = j * T // 8
+        if 1 < a < T - 1:
+            out.append(np.concatenate([x[:a], np.repeat(x[a - 1 : a], T - a, axis=0)]))
+    out.extend(x * s for s in SCALES)
+    fixed = []
+    for c in out[:MAX_CANDIDATES_PER_ROUND]:
+        c = c.copy()
+        c[0] = 0.0
+        fixed.append(finish(c, dt))
+    return fixed
 
 
 def _simplest_failing(x, evaluator, still_fails, room: int):
@@ -163,7 +199,7 @@ def _simplest_failing(x, evaluator, still_fails, room: int):
     # a hold appended to each: a simplification may fail a little later than the original
     # did (truncation cut right after its failure); the prefix is truncated again below
     tail = int(round(TAIL_S / dt))
-    cands = [np.concatenate([c, np.full(tail, c[-1])]) for c in cands]
+    cands = [np.concatenate([c, np.repeat(c[-1:], tail, axis=0)]) for c in cands]
     batch = evaluator.evaluate(cands)
     best, best_row = None, None
     for b, c in enumerate(cands):

@@ -11,82 +11,24 @@ evaluator, shrinking, campaigns and the corpus ask the target; none of them comp
 |------------|----------------------------------|--------------------------------------------------|
 | rig        | bushing displacement, m          | the models' batched kernels on prescribed motion |
 | quartercar | road height under the wheel, m   | ``QuarterCarBatch``: the car, model vs twin      |
+| rig3       | (T, 3) axial m, radial m, rot rad| planar model vs the coupled planar reference,    |
+|            |                                  | judged per coordinate (``target_rig3.py``)       |
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from bushenv import excitation as ex
-from bushenv.divergence import Verdict, judge
+from bushenv.divergence import judge
 from bushenv.errors import DIVERGENCE_RAISES, ModelRaised
 from bushenv.models.base import BushingModel, velocity_of
 from bushenv.registry import Registry
 from bushenv.scales import MACHINE
 from bushenv.search.base import SearchError
-from bushenv.search.families import FAMILIES, Family
 from bushenv.search.roads import quarter_car_responses
-
-
-@dataclass
-class Responses:
-    """A batch simulated on a target: the verdict and what it was judged on, all (T, B)."""
-
-    verdict: Verdict
-    x: np.ndarray  # the model's bushing deflection, m
-    f_model: np.ndarray  # N
-    f_ref: np.ndarray  # N
-
-
-class Target:
-    """Base: the families and limits every target has; subclasses simulate and build RL envs."""
-
-    name = ""
-    env_id = ""
-    profile_label = ""  # what a profile is, with its plotting unit
-    cma_family = ""  # the family CMA-ES searches by default
-    default_searchers: tuple[str, ...] = ()
-    float32 = False  # NARX models may run in float32 on this target
-    paper_step = False  # the papers' 4 mm step applies (prescribed displacement)
-    reference_free = False  # can judge a model with no reference (criteria that need none)
-    judges_static = False  # holds are of the bushing itself (the static criterion applies)
-
-    def families(self) -> list[Family]:
-        return [f for f in FAMILIES.values() if f.target == self.name]
-
-    def family_names(self) -> tuple[str, ...]:
-        return tuple(f.name for f in self.families())
-
-    def random_families(self) -> tuple[str, ...]:
-        return tuple(f.name for f in self.families() if f.random)
-
-    def family(self, name: str) -> Family:
-        fam = FAMILIES[name]
-        if fam.target != self.name:
-            raise SearchError(
-                f"family {name!r} is for the {fam.target} target, not the {self.name}; "
-                f"known for the {self.name}: {', '.join(self.family_names())}"
-            )
-        return fam
-
-    def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
-        """``x`` kept within the env's limits (a shrinking move may step outside them)."""
-        return x
-
-    def profile_bounds(self, limits=MACHINE) -> tuple[float, float]:
-        """The largest |profile| (m) and |rate| (m/s) the env takes: every family's profile
-        and every shrinking move stays within them (``bushenv/search/checks.py``)."""
-        raise NotImplementedError
-
-    def responses(
-        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
-    ) -> Responses:
-        raise NotImplementedError
-
-    def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
-        raise NotImplementedError
+from bushenv.search.target_base import Responses, Target
+from bushenv.search.target_rig3 import Rig3Target
 
 
 class RigTarget(Target):
@@ -161,6 +103,7 @@ class QuarterCarTarget(Target):
 TARGETS: Registry[Target] = Registry("target", SearchError)
 TARGETS.add("rig", RigTarget())
 TARGETS.add("quartercar", QuarterCarTarget())
+TARGETS.add("rig3", Rig3Target())
 
 
 def get_target(target: str | Target) -> Target:

@@ -1,0 +1,252 @@
+"""``bushenv attack --env rig3``: the attack on a planar (three-coordinate) model.
+
+The one-axis pipeline (``campaign.py``) resolves one-axis models and judges (vetting, static
+curve, fitted control); none of that exists for planar models yet, so a planar attack has its
+own short pipeline through the same search contracts: the planar model and the coupled planar
+reference resolved as BushRig3-v0 resolves them, each searcher run on a ``BatchEvaluator`` of
+the ``rig3`` target, the failures rechecked on the control (the planar Table-1 linear model,
+which must stay clean) and on ``--hybrid`` when given, the first ``max_shrink`` shrunk per axis
+and written as cases (``case_file.py``; ``--save`` adds them to the corpus). ``report.json``
+and ``report.md`` in ``--out`` tally the failures by family and by the axis that failed.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from bushenv.persist import write_json
+from bushenv.progress import Progress
+from bushenv.search.base import SearchError
+from bushenv.search.campaign_config import CampaignConfig
+from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.searchers import SEARCHERS
+from bushenv.search.shrink import shrink
+from bushenv.search.targets import TARGETS
+
+DEFAULT_REFERENCE = "reference"
+DEFAULT_CONTROL = "linear"
+
+
+@dataclass
+class PlanarAttack:
+    report: dict
+    report_path: Path
+    control_flagged: bool
+
+
+def resolve_planar_spec(spec: str, dt: float | None, what: str):
+    """A planar model by ``PLANAR_MODELS`` name (with a preset) or ``.npz`` file."""
+    from bushenv.models.base import PAPER_DT
+    from bushenv.rigs.bushrig3 import resolve_planar
+
+    return resolve_planar(spec, PAPER_DT if dt is None else dt, what)
+
+
+def resolved_planar(spec: str, dt: float | None, what: str):
+    """``resolve_planar_spec`` as a ``ResolvedModel`` (its file and sha256, for cases)."""
+    from bushenv.models import file_hash
+    from bushenv.resolved import ResolvedModel, report_key
+
+    model = resolve_planar_spec(spec, dt, what)
+    path = Path(spec) if str(spec).endswith(".npz") and Path(spec).is_file() else None
+    return ResolvedModel(
+        key=report_key(spec),
+        spec=str(spec),
+        model=model,
+        file=path,
+        sha256=None if path is None else file_hash(path),
+        registered=path is None,
+    )
+
+
+def _tally(failures) -> dict:
+    fam = Counter(c.family for c in failures)
+    axis = Counter(str(c.verdict.get("axis")) for c in failures)
+    crit = Counter(str(c.verdict.get("first_criterion")) for c in failures)
+    pairs = Counter(f"{c.family}/{c.verdict.get('axis')}" for c in failures)
+    coords = TARGETS["rig3"].coords
+    at_rest = sum(  # failed in a coordinate the profile never moved: a cross-axis failure
+        1
+        for c in failures
+        if c.verdict.get("axis") in coords
+        and not np.any(c.profile[:, coords.index(c.verdict["axis"])])
+    )
+    return {
+        "in_a_coordinate_at_rest": at_rest,
+        "by_family": dict(fam.most_common()),
+        "by_axis": dict(axis.most_common()),
+        "by_criterion": dict(crit.most_common()),
+        "by_family_axis": dict(pairs.most_common()),
+    }
+
+
+def _recheck(model, reference, profiles, target, threads) -> dict:
+    if not profiles:
+        return {"profiles": 0, "diverged": 0}
+    with BatchEvaluator(model, reference, target, threads=threads) as ev:
+        v = ev.evaluate(profiles).verdict
+    axes = Counter(str(a) for a, d in zip(v.first_axis, v.diverged, strict=True) if d)
+    return {"profiles": len(profiles), "diverged": int(v.diverged.sum()), "by_axis": dict(axes)}
+
+
+def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttack:
+    """The planar attack the config describes (see the module doc)."""
+    c = config.checked()
+    target = TARGETS[c.target]
+    out = Path(c.out)
+    report_path = out / "report.json"
+    if c.resume:
+        raise SearchError("--resume: a planar attack is not resumable yet; run it with --force")
+    if report_path.exists() and not c.force:
+        raise SearchError(f"{report_path} exists: pass --force to overwrite it")
+    for s in c.searchers:
+        if s not in target.default_searchers:
+            known = ", ".join(target.default_searchers)
+            raise SearchError(f"--searchers {s}: the {c.target} target takes {known}")
+    model = resolve_planar_spec(c.model, None, "--model")
+    reference = resolve_planar_spec(c.reference or DEFAULT_REFERENCE, model.dt, "--reference")
+    others = {"control": resolve_planar_spec(c.control or DEFAULT_CONTROL, model.dt, "--control")}
+    if c.hybrid and c.hybrid != "none":
+        others["hybrid"] = resolve_planar_spec(c.hybrid, model.dt, "--hybrid")
+    threads = max(1, int(c.threads or 1))
+    t0 = time.perf_counter()
+    searches, failing = [], []
+    total = c.budget * len(c.searchers)
+    progress.total = total
+    done = 0
+    for name in c.searchers:
+        progress.say(f"[{c.model}] {name}: budget {c.budget} evaluations on {c.target} ...")
+        with BatchEvaluator(model, reference, target, threads=threads) as ev:
+
+            def said(msg: str, start=done, ev=ev) -> None:
+                progress.update(start + ev.n_evaluations, f"  {msg}")
+
+            result = SEARCHERS[name].make().run(ev, c.budget, seed=c.seed, progress=said)
+        done += c.budget
+        progress.update(done, f"[{c.model}] {name}: {result.n_failures} failures", force=True)
+        summary = result.summary()
+        summary["failures"] = _tally(result.failures)
+        if result.first_failure is not None:
+            summary["first_failure"] = {
+                "family": result.first_failure.family,
+                **result.first_failure.verdict,
+            }
+        searches.append(summary)
+        failing += [(name, f) for f in result.failures]
+    profiles = [f.profile for _, f in failing]
+    rechecks = {
+        role: _recheck(m, reference, profiles, target, threads) for role, m in others.items()
+    }
+    shrunk = _shrink_some(model, reference, target, failing, c, progress, out)
+    report = {
+        "env": c.target,
+        "model": c.model,
+        "reference": c.reference or DEFAULT_REFERENCE,
+        "budget": c.budget,
+        "seed": c.seed,
+        "searchers": searches,
+        "recheck": rechecks,
+        "shrunk": shrunk,
+        "seconds": round(time.perf_counter() - t0, 2),
+    }
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(report_path, report)
+    (out / "report.md").write_text(format_planar_table(report) + "\n")
+    flagged = rechecks.get("control", {}).get("diverged", 0) > 0
+    return PlanarAttack(report, report_path, flagged)
+
+
+def _shrink_some(model, reference, target, failing, c, progress, out: Path) -> list[dict]:
+    """The first ``max_shrink`` failures shrunk per axis and written as cases."""
+    from bushenv.models import params_sha
+    from bushenv.search.corpus import make_case, save_case
+
+    control = resolved_planar(c.control or DEFAULT_CONTROL, model.dt, "--control")
+    subject = resolved_planar(c.model, model.dt, "--model")
+    ref_spec = c.reference or DEFAULT_REFERENCE
+    ref_record = {"spec": ref_spec, "file_sha256": None, "params_sha256": params_sha(reference)}
+    kept = []
+    for name, cand in failing[: c.max_shrink]:
+        with BatchEvaluator(model, reference, target) as ev:
+            res = shrink(cand.profile, ev, budget=c.shrink_budget)
+        moving = [a for i, a in enumerate(target.coords) if np.any(res.profile[:, i] != 0.0)]
+        progress.say(
+            f"  shrunk a {cand.family} failure ({cand.verdict.get('axis')}): "
+            f"{res.original} -> {res.final}, moving {', '.join(moving)}"
+        )
+        case = make_case(
+            res.profile,
+            env=c.target,
+            axis="planar",
+            family=cand.family,
+            params=cand.params,
+            found_by={
+                "searcher": name,
+                "seed": c.seed,
+                "model": c.model,
+                "model_sha256": subject.sha256,
+            },
+            models={c.model: model, control.spec: control.model},
+            reference=reference,
+            reference_spec=ref_spec,
+            shas={c.model: subject.sha256, control.spec: control.sha256},
+            shrink=res.summary(),
+            reference_record=ref_record,
+            notes=f"moving: {', '.join(moving)}; failed in {res.verdict.get('axis')}",
+        )
+        paths = [save_case(case, out / "cases", force=True)]
+        if c.save:
+            paths.append(save_case(case, c.corpus, force=c.force))
+        kept.append(
+            {
+                "searcher": name,
+                "family": cand.family,
+                "axis": res.verdict.get("axis"),
+                "criterion": res.verdict.get("first_criterion"),
+                "moving": moving,
+                **res.summary(),
+                "cases": [str(p) for p in paths if p is not None],
+            }
+        )
+    return kept
+
+
+def format_planar_table(report: dict) -> str:
+    """The attack's table: one line per searcher, then what broke it and the rechecks."""
+    lines = [
+        f"planar attack on {report['model']} ({report['env']}, vs {report['reference']}), "
+        f"budget {report['budget']}, seed {report['seed']}",
+        "",
+        "| searcher | failures / evaluations | first failure at | first: family (axis) | "
+        "worst robustness |",
+        "|---|---|---|---|---|",
+    ]
+    for s in report["searchers"]:
+        ff = s.get("first_failure")
+        first = f"{ff['family']} ({ff.get('axis')})" if ff else "-"
+        worst = s.get("worst_robustness")
+        lines.append(
+            f"| {s['searcher']} | {s['n_failures']} / {s['evaluations']} | "
+            f"{s['evaluations_to_failure'] or '-'} | {first} | "
+            f"{'-' if worst is None else f'{worst:.3g}'} |"
+        )
+    for s in report["searchers"]:
+        f = s["failures"]
+        if f["by_family"]:
+            lines.append("")
+            lines.append(f"{s['searcher']}: failures by family {json.dumps(f['by_family'])}")
+            lines.append(f"{s['searcher']}: failures by axis {json.dumps(f['by_axis'])}")
+    for role, r in report["recheck"].items():
+        lines.append(f"recheck {role}: {r['diverged']} of {r['profiles']} failing profiles diverge")
+    for k in report["shrunk"]:
+        lines.append(
+            f"shrunk {k['family']} ({k['axis']}, {k['criterion']}): moving {k['moving']}, "
+            f"{k['original']['segments']} -> {k['final']['segments']} segments"
+        )
+    return "\n".join(lines)

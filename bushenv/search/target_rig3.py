@@ -1,0 +1,190 @@
+"""The ``rig3`` target: BushRig3-v0's prescribed motion in three coordinates, a planar model
+against the coupled planar reference, judged axis by axis.
+
+A profile is a (T, 3) array (axial m, radial m, rotation rad) within the rig's stroke and rate
+(``families_planar.rig3_limits``); a batch is (T, B, 3). Each coordinate's force (or moment) is
+judged by ``divergence.judge`` on its own scale (``axis_scales``): stroke, rate and force limit
+of that coordinate from the env's spec, and a force floor per coordinate. A profile fails when
+any coordinate fails; the verdict names the coordinate (``PlanarVerdict.first_axis``: the one
+that failed first, or, when none failed, the closest to failing).
+
+The force floor of the rotation (``ROTATION_FLOOR_NM``) is the one-axis 200 N floor scaled by
+the moment cell's range over the force cell's (2500 N m / 25 kN): the floor's reason is the
+load cell's resolution, which scales with its range. The static criterion does not run here
+(the planar reference has no static curve yet), nor does RL.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from bushenv.divergence import Verdict, judge
+from bushenv.errors import DIVERGENCE_RAISES, ModelRaised
+from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
+from bushenv.search.base import SearchError
+from bushenv.search.families_planar import COORDS, ENV_ID, clip3, rig3_limits
+from bushenv.search.target_base import Responses, Target
+
+ROTATION_FLOOR_NM = FORCE_FLOOR_N * 2500.0 / 25000.0
+
+
+@dataclass
+class PlanarVerdict(Verdict):
+    """A ``Verdict`` over the three coordinates, with the coordinate that decided it."""
+
+    first_axis: list[str | None] = field(default_factory=list)
+    axis_robustness: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def row(self, b: int) -> dict:
+        out = super().row(b)
+        out["axis"] = self.first_axis[b]
+        out["axis_robustness"] = {a: _json_float(r[b]) for a, r in self.axis_robustness.items()}
+        return out
+
+    def merged_extra(self, parts: list[PlanarVerdict]) -> dict:
+        return {
+            "first_axis": [a for p in parts for a in p.first_axis],
+            "axis_robustness": {
+                a: np.concatenate([p.axis_robustness[a] for p in parts])
+                for a in self.axis_robustness
+            },
+        }
+
+
+def _json_float(v) -> float | None:
+    v = float(v)
+    return v if np.isfinite(v) else None
+
+
+def axis_scales() -> list[BushingScales]:
+    """One ``BushingScales`` per coordinate: its force floor and BushRig3-v0's force limit
+    (``judge`` reads only those two; the stroke and rate are the target's, not a scale's)."""
+    from bushenv.rigs.specs import load_spec
+
+    kw = load_spec(ENV_ID)["kwargs"]
+    floors = (FORCE_FLOOR_N, FORCE_FLOOR_N, ROTATION_FLOOR_NM)
+    return [
+        BushingScales(
+            force_floor_n=floors[i],
+            force_limit_n=float(kw["force_limit"][c]),
+            source=f"{ENV_ID} spec, {c}",
+        )
+        for i, c in enumerate(COORDS)
+    ]
+
+
+def judge_axes(x, fm, fr, dt, lengths) -> PlanarVerdict:
+    """``judge`` on each coordinate of (T, B, 3) arrays, combined: fails if any fails."""
+    parts = [
+        judge(x[..., i], fm[..., i], fr[..., i], dt, lengths=lengths, scales=s)
+        for i, s in enumerate(axis_scales())
+    ]
+    rob = np.stack([p.robustness for p in parts])  # (3, B)
+    first = np.stack([p.first_time_s for p in parts])
+    B = rob.shape[1]
+    deciding = np.argmin(rob, axis=0)
+    failed = np.isfinite(first)
+    for b in range(B):  # of the coordinates that failed, the first to fail decides
+        if failed[:, b].any():
+            deciding[b] = int(np.nanargmin(np.where(failed[:, b], first[:, b], np.nan)))
+    pick = np.arange(B)
+
+    def stacked(get):
+        return np.stack([get(p) for p in parts])
+
+    first_time = _nanmin(first)
+    return PlanarVerdict(
+        diverged=np.any(stacked(lambda p: p.diverged), axis=0),
+        flags={c: np.any(stacked(lambda p, c=c: p.flags[c]), axis=0) for c in parts[0].flags},
+        first_time_s=first_time,
+        first_criterion=[parts[deciding[b]].first_criterion[b] for b in range(B)],
+        worst_deviation=np.max(stacked(lambda p: p.worst_deviation), axis=0),
+        robustness=np.min(rob, axis=0),
+        criterion_robustness={
+            c: np.min(stacked(lambda p, c=c: p.criterion_robustness[c]), axis=0)
+            for c in parts[0].criterion_robustness
+        },
+        scale_n=stacked(lambda p: p.scale_n)[deciding, pick],
+        criteria_run=parts[0].criteria_run,
+        reference_unusable=np.any(stacked(lambda p: p.reference_unusable), axis=0),
+        criterion_first_s={
+            c: _nanmin(stacked(lambda p, c=c: p.criterion_first_s[c]))
+            for c in parts[0].criterion_first_s
+        },
+        first_axis=[
+            COORDS[deciding[b]] if np.isfinite(rob[deciding[b], b]) else None for b in range(B)
+        ],
+        axis_robustness={c: rob[i] for i, c in enumerate(COORDS)},
+    )
+
+
+def _nanmin(a: np.ndarray) -> np.ndarray:
+    """Column minimum ignoring NaN; NaN where a column is all NaN (no warning)."""
+    low = np.min(np.where(np.isnan(a), np.inf, a), axis=0)
+    return np.where(np.isinf(low) & np.all(np.isnan(a), axis=0), np.nan, low)
+
+
+def simulate_planar_or_nan(model, q: np.ndarray) -> np.ndarray:
+    """``model.simulate(q)`` for (T, B, 3) ``q``; a history the model refuses on (a
+    ``ModelRefused`` or ``ArithmeticError``) is NaN from the start (a non-finite output, a
+    divergence); anything else it raises is its own bug (``ModelRaised``)."""
+    try:
+        return model.simulate(q)
+    except DIVERGENCE_RAISES:
+        pass
+    except Exception as exc:
+        raise ModelRaised(model.name, exc) from exc
+    out = np.full_like(q, np.nan)
+    for b in range(q.shape[1]):
+        try:
+            out[:, b] = model.simulate(np.ascontiguousarray(q[:, b]))
+        except DIVERGENCE_RAISES:
+            pass
+        except Exception as exc:
+            raise ModelRaised(model.name, exc) from exc
+    return out
+
+
+class Rig3Target(Target):
+    """BushRig3-v0: prescribed motion in axial, radial and rotation; model and reference see
+    the same motion, each coordinate judged on its own scale."""
+
+    name = "rig3"
+    env_id = ENV_ID
+    profile_label = "deflection [mm, mm, mrad]"
+    cma_family = "any3"
+    default_searchers = ("random", "cma")
+    coords = COORDS
+
+    def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
+        return clip3(x, dt)
+
+    def profile_bounds(self, limits=MACHINE) -> tuple[np.ndarray, np.ndarray]:
+        """Per coordinate (3,) arrays: BushRig3-v0's stroke and rate (``limits``, a one-axis
+        bushing's, do not apply)."""
+        return rig3_limits()
+
+    def responses(
+        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
+    ) -> Responses:
+        if x.ndim != 3 or x.shape[2] != 3:
+            raise SearchError(f"the rig3 target takes (T, B, 3) profiles, got {x.shape}")
+        fm = simulate_planar_or_nan(model, x)
+        fr = reference.forces(x, lengths)
+        verdict = judge_axes(x, fm, fr, dt, lengths)
+        return Responses(verdict, x, fm, fr)
+
+    def check_models(self, kind: str):
+        """(model, reference) the contract checks run: ``active`` a planar Kelvin-Voigt with
+        negative damping, ``passive`` one 20 % softer, both against the planar linear preset."""
+        from bushenv.planar.linear import PlanarLinear
+
+        ref = PlanarLinear.preset()
+        if kind == "active":
+            return PlanarLinear(ref.k_matrix, -0.5 * ref.c_matrix, ref.dt), ref
+        return PlanarLinear(0.8 * ref.k_matrix, ref.c_matrix, ref.dt), ref
+
+    def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
+        raise SearchError("the rig3 target has no RL env for the search yet")

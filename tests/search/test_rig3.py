@@ -1,0 +1,185 @@
+"""The rig3 target: planar families, the per-axis verdict and per-axis shrinking."""
+
+import numpy as np
+import pytest
+
+from bushenv.models.base import PAPER_DT
+from bushenv.planar.linear import PlanarLinear
+from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.families import FAMILIES, pad_batch
+from bushenv.search.families_planar import COORDS, rig3_limits
+from bushenv.search.shrink import shrink
+from bushenv.search.targets import TARGETS
+
+DT = PAPER_DT
+
+
+def _only_axis_active(i: int) -> PlanarLinear:
+    """The planar Table-1 model with negative damping in coordinate ``i`` only."""
+    ref = PlanarLinear.preset()
+    c = ref.c_matrix.copy()
+    c[i, i] *= -0.5
+    return PlanarLinear(ref.k_matrix, c, ref.dt)
+
+
+def test_planar_families_are_the_rig3_targets_and_not_the_rigs():
+    planar = {"preload_step", "rotation_sweep", "orbit", "random3", "any3", "one_axis"}
+    assert set(TARGETS["rig3"].family_names()) == planar
+    assert not planar & set(TARGETS["rig"].family_names())
+    assert set(TARGETS["rig3"].random_families()) == planar - {"any3", "one_axis"}
+
+
+def test_one_axis_moves_one_coordinate_only_as_a_single_axis_test_does():
+    fam = FAMILIES["one_axis"]
+    rng = np.random.default_rng(5)
+    seen = set()
+    for _ in range(30):
+        u = rng.random(fam.dim)
+        q = fam.profile(u, DT)
+        moving = [COORDS[i] for i in range(3) if np.any(q[:, i] != 0)]
+        assert len(moving) <= 1
+        assert moving in ([], [fam.describe(u, DT)["axis"]])
+        seen |= set(moving)
+    assert seen == set(COORDS)
+
+
+@pytest.mark.parametrize("name", ["preload_step", "rotation_sweep", "orbit", "random3"])
+def test_every_planar_family_moves_more_than_one_axis_somewhere(name):
+    fam = FAMILIES[name]
+    rng = np.random.default_rng(3)
+    moving = set()
+    for _ in range(12):
+        q = fam.profile(rng.random(fam.dim), DT)
+        assert q.ndim == 2 and q.shape[1] == 3
+        moving |= {i for i in range(3) if np.any(q[:, i] != 0)}
+    assert len(moving) >= 2, f"{name} only ever moves {moving}"
+
+
+def test_preload_step_holds_the_preload_while_the_other_axis_steps():
+    u = np.array([0.5, 0.9, 1.0, 1.0, 0.0, 0.5])  # preload radial at +80 %, step the rotation
+    q = FAMILIES["preload_step"].profile(u, DT)
+    desc = FAMILIES["preload_step"].describe(u, DT)
+    assert (desc["preload_axis"], desc["step_axis"]) == ("radial", "rotation")
+    stroke = rig3_limits()[0]
+    step_starts = int(np.flatnonzero(q[:, 2])[0])
+    assert q[step_starts, 1] == pytest.approx(0.8 * stroke[1])
+    assert np.all(q[:, 0] == 0)
+    assert q[-1, 2] == pytest.approx(0.95 * stroke[2])
+
+
+def test_a_circular_orbit_keeps_its_radius_between_the_fades():
+    u = np.array([0.5, 1.0, 0.3, 0.2, 0.0, 0.4])  # minor/major 1: a circle
+    q = FAMILIES["orbit"].profile(u, DT)
+    r = np.hypot(q[:, 0], q[:, 1])
+    nf = int(round(0.25 / DT))
+    moving = np.flatnonzero(r > 0)
+    mid = r[moving[0] + nf + 2 : moving[-1] - nf - 2]
+    assert mid.size > 50 and np.ptp(mid) < 1e-9 * mid.max() + 1e-12
+    assert np.all(q[:, 2] == 0)
+
+
+def test_random3_lags_the_radial_behind_the_axial_as_its_coordinate_says():
+    base = np.array([1.0, 1.0, 0.0, 0.5, 0.5, 0.0, 0.0, 0.3, 0.3])
+    lagged = base.copy()
+    lagged[5] = 1.0
+    d0 = FAMILIES["random3"].describe(base, DT)
+    d1 = FAMILIES["random3"].describe(lagged, DT)
+    assert d0["lag_s"][1] == 0.0 and d1["lag_s"][1] > 0.1
+    q = FAMILIES["random3"].profile(lagged, DT)
+    lag = int(round(d1["lag_s"][1] / DT))
+    first_axial = int(np.flatnonzero(q[:, 0])[0])
+    assert int(np.flatnonzero(q[:, 1])[0]) == first_axial + lag
+
+
+def test_pad_batch_stacks_planar_profiles_holding_their_last_row():
+    a, b = np.ones((4, 3)), np.arange(6.0).reshape(2, 3)
+    x, lengths = pad_batch([a, b])
+    assert x.shape == (4, 2, 3) and lengths.tolist() == [4, 2]
+    assert np.array_equal(x[:, 1], [[0, 1, 2], [3, 4, 5], [3, 4, 5], [3, 4, 5]])
+
+
+@pytest.mark.parametrize("i", range(3))
+def test_the_verdict_names_the_axis_that_failed(i):
+    ref = PlanarLinear.preset()
+    orbit = FAMILIES["random3"].profile(np.full(9, 0.7), DT)
+    with BatchEvaluator(_only_axis_active(i), ref, "rig3") as ev:
+        row = ev.evaluate([orbit]).verdict.row(0)
+    assert row["diverged"] and row["axis"] == COORDS[i]
+    assert row["axis_robustness"][COORDS[i]] < 0
+    others = [row["axis_robustness"][c] for c in COORDS if c != COORDS[i]]
+    assert all(r > 0 for r in others)
+
+
+def test_a_moment_error_is_judged_on_the_moments_scale_not_the_forces():
+    """60 N m of extra moment is nothing next to 200 N but a failure next to 20 N m."""
+    ref = PlanarLinear.preset()
+
+    class Offset(PlanarLinear):
+        def _advance(self, q, v, out):
+            super()._advance(q, v, out)
+            out[..., 2] += 60.0 * (np.abs(q[..., 1]) > 1e-3)
+
+    model = Offset(ref.k_matrix, ref.c_matrix, ref.dt)
+    u = np.array([0.5, 0.0, 1.0, 0.5, 0.0, 1.0])  # radial preload, no rotation at all
+    q = FAMILIES["preload_step"].profile(u, DT)
+    with BatchEvaluator(model, ref, "rig3") as ev:
+        row = ev.evaluate([q]).verdict.row(0)
+    assert row["diverged"] and row["axis"] == "rotation"
+
+
+def test_the_linear_reference_of_itself_is_never_flagged():
+    ref = PlanarLinear.preset()
+    rng = np.random.default_rng(0)
+    profiles = []
+    for name in TARGETS["rig3"].random_families():
+        fam = FAMILIES[name]
+        profiles += [fam.profile(rng.random(fam.dim), DT) for _ in range(3)]
+    with BatchEvaluator(PlanarLinear.preset(), ref, "rig3") as ev:
+        assert not ev.evaluate(profiles).verdict.diverged.any()
+
+
+def test_shrinking_puts_the_axes_that_do_not_matter_at_rest():
+    ref = PlanarLinear.preset()
+    q = FAMILIES["random3"].profile(np.full(9, 0.7), DT)
+    assert all(np.any(q[:, i] != 0) for i in range(3))
+    with BatchEvaluator(_only_axis_active(2), ref, "rig3") as ev:
+        small = shrink(q, ev, budget=120)
+    assert small.verdict["diverged"] and small.verdict["axis"] == "rotation"
+    assert np.all(small.profile[:, :2] == 0), "the axial and radial motion should be gone"
+    assert np.any(small.profile[:, 2] != 0)
+    assert small.final < small.original
+
+
+def test_the_controls_are_never_flagged_against_the_coupled_reference():
+    """The planar Table-1 linear model and the measured reference (load-cell noise) against
+    the coupled reference: no planar family's corners, centre or random points flag them."""
+    from bushenv.planar.reference import PlanarRubber
+    from bushenv.search.checks import family_profiles
+
+    target = TARGETS["rig3"]
+    profiles = [x for _, x in family_profiles(target)]
+    rng = np.random.default_rng(11)
+    for name in target.family_names():
+        fam = FAMILIES[name]
+        profiles += [fam.profile(rng.random(fam.dim), DT) for _ in range(6)]
+    ref = PlanarRubber.preset(measurement=False)
+    for control in (PlanarLinear.preset(), PlanarRubber.preset(measurement=True)):
+        with BatchEvaluator(control, ref, "rig3") as ev:
+            v = ev.evaluate(profiles).verdict
+        assert not v.diverged.any(), [v.row(b) for b in np.flatnonzero(v.diverged)][:2]
+
+
+def test_two_threads_give_the_verdicts_and_axes_of_one():
+    ref = PlanarLinear.preset()
+    rng = np.random.default_rng(2)
+    profiles = []
+    for name in TARGETS["rig3"].random_families():
+        fam = FAMILIES[name]
+        profiles += [fam.profile(rng.random(fam.dim), DT) for _ in range(2)]
+    rows = []
+    for threads in (1, 2):
+        with BatchEvaluator(_only_axis_active(1), ref, "rig3", threads=threads) as ev:
+            v = ev.evaluate(profiles).verdict
+        rows.append([v.row(b) for b in range(len(profiles))])
+    assert rows[0] == rows[1]
+    assert any(r["diverged"] for r in rows[0]) and {r["axis"] for r in rows[0]} >= {"radial"}

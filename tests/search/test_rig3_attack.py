@@ -1,0 +1,73 @@
+"""``bushenv attack --env rig3``: a planar attack end to end, its cases replaying."""
+
+import json
+
+import numpy as np
+import pytest
+
+from bushenv.cli import main
+from bushenv.planar.linear import PlanarLinear
+from bushenv.search.corpus import case_files, check, load_case
+
+
+def _rotation_active(path):
+    """The planar Table-1 model with negative damping in the rotation only, saved."""
+    ref = PlanarLinear.preset()
+    c = ref.c_matrix.copy()
+    c[2, 2] *= -0.5
+    return PlanarLinear(ref.k_matrix, c, ref.dt).save(path)
+
+
+def test_a_planar_attack_finds_shrinks_and_keeps_the_axis_that_fails(tmp_path, capsys):
+    model = _rotation_active(tmp_path / "active.npz")
+    out, corpus = tmp_path / "run", tmp_path / "corpus"
+    argv = ["attack", "--env", "rig3", "--model", str(model), "--budget", "24", "--quiet",
+            "--searchers", "random", "--out", str(out), "--max-shrink", "1",
+            "--shrink-budget", "60", "--save", "--corpus", str(corpus)]  # fmt: skip
+    assert main(argv) == 0
+    report = json.loads((out / "report.json").read_text())
+    search = report["searchers"][0]
+    assert search["n_failures"] > 0
+    assert set(search["failures"]["by_axis"]) == {"rotation"}
+    assert report["recheck"]["control"]["diverged"] == 0
+    (shrunk,) = report["shrunk"]
+    assert shrunk["axis"] == "rotation" and shrunk["moving"] == ["rotation"]
+    assert "| random |" in capsys.readouterr().out
+    (path,) = case_files(corpus)
+    raw = json.loads(path.read_text())
+    assert raw["env"] == "rig3" and raw["profile"]["shape"][1] == 3
+    case = load_case(path)
+    assert case.profile.ndim == 2 and np.all(case.profile[:, :2] == 0)
+    assert case.expect[str(model)]["diverged"] and not case.expect["linear"]["diverged"]
+    assert check(case) == []
+
+
+def test_a_planar_case_whose_model_changed_no_longer_replays(tmp_path):
+    model = _rotation_active(tmp_path / "active.npz")
+    out = tmp_path / "run"
+    argv = ["attack", "--env", "rig3", "--model", str(model), "--budget", "16", "--quiet",
+            "--searchers", "random", "--out", str(out), "--max-shrink", "1",
+            "--shrink-budget", "20"]  # fmt: skip
+    assert main(argv) == 0
+    (path,) = case_files(out / "cases")
+    PlanarLinear.preset().save(model)  # the model fixed: the case's verdict changes
+    kept = path.parent / "models"
+    for f in kept.glob("*.npz"):
+        PlanarLinear.preset().save(f)
+    problems = check(load_case(path))
+    assert problems and "expected to diverge but stayed bounded" in problems[0]
+
+
+def test_a_one_axis_model_name_on_rig3_is_refused_in_one_line(tmp_path, capsys):
+    argv = ["attack", "--env", "rig3", "--model", "nn-paper", "--budget", "4", "--quiet",
+            "--out", str(tmp_path / "run")]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nn-paper" in err[0] and "planar model" in err[0]
+
+
+def test_the_matrix_refuses_a_planar_target_pointing_at_the_attack(tmp_path):
+    from bushenv.search.matrix import MatrixConfig, MatrixError
+
+    with pytest.raises(MatrixError, match="bushenv attack --env rig3"):
+        MatrixConfig(target="rig3", out=tmp_path).checked()
