@@ -25,6 +25,7 @@ from bushenv.progress import Progress
 from bushenv.search.base import SearchError
 from bushenv.search.campaign_config import CampaignConfig
 from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.planar_models import resolve_planar_spec, resolved_planar
 from bushenv.search.searchers import SEARCHERS
 from bushenv.search.shrink import shrink
 from bushenv.search.targets import TARGETS
@@ -38,31 +39,6 @@ class PlanarAttack:
     report: dict
     report_path: Path
     control_flagged: bool
-
-
-def resolve_planar_spec(spec: str, dt: float | None, what: str):
-    """A planar model by ``PLANAR_MODELS`` name (with a preset) or ``.npz`` file."""
-    from bushenv.models.base import PAPER_DT
-    from bushenv.rigs.bushrig3 import resolve_planar
-
-    return resolve_planar(spec, PAPER_DT if dt is None else dt, what)
-
-
-def resolved_planar(spec: str, dt: float | None, what: str):
-    """``resolve_planar_spec`` as a ``ResolvedModel`` (its file and sha256, for cases)."""
-    from bushenv.models import file_hash
-    from bushenv.resolved import ResolvedModel, report_key
-
-    model = resolve_planar_spec(spec, dt, what)
-    path = Path(spec) if str(spec).endswith(".npz") and Path(spec).is_file() else None
-    return ResolvedModel(
-        key=report_key(spec),
-        spec=str(spec),
-        model=model,
-        file=path,
-        sha256=None if path is None else file_hash(path),
-        registered=path is None,
-    )
 
 
 def _tally(failures) -> dict:

@@ -104,7 +104,7 @@ def _resolve(case: Case, spec: str, reference: bool = False) -> ResolvedModel:
     or file) on a target whose profiles have coordinates, a one-axis model otherwise."""
     if not TARGETS[case.env].coords:
         return resolve_model(spec, axis=case.axis, dt=case.dt, reference=reference)
-    from bushenv.search.campaign_planar import resolved_planar
+    from bushenv.search.planar_models import resolved_planar
 
     return resolved_planar(spec, case.dt, "reference" if reference else "model")
 
