@@ -249,20 +249,3 @@ def test_a_pair_with_an_unseen_delay_that_fits_better_leaves_the_pair_answer_amb
     ans = rule.answer(singles, rule.rank(pairs, ["relaxation", "friction", "delay"], ctx), ctx)
     assert ans.effect == rule.AMBIGUOUS and ans.between == ["friction", "delay"]
     assert ans.top_two == ["relaxation", "friction"]
-
-
-def test_a_candidate_that_passes_but_leaves_most_of_the_gap_gives_outside_candidates():
-    ctx, a, _, row, r1, r2 = _rows_for_pair_rule()
-    part = row("relaxation", ["relaxation"], 0.4 * r1, 12)
-    rule.mark_failed([part], ctx)
-    rule.mark_passes([part], ctx)
-    assert part["passes"]
-    ans = rule.answer([part], [], ctx)
-    assert ans.effect == rule.OUTSIDE and ans.row is None and ans.top_two[0] == "relaxation"
-    text = " ".join(rule.unexplained(ans, [part], ctx.gap_null, ctx)["text"])
-    assert "outside the candidates" in text and "relaxation, leaves" in text
-    # the same candidate closing most of the gap is named
-    rule.mark_failed([a], ctx)
-    rule.mark_passes([a], ctx)
-    ans = rule.answer([a], [], ctx)
-    assert ans.effect == "relaxation"
