@@ -249,3 +249,21 @@ def test_a_pair_with_an_unseen_delay_that_fits_better_leaves_the_pair_answer_amb
     ans = rule.answer(singles, rule.rank(pairs, ["relaxation", "friction", "delay"], ctx), ctx)
     assert ans.effect == rule.AMBIGUOUS and ans.between == ["friction", "delay"]
     assert ans.top_two == ["relaxation", "friction"]
+
+
+def test_a_candidate_that_passes_but_leaves_most_of_the_gap_is_named_and_flagged_mostly_outside():
+    """Named (a friction damper's verdict on earthquake records rests on a 26 % shrink), but
+    the report says the gap lies mostly outside the candidates."""
+    ctx, a, _, row, r1, r2 = _rows_for_pair_rule()
+    part = row("relaxation", ["relaxation"], 0.4 * r1, 12)
+    rule.mark_failed([part], ctx)
+    rule.mark_passes([part], ctx)
+    ans = rule.answer([part], [], ctx)
+    assert ans.effect == "relaxation"
+    out = rule.unexplained(ans, [part], ctx.gap_null, ctx)
+    assert out["mostly_outside_candidates"] and "mostly outside" in " ".join(out["text"])
+    rule.mark_failed([a], ctx)
+    rule.mark_passes([a], ctx)
+    assert not rule.unexplained(rule.answer([a], [], ctx), [a], ctx.gap_null, ctx)[
+        "mostly_outside_candidates"
+    ]
