@@ -119,7 +119,12 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     rechecks = {
         role: _recheck(m, reference, profiles, target, threads) for role, m in others.items()
     }
-    shrunk = _shrink_some(model, reference, target, failing, c, progress, out)
+    shrunk, shown = _shrink_some(model, reference, target, failing, c, progress, out)
+    plots = []
+    if c.plots and shown:
+        from bushenv.search.campaign_planar_plots import plot_shrunk
+
+        plots = [str(p) for p in plot_shrunk(model, reference, shown, out / "plots")]
     report = {
         "env": c.target,
         "model": c.model,
@@ -129,6 +134,7 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
         "searchers": searches,
         "recheck": rechecks,
         "shrunk": shrunk,
+        "plots": plots,
         "seconds": round(time.perf_counter() - t0, 2),
     }
     out.mkdir(parents=True, exist_ok=True)
@@ -138,8 +144,9 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     return PlanarAttack(report, report_path, flagged)
 
 
-def _shrink_some(model, reference, target, failing, c, progress, out: Path) -> list[dict]:
-    """The first ``max_shrink`` failures shrunk per axis and written as cases."""
+def _shrink_some(model, reference, target, failing, c, progress, out: Path):
+    """The first ``max_shrink`` failures shrunk per axis and written as cases: their report
+    rows and ``(title, shrunk profile)`` for the plots."""
     from bushenv.models import params_sha
     from bushenv.search.corpus import make_case, save_case
 
@@ -147,7 +154,7 @@ def _shrink_some(model, reference, target, failing, c, progress, out: Path) -> l
     subject = resolved_planar(c.model, model.dt, "--model")
     ref_spec = c.reference or DEFAULT_REFERENCE
     ref_record = {"spec": ref_spec, "file_sha256": None, "params_sha256": params_sha(reference)}
-    kept = []
+    kept, shown = [], []
     for name, cand in failing[: c.max_shrink]:
         with BatchEvaluator(model, reference, target) as ev:
             res = shrink(cand.profile, ev, budget=c.shrink_budget)
@@ -190,7 +197,8 @@ def _shrink_some(model, reference, target, failing, c, progress, out: Path) -> l
                 "cases": [str(p) for p in paths if p is not None],
             }
         )
-    return kept
+        shown.append((f"{cand.family}, failed in {res.verdict.get('axis')}", res.profile))
+    return kept, shown
 
 
 def format_planar_table(report: dict) -> str:

@@ -75,10 +75,29 @@ def axis_scales() -> list[BushingScales]:
     ]
 
 
+# metres per radian when a rotation counts as motion (any positive lever arm would do: a hold
+# is a run of samples where no coordinate moves)
+ROTATION_LEVER_M = 0.04
+
+
+def held_vector(x: np.ndarray) -> np.ndarray:
+    """(T, B) a signal that stays constant exactly while no coordinate of (T, B, 3) ``x``
+    moves: the accumulated largest step, rotation taken at ``ROTATION_LEVER_M``."""
+    step = np.abs(np.diff(x, axis=0, prepend=x[:1]))
+    step[..., 2] *= ROTATION_LEVER_M
+    return np.cumsum(step.max(axis=-1), axis=0)
+
+
 def judge_axes(x, fm, fr, dt, lengths) -> PlanarVerdict:
-    """``judge`` on each coordinate of (T, B, 3) arrays, combined: fails if any fails."""
+    """``judge`` on each coordinate of (T, B, 3) arrays, combined: fails if any fails.
+
+    A hold is a hold of the whole deflection vector: a coordinate held while another moves is
+    not at rest (the coupling moves its force: the reference's moment follows a radial step),
+    so the hold criteria (``self_sustained``, ``static``) see the bushing's motion, not the
+    coordinate's alone."""
+    hold = held_vector(x)
     parts = [
-        judge(x[..., i], fm[..., i], fr[..., i], dt, lengths=lengths, scales=s)
+        judge(x[..., i], fm[..., i], fr[..., i], dt, lengths=lengths, hold_input=hold, scales=s)
         for i, s in enumerate(axis_scales())
     ]
     rob = np.stack([p.robustness for p in parts])  # (3, B)

@@ -183,3 +183,25 @@ def test_two_threads_give_the_verdicts_and_axes_of_one():
         rows.append([v.row(b) for b in range(len(profiles))])
     assert rows[0] == rows[1]
     assert any(r["diverged"] for r in rows[0]) and {r["axis"] for r in rows[0]} >= {"radial"}
+
+
+def test_a_coordinate_held_while_another_moves_is_not_in_a_hold():
+    """A radial step moves a coupled model's moment; the rotation was held all along, but the
+    bushing was not at rest: no ``self_sustained`` verdict on it (it was, when each coordinate
+    was judged on its own hold)."""
+    from bushenv.search.target_rig3 import held_vector, judge_axes
+
+    ref = PlanarLinear.preset()
+    k = ref.k_matrix.copy()
+    k[2, 1] += 2000.0  # 6 N m of moment at 3 mm radial: above the rotation's 5 N m hold margin
+    model = PlanarLinear(k, ref.c_matrix, ref.dt)
+    dt = ref.dt
+    n0, n1, n2 = int(1.2 / dt), 5, int(1.5 / dt)
+    q = np.zeros((n0 + n1 + n2, 3))
+    q[n0 : n0 + n1, 1] = np.linspace(0.0, 3e-3, n1)
+    q[n0 + n1 :, 1] = 3e-3
+    hold = held_vector(q[:, None, :])
+    assert hold[n0 - 1, 0] == 0.0 and hold[-1, 0] == hold[n0 + n1, 0] > 0.0
+    v = judge_axes(q[:, None, :], model.simulate(q)[:, None, :], ref.simulate(q)[:, None, :],
+                   dt, np.array([q.shape[0]]))  # fmt: skip
+    assert not v.flags["self_sustained"][0] and not v.diverged[0]
