@@ -11,7 +11,9 @@ the same searchers and the same budget per search:
   coordinate at a time, the others at rest; random search draws the coordinate, CMA-ES searches
   it). A member passes when no profile fails in the coordinate it drives, on any axis: that is
   all a single-axis rig measures. A failure in a coordinate at rest is counted apart;
-- the attack across axes: each searcher over the planar families (``campaign_planar``'s search).
+- the attack across axes: each searcher over the planar families (``campaign_planar``'s search);
+  its failures in a coordinate the profile moves are counted apart too (a member whose only
+  failures are force in a coordinate held at rest has wrong coupling, not a runaway).
 
 ``run_planar_cell`` is a pure function of the cell (module-level, so any backend can ship it).
 """
@@ -96,8 +98,12 @@ def _attack(model, reference, searcher: str, budget: int, seed: int) -> dict[str
     res = planar_search(model, reference, searcher, budget, seed)
     ff = res.first_failure
     t = tally(res.failures)
+    # failures in a coordinate the profile moves: not only force in a coordinate held at rest
+    moving = [c.evaluation for c in res.failures if driven_failed(c)]
     return {
         "diverged": res.diverged,
+        "moving_failures": len(moving),
+        "moving_evaluations_to_failure": min(moving) if moving else None,
         "evaluations": res.evaluations,
         "evaluations_to_failure": ff.evaluation if ff else None,
         "first_family": ff.family if ff else None,
@@ -136,5 +142,6 @@ def run_planar_cell(cell: dict[str, Any]) -> dict[str, Any]:
         "attacks": attacks,
         "passed_single_axis": all(v["passed"] for v in single.values()),
         "diverged": any(a["diverged"] for a in attacks.values()),
+        "diverged_moving": any(a["moving_failures"] > 0 for a in attacks.values()),
         "judge_s": time.perf_counter() - t1,
     }

@@ -24,13 +24,21 @@ def _broken(rows: list[dict]) -> list[dict]:
     return [r for r in rows if r["diverged"]]
 
 
+def _quiet_at_rest(row: dict) -> bool:
+    """No single-axis profile failed the member in any coordinate, at rest ones included: what
+    a single-axis rig reading all three load-cell channels would pass."""
+    return all(v["passed"] and v["cross_axis_failures"] == 0 for v in row["single_axis"].values())
+
+
 def group_summary(rows: list[dict]) -> dict[str, Any]:
     passed = [r for r in rows if r["passed_single_axis"]]
     searchers = sorted({s for r in rows for s in r["attacks"]})
     return {
         "members": len(rows),
         "passed_single_axis": rate(len(passed), len(rows)),
+        "passed_single_axis_all_channels": rate(sum(map(_quiet_at_rest, rows)), len(rows)),
         "broken_of_passed": rate(len(_broken(passed)), len(passed)),
+        "broken_moving_of_passed": rate(sum(r["diverged_moving"] for r in passed), len(passed)),
         "broken": rate(len(_broken(rows)), len(rows)),
         "by_searcher": {
             s: {
@@ -71,6 +79,7 @@ def summarise(rows: list[dict]) -> dict[str, Any]:
     mimo = [r for r in rows if r["model"] in MIMO_MODELS]
     passed = [r for r in mimo if r["passed_single_axis"]]
     pooled = rate(len(_broken(passed)), len(passed))
+    moving = rate(sum(r["diverged_moving"] for r in passed), len(passed))
     return {
         "groups": {k: group_summary(g) for k, g in groups.items()},
         "mimo_pooled": {
@@ -78,6 +87,8 @@ def summarise(rows: list[dict]) -> dict[str, Any]:
             "target": TARGET_RATE,
             # met when the interval's lower end clears the target, not the point estimate
             "target_met": bool(passed) and pooled["ci95"][0] >= TARGET_RATE,
+            "broken_moving_of_passed": moving,
+            "target_met_moving": bool(passed) and moving["ci95"][0] >= TARGET_RATE,
         },
         "certified_hybrids": NO_CERTIFIED,
     }
@@ -86,9 +97,10 @@ def summarise(rows: list[dict]) -> dict[str, Any]:
 def markdown(summary: dict[str, Any]) -> str:
     lines = [
         "| recipe / model | members | pass every single-axis check | of those, broken across "
-        "axes | all broken across axes | by searcher (of those passing; median evals to "
-        "failure) | RMS ratio, unseen correlated (median a / r / rot) |",
-        "|---|---|---|---|---|---|---|",
+        "axes | of those, broken in a moving coordinate | all broken across axes | by searcher "
+        "(of those passing; median evals to failure) | pass single-axis in all three channels "
+        "| RMS ratio, unseen correlated (median a / r / rot) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for key, g in summary["groups"].items():
         per = "; ".join(
@@ -101,7 +113,9 @@ def markdown(summary: dict[str, Any]) -> str:
         )
         lines.append(
             f"| {key} | {g['members']} | {pct(g['passed_single_axis'])} | "
-            f"{pct(g['broken_of_passed'])} | {pct(g['broken'])} | {per or '-'} | {acc} % |"
+            f"{pct(g['broken_of_passed'])} | {pct(g['broken_moving_of_passed'])} | "
+            f"{pct(g['broken'])} | {per or '-'} | {pct(g['passed_single_axis_all_channels'])} "
+            f"| {acc} % |"
         )
     p = summary["mimo_pooled"]
     verdict = "met" if p["target_met"] else "not shown"
@@ -109,7 +123,9 @@ def markdown(summary: dict[str, Any]) -> str:
         "",
         f"MIMO networks (nn, hybrid) passing every single-axis check, broken across axes: "
         f"{pct(p['broken_of_passed'])}; target >= {100 * p['target']:.0f} % (lower end of the "
-        f"interval): {verdict}.",
+        f"interval): {verdict}. Broken in a coordinate the profile moves: "
+        f"{pct(p['broken_moving_of_passed'])} "
+        f"({'met' if p['target_met_moving'] else 'not shown'}).",
         f"Certified MIMO hybrids: {summary['certified_hybrids']}.",
     ]
     return "\n".join(lines) + "\n"

@@ -70,9 +70,11 @@ def test_a_single_axis_failure_counts_only_in_the_coordinate_it_drives():
     assert not driven_failed(_candidate(q, (-0.5, 0.1, None)))  # failed at rest: cross-axis
 
 
-def _row(model, passed, diverged, at_rest=0):
+def _row(model, passed, diverged, at_rest=0, moving=None, cross=0):
+    moving = diverged if moving is None else moving
     attack = {
         "diverged": diverged,
+        "moving_failures": int(moving),
         "evaluations_to_failure": 3 if diverged else None,
         "in_a_coordinate_at_rest": at_rest,
         "by_axis": {"radial": 1} if diverged else {},
@@ -83,7 +85,14 @@ def _row(model, passed, diverged, at_rest=0):
         "model": model,
         "passed_single_axis": passed,
         "diverged": diverged,
-        "single_axis": {"random": {"driven_failures": 0 if passed else 2}},
+        "diverged_moving": moving,
+        "single_axis": {
+            "random": {
+                "passed": passed,
+                "driven_failures": 0 if passed else 2,
+                "cross_axis_failures": cross,
+            }
+        },
         "attacks": {"random": attack},
         "accuracy": {"correlated": acc},
         "train_s": 1.0,
@@ -109,6 +118,17 @@ def test_the_summary_counts_broken_among_those_passing_with_wilson_intervals():
     assert "no certified MIMO hybrid" in markdown(s)
 
 
+def test_failures_only_in_coordinates_at_rest_are_counted_apart():
+    rows = [_row("hybrid", True, True, at_rest=3, moving=False, cross=5)] * 3
+    rows += [_row("hybrid", True, True)]
+    g = summarise(rows)["groups"]["free-run/hybrid"]
+    assert g["broken_of_passed"]["failed"] == 4
+    assert g["broken_moving_of_passed"]["failed"] == 1
+    assert g["failed_in_a_coordinate_at_rest"]["failed"] == 3
+    # three members pass on the driven coordinate only: a rig reading every channel fails them
+    assert g["passed_single_axis_all_channels"]["failed"] == 1
+
+
 def test_the_nn_axis_baseline_stays_out_of_the_mimo_pool():
     s = summarise([_row("nn-axis", True, True), _row("hybrid", True, False)])
     assert s["mimo_pooled"]["broken_of_passed"]["of"] == 1
@@ -131,6 +151,9 @@ def test_a_member_trains_checks_single_axes_and_is_attacked_deterministically(tm
     for s in ("random", "cma"):
         assert row["single_axis"][s]["evaluations"] == 8 == row["attacks"][s]["evaluations"]
         assert row["single_axis"][s]["passed"] == (row["single_axis"][s]["driven_failures"] == 0)
+        a = row["attacks"][s]
+        assert a["moving_failures"] <= a["n_failures"]
+        assert (a["moving_evaluations_to_failure"] is None) == (a["moving_failures"] == 0)
     assert row["passed_single_axis"] == all(v["passed"] for v in row["single_axis"].values())
     assert set(row["accuracy"]) == {"independent", "correlated"}
     again = run_planar_cell(cell)
