@@ -20,6 +20,11 @@ TARGET_RATE = 0.9  # issue 25 item 7
 NO_CERTIFIED = "no certified MIMO hybrid exists (planar training has no certified mode yet)"
 
 
+def _pct(r: dict) -> str:
+    """``summary.pct``, or "-" for a rate of nothing (no member passed)."""
+    return pct(r) if r["of"] else "-"
+
+
 def _broken(rows: list[dict]) -> list[dict]:
     return [r for r in rows if r["diverged"]]
 
@@ -104,7 +109,7 @@ def markdown(summary: dict[str, Any]) -> str:
     ]
     for key, g in summary["groups"].items():
         per = "; ".join(
-            f"{s} {pct(v)}, {v['median_evaluations_to_failure']}"
+            f"{s} {_pct(v)}, {v['median_evaluations_to_failure'] or '-'}"
             for s, v in g["by_searcher"].items()
         )
         acc = " / ".join(
@@ -112,9 +117,9 @@ def markdown(summary: dict[str, Any]) -> str:
             for v in g["median_rms_ratio_correlated"].values()
         )
         lines.append(
-            f"| {key} | {g['members']} | {pct(g['passed_single_axis'])} | "
-            f"{pct(g['broken_of_passed'])} | {pct(g['broken_moving_of_passed'])} | "
-            f"{pct(g['broken'])} | {per or '-'} | {pct(g['passed_single_axis_all_channels'])} "
+            f"| {key} | {g['members']} | {_pct(g['passed_single_axis'])} | "
+            f"{_pct(g['broken_of_passed'])} | {_pct(g['broken_moving_of_passed'])} | "
+            f"{_pct(g['broken'])} | {per or '-'} | {_pct(g['passed_single_axis_all_channels'])} "
             f"| {acc} % |"
         )
     p = summary["mimo_pooled"]
@@ -122,9 +127,9 @@ def markdown(summary: dict[str, Any]) -> str:
     lines += [
         "",
         f"MIMO networks (nn, hybrid) passing every single-axis check, broken across axes: "
-        f"{pct(p['broken_of_passed'])}; target >= {100 * p['target']:.0f} % (lower end of the "
+        f"{_pct(p['broken_of_passed'])}; target >= {100 * p['target']:.0f} % (lower end of the "
         f"interval): {verdict}. Broken in a coordinate the profile moves: "
-        f"{pct(p['broken_moving_of_passed'])} "
+        f"{_pct(p['broken_moving_of_passed'])} "
         f"({'met' if p['target_met_moving'] else 'not shown'}).",
         f"Certified MIMO hybrids: {summary['certified_hybrids']}.",
     ]

@@ -116,6 +116,8 @@ def test_the_summary_counts_broken_among_those_passing_with_wilson_intervals():
     assert (pooled["broken_of_passed"]["failed"], pooled["broken_of_passed"]["of"]) == (10, 11)
     assert not pooled["target_met"]  # 10/11 is above 90 %, its interval's lower end is not
     assert "no certified MIMO hybrid" in markdown(s)
+    none_passed = markdown(summarise([_row("nn", False, True)]))
+    assert "| free-run/nn | 1 | 0/1 (0-79 %) | - | - | 1/1 (21-100 %) |" in none_passed
 
 
 def test_failures_only_in_coordinates_at_rest_are_counted_apart():
