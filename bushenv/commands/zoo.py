@@ -9,7 +9,7 @@ from pathlib import Path
 from bushenv.execution import get_backend
 from bushenv.progress import Progress
 from bushenv.search.matrix import parse_seeds
-from bushenv.zoo.planar_study import PlanarZooConfig, run_planar_study
+from bushenv.zoo.planar_study import PlanarZooConfig, refuse_other_kind, run_planar_study
 from bushenv.zoo.study import ZooConfig, ZooError, run_study
 
 EXAMPLE = (
@@ -102,7 +102,10 @@ def run(args: argparse.Namespace) -> int:
         workers=args.workers,
         address=args.ray_address,
     )
-    if isinstance(config, PlanarZooConfig):
+    planar = isinstance(config, PlanarZooConfig)
+    if config.resume:
+        refuse_other_kind(config.out / "cells.jsonl", planar)
+    if planar:
         run_planar_study(config, backend, Progress(quiet=args.quiet))
         print((config.out / "summary.md").read_text())
         print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md")

@@ -10,6 +10,7 @@ networks to ``DIR/models``; when every member is done, ``DIR/summary.json`` and 
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field, replace
 from itertools import product
 from pathlib import Path
@@ -75,6 +76,22 @@ class PlanarZooConfig:
             }
             for r, m, s in product(self.recipes, self.models, self.seeds)
         ]
+
+
+def refuse_other_kind(path: Path, planar: bool) -> None:
+    """Refuse to resume a results file of the other study (one-axis rows lack ``env``, planar
+    rows ``axis``): the results file would read them as torn lines and cut the last one."""
+    if not path.is_file():
+        return
+    with path.open(encoding="utf-8", errors="replace") as fh:
+        first = next((line for line in fh if line.strip()), "")
+    try:
+        row = json.loads(first)
+    except json.JSONDecodeError:
+        return  # the results file's own reading names a corrupt line
+    if isinstance(row, dict) and ("env" in row) != planar:
+        kind = "MIMO (--env rig3)" if "env" in row else "one-axis (--env rig)"
+        raise ZooError(f"{path} line 1: a {kind} study's results; resume it with that --env")
 
 
 def _describe(row: dict[str, Any]) -> str:

@@ -17,6 +17,7 @@ from bushenv.zoo.planar_study import (
     PLANAR_CELL_KEYS,
     PLANAR_RESULT_KEYS,
     PlanarZooConfig,
+    refuse_other_kind,
     run_planar_study,
 )
 from bushenv.zoo.planar_summary import markdown, summarise
@@ -192,3 +193,19 @@ def test_a_small_mimo_population_runs_summarises_and_resumes(tmp_path):
     assert set(summary["groups"]) == {"teacher-forcing/nn", "teacher-forcing/hybrid"}
     assert "broken_of_passed" in summary["mimo_pooled"]
     assert "| teacher-forcing/hybrid | 1 |" in (tmp_path / "summary.md").read_text()
+
+
+def test_resuming_the_other_kind_of_study_is_refused_and_its_file_kept(tmp_path, capsys):
+    from bushenv.cli import main
+
+    one_axis = tmp_path / "cells.jsonl"
+    one_axis.write_text(json.dumps({"recipe": "free-run", "axis": "axial", "seed": 0}) + "\n")
+    before = one_axis.read_bytes()
+    argv = ["zoo", "--env", "rig3", "--seeds", "0", "--resume", "--out", str(tmp_path)]
+    assert main(argv) == 2
+    assert "cells.jsonl line 1: a one-axis (--env rig) study's results" in capsys.readouterr().err
+    assert one_axis.read_bytes() == before  # not read as a torn line and cut
+    refuse_other_kind(one_axis, planar=False)  # the same kind resumes as before
+    one_axis.write_text(json.dumps({"env": "rig3", "seed": 0}) + "\n")
+    with pytest.raises(ZooError, match="line 1: a MIMO"):
+        refuse_other_kind(one_axis, planar=False)
