@@ -209,3 +209,37 @@ def test_resuming_the_other_kind_of_study_is_refused_and_its_file_kept(tmp_path,
     one_axis.write_text(json.dumps({"env": "rig3", "seed": 0}) + "\n")
     with pytest.raises(ZooError, match="line 1: a MIMO"):
         refuse_other_kind(one_axis, planar=False)
+
+
+@pytest.mark.slow
+def test_a_member_run_on_ray_gives_the_local_result(tmp_path):
+    ray = pytest.importorskip("ray", reason="Ray not installed (pip install 'bushenv[ray]')")
+    from bushenv.execution import RayBackend
+
+    def run(out, backend):
+        config = PlanarZooConfig(
+            models=("hybrid",),
+            recipes=("teacher-forcing",),
+            seeds=(1,),
+            searchers=("random",),
+            budget=4,
+            out=out,
+            train_options=TINY,
+        ).checked()
+        log = RunLog(out / "cells.jsonl", PLANAR_CELL_KEYS, PLANAR_RESULT_KEYS, ZooError)
+        return run_cells(config.cells(), run_planar_cell, log, backend, False, Progress(True), str)
+
+    def same(row):  # what a member found, without where and how long
+        return {
+            k: v for k, v in row.items() if k not in {"out", "train_s", "judge_s", "worker_backend"}
+        }
+
+    with LocalBackend(workers=1) as one:
+        local = run(tmp_path / "local", one)
+    backend = RayBackend(num_cpus=1)
+    try:
+        remote = run(tmp_path / "ray", backend)
+    finally:
+        backend.close()
+    assert not ray.is_initialized()
+    assert [same(r) for r in remote] == [same(r) for r in local]
