@@ -64,6 +64,17 @@ def tally(failures) -> dict:
     }
 
 
+# How each of the rig3 target's searchers is held to one family.
+HELD_TO = {"random": lambda f: {"families": (f,)}, "cma": lambda f: {"family": f}}
+
+
+def held_to(searcher: str, family: str) -> dict:
+    """The searcher's arguments that hold it to ``family``."""
+    if searcher not in HELD_TO:
+        raise SearchError(f"{searcher} cannot be held to one family; these can: {list(HELD_TO)}")
+    return HELD_TO[searcher](family)
+
+
 def planar_search(
     model,
     reference,
@@ -73,10 +84,17 @@ def planar_search(
     threads: int = 1,
     progress: Callable[[str, int], None] | None = None,
     target: str = "rig3",
+    family: str | None = None,
 ) -> SearchResult:
     """One search of the planar attack on the ``rig3`` target; ``progress`` gets each line of
-    the searcher's with the evaluations made so far (the population study runs it as it is)."""
-    s = SEARCHERS[searcher].make() if isinstance(searcher, str) else searcher
+    the searcher's with the evaluations made so far (the population study runs it as it is).
+    ``family``: the searcher held to that one family (``one_axis``: the single-axis check)."""
+    if isinstance(searcher, str):
+        s = SEARCHERS[searcher].make(**({} if family is None else held_to(searcher, family)))
+    elif family is None:
+        s = searcher
+    else:
+        raise SearchError("planar_search: family= holds a searcher given by name only")
     with BatchEvaluator(model, reference, TARGETS[target], threads=threads) as ev:
         said = None if progress is None else (lambda msg: progress(msg, ev.n_evaluations))
         return s.run(ev, budget, seed=seed, progress=said)

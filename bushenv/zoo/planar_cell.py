@@ -34,14 +34,11 @@ from bushenv.planar.reference import PlanarRubber
 from bushenv.search.campaign_planar import DEFAULT_REFERENCE, planar_search, tally
 from bushenv.search.families_planar import COORDS
 from bushenv.search.planar_models import resolve_planar_spec
-from bushenv.search.searchers import get_searcher
 
 TRAIN_S, UNSEEN_S = 60.0, 20.0
 # The planar training's two stages (``planar.train``): one step ahead only, or then free-run
 # windows too (the default training); the recipes' names are the one-axis zoo's.
 PLANAR_RECIPES = {"teacher-forcing": {"free_run_steps": 0}, "free-run": {}}
-# Each searcher of the single-axis check, held to the one_axis family.
-ONE_AXIS = {"random": {"families": ("one_axis",)}, "cma": {"family": "one_axis"}}
 
 
 def planar_cell_name(cell: dict[str, Any]) -> str:
@@ -77,9 +74,7 @@ def driven_failed(candidate) -> bool:
 
 
 def _single_axis(model, reference, searcher: str, budget: int, seed: int) -> dict[str, Any]:
-    res = planar_search(
-        model, reference, get_searcher(searcher, **ONE_AXIS[searcher]), budget, seed
-    )
+    res = planar_search(model, reference, searcher, budget, seed, family="one_axis")
     driven = [c for c in res.failures if driven_failed(c)]
     by_axis = {c: 0 for c in COORDS}
     for c in driven:  # a one_axis profile moves one coordinate

@@ -20,8 +20,9 @@ from bushenv.planar.fitting import PlanarNetworkOptions
 from bushenv.planar.train import KINDS
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
+from bushenv.search.campaign_planar import HELD_TO
 from bushenv.search.targets import TARGETS
-from bushenv.zoo.planar_cell import ONE_AXIS, PLANAR_RECIPES, run_planar_cell
+from bushenv.zoo.planar_cell import PLANAR_RECIPES, run_planar_cell
 from bushenv.zoo.planar_summary import write
 from bushenv.zoo.study import ZooError
 
@@ -47,7 +48,7 @@ class PlanarZooConfig:
         for flag, names, known in (
             ("--recipes", self.recipes, tuple(PLANAR_RECIPES)),
             ("--models", self.models, tuple(KINDS)),
-            ("--searchers", self.searchers, tuple(ONE_AXIS)),
+            ("--searchers", self.searchers, tuple(HELD_TO)),
         ):
             bad = [n for n in names if n not in known]
             if bad or not names:
