@@ -243,3 +243,16 @@ def test_a_member_run_on_ray_gives_the_local_result(tmp_path):
         backend.close()
     assert not ray.is_initialized()
     assert [same(r) for r in remote] == [same(r) for r in local]
+
+
+def test_only_the_searchers_that_can_be_held_to_one_family_run_the_single_axis_check():
+    from bushenv.search.base import SearchError
+    from bushenv.search.campaign_planar import held_to, planar_search
+    from bushenv.search.searchers import RandomSearch
+
+    assert held_to("random", "one_axis") == {"families": ("one_axis",)}
+    assert held_to("cma", "one_axis") == {"family": "one_axis"}
+    with pytest.raises(SearchError, match="certificate cannot be held"):
+        held_to("certificate", "one_axis")
+    with pytest.raises(SearchError, match="by name only"):
+        planar_search(None, None, RandomSearch(), 1, 0, family="one_axis")
