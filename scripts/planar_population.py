@@ -13,7 +13,8 @@ motion at n = 1, default options, as ``scripts/planar_benchmark.py``), then for 
 
 Prints, per kind, how many passed the single-axis test and how many of those the attack broke,
 with Wilson 95 % intervals (``bushenv.zoo.summary.rate``). Trained networks are kept under
-``--out``/models and reused.
+``--out``/models and reused. ``bushenv zoo --env rig3`` is the study this script began: both
+searchers, recipes, resumable members (docs/planar_search.md).
 """
 
 from __future__ import annotations
@@ -27,13 +28,14 @@ import numpy as np
 import torch
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar import COORDS, load_planar_model
+from bushenv.planar import load_planar_model
 from bushenv.planar.programme import random_independent
 from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.train import fit_planar_network
 from bushenv.progress import Progress
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import RandomSearch
+from bushenv.zoo.planar_cell import driven_failed
 from bushenv.zoo.summary import rate
 
 KINDS = ("nn", "nn-axis", "hybrid")
@@ -56,7 +58,7 @@ def member(model, seed: int, single_budget: int, budget: int) -> dict:
         planar = RandomSearch().run(ev, budget, seed=seed)
     # a single-axis rig measures the driven coordinate only: a failure there fails the test;
     # one in a coordinate at rest is a cross-axis failure such a rig does not see
-    driven = [c for c in single.failures if _driven_failed(c)]
+    driven = [c for c in single.failures if driven_failed(c)]
     return {
         "seed": seed,
         "single_axis_failures": len(driven),
@@ -66,12 +68,6 @@ def member(model, seed: int, single_budget: int, budget: int) -> dict:
             planar.first_failure.evaluation if planar.first_failure else None
         ),
     }
-
-
-def _driven_failed(candidate) -> bool:
-    moving = np.flatnonzero(np.any(candidate.profile != 0, axis=0))
-    rob = candidate.verdict["axis_robustness"]
-    return any(rob[COORDS[i]] is not None and rob[COORDS[i]] < 0 for i in moving)
 
 
 def main() -> None:

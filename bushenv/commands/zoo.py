@@ -1,4 +1,5 @@
-"""``bushenv zoo``: argparse in, a ``ZooConfig`` out, the population study (``zoo/study.py``)."""
+"""``bushenv zoo``: argparse in, a ``ZooConfig`` out, the population study (``zoo/study.py``);
+with ``--env rig3`` a ``PlanarZooConfig``, the MIMO population (``zoo/planar_study.py``)."""
 
 from __future__ import annotations
 
@@ -8,21 +9,37 @@ from pathlib import Path
 from bushenv.execution import get_backend
 from bushenv.progress import Progress
 from bushenv.search.matrix import parse_seeds
-from bushenv.zoo.study import ZooConfig, run_study
+from bushenv.zoo.planar_study import PlanarZooConfig, refuse_other_kind, run_planar_study
+from bushenv.zoo.study import ZooConfig, ZooError, run_study
 
 EXAMPLE = (
     "bushenv zoo --recipes teacher-forcing,free-run --models nn,hybrid --seeds 0-9 "
-    "--axes axial,radial --out runs/zoo"
+    "--axes axial,radial --out runs/zoo\n  "
+    "bushenv zoo --env rig3 --recipes teacher-forcing,free-run --models nn,hybrid --seeds 0-9 "
+    "--out runs/zoo-rig3"
 )
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     d = ZooConfig()
+    p.add_argument(
+        "--env",
+        choices=("rig", "rig3"),
+        default="rig",
+        help="rig: one-axis NARX models per axis; rig3: MIMO planar networks, the single-axis "
+        "check then the attack across axes",
+    )
     p.add_argument("--recipes", default=",".join(d.recipes), help="training recipes")
     p.add_argument("--models", default=",".join(d.models), help="NARX models to train")
-    p.add_argument("--axes", default=",".join(d.axes), help="bushing axes")
+    p.add_argument(
+        "--axes", default=None, help=f"bushing axes (default {','.join(d.axes)}; rig only)"
+    )
     p.add_argument("--seeds", default="0-9", help="training and record seeds, e.g. 0-9 or 1,4")
-    p.add_argument("--searchers", default=",".join(d.searchers), help="searchers per model")
+    p.add_argument(
+        "--searchers",
+        default=None,
+        help=f"searchers per model (default {','.join(d.searchers)}; rig3: random,cma)",
+    )
     p.add_argument("--budget", type=int, default=d.budget, help="evaluations per search")
     p.add_argument(
         "--certified",
@@ -42,18 +59,39 @@ def _names(text: str) -> tuple[str, ...]:
     return tuple(n.strip() for n in text.split(",") if n.strip())
 
 
-def config_from(args: argparse.Namespace) -> ZooConfig:
+def config_from(args: argparse.Namespace) -> ZooConfig | PlanarZooConfig:
     """The study the arguments describe (checked)."""
+    if getattr(args, "env", "rig") == "rig3":
+        return planar_config_from(args)
+    d = ZooConfig()
     return ZooConfig(
         recipes=_names(args.recipes),
         models=_names(args.models),
-        axes=_names(args.axes),
+        axes=_names(args.axes) if args.axes is not None else d.axes,
         seeds=tuple(parse_seeds(args.seeds)),
-        searchers=_names(args.searchers),
+        searchers=_names(args.searchers) if args.searchers is not None else d.searchers,
         budget=args.budget,
         out=Path(args.out),
         resume=args.resume,
         train_options={"certified": "on"} if args.certified == "on" else {},
+    ).checked()
+
+
+def planar_config_from(args: argparse.Namespace) -> PlanarZooConfig:
+    """The MIMO population the arguments describe (checked)."""
+    if args.axes is not None:
+        raise ZooError("--axes: --env rig3 drives all three coordinates; leave --axes out")
+    if args.certified == "on":
+        raise ZooError("--certified on: planar networks have no certified training yet")
+    d = PlanarZooConfig()
+    return PlanarZooConfig(
+        recipes=_names(args.recipes),
+        models=_names(args.models),
+        seeds=tuple(parse_seeds(args.seeds)),
+        searchers=_names(args.searchers) if args.searchers is not None else d.searchers,
+        budget=args.budget,
+        out=Path(args.out),
+        resume=args.resume,
     ).checked()
 
 
@@ -64,6 +102,14 @@ def run(args: argparse.Namespace) -> int:
         workers=args.workers,
         address=args.ray_address,
     )
+    planar = isinstance(config, PlanarZooConfig)
+    if config.resume:
+        refuse_other_kind(config.out / "cells.jsonl", planar)
+    if planar:
+        run_planar_study(config, backend, Progress(quiet=args.quiet))
+        print((config.out / "summary.md").read_text())
+        print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md")
+        return 0
     run_study(config, backend, Progress(quiet=args.quiet))
     print((config.out / "summary.md").read_text())
     print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md, accuracy_vs_robustness.png")

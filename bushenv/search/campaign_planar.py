@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,7 +23,7 @@ import numpy as np
 
 from bushenv.persist import write_json
 from bushenv.progress import Progress
-from bushenv.search.base import SearchError
+from bushenv.search.base import Searcher, SearchError, SearchResult
 from bushenv.search.campaign_config import CampaignConfig
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.planar_models import resolve_planar_spec, resolved_planar
@@ -41,7 +42,8 @@ class PlanarAttack:
     control_flagged: bool
 
 
-def _tally(failures) -> dict:
+def tally(failures) -> dict:
+    """Failures by family, by the axis that failed, by criterion; those in a coordinate at rest."""
     fam = Counter(c.family for c in failures)
     axis = Counter(str(c.verdict.get("axis")) for c in failures)
     crit = Counter(str(c.verdict.get("first_criterion")) for c in failures)
@@ -60,6 +62,42 @@ def _tally(failures) -> dict:
         "by_criterion": dict(crit.most_common()),
         "by_family_axis": dict(pairs.most_common()),
     }
+
+
+# How each of the rig3 target's searchers is held to one family.
+HELD_TO = {"random": lambda f: {"families": (f,)}, "cma": lambda f: {"family": f}}
+
+
+def held_to(searcher: str, family: str) -> dict:
+    """The searcher's arguments that hold it to ``family``."""
+    if searcher not in HELD_TO:
+        raise SearchError(f"{searcher} cannot be held to one family; these can: {list(HELD_TO)}")
+    return HELD_TO[searcher](family)
+
+
+def planar_search(
+    model,
+    reference,
+    searcher: str | Searcher,
+    budget: int,
+    seed: int,
+    threads: int = 1,
+    progress: Callable[[str, int], None] | None = None,
+    target: str = "rig3",
+    family: str | None = None,
+) -> SearchResult:
+    """One search of the planar attack on the ``rig3`` target; ``progress`` gets each line of
+    the searcher's with the evaluations made so far (the population study runs it as it is).
+    ``family``: the searcher held to that one family (``one_axis``: the single-axis check)."""
+    if isinstance(searcher, str):
+        s = SEARCHERS[searcher].make(**({} if family is None else held_to(searcher, family)))
+    elif family is None:
+        s = searcher
+    else:
+        raise SearchError("planar_search: family= holds a searcher given by name only")
+    with BatchEvaluator(model, reference, TARGETS[target], threads=threads) as ev:
+        said = None if progress is None else (lambda msg: progress(msg, ev.n_evaluations))
+        return s.run(ev, budget, seed=seed, progress=said)
 
 
 def _recheck(model, reference, profiles, target, threads) -> dict:
@@ -98,16 +136,15 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     done = 0
     for name in c.searchers:
         progress.say(f"[{c.model}] {name}: budget {c.budget} evaluations on {c.target} ...")
-        with BatchEvaluator(model, reference, target, threads=threads) as ev:
 
-            def said(msg: str, start=done, ev=ev) -> None:
-                progress.update(start + ev.n_evaluations, f"  {msg}")
+        def said(msg: str, evaluations: int, start=done) -> None:
+            progress.update(start + evaluations, f"  {msg}")
 
-            result = SEARCHERS[name].make().run(ev, c.budget, seed=c.seed, progress=said)
+        result = planar_search(model, reference, name, c.budget, c.seed, threads, said, c.target)
         done += c.budget
         progress.update(done, f"[{c.model}] {name}: {result.n_failures} failures", force=True)
         summary = result.summary()
-        summary["failures"] = _tally(result.failures)
+        summary["failures"] = tally(result.failures)
         if result.first_failure is not None:
             summary["first_failure"] = {
                 "family": result.first_failure.family,

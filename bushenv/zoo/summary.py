@@ -57,7 +57,7 @@ def _by(rows: list[dict], pick) -> dict[str, dict]:
     }
 
 
-def _median(values) -> float | None:
+def median_of(values) -> float | None:
     vals = [v for v in values if v is not None]
     return float(np.median(vals)) if vals else None
 
@@ -71,7 +71,7 @@ def group_summary(rows: list[dict]) -> dict[str, Any]:
         "by_searcher": {
             s: {
                 **rate(sum(r["attacks"][s]["diverged"] for r in rows), len(rows)),
-                "median_evaluations_to_failure": _median(
+                "median_evaluations_to_failure": median_of(
                     r["attacks"][s]["evaluations_to_failure"] for r in rows
                 ),
             }
@@ -83,7 +83,7 @@ def group_summary(rows: list[dict]) -> dict[str, Any]:
             "bounded": rate(sum(s["bounded"] for s in steps), len(steps)),
             "departures_s": sorted(s["departure_s"] for s in steps if s["departure_s"] is not None),
             "wrong_sign": rate(sum(s["wrong_sign"] for s in steps), len(steps)),
-            "median_static_error_4mm": _median(r["static_error_4mm"] for r in rows),
+            "median_static_error_4mm": median_of(r["static_error_4mm"] for r in rows),
         },
         "certificate": {
             "passes_holds": rate(sum(r["certificate"]["passes_holds"] for r in rows), len(rows)),
@@ -98,7 +98,7 @@ def group_summary(rows: list[dict]) -> dict[str, Any]:
         },
         "accuracy": {
             k: {
-                "median": _median(r["accuracy"][k] for r in rows),
+                "median": median_of(r["accuracy"][k] for r in rows),
                 "range": [
                     min(r["accuracy"][k] for r in rows),
                     max(r["accuracy"][k] for r in rows),
@@ -115,7 +115,7 @@ def summarise(rows: list[dict]) -> dict[str, Any]:
     return {f"{rec}/{model}": group_summary(g) for (rec, model), g in _groups(rows).items()}
 
 
-def _pct(r: dict) -> str:
+def pct(r: dict) -> str:
     lo, hi = r["ci95"]
     return f"{r['failed']}/{r['of']} ({100 * lo:.0f}-{100 * hi:.0f} %)"
 
@@ -125,14 +125,14 @@ def markdown(summary: dict[str, Any]) -> str:
     lines = ["| recipe / model | cells | any searcher | " + "by searcher |", "|---|---|---|---|"]
     for key, g in summary.items():
         per = "; ".join(
-            f"{s} {_pct(v)}, median {v['median_evaluations_to_failure']} evals"
+            f"{s} {pct(v)}, median {v['median_evaluations_to_failure']} evals"
             for s, v in g["by_searcher"].items()
         )
-        lines.append(f"| {key} | {g['cells']} | {_pct(g['diverged_any_searcher'])} | {per} |")
+        lines.append(f"| {key} | {g['cells']} | {pct(g['diverged_any_searcher'])} | {per} |")
     lines += ["", "| recipe / model | by criterion | by family |", "|---|---|---|"]
     for key, g in summary.items():
-        crit = "; ".join(f"{c} {_pct(v)}" for c, v in g["by_criterion"].items()) or "-"
-        fam = "; ".join(f"{c} {_pct(v)}" for c, v in g["by_family"].items()) or "-"
+        crit = "; ".join(f"{c} {pct(v)}" for c, v in g["by_criterion"].items()) or "-"
+        fam = "; ".join(f"{c} {pct(v)}" for c, v in g["by_family"].items()) or "-"
         lines.append(f"| {key} | {crit} | {fam} |")
     lines += [
         "",
@@ -147,9 +147,9 @@ def markdown(summary: dict[str, Any]) -> str:
         deps = st["departures_s"]
         dep = f"{len(deps)}, median {np.median(deps) - STEP_AT_S:.1f} s" if deps else "-"
         lines.append(
-            f"| {key} | {_pct(st['bounded'])} | {dep} | {_pct(st['wrong_sign'])} | "
-            f"{100 * (st['median_static_error_4mm'] or 0):.0f} % | {_pct(ce['passes_holds'])} | "
-            f"{_pct(ce['with_folds'])} | {_pct(ce['non_passive_at_rest'])} | "
+            f"| {key} | {pct(st['bounded'])} | {dep} | {pct(st['wrong_sign'])} | "
+            f"{100 * (st['median_static_error_4mm'] or 0):.0f} % | {pct(ce['passes_holds'])} | "
+            f"{pct(ce['with_folds'])} | {pct(ce['non_passive_at_rest'])} | "
             f"{100 * ac['rms_ratio_n1']['median']:.1f} / "
             f"{100 * ac['rms_ratio_n15']['median']:.1f} % |"
         )

@@ -34,6 +34,8 @@ STAGE_MODULES = (
     "commands/zoo",
     "zoo/cell",
     "zoo/study",
+    "zoo/planar_cell",
+    "zoo/planar_study",
 )
 TYPED_RESULTS = ("campaign_report", "campaign_cases", "campaign_plots")
 
@@ -123,3 +125,9 @@ def test_a_campaign_cell_and_a_zoo_member_compose_the_stages_not_a_run_of_their_
     assert {"resolve_target", "run_search"} <= names
     # judging and searching are the stages' (no judge, evaluator or searcher built here)
     assert not names & {"build_judge", "judge_of", "BatchEvaluator", "get_searcher"}, names
+
+
+def test_a_mimo_zoo_member_runs_the_planar_attacks_search_not_one_of_its_own():
+    names = _imported_names(PACKAGE / "zoo" / "planar_cell.py")
+    assert "planar_search" in names
+    assert not names & {"BatchEvaluator", "get_searcher", "SEARCHERS"}, names
