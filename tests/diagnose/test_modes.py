@@ -267,3 +267,28 @@ def test_a_candidate_that_passes_but_leaves_most_of_the_gap_is_named_and_flagged
     assert not rule.unexplained(rule.answer([a], [], ctx), [a], ctx.gap_null, ctx)[
         "mostly_outside_candidates"
     ]
+
+
+def test_records_that_start_warm_are_named_thermal():
+    """A specimen warmed by earlier tests: each record starts softened by 12 % and recovers
+    as it cools (tau 30 s) while its own dissipation heats it again."""
+    from bushenv.diagnose.effects.thermal import heating_state
+
+    dt, tau = 1 / 204.8, 30.0
+    recs = []
+    b = None
+    for seed, name in ((31, "train"), (32, "t1"), (33, "t2")):
+        x = motion(seed, 30.0, dt)
+        v = np.gradient(x, dt)
+        theta = heating_state(v, dt, tau, "viscous", 1.0)
+        b = 0.1 / theta.max() if b is None else b  # one specimen: 10 % lost to its own heat
+        start = 0.12 * np.exp(-np.arange(x.size) * dt / tau)  # share of k and c lost
+        loss = start + b * theta
+        f = (1 - loss) * (K * x + C * v)
+        noise = 0.003 * np.std(f) * np.random.default_rng(seed).normal(size=x.size)
+        recs.append(Rec(np.arange(x.size) * dt, x, f + noise, dt, name))
+    result = diagnose(recs[0], recs[1:])
+    assert result["effect"] == "thermal", result["effect"]
+    p = result["parameters"]["thermal"]
+    assert p["time_constant_s"] == tau
+    assert p["stiffness_lost_at_start_n_per_m"] == pytest.approx(0.12 * K, rel=0.25)

@@ -28,11 +28,18 @@ def heating_state(v: np.ndarray, dt: float, tau: float, heating: str, v_rms: flo
     return signal.lfilter([dt], [1.0, -a], p)
 
 
+def warm_heat(tau: float, scales: Scales) -> float:
+    """The steady heat (m^2/s) at TRAIN's RMS velocity with a leak of ``tau``: the unit of a
+    warm start (a record that starts at this heat has run long enough to settle)."""
+    return scales.v_rms**2 * tau
+
+
 class Thermal(Effect):
     """``-theta (b_k x + b_c v)``: self-heating softens the spring and the damper.
 
     theta integrates a heating power (viscous ``v^2`` or hysteretic ``|v|``) with a leak to
-    ambient of time constant ``tau_th``; each record starts cold. Both heating laws and five
+    ambient of time constant ``tau_th``; a record may start warm (a heat that cools with the same
+    leak, its stiffness and damping losses at the start fitted). Both heating laws and five
     time constants are tried.
     """
 
@@ -51,7 +58,11 @@ class Thermal(Effect):
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         heating, tau = shape
         theta = heating_state(s.v, s.dt, tau, heating, scales.v_rms)
-        return np.stack([-theta * s.x, -theta * s.v], axis=1)
+        cols = [-theta * s.x, -theta * s.v]
+        if np.isfinite(tau):  # a record that starts warm cools with the same leak
+            warm = np.exp(-np.arange(s.x.size) * s.dt / tau) * warm_heat(tau, scales)
+            cols += [-warm * s.x, -warm * s.v]
+        return np.stack(cols, axis=1)
 
     def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
         """Viscous heating without a leak: 30 % of the stiffness (and of a damping of
@@ -69,5 +80,11 @@ class Thermal(Effect):
             "time_constant_s": float(shape[1]),
             "stiffness_loss_n_per_m_per_heat": float(w[0]),
             "damping_loss_ns_per_m_per_heat": float(w[1]),
+            "stiffness_lost_at_start_n_per_m": float(w[2] * warm_heat(shape[1], scales))
+            if len(w) > 2
+            else 0.0,
+            "damping_lost_at_start_ns_per_m": float(w[3] * warm_heat(shape[1], scales))
+            if len(w) > 3
+            else 0.0,
             "heat_unit": "m^2/s (integral of v^2 or |v| v_rms)",
         }
