@@ -44,8 +44,11 @@ class Thermal(Effect):
     """
 
     name = "thermal"
-    form = "-theta (b_k x + b_c v), theta' = P - theta / tau_th, P = v^2 or abs(v) v_rms"
-    weights = "b_k, b_c >= 0"
+    form = (
+        "-theta (b_k x + b_c v) - exp(-t / tau_th) (s_k x + s_c v), theta' = P - theta / tau_th, "
+        "P = v^2 or abs(v) v_rms (s_k, s_c: lost at the start of a record that starts warm)"
+    )
+    weights = "b_k, b_c, s_k, s_c >= 0"
     telling_test = (
         "a long constant-amplitude sine with rests (a stiffness that falls while it runs "
         "and recovers in the rests)"
