@@ -91,6 +91,7 @@ class Run:
             "shrink": 1.0 - gap / self.gap_before if self.gap_before > 0 else 0.0,
             "shrink_vs_null": 1.0 - gap / self.gap_null if self.gap_null > 0 else 0.0,
             "n_extra_parameters": j.n_extra,
+            "_dissipative": any(get_effect(n).shows_dissipation for n in j.combo.names),
             "shape": describe_shapes(j.fits[0]),
             "gap_train": j.gap_train,
             "_mse": j.mse,
@@ -207,7 +208,8 @@ def diagnose(
     )
     say(f"delay: {lag.text}")
     null_pred = run.stack(run.null.predictions)
-    ctx = rule.Context(run.force, null_pred, run.edges, run.gap_null, run.gap_noise, lag)
+    dx = np.concatenate([p.signals.v * p.dt for p in run.judged])
+    ctx = rule.Context(run.force, null_pred, run.edges, run.gap_null, run.gap_noise, lag, dx)
     singles, pairs = _judge_all(run, eff, say, ctx)
     ans = rule.answer(singles, pairs, ctx)
     say(f"answer: {ans.effect}" + (f" ({' or '.join(ans.between)})" if ans.between else ""))

@@ -292,3 +292,51 @@ def test_records_that_start_warm_are_named_thermal():
     p = result["parameters"]["thermal"]
     assert p["time_constant_s"] == tau
     assert p["stiffness_lost_at_start_n_per_m"] == pytest.approx(0.12 * K, rel=0.25)
+
+
+def _dissipation_case(measured_extra: str):
+    """Motion of growing amplitude at 1 Hz; the measured force beyond the null is either a
+    friction loop (it dissipates) or a stiffness falling with the amplitude (it does not)."""
+    dt = 0.005
+    t = np.arange(0, 40, dt)
+    amp = 1e-3 * (0.3 + 0.7 * t / t[-1])
+    x = amp * np.sin(2 * np.pi * t)
+    v = np.gradient(x, dt)
+    loop = 50.0 * np.tanh(v / 1e-3)  # a slip force of 50 N, sharp reversals
+    elastic = -2e4 * (amp / amp.max()) * x  # amplitude softening: no loop
+    y = loop if measured_extra == "loop" else elastic
+    edges = [(i, i + 200) for i in range(0, t.size, 200)]
+    ctx = rule.Context(y, np.zeros(t.size), edges, 1.0, 0.0, lag_evidence([]), v * dt)
+    return ctx, y, loop, elastic
+
+
+def test_friction_is_named_only_when_the_records_show_the_dissipation_it_claims():
+    cases = (("loop", lambda lp, el: 0.9 * lp), ("elastic", lambda lp, el: el + 0.1 * lp))
+    for measured, pred_of in cases:
+        ctx, y, loop, elastic = _dissipation_case(measured)
+        pred = pred_of(loop, elastic)
+        r = {"effect": "friction", "members": ["friction"], "_pred": pred, "_dissipative": True}
+        r.update(n_extra_parameters=8, gap_after=rms_ratio(y, pred), gap_train=0.0)
+        ctx.gap_null = rms_ratio(y, 0 * y)
+        rule.mark_failed([r], ctx)
+        rule.mark_passes([r], ctx)
+        if measured == "loop":  # the loop it claims is the one measured
+            assert r["dissipation_left"] < 0.05 and r["passes"]
+        else:  # it cuts the error (the elastic part) but claims a loop nobody measured
+            assert r["closes_excess"] > rule.SHRINK_MIN and r["significant"]
+            assert r["dissipation_left"] is None or r["dissipation_left"] > 1.0
+            assert not r["passes"]
+            r.pop("_dissipative")  # an elastic effect is not asked for a loop
+            rule.mark_passes([r], ctx)
+            assert r["passes"] and "dissipation_left" in r  # (kept from before, not recomputed)
+
+
+def test_dissipation_left_counts_the_noise_as_neither_explained_nor_left():
+    ctx, y, loop, _ = _dissipation_case("loop")
+    rng = np.random.default_rng(1)
+    noisy = y + 20.0 * rng.normal(size=y.size)
+    ctx.force = noisy
+    ctx.gap_noise = 20.0 / float(np.sqrt(np.mean(noisy**2)))
+    r = {"_pred": loop}
+    assert rule.dissipation_left(r, ctx) < 0.05  # the right loop under noise: nothing left
+    assert rule.dissipation_left({"_pred": 0 * loop}, ctx) > 0.9  # no loop: all of it left

@@ -119,7 +119,9 @@ class Effect(ABC):
     name; every other list of effects reads it from here), ``form`` (the force it adds),
     ``weights`` (their bounds, in words), ``shape_text`` (the shape settings tried),
     ``telling_test`` (a programme that shows what only this effect does, offered when an
-    answer cannot tell two effects apart). ``replaces_spring``: the columns replace the
+    answer cannot tell two effects apart). ``shows_dissipation``: the effect's own evidence is
+    the energy it dissipates (a hysteresis loop): it is named only when the records show the
+    dissipation it claims (``rule.dissipation_left``). ``replaces_spring``: the columns replace the
     linear spring ``k x`` (a backbone of its own); ``continuous_shape``: the best grid shape
     is refined by a 1-D search on the fitting error.
 
@@ -136,6 +138,7 @@ class Effect(ABC):
     weights: ClassVar[str] = ""
     shape_text: ClassVar[str] = "none"
     telling_test: ClassVar[str] = "a programme that excites it alone"
+    shows_dissipation: ClassVar[bool] = False
     replaces_spring: ClassVar[bool] = False
     continuous_shape: ClassVar[bool] = False
 

@@ -55,6 +55,7 @@ class Friction(Effect):
     """
 
     name = "friction"
+    shows_dissipation = True
     form = (
         "sum_j F_j z_j, dz_j/dx = (sgn dx - z_j)/x_j, x_j = sigma_x {0.003..1}; "
         "- sum_m q_m x A_m / sigma_x, A_m = envelope of abs(x) (2 s, 20 s)"
