@@ -95,3 +95,13 @@ def test_records_at_two_rates_name_the_time_unit_to_check(tmp_path, capsys):
     line = fails([*args, "--out", str(tmp_path / "m.npz")], capsys)
     assert "b.csv is sampled at 2000 Hz" in line and "a.csv at 500 Hz" in line
     assert "'time [ms]'" in line
+
+
+def test_measure_with_a_model_fitted_at_another_rate_says_which_rate_to_pass(tmp_path, capsys):
+    rec = save_planar_csv(tmp_path / "r.csv", *bushing())
+    assert fit([rec], tmp_path / "m.npz", "--model", "linear") == 0
+    args = ["measure", "--axes", "3", "--model", str(tmp_path / "m.npz"), "--programme", "random"]
+    args += ["--duration", "2", "--quiet", "--out", str(tmp_path / "out")]
+    line = fails(args, capsys)
+    assert "m.npz: model sampled at 500 Hz, --rate is 204.8 Hz: pass --rate 500" in line
+    assert main([*args, "--rate", "500"]) == 0
