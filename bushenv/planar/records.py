@@ -9,7 +9,8 @@ Columns are s, m, m, rad, N, N, N m unless a unit is written after a name in bra
 ``displacement_axial [mm]``, ``rotation [deg]``, ``moment [N mm]`` (``UNITS``), converted to SI
 on load. The seven names may come in any order (a rig that writes each axis's displacement
 beside its force is read as it is); each once, nothing else. As for one-axis records
-(``bushenv.records``): finite decimal numbers, blank lines only at the end, time strictly
+(``bushenv.records``): finite decimal numbers (plain ones read by numpy's parser, the rest line
+by line to name a problem), blank lines only at the end, time strictly
 increasing with a uniform step (1 % of dt + 1 ns), at least two samples, plausibility limits
 for columns without a stated unit. Every problem raises ``RecordError`` naming the file, the
 line and the value, and the fix.
@@ -21,6 +22,8 @@ import csv
 import difflib
 import io
 import os
+import re
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -169,10 +172,48 @@ def load_planar_csv(path: str | os.PathLike) -> PlanarRecord:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
         raise RecordError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    rows = list(csv.reader(io.StringIO(text)))
-    if not rows:
+    head, _, body = text.partition("\n")
+    fields = next(csv.reader([head]), [])
+    if not text.strip():
         raise RecordError(f"{path}: empty file; expected the header '{HEADER_TEXT}' and data")
-    order, factors = _header(path, rows[0])
+    order, factors = _header(path, fields)
+    a = _plain_rows(body)
+    a = _parse_rows(path, text, order) if a is None else a[:, order]
+    stated = np.array([bool(_NAME_UNIT.match(fields[j])) for j in order])
+    _check_plausible(path, a, stated)
+    a = a * factors
+    _check_time(path, a[:, 0])
+    if not stated[0]:
+        _check_rate(a[:, 0], str(path), lambda i: f"{path} line {i + 2}")
+    return PlanarRecord(
+        a[:, 0], np.ascontiguousarray(a[:, 1:4]), np.ascontiguousarray(a[:, 4:7]), str(path)
+    )
+
+
+_PLAIN = str.maketrans("", "", "0123456789+-.eE,\n\r \t")  # what numpy reads as float does
+_BLANK_LINE = re.compile(r"(?:^|\n)[ \t\r]*(?:\n|$)")
+
+
+def _plain_rows(body: str) -> np.ndarray | None:
+    """The data through numpy's parser when they are plain numbers, seven a line, no blank
+    line before the end (the common case, 20x faster); None: the line-by-line parser then
+    reads them and names any problem."""
+    body = body.rstrip()
+    if body.translate(_PLAIN) or _BLANK_LINE.search(body):
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            a = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2)
+    except ValueError:
+        return None
+    ok = a.shape[0] >= 2 and a.shape[1] == len(HEADER) and np.isfinite(a).all()
+    return a if ok else None
+
+
+def _parse_rows(path: Path, text: str, order: np.ndarray) -> np.ndarray:
+    """(T, 7) in ``HEADER`` order, line by line; ``RecordError`` naming the first bad line."""
+    rows = list(csv.reader(io.StringIO(text)))
     data = []
     end = len(rows)
     while end > 1 and not "".join(rows[end - 1]).strip():
@@ -201,16 +242,7 @@ def load_planar_csv(path: str | os.PathLike) -> PlanarRecord:
         data.append(vals)
     if len(data) < 2:
         raise RecordError(f"{path}: {len(data)} sample(s); a record needs at least two")
-    a = np.array(data)
-    stated = np.array([bool(_NAME_UNIT.match(rows[0][j])) for j in order])
-    _check_plausible(path, a, stated)
-    a = a * factors
-    _check_time(path, a[:, 0])
-    if not stated[0]:
-        _check_rate(a[:, 0], str(path), lambda i: f"{path} line {i + 2}")
-    return PlanarRecord(
-        a[:, 0], np.ascontiguousarray(a[:, 1:4]), np.ascontiguousarray(a[:, 4:7]), str(path)
-    )
+    return np.array(data)
 
 
 def _check_plausible(path: Path, a: np.ndarray, stated: np.ndarray) -> None:

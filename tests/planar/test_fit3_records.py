@@ -139,3 +139,26 @@ def test_a_force_offset_at_rest_is_noted_with_its_value(tmp_path):
     rec = load_planar_csv(save_planar_csv(tmp_path / "off.csv", t, q, f + [0.0, -150.0, 0.0]))
     (note,) = start_notes(rec)
     assert "reads force_radial -150 N at rest" in note and "load-cell offset" in note
+
+
+def test_plain_numbers_read_fast_equal_the_line_by_line_reading_bit_for_bit(tmp_path):
+    from bushenv.planar import records
+
+    path = write(tmp_path / "user.csv", *user_columns(*bushing()))
+    text = path.read_text()
+    order = np.array([1, 2, 3, 4, 5, 6, 0])  # any permutation: both take the same columns
+    fast = records._plain_rows(text.partition("\n")[2])
+    np.testing.assert_array_equal(fast[:, order], records._parse_rows(path, text, order))
+    crlf = path.with_name("crlf.csv")
+    crlf.write_bytes(text.replace("\n", "\r\n").encode())
+    a, b = load_planar_csv(path), load_planar_csv(crlf)
+    np.testing.assert_array_equal(a.f, b.f)
+
+
+def test_a_blank_line_inside_the_data_is_named(tmp_path):
+    t, q, f = bushing(seconds=1.0)
+    path = save_planar_csv(tmp_path / "r.csv", t, q, f)
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join([*lines[:10], "", *lines[10:]]) + "\n")
+    with pytest.raises(RecordError, match=r"r.csv line 11: 0 values, expected 7"):
+        load_planar_csv(path)
