@@ -278,7 +278,7 @@ def _check_time(path: Path, t: np.ndarray) -> None:
 
 START_S = 0.01  # the start a record is judged on
 OFFSET_SHARE = 0.03  # force at rest above this share of the record's largest |f|: an offset
-REST_SHARE = 0.02  # at rest: |q| and |dq/dt| below this share of their largest values
+REST_SHARE = 0.02  # at rest: |q| over the start below this share of its largest value
 DEFLECTED_SHARE = 0.05  # start deflection above this share of the record's largest |q|
 
 
@@ -287,16 +287,18 @@ def start_notes(record: PlanarRecord) -> list[str]:
 
     Every planar model runs free from rest (zero deflection, zero force). A record that starts
     deflected (a preload applied before the recording began) makes its first samples a step
-    from rest; a force that reads clearly non-zero while the bushing is at rest (no deflection,
-    no motion) is an offset (a load cell not zeroed), which no model at rest produces and
+    from rest; a force that reads clearly non-zero while the bushing is at rest (no deflection
+    over the start) is an offset (a load cell not zeroed), which no model at rest produces and
     which biases a fit.
     """
     n = max(2, int(round(START_S / record.dt)))
     q0, f0 = record.q[:n].mean(axis=0), record.f[:n].mean(axis=0)
-    v = np.diff(record.q, axis=0)
-    q_peak = np.maximum(np.abs(record.q).max(axis=0), 1e-300)
+    # a floor of 5 noise sigmas (from sample-to-sample steps) keeps an axis that only
+    # carries sensor noise from counting as deflected or loaded
+    q_floor, f_floor = 5 * _noise(record.q), 5 * _noise(record.f)
+    q_peak = np.abs(record.q).max(axis=0)
     name = record.source or "record"
-    deflected = np.abs(q0) > DEFLECTED_SHARE * q_peak
+    deflected = np.abs(q0) > np.maximum(DEFLECTED_SHARE * q_peak, q_floor)
     notes = []
     if deflected.any():
         shown = ", ".join(f"{HEADER[1 + i]} {_si(q0[i], UNIT_OF[i])}"
@@ -306,19 +308,22 @@ def start_notes(record: PlanarRecord) -> list[str]:
             "from rest, so its first samples are a step to that deflection; record from rest "
             "(before the preload) for a fair comparison"
         )
-    at_rest = np.all(np.abs(record.q[:n]) <= REST_SHARE * q_peak) and np.all(
-        np.abs(v[: n - 1]) <= REST_SHARE * np.maximum(np.abs(v).max(axis=0), 1e-300)
-    )
-    offset = np.abs(f0) > OFFSET_SHARE * np.maximum(np.abs(record.f).max(axis=0), 1e-300)
+    at_rest = np.all(np.abs(record.q[:n]) <= np.maximum(REST_SHARE * q_peak, q_floor))
+    offset = np.abs(f0) > np.maximum(OFFSET_SHARE * np.abs(record.f).max(axis=0), f_floor)
     if at_rest and offset.any():
         shown = ", ".join(f"{HEADER[4 + i]} {_si(f0[i], FORCE_UNIT_OF[i])}"
                           for i in np.flatnonzero(offset))  # fmt: skip
         notes.append(
             f"{name} line 2: reads {shown} at rest (mean of the first {n} samples, no "
-            "deflection, no motion): a load-cell offset? Models give zero force at rest; "
+            "deflection): a load-cell offset? Models give zero force at rest; "
             "subtract the offset from the column (zero the load cell) before fitting"
         )
     return notes
+
+
+def _noise(a: np.ndarray) -> np.ndarray:
+    """Per column, the white-noise sigma a smooth record's sample-to-sample steps show."""
+    return np.std(np.diff(a, axis=0), axis=0) / np.sqrt(2.0)
 
 
 UNIT_OF = ("m", "m", "rad")

@@ -162,3 +162,13 @@ def test_a_blank_line_inside_the_data_is_named(tmp_path):
     path.write_text("\n".join([*lines[:10], "", *lines[10:]]) + "\n")
     with pytest.raises(RecordError, match=r"r.csv line 11: 0 values, expected 7"):
         load_planar_csv(path)
+
+
+def test_an_axis_holding_only_sensor_noise_is_neither_deflected_nor_loaded(tmp_path):
+    t, q, f = bushing()
+    rng = np.random.default_rng(1)
+    q[:, 0] = 1e-6 * rng.standard_normal(t.size)  # the axial actuator held, its sensor noise
+    f[:, 0] = 2.0 * rng.standard_normal(t.size)
+    q[:5, 0] += 4e-6  # a start a few sigmas off: noise, not a preload
+    rec = load_planar_csv(save_planar_csv(tmp_path / "held.csv", t, q, f))
+    assert start_notes(rec) == []
