@@ -107,11 +107,16 @@ def test_measure_with_a_model_fitted_at_another_rate_says_which_rate_to_pass(tmp
     assert main([*args, "--rate", "500"]) == 0
 
 
-def test_attack_on_rig3_runs_a_model_fitted_at_500_hz_at_its_own_rate(tmp_path):
+def test_attack_on_rig3_runs_a_model_fitted_at_500_hz_at_its_own_rate(tmp_path, capsys):
     rec = save_planar_csv(tmp_path / "r.csv", *bushing())
     assert fit([rec], tmp_path / "m.npz", "--model", "linear") == 0
     args = ["attack", "--env", "rig3", "--model", str(tmp_path / "m.npz"), "--budget", "2"]
     args += ["--searchers", "random", "--max-shrink", "0", "--quiet", "--out", str(tmp_path / "a")]
+    capsys.readouterr()
     assert main(args) == 0  # before: refused, "model sampled at 500 Hz, expected 204.8 Hz"
     report = json.loads((tmp_path / "a" / "report.json").read_text())
     assert report["model"].endswith("m.npz") and report["budget"] == 2
+    assert "judged against bushenv's planar reference rubber" in capsys.readouterr().err
+    own = [*args, "--reference", str(tmp_path / "m.npz"), "--force"]
+    assert main(own) == 0
+    assert "reference rubber" not in capsys.readouterr().err
