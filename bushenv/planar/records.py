@@ -144,8 +144,8 @@ def _header(path: Path, fields: list[str]) -> tuple[np.ndarray, np.ndarray]:
     if missing:
         raise RecordError(
             f"{path} line 1: header '{shown}' lacks {', '.join(missing)}; a planar record has "
-            f"the seven columns {HEADER_TEXT} (a one-axis record 'time,displacement,force' goes "
-            "to the one-axis commands)"
+            f"the seven columns {HEADER_TEXT}: write an axis the test held still as columns of "
+            "zeros"
         )
     order = np.array([names.index(n) for n in HEADER])
     factors = np.ones(len(HEADER))

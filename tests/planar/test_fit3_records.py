@@ -172,3 +172,11 @@ def test_an_axis_holding_only_sensor_noise_is_neither_deflected_nor_loaded(tmp_p
     q[:5, 0] += 4e-6  # a start a few sigmas off: noise, not a preload
     rec = load_planar_csv(save_planar_csv(tmp_path / "held.csv", t, q, f))
     assert start_notes(rec) == []
+
+
+def test_a_torsion_only_header_names_the_missing_columns_and_the_zeros_fix(tmp_path):
+    path = tmp_path / "torsion.csv"
+    path.write_text("time,rotation [deg],moment\n0,0,0\n0.002,0.1,0.2\n")
+    with pytest.raises(RecordError, match=r"lacks displacement_axial, displacement_radial, "
+                       r"force_axial, force_radial; .* as columns of zeros"):  # fmt: skip
+        load_planar_csv(path)
