@@ -13,7 +13,7 @@
   over max |f| as in Table 3, max error in N or N m; fractions). An axis whose measured force
   is zero throughout has null ratios there (its max error is the force the model invents);
 - ``notes``: what the records hold that the models cannot follow (a start away from rest, a
-  force offset at rest, ``bushenv.planar.records.start_notes``) and any resampling.
+  force offset at rest, ``bushenv.planar.records.start_notes``).
 """
 
 from __future__ import annotations
@@ -71,7 +71,7 @@ def save_planar_fit(
     result: Any, model_path: Path, train: list, held_out: list, notes: list[str] | None = None
 ) -> dict[str, Any]:
     """Write the model file, then its card (JSON + markdown); returns the card. ``notes``:
-    what the user should know about the records (``records.start_notes``, resampling)."""
+    what the user should know about the records (``records.start_notes``)."""
     from bushenv import __version__
 
     model = result.model
