@@ -106,9 +106,18 @@ def looks_planar(fields: list[str]) -> bool:
     """Whether a header row is meant as a planar one: seven columns, or a name only planar
     records have (so a misspelt planar header gets the planar loader's message)."""
     own = set(HEADER) - set(ONE_AXIS_HEADER)
-    if len(fields) == 1 and ";" in fields[0]:
-        fields = fields[0].split(";")
+    sep = _other_separator(fields)
+    fields = fields[0].split(sep) if sep else fields
     return len(fields) == len(HEADER) or bool(own & set(header_names(fields)))
+
+
+def _other_separator(fields: list[str]) -> str | None:
+    """';' or a tab when a header row read with commas is one field split by it, else None."""
+    if len(fields) == 1:
+        for sep in (";", "\t"):
+            if len(fields[0].split(sep)) > 1:
+                return sep
+    return None
 
 
 def _header(path: Path, fields: list[str]) -> tuple[np.ndarray, np.ndarray]:
@@ -116,9 +125,11 @@ def _header(path: Path, fields: list[str]) -> tuple[np.ndarray, np.ndarray]:
     may come in any order. ``RecordError`` naming the header problem."""
     names = header_names(fields)
     shown = ",".join(f.strip() for f in fields)
-    if len(fields) == 1 and ";" in fields[0]:
+    sep = _other_separator(fields)
+    if sep:
+        sep = "tab" if sep == "\t" else repr(sep)
         raise RecordError(
-            f"{path} line 1: header '{shown}' looks ';'-separated; save the file with commas "
+            f"{path} line 1: header '{shown}' looks {sep}-separated; save the file with commas "
             f"between values and a point as the decimal mark ('{HEADER_TEXT}')"
         )
     if tuple(names) == ONE_AXIS_HEADER:

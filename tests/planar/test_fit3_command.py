@@ -74,6 +74,14 @@ def test_a_misspelt_3_axis_header_gets_the_3_axis_message(tmp_path, capsys):
     assert "typo.csv line 1:" in line and "did you mean 'rotation'?" in line
 
 
+@pytest.mark.parametrize("sep", [";", "\t"])
+def test_a_3_axis_file_with_another_separator_gets_the_3_axis_message(tmp_path, capsys, sep):
+    rec = tmp_path / "sep.csv"
+    rec.write_text(HEADER_TEXT.replace(",", sep) + "\n" + sep.join("0" * 7) + "\n")
+    line = fails(["fit", str(rec), "--model", "linear", "--out", str(tmp_path / "m.npz")], capsys)
+    assert "-separated; save the file with commas" in line and f"({HEADER_TEXT!r})" in line
+
+
 def test_a_one_axis_record_beside_3_axis_ones_is_refused(tmp_path, capsys):
     t, q, f = bushing(seconds=1.0)
     three = save_planar_csv(tmp_path / "three.csv", t, q, f)

@@ -77,6 +77,10 @@ def test_a_header_in_another_order_and_units_reads_as_the_si_record(tmp_path):
             HEADER_TEXT.replace(",", ";"),
             r"line 1: header .* looks ';'-separated; save the file with commas",
         ),
+        (
+            HEADER_TEXT.replace(",", "\t"),
+            r"line 1: header .* looks tab-separated; save the file with commas",
+        ),
         (HEADER_TEXT + ",temperature", r"column 8 'temperature' is not a planar record column"),
     ],
 )
