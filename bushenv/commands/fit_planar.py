@@ -14,25 +14,21 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from bushenv.planar.records import HEADER, HEADER_TEXT
-from bushenv.records import _NAME_UNIT
+from bushenv.planar.records import HEADER_TEXT, looks_planar
 
 PLANAR_LABEL = " (3-axis)"  # how the planar models own their flags in ``bushenv fit --help``
 
 
 def is_planar_csv(path: str) -> bool:
-    """Whether the file's first line is a planar record header (units in brackets allowed);
-    an unreadable file is not (the one-axis loader then names its problem)."""
+    """Whether the file's first line is meant as a planar record header (any order, units in
+    brackets, or a misspelt one: ``looks_planar``); an unreadable file is not (the one-axis
+    loader then names its problem)."""
     try:
         with open(path, encoding="utf-8-sig", newline="") as fh:
             first = next(csv.reader(fh), [])
     except (OSError, UnicodeDecodeError, csv.Error):
         return False
-    names = []
-    for text in first:
-        m = _NAME_UNIT.match(text)
-        names.append((m.group(1) if m else text).strip())
-    return tuple(names) == HEADER
+    return looks_planar(first)
 
 
 def planar_records(args: argparse.Namespace) -> bool:
@@ -74,8 +70,8 @@ def run_planar(args: argparse.Namespace, out: Path, given: dict[str, Any]) -> in
     """Load the 3-axis records, identify, write the model and its card, print the summary."""
     from bushenv.cli import CliError
     from bushenv.planar.card import save_planar_fit
-    from bushenv.planar.fitting import PLANAR_FITS, fit_planar
-    from bushenv.planar.records import load_planar_csv
+    from bushenv.planar.fitting import PLANAR_FITS, fit_planar, length_problem
+    from bushenv.planar.records import load_planar_csv, start_notes
     from bushenv.records import STEP_RTOL
 
     if args.model not in PLANAR_FITS:
@@ -92,16 +88,23 @@ def run_planar(args: argparse.Namespace, out: Path, given: dict[str, Any]) -> in
     for rec in train[1:] + held:
         if abs(rec.dt - dt) > STEP_RTOL * dt:
             raise CliError(
-                f"{rec.source} is sampled at {1 / rec.dt:.6g} Hz, {train[0].source} at "
-                f"{1 / dt:.6g} Hz: give 3-axis records at one rate (resample them first)"
+                f"{rec.source} is sampled at {1 / rec.dt:.6g} Hz (line 3 on), {train[0].source} "
+                f"at {1 / dt:.6g} Hz: check both time columns' units ('time [ms]'), then give "
+                "3-axis records at one rate (resample them first)"
             )
+    short = length_problem(args.model, given, {r.source: r.time.size for r in train})
+    if short:
+        raise CliError(short)
     say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+    notes = [n for rec in train + held for n in start_notes(rec)]
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr, flush=True)
     if say:
         seconds = sum(r.time.size * dt for r in train)
         say(f"fit {args.model} (3-axis) on {len(train)} record(s), {seconds:.1f} s at "
             f"{1 / dt:.6g} Hz")  # fmt: skip
     result = fit_planar([(r.q, r.f) for r in train], args.model, given, dt, args.seed, say)
-    card = save_planar_fit(result, out, train, held)
+    card = save_planar_fit(result, out, train, held, notes)
     print(summary(card, out))
     return 0
 
@@ -118,6 +121,8 @@ def summary(card: dict[str, Any], out: Path) -> str:
         f"identified in {src['wall_time_s']:.1f} s, seed {src['seed']}",
     ]
     lines += [f"{k}: {v}" for k, v in src["info"].items()]
+    if card.get("notes"):
+        lines.append(f"{len(card['notes'])} note(s) on the records, in the card (shown above)")
     names = [r["file"] or r["name"] for r in card["records"]]
     width = max(30, *(len(n) for n in names))
     lines += ["", f"{'record':{width}s} {'role':9s} {'axis':9s} {'RMS ratio %':>12s} "

@@ -14,6 +14,7 @@ def _model_for(args: argparse.Namespace, dt: float):
     """The planar model measured: the reference (default, with load-cell noise), a registered
     planar name with a preset, or a planar ``.npz`` file."""
     from bushenv.cli import CliError
+    from bushenv.models.base import DT_TOLERANCE
     from bushenv.planar import PLANAR_MODELS, load_planar_model, model_class
     from bushenv.planar.machine import reference_for
 
@@ -21,7 +22,12 @@ def _model_for(args: argparse.Namespace, dt: float):
     if spec == "reference":
         return spec, reference_for(args.seed, dt)
     if spec.endswith(".npz"):
-        model = load_planar_model(spec, dt=dt)
+        model = load_planar_model(spec)
+        if abs(model.dt - dt) > DT_TOLERANCE * dt:  # a fitted model runs only at its rate
+            raise CliError(
+                f"{spec}: model sampled at {1 / model.dt:.6g} Hz, --rate is {1 / dt:.6g} Hz: "
+                f"pass --rate {1 / model.dt:.6g}"
+            )
         return spec, lambda k: model.copy()
     if spec in PLANAR_MODELS and hasattr(model_class(spec), "preset"):
         cls = model_class(spec)

@@ -11,7 +11,9 @@
   ``metrics`` per axis (``axial``, ``radial``, ``rotation``) of the model's free run from rest:
   ``bushenv.metrics.all_metrics`` (RMS ratio and ESR of seed 000 eqs 8-9, MAX as max error
   over max |f| as in Table 3, max error in N or N m; fractions). An axis whose measured force
-  is zero throughout has null ratios there.
+  is zero throughout has null ratios there (its max error is the force the model invents);
+- ``notes``: what the records hold that the models cannot follow (a start away from rest, a
+  force offset at rest, ``bushenv.planar.records.start_notes``).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from bushenv.planar.base import COORDS, FORCE_UNITS
 
 CARD_FORMAT = "bushenv-planar-model-card"
 CARD_VERSION = 1
+RATIOS = ("rms_ratio", "esr", "max_error_ratio", "nrmse", "fit_index")  # all_metrics' ratios
 
 
 def axis_metrics(f_exp: np.ndarray, f_pre: np.ndarray) -> dict[str, dict[str, float | None]]:
@@ -38,6 +41,10 @@ def axis_metrics(f_exp: np.ndarray, f_pre: np.ndarray) -> dict[str, dict[str, fl
     out = {}
     with np.errstate(divide="ignore", invalid="ignore"):
         for i, c in enumerate(COORDS):
+            if not np.any(f_exp[:, i]):  # nothing measured: no ratio (metrics divide by it)
+                err = float(np.max(np.abs(f_pre[:, i])))
+                out[c] = {k: None for k in RATIOS} | {"max_error": err, "peak_error": err}
+                continue
             m = all_metrics(f_exp[:, i], f_pre[:, i])
             out[c] = {k: (float(v) if np.isfinite(v) else None) for k, v in m.items()}
     return out
@@ -60,8 +67,11 @@ def record_entry(record: Any, role: str, model: Any, card_dir: Path) -> dict[str
     return entry
 
 
-def save_planar_fit(result: Any, model_path: Path, train: list, held_out: list) -> dict[str, Any]:
-    """Write the model file, then its card (JSON + markdown); returns the card."""
+def save_planar_fit(
+    result: Any, model_path: Path, train: list, held_out: list, notes: list[str] | None = None
+) -> dict[str, Any]:
+    """Write the model file, then its card (JSON + markdown); returns the card. ``notes``:
+    what the user should know about the records (``records.start_notes``)."""
     from bushenv import __version__
 
     model = result.model
@@ -86,6 +96,7 @@ def save_planar_fit(result: Any, model_path: Path, train: list, held_out: list) 
         },
         "records": [record_entry(r, "train", model, here) for r in train]
         + [record_entry(r, "held-out", model, here) for r in held_out],
+        "notes": list(notes or []),
     }
     card = plain(card)
     json_path, md_path = card_paths(model_path)
@@ -110,6 +121,7 @@ def card_markdown(card: dict[str, Any]) -> str:
         f"{src['seed']}, wall time {src['wall_time_s']:.1f} s",
     ]
     lines += [f"- {k}: {v}" for k, v in src["info"].items()]
+    lines += [f"- note: {n}" for n in card.get("notes", [])]
     lines += [
         "",
         "## Free run from rest, per axis",

@@ -153,6 +153,35 @@ def _hybrid_bw(histories, dt, opts, seed, say):
 PLANAR_FITS.add("hybrid-bw", PlanarFit(PlanarHybridBWOptions, _hybrid_bw))
 
 
+BOUCWEN_MIN_SAMPLES = 20  # per record (``boucwen_fit``)
+NETWORK_MIN_WINDOWS = 20  # free-run windows the training history holds at least (``train``)
+
+
+def length_problem(name: str, options: Any, lengths: dict[str, int]) -> str | None:
+    """What is too short for identifying ``name`` from records of ``lengths`` (label ->
+    samples), with the fix; None when they are long enough."""
+    opts = options_of(PLANAR_FITS[name].options, options, name)
+    if name in ("boucwen", "hybrid-bw"):
+        short = {k: n for k, n in lengths.items() if n < BOUCWEN_MIN_SAMPLES}
+        if short:
+            label, n = next(iter(short.items()))
+            return (
+                f"{label}: {n} samples; the {name} identification needs at least "
+                f"{BOUCWEN_MIN_SAMPLES} per record: give longer records"
+            )
+    if isinstance(opts, PlanarNetworkOptions):
+        need, total = NETWORK_MIN_WINDOWS * opts.window, sum(lengths.values())
+        if total < need:
+            shown = ", ".join(f"{k}: {n}" for k, n in lengths.items())
+            return (
+                f"{total} training samples ({shown}); the {name} network trains on at least "
+                f"{NETWORK_MIN_WINDOWS} x --window {opts.window} = {need} samples (all training "
+                "records joined): give longer records"
+                + (f" or --window {total // NETWORK_MIN_WINDOWS}" if total >= 160 else "")
+            )
+    return None
+
+
 def fit_planar(
     histories: Sequence[History],
     name: str,

@@ -1,0 +1,130 @@
+"""``bushenv fit`` on a user's own 3-axis records: what it reads, notes and refuses (exit 2)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from bushenv.cli import main
+from bushenv.planar import load_planar_model
+from bushenv.planar.records import HEADER_TEXT, save_planar_csv
+
+from .test_fit3_records import bushing, user_columns, write
+
+
+def fails(argv, capsys):
+    capsys.readouterr()
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err
+    return err
+
+
+def fit(paths, out, *extra):
+    return main(["fit", *map(str, paths), "--out", str(out), "--quiet", *extra])
+
+
+def test_a_fit_on_the_users_column_order_and_units_gives_the_si_fit(tmp_path):
+    t, q, f = bushing()
+    si = save_planar_csv(tmp_path / "si.csv", t, q, f)
+    user = write(tmp_path / "user.csv", *user_columns(t, q, f))
+    assert fit([si], tmp_path / "a.npz", "--model", "linear") == 0
+    assert fit([user], tmp_path / "b.npz", "--model", "linear") == 0
+    a, b = load_planar_model(tmp_path / "a.npz"), load_planar_model(tmp_path / "b.npz")
+    np.testing.assert_allclose(b.k_matrix, a.k_matrix, rtol=1e-6)
+    assert a.dt == pytest.approx(0.002) and b.dt == pytest.approx(0.002)
+
+
+def test_an_axis_with_no_force_gets_null_ratios_on_the_card_not_a_crash(tmp_path):
+    t, q, f = bushing()
+    q[:, 2] = 0.0
+    f[:, 2] = 0.0  # a radial-axial test: the rotation column written as zeros
+    rec = save_planar_csv(tmp_path / "two_axes.csv", t, q, f)
+    assert fit([rec], tmp_path / "m.npz", "--model", "linear") == 0
+    card = json.loads((tmp_path / "m.card.json").read_text())
+    rot = card["records"][0]["metrics"]["rotation"]
+    assert rot["rms_ratio"] is None and rot["max_error_ratio"] is None
+    assert rot["max_error"] == pytest.approx(0.0, abs=1e-6)
+    assert card["records"][0]["metrics"]["radial"]["rms_ratio"] < 0.5
+
+
+def test_records_too_short_for_a_network_are_refused_naming_them_and_the_window(tmp_path, capsys):
+    rec = save_planar_csv(tmp_path / "short.csv", *bushing(seconds=1.0))
+    line = fails(["fit", str(rec), "--model", "hybrid", "--out", str(tmp_path / "m.npz")], capsys)
+    assert "500 training samples" in line and "short.csv: 500" in line
+    assert "20 x --window 64 = 1280" in line and "--window 25" in line
+
+
+def test_a_force_offset_is_noted_on_stderr_and_on_the_card(tmp_path, capsys):
+    t, q, f = bushing()
+    rec = save_planar_csv(tmp_path / "offset.csv", t, q, f + [80.0, 0.0, 0.0])
+    capsys.readouterr()
+    assert fit([rec], tmp_path / "m.npz", "--model", "linear") == 0
+    err = capsys.readouterr().err
+    assert "note: " in err and "reads force_axial 80 N at rest" in err
+    card = json.loads((tmp_path / "m.card.json").read_text())
+    assert len(card["notes"]) == 1 and "load-cell offset" in card["notes"][0]
+    assert "load-cell offset" in (tmp_path / "m.card.md").read_text()
+
+
+def test_a_misspelt_3_axis_header_gets_the_3_axis_message(tmp_path, capsys):
+    t, q, f = bushing(seconds=1.0)
+    rec = write(tmp_path / "typo.csv", HEADER_TEXT.replace("rotation", "rotaion"), [t, q, f])
+    line = fails(["fit", str(rec), "--model", "linear", "--out", str(tmp_path / "m.npz")], capsys)
+    assert "typo.csv line 1:" in line and "did you mean 'rotation'?" in line
+
+
+@pytest.mark.parametrize("sep", [";", "\t"])
+def test_a_3_axis_file_with_another_separator_gets_the_3_axis_message(tmp_path, capsys, sep):
+    rec = tmp_path / "sep.csv"
+    rec.write_text(HEADER_TEXT.replace(",", sep) + "\n" + sep.join("0" * 7) + "\n")
+    line = fails(["fit", str(rec), "--model", "linear", "--out", str(tmp_path / "m.npz")], capsys)
+    assert "-separated; save the file with commas" in line and f"({HEADER_TEXT!r})" in line
+
+
+def test_a_one_axis_record_beside_3_axis_ones_is_refused(tmp_path, capsys):
+    t, q, f = bushing(seconds=1.0)
+    three = save_planar_csv(tmp_path / "three.csv", t, q, f)
+    one = write(tmp_path / "one.csv", "time,displacement,force", [t, q[:, 0], f[:, 0]])
+    args = ["fit", str(three), "--model", "linear", "--validate", str(one)]
+    line = fails([*args, "--out", str(tmp_path / "m.npz")], capsys)
+    assert "three.csv is a 3-axis record but" in line and "one.csv is not" in line
+    line = fails(
+        ["fit", str(one), "--model", "hybrid-bw", "--out", str(tmp_path / "m.npz")], capsys
+    )
+    assert "model hybrid-bw is a 3-axis model" in line
+
+
+def test_records_at_two_rates_name_the_time_unit_to_check(tmp_path, capsys):
+    t, q, f = bushing(seconds=1.0)
+    slow = save_planar_csv(tmp_path / "a.csv", t, q, f)
+    fast = save_planar_csv(tmp_path / "b.csv", t / 4, q, f)
+    args = ["fit", str(slow), "--model", "linear", "--validate", str(fast)]
+    line = fails([*args, "--out", str(tmp_path / "m.npz")], capsys)
+    assert "b.csv is sampled at 2000 Hz" in line and "a.csv at 500 Hz" in line
+    assert "'time [ms]'" in line
+
+
+def test_measure_with_a_model_fitted_at_another_rate_says_which_rate_to_pass(tmp_path, capsys):
+    rec = save_planar_csv(tmp_path / "r.csv", *bushing())
+    assert fit([rec], tmp_path / "m.npz", "--model", "linear") == 0
+    args = ["measure", "--axes", "3", "--model", str(tmp_path / "m.npz"), "--programme", "random"]
+    args += ["--duration", "2", "--quiet", "--out", str(tmp_path / "out")]
+    line = fails(args, capsys)
+    assert "m.npz: model sampled at 500 Hz, --rate is 204.8 Hz: pass --rate 500" in line
+    assert main([*args, "--rate", "500"]) == 0
+
+
+def test_attack_on_rig3_runs_a_model_fitted_at_500_hz_at_its_own_rate(tmp_path, capsys):
+    rec = save_planar_csv(tmp_path / "r.csv", *bushing())
+    assert fit([rec], tmp_path / "m.npz", "--model", "linear") == 0
+    args = ["attack", "--env", "rig3", "--model", str(tmp_path / "m.npz"), "--budget", "2"]
+    args += ["--searchers", "random", "--max-shrink", "0", "--quiet", "--out", str(tmp_path / "a")]
+    capsys.readouterr()
+    assert main(args) == 0  # before: refused, "model sampled at 500 Hz, expected 204.8 Hz"
+    report = json.loads((tmp_path / "a" / "report.json").read_text())
+    assert report["model"].endswith("m.npz") and report["budget"] == 2
+    assert "judged against bushenv's planar reference rubber" in capsys.readouterr().err
+    own = [*args, "--reference", str(tmp_path / "m.npz"), "--force"]
+    assert main(own) == 0
+    assert "reference rubber" not in capsys.readouterr().err
