@@ -18,10 +18,24 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
-def run(args: argparse.Namespace) -> int:
-    from bushenv.identify.card import load_card
+def _metric_text(m: dict | None) -> str:
+    """RMS ratio of a record: one figure, or per axis on a planar card."""
+    if not m:
+        return ""
+    if "rms_ratio" in m:
+        return f"RMS ratio {100 * m['rms_ratio']:.2f} %"
+    cells = [
+        f"{c} {100 * m[c]['rms_ratio']:.2f} %" if m[c]["rms_ratio"] is not None else f"{c} -"
+        for c in m
+    ]
+    return "RMS ratio " + ", ".join(cells)
 
-    card = load_card(args.card, records=args.records)
+
+def run(args: argparse.Namespace) -> int:
+    from bushenv.identify.card import CARD_FORMAT, load_card
+    from bushenv.planar.card import CARD_FORMAT as PLANAR_FORMAT
+
+    card = load_card(args.card, records=args.records, formats=(CARD_FORMAT, PLANAR_FORMAT))
     d = card.data
     src = d["source"]
     print(
@@ -29,8 +43,7 @@ def run(args: argparse.Namespace) -> int:
         f"{d['sample_rate_hz']:.6g} Hz, made by {src['kind']} with bushenv {d['bushenv_version']}"
     )
     for r in card.records:
-        m = r.get("metrics")
-        score = f"RMS ratio {100 * m['rms_ratio']:.2f} %" if m else ""
+        score = _metric_text(r.get("metrics"))
         checked = (
             " (checked)" if (r["file"] or r["name"]).endswith(tuple(card.checked_records)) else ""
         )

@@ -303,13 +303,17 @@ def _entry_name(entry: dict[str, Any]) -> str:
 
 
 def load_card(
-    path: str | os.PathLike, records: list | None = None, check_model: bool = True
+    path: str | os.PathLike,
+    records: list | None = None,
+    check_model: bool = True,
+    formats: tuple[str, ...] = (CARD_FORMAT,),
 ) -> ModelCard:
     """Read the card of a model (``MODEL.card.json``, or ``MODEL.npz`` for the card beside it).
 
     Checks that the model file still has the card's hash (``check_model``) and that each of
     ``records`` (paths or ``Record`` objects) matches the card's record of the same file name;
-    raises ``CardError`` naming the record or file that does not.
+    raises ``CardError`` naming the record or file that does not. ``formats``: the format
+    tags accepted (a planar card, ``bushenv.planar.card``, has the same model and record keys).
     """
     p = Path(path)
     if p.suffix == ".npz":
@@ -320,7 +324,7 @@ def load_card(
         data = json.loads(p.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise CardError(f"{p}: not a model card (unreadable JSON: {exc})") from None
-    if not isinstance(data, dict) or data.get("format") != CARD_FORMAT:
+    if not isinstance(data, dict) or data.get("format") not in formats:
         raise CardError(f"{p}: not a model card (format tag missing)")
     if data.get("version") != CARD_VERSION:
         raise CardError(f"{p}: card version {data.get('version')!r}, this bushenv reads 1")

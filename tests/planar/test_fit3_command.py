@@ -128,3 +128,21 @@ def test_attack_on_rig3_runs_a_model_fitted_at_500_hz_at_its_own_rate(tmp_path, 
     own = [*args, "--reference", str(tmp_path / "m.npz"), "--force"]
     assert main(own) == 0
     assert "reference rubber" not in capsys.readouterr().err
+
+
+def test_bushenv_card_reads_a_planar_card_checks_its_records_and_shows_ratios_per_axis(
+    tmp_path, capsys
+):
+    t, q, f = bushing()
+    rec = save_planar_csv(tmp_path / "train.csv", t, q, f)
+    held = save_planar_csv(tmp_path / "held.csv", t, q, 1.01 * f)
+    assert fit([rec], tmp_path / "m.npz", "--model", "linear", "--validate", str(held)) == 0
+    capsys.readouterr()
+    assert main(["card", str(tmp_path / "m.npz"), str(rec)]) == 0
+    out = capsys.readouterr().out
+    assert "model linear in m.npz (sha256 matches)" in out
+    assert "train.csv" in out and "(checked)" in out and "axial" in out and "rotation" in out
+    assert "1 record file(s) match the card" in out
+    held.write_text(held.read_text().replace("0", "1", 5))  # the held-out record changed
+    line = fails(["card", str(tmp_path / "m.npz"), str(held)], capsys)
+    assert "held.csv does not match the card" in line
