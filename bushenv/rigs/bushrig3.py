@@ -17,6 +17,7 @@ from gymnasium import spaces
 
 from bushenv.divergence import force_termination
 from bushenv.errors import BadInput, ModelRaised
+from bushenv.models.base import DT_TOLERANCE
 from bushenv.planar import PLANAR_MODELS, PlanarModel, load_planar_model, model_class
 from bushenv.rigs.bushrig3_kernels import rig3_motion, rig3_outcome
 from bushenv.rigs.common import RigError, positive, positive_int
@@ -28,9 +29,12 @@ COORDS = ("axial", "radial", "rotation")
 MODEL_ERRORS = (BadInput, ModelRaised, ArithmeticError)
 
 
-def resolve_planar(value: Any, dt: float, what: str, env_id: str = ENV_ID) -> PlanarModel:
+def resolve_planar(
+    value: Any, dt: float, what: str, env_id: str = ENV_ID, rate_setting: str = ""
+) -> PlanarModel:
     """A planar model from a registered name (its ``preset``), an ``.npz`` file or an object;
-    errors name ``env_id`` and the argument ``what``."""
+    errors name ``env_id`` and the argument ``what``; a file at another rate names
+    ``rate_setting`` (the caller's argument that sets the step) with the value to give."""
     if isinstance(value, PlanarModel):
         return value.copy()
     if isinstance(value, str) and value in PLANAR_MODELS:
@@ -43,7 +47,14 @@ def resolve_planar(value: Any, dt: float, what: str, env_id: str = ENV_ID) -> Pl
         kwargs = {"measurement": False} if value == "reference" else {}
         return cls.preset(dt=dt, **kwargs)
     if isinstance(value, str | Path) and str(value).endswith(".npz"):
-        return load_planar_model(value, dt=dt)
+        own = load_planar_model(value)
+        if abs(own.dt - dt) > DT_TOLERANCE * dt:  # a fit at its records' rate: say what to set
+            fix = f"pass {rate_setting}={own.dt:.6g}" if rate_setting else "give both one rate"
+            raise RigError(
+                f"{env_id}: {what} {value}: model sampled at {1 / own.dt:.6g} Hz, "
+                f"expected {1 / dt:.6g} Hz (dt={dt:.6g} s): {fix}"
+            )
+        return own
     raise RigError(
         f"{env_id}: {what} {value!r}: {PLANAR_MODELS.unknown_message(value)}, "
         "or a .npz planar model file"
@@ -68,8 +79,10 @@ class Rig3Core:
         self.force_limit = _per_coord("force_limit", kwargs["force_limit"])
         self.force_scale = _per_coord("force_scale", kwargs["force_scale"])
         self.reward_cap = positive("reward_cap", kwargs["reward_cap"])
-        self.model = resolve_planar(kwargs["model"], self.dt, "model")
-        self.reference = resolve_planar(kwargs["reference"], self.dt, "reference")
+        self.model = resolve_planar(kwargs["model"], self.dt, "model", rate_setting="dt_s")
+        self.reference = resolve_planar(
+            kwargs["reference"], self.dt, "reference", rate_setting="dt_s"
+        )
         self.batch = batch
         self.reset(np.ones(batch, dtype=bool))
 

@@ -146,3 +146,17 @@ def test_bushenv_card_reads_a_planar_card_checks_its_records_and_shows_ratios_pe
     held.write_text(held.read_text().replace("0", "1", 5))  # the held-out record changed
     line = fails(["card", str(tmp_path / "m.npz"), str(held)], capsys)
     assert "held.csv does not match the card" in line
+
+
+def test_bushrig3_with_a_fit_at_another_rate_names_the_dt_s_to_pass(tmp_path):
+    import gymnasium as gym
+
+    from bushenv.rigs.common import RigError
+
+    rec = save_planar_csv(tmp_path / "r.csv", *bushing())  # 500 Hz records
+    assert fit([rec], tmp_path / "m.npz", "--model", "linear") == 0
+    with pytest.raises(RigError, match=r"model sampled at 500 Hz, expected 204.8 Hz.*dt_s=0\.002"):
+        gym.make("BushRig3-v0", model=str(tmp_path / "m.npz"))
+    env = gym.make("BushRig3-v0", model=str(tmp_path / "m.npz"), dt_s=0.002, reference="linear")
+    env.reset(seed=0)
+    env.close()
