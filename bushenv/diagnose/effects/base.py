@@ -121,9 +121,9 @@ class Effect(ABC):
     ``telling_test`` (a programme that shows what only this effect does, offered when an
     answer cannot tell two effects apart). ``shows_dissipation``: the effect's own evidence is
     the energy it dissipates (a hysteresis loop): it is named only when the records show the
-    dissipation it claims (``rule.dissipation_left``). ``replaces_spring``: the columns replace the
-    linear spring ``k x`` (a backbone of its own); ``continuous_shape``: the best grid shape
-    is refined by a 1-D search on the fitting error.
+    dissipation it claims (``rule.dissipation_evidence``). ``replaces_spring``: the columns
+    replace the linear spring ``k x`` (a backbone of its own); ``continuous_shape``: the best
+    grid shape is refined by a 1-D search on the fitting error.
 
     Implemented by each effect: ``columns`` (its regressors) and ``example`` (a typical
     instance: what synthetic records and the checks are made of). ``lower`` (the weights'
