@@ -151,7 +151,7 @@ def hold_check(reference: BushingModel, scales: BushingScales) -> Check:
     return Check("holds", False, f"{span}: " + ", ".join(parts) + f" (floor {floor:.4g} N)")
 
 
-def _card_records(card: dict | None, card_file: Any) -> tuple[list[Path], list[str]]:
+def card_records(card: dict | None, card_file: Any) -> tuple[list[Path], list[str]]:
     """The record files a card names that exist (relative paths against the card's folder),
     and the names of those that do not."""
     if not card:
@@ -190,14 +190,14 @@ def records_check(reference: BushingModel, card: dict | None, card_file: Any, wh
     """Check 2: the reference's error on the records its card names."""
     if card is None:
         return Check("records", None, "no model card: nothing to check it against")
-    paths, missing = _card_records(card, card_file)
+    paths, missing = card_records(card, card_file)
     if not paths:
         return Check("records", None, f"{what} are not there ({', '.join(missing) or 'none'})")
     errors = _record_errors(reference, paths)
-    return _judged("records", errors, what, RECORD_LIMIT)
+    return judged_errors("records", errors, what, RECORD_LIMIT)
 
 
-def _judged(name: str, errors: list[tuple[str, float]], what: str, limit: float) -> Check:
+def judged_errors(name: str, errors: list[tuple[str, float]], what: str, limit: float) -> Check:
     text = ", ".join(f"{n} {e:.1%}" if np.isfinite(e) else f"{n} not comparable" for n, e in errors)
     usable = [e for _, e in errors if not np.isnan(e)]
     if not usable:
@@ -216,10 +216,10 @@ def compatibility_check(
     model_file: Any,
 ) -> Check:
     """Check 3: the reference and the model under test are models of one bushing."""
-    paths, _ = _card_records(model_card, model_file)
+    paths, _ = card_records(model_card, model_file)
     if paths:
         errors = _record_errors(reference, paths)
-        return _judged("compatibility", errors, "the model's card's records", RECORD_LIMIT)
+        return judged_errors("compatibility", errors, "the model's card's records", RECORD_LIMIT)
     if model is None:
         return Check("compatibility", None, "no model under test to compare with")
     from bushenv.identify.linear import fitted_linear

@@ -13,7 +13,6 @@ what is missing; every step is seeded, so the result is the same) or ``--force``
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 from bushenv.models import AXES
@@ -144,15 +143,6 @@ def run(args: argparse.Namespace) -> int:
     if TARGETS[args.env].coords:  # planar profiles: the planar attack
         from bushenv.search.campaign_planar import format_planar_table, run_planar_attack
 
-        if str(args.model).endswith(".npz") and args.reference is None:
-            # a fit of the user's own bushing: the default judge is bushenv's rubber, not it
-            print(
-                f"note: {args.model} is judged against bushenv's planar reference rubber (the "
-                "default --reference): failures also measure how your bushing differs from it; "
-                "pass --reference YOUR_BEST.npz (e.g. your hybrid-bw fit) to judge it against "
-                "a model of your own bushing",
-                file=sys.stderr,
-            )
         planar = run_planar_attack(config_from(args), progress)
         print(format_planar_table(planar.report))
         print(f"\nreport: {planar.report_path}  ({planar.report['seconds']:.1f} s in total)")

@@ -128,6 +128,7 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     others = {"control": resolve_planar_spec(c.control or DEFAULT_CONTROL, model.dt, "--control")}
     if c.hybrid and c.hybrid != "none":
         others["hybrid"] = resolve_planar_spec(c.hybrid, model.dt, "--hybrid")
+    judge = _vetted_judge(c, model, reference, target, progress)
     threads = max(1, int(c.threads or 1))
     t0 = time.perf_counter()
     searches, failing = [], []
@@ -166,6 +167,7 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
         "env": c.target,
         "model": c.model,
         "reference": c.reference or DEFAULT_REFERENCE,
+        "judge": judge,
         "budget": c.budget,
         "seed": c.seed,
         "searchers": searches,
@@ -179,6 +181,40 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     (out / "report.md").write_text(format_planar_table(report) + "\n")
     flagged = rechecks.get("control", {}).get("diverged", 0) > 0
     return PlanarAttack(report, report_path, flagged)
+
+
+def _vetted_judge(c: CampaignConfig, model, reference, target, progress: Progress) -> dict:
+    """The reference checked before it judges (``planar.vetting``): refused when it fails,
+    unless ``trust_reference``; what judged (reference, floors, stroke) for the report."""
+    from bushenv.planar.vetting import vet_planar_reference
+    from bushenv.search.target_rig3 import axis_scales
+
+    ref_spec = str(c.reference or DEFAULT_REFERENCE)
+    stroke, _ = target.profile_bounds()
+    floors = np.array([s.force_floor_n for s in axis_scales()])
+    vetting = vet_planar_reference(
+        reference,
+        ref_spec,
+        stroke,
+        floors,
+        reference_file=ref_spec if ref_spec.endswith(".npz") else None,
+        model=model,
+        model_file=c.model if str(c.model).endswith(".npz") else None,
+    )
+    for line in vetting.lines():
+        progress.say(f"reference {ref_spec}: {line}")
+    if not vetting.passed and not c.trust_reference:
+        raise SearchError(
+            f"the reference {ref_spec} failed its vetting ({vetting.summary()}): it cannot judge; "
+            "give another --reference, or pass --trust-reference to judge with it anyway "
+            "(every verdict is then marked)"
+        )
+    return {
+        "vetting": vetting.describe(),
+        "trusted_despite_failed_vetting": bool(not vetting.passed),
+        "force_floors": dict(zip(target.coords, floors.tolist(), strict=True)),
+        "stroke": dict(zip(target.coords, np.asarray(stroke).tolist(), strict=True)),
+    }
 
 
 def _shrink_some(model, reference, target, failing, c, progress, out: Path):
@@ -238,12 +274,27 @@ def _shrink_some(model, reference, target, failing, c, progress, out: Path):
     return kept, shown
 
 
+def _judge_lines(judge: dict | None) -> list[str]:
+    """What judged: the reference's vetting, the floors; marked when trusted despite failing."""
+    if not judge:
+        return []
+    v = judge["vetting"]
+    mark = {True: "ok", False: "FAILED", None: "undecided"}
+    checks = "; ".join(f"{c['check']} {mark[c['passed']]}" for c in v["checks"])
+    floors = ", ".join(f"{k} {x:g}" for k, x in judge["force_floors"].items())
+    head = "JUDGED BY A REFERENCE THAT FAILED ITS VETTING (--trust-reference): " if (
+        judge["trusted_despite_failed_vetting"]) else ""  # fmt: skip
+    return [f"{head}judge: reference {v['reference']} vetted ({checks}); force floors {floors} "
+            "(N, N, N m)", ""]  # fmt: skip
+
+
 def format_planar_table(report: dict) -> str:
     """The attack's table: one line per searcher, then what broke it and the rechecks."""
     lines = [
         f"planar attack on {report['model']} ({report['env']}, vs {report['reference']}), "
         f"budget {report['budget']}, seed {report['seed']}",
         "",
+        *_judge_lines(report.get("judge")),
         "| searcher | failures / evaluations | first failure at | first: family (axis) | "
         "worst robustness |",
         "|---|---|---|---|---|",

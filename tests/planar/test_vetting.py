@@ -1,0 +1,75 @@
+"""The planar reference is checked before it judges (``bushenv.planar.vetting``)."""
+
+import json
+
+import numpy as np
+
+from bushenv.cli import main
+from bushenv.planar import model_class
+from bushenv.planar.linear import PlanarLinear
+from bushenv.planar.vetting import held_vectors, vet_planar_reference
+
+STROKE = np.array([0.0125, 0.0125, 0.15])
+FLOORS = np.array([200.0, 200.0, 20.0])
+
+
+def _linear(k_scale=(1.0, 1.0, 1.0), c_scale=(1.0, 1.0, 1.0), radial_into_axial=0.0):
+    ref = PlanarLinear.preset()
+    k, c = ref.k_matrix.copy(), ref.c_matrix.copy()
+    k[np.diag_indices(3)] *= k_scale
+    c[np.diag_indices(3)] *= c_scale
+    k[0, 1] += radial_into_axial * k[0, 0]
+    return PlanarLinear(k, c, ref.dt)
+
+
+def test_the_coupled_reference_and_a_linear_bushing_pass_their_holds():
+    ref = model_class("reference").preset(dt=PlanarLinear.preset().dt, measurement=False)
+    for model in (ref, _linear()):
+        v = vet_planar_reference(model, "m", STROKE, FLOORS)
+        assert v.passed and v.checks[0].passed is True and v.checks[2].passed is True, v.lines()
+
+
+def test_holds_cover_every_coordinate_alone_and_the_corners_of_the_stroke_box():
+    qs = held_vectors(STROKE)
+    assert qs.shape == (32, 3)
+    assert np.all(np.abs(qs) <= STROKE + 1e-12)
+    alone = np.count_nonzero(qs, axis=1) == 1
+    assert alone.sum() == 24 and np.all(np.abs(qs[~alone]) > 0)
+
+
+def test_a_reference_with_a_negative_stiffness_axis_is_refused_naming_the_hold():
+    v = vet_planar_reference(_linear(k_scale=(1.0, -0.5, 1.0)), "bad", STROKE, FLOORS)
+    assert not v.passed
+    assert "pushing into the deflection" in v.checks[0].detail and "mm" in v.checks[0].detail
+
+
+def test_a_reference_with_negative_damping_holds_still_but_is_refused_as_active():
+    v = vet_planar_reference(_linear(c_scale=(1.0, 1.0, -0.5)), "active", STROKE, FLOORS)
+    holds, _, passive, _ = v.checks
+    assert holds.passed is True  # a hold cannot show a negative damper
+    assert passive.passed is False and "gives energy back" in passive.detail
+    assert not v.passed
+
+
+def test_a_reference_three_times_as_stiff_as_the_model_is_a_warning_not_a_refusal():
+    v = vet_planar_reference(_linear(k_scale=(3.0, 3.0, 3.0)), "stiff", STROKE, FLOORS,
+                             model=_linear())  # fmt: skip
+    comp = v.checks[3]
+    assert comp.passed is None and comp.detail.startswith("WARNING") and "factor" in comp.detail
+    assert v.passed  # a warning: the model is the only word on which bushing it is
+
+
+def test_the_attack_refuses_a_reference_that_fails_its_vetting_unless_trusted(tmp_path, capsys):
+    bad = _linear(k_scale=(1.0, -0.5, 1.0)).save(tmp_path / "bad_ref.npz")
+    argv = ["attack", "--env", "rig3", "--model", "linear", "--reference", str(bad),
+            "--budget", "4", "--searchers", "random", "--quiet", "--no-plots"]  # fmt: skip
+    capsys.readouterr()
+    assert main(argv + ["--out", str(tmp_path / "a")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "failed its vetting" in err and "--trust-reference" in err and "\n" not in err
+    assert not (tmp_path / "a" / "report.json").exists()
+    assert main(argv + ["--out", str(tmp_path / "b"), "--trust-reference"]) == 0
+    report = json.loads((tmp_path / "b" / "report.json").read_text())
+    assert report["judge"]["trusted_despite_failed_vetting"] is True
+    assert report["judge"]["vetting"]["passed"] is False
+    assert "FAILED ITS VETTING" in (tmp_path / "b" / "report.md").read_text()
