@@ -84,6 +84,21 @@ def _accuracy(model, unseen) -> dict[str, dict[str, float]]:
     return out
 
 
+def _network_share(model, unseen) -> dict[str, float] | None:
+    """A hybrid's network part (its force less the linear backbone's) as an RMS ratio of the
+    measured force on the unseen correlated record, per coordinate: how much of the model is
+    network (None for the pure networks, all network). A certified hybrid whose share is ~0
+    is its backbone."""
+    from bushenv.models.base import velocity_of
+
+    if not hasattr(model, "k_matrix"):
+        return None
+    q, f = unseen["correlated"]
+    part = model.simulate(q) - q @ model.k_matrix.T - velocity_of(q, model.dt) @ model.c_matrix.T
+    rms = np.sqrt(np.mean(f**2, axis=0))
+    return {c: float(np.sqrt(np.mean(part[:, i] ** 2)) / rms[i]) for i, c in enumerate(COORDS)}
+
+
 def driven_failed(candidate) -> bool:
     """Whether a single-axis profile failed in a coordinate it moves."""
     moving = np.flatnonzero(np.any(candidate.profile != 0, axis=0))
@@ -152,6 +167,7 @@ def run_planar_cell(cell: dict[str, Any]) -> dict[str, Any]:
         "model_file": str(path.relative_to(cell["out"])),
         "train_s": fit.seconds,
         "accuracy": _accuracy(model, unseen),
+        "network_share": _network_share(model, unseen),
         "certificate": certificate,
         # the certified training's own verdict on the weights it kept (None: not certified)
         "certified_admitted": getattr(model, "training", {}).get("certified", {}).get("admitted"),

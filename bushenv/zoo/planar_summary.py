@@ -93,6 +93,11 @@ def group_summary(rows: list[dict]) -> dict[str, Any]:
             for c in ("axial", "radial", "rotation")
         },
         "holds": _holds(rows),
+        # the network's part of a hybrid's force (RMS ratio, unseen correlated record)
+        "median_network_share_correlated": {
+            c: median_of((r.get("network_share") or {}).get(c) for r in rows)
+            for c in ("axial", "radial", "rotation")
+        },
         "train_s": sum(r["train_s"] for r in rows),
         "judge_s": sum(r["judge_s"] for r in rows),
     }
@@ -191,8 +196,15 @@ def _certified_lines(c: dict | str) -> list[str]:
         f"their training's check {_pct(c['weights_admitted'])}; pass every single-axis check "
         f"{_pct(c['passed_single_axis'])}; of those, **bounded across axes "
         f"{_pct(c['bounded_of_passed'])}**, broken {_pct(c['broken_of_passed'])} (by searcher: "
-        f"{per or '-'}), broken in a moving coordinate {_pct(c['broken_moving_of_passed'])}."
+        f"{per or '-'}), broken in a moving coordinate {_pct(c['broken_moving_of_passed'])}. "
+        f"Their networks' part of the force (median RMS ratio a / r / rot, unseen correlated): "
+        f"{_share(c['median_network_share_correlated'])} (near 0: the backbone alone)."
     ]
+
+
+def _share(share: dict) -> str:
+    vals = [f"{100 * v:.1f}" if v is not None else "-" for v in share.values()]
+    return " / ".join(vals) + " %"
 
 
 def write(out: Path, rows: list[dict]) -> dict[str, Any]:

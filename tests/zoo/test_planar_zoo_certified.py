@@ -53,6 +53,9 @@ def _row(certified, diverged, admitted=True, passed=True):
         "attacks": {"random": attack},
         "accuracy": {"correlated": {"axial": 0.1, "radial": 0.1, "rotation": 0.1}},
         "certificate": {"out_of_band": 0 if certified else 5, "unstable": 0, "unsettled_holds": 0},
+        "network_share": dict.fromkeys(
+            ("axial", "radial", "rotation"), 0.01 if certified else 0.08
+        ),
         "train_s": 1.0,
         "judge_s": 1.0,
     }
@@ -71,6 +74,8 @@ def test_certified_hybrids_get_their_own_rates_and_stay_out_of_the_pool():
     assert 0.3 < lo < 0.4 and 0.96 < hi < 0.97  # Wilson, 4 of 5
     text = markdown(s)
     assert "bounded across axes 4/5 (38-96 %)" in text
+    assert "Their networks' part of the force (median RMS ratio a / r / rot, unseen " in text
+    assert "1.0 / 1.0 / 1.0 % (near 0: the backbone alone)" in text
     assert s["groups"]["free-run/hybrid"]["holds"]["out_of_band"]["failed"] == 3
     # plain hybrids alone are never reported as certified
     assert summarise([_row(False, False)] * 2)["certified_hybrids"] == NO_CERTIFIED
@@ -90,6 +95,7 @@ def test_a_tiny_certified_study_runs_end_to_end(tmp_path):
     row = rows[0]
     assert isinstance(row["certified_admitted"], bool)
     assert row["certificate"]["holds"] == 343
+    assert set(row["network_share"]) == {"axial", "radial", "rotation"}
     assert (tmp_path / row["model_file"]).is_file() and "certified" in row["model_file"]
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["certified_hybrids"]["members"] == 1
@@ -98,3 +104,19 @@ def test_a_tiny_certified_study_runs_end_to_end(tmp_path):
         "Certified MIMO hybrids (--certified on): 1 members"
         in (tmp_path / "summary.md").read_text()
     )
+
+
+def test_the_network_share_of_a_silent_hybrid_is_zero_and_of_a_live_one_is_not():
+    import numpy as np
+
+    from bushenv.planar.narx import PlanarHybrid
+    from bushenv.zoo.planar_cell import _network_share, planar_records
+
+    live = PlanarHybrid.untrained(seed=0)
+    p = live.params
+    silent = PlanarHybrid(**{**p, "w_out": 0 * p["w_out"], "b_out": -p["f_offset"] / p["f_scale"]})
+    _, unseen = planar_records(0)
+    assert max(_network_share(silent, unseen).values()) < 1e-12
+    assert min(_network_share(live, unseen).values()) > 0.01
+    assert _network_share(object(), unseen) is None
+    assert np.isfinite(list(_network_share(live, unseen).values())).all()
