@@ -45,7 +45,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--certified",
         choices=("off", "on"),
         default="off",
-        help="train every model with the certified-holds loss term (bushenv fit --certified on)",
+        help="train every model with the certified-holds loss term (bushenv fit --certified on; "
+        "rig3: the planar term, planar/certified.py)",
     )
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--resume", action="store_true", help="continue an interrupted study")
@@ -81,8 +82,6 @@ def planar_config_from(args: argparse.Namespace) -> PlanarZooConfig:
     """The MIMO population the arguments describe (checked)."""
     if args.axes is not None:
         raise ZooError("--axes: --env rig3 drives all three coordinates; leave --axes out")
-    if args.certified == "on":
-        raise ZooError("--certified on: planar networks have no certified training yet")
     d = PlanarZooConfig()
     return PlanarZooConfig(
         recipes=_names(args.recipes),
@@ -92,6 +91,7 @@ def planar_config_from(args: argparse.Namespace) -> PlanarZooConfig:
         budget=args.budget,
         out=Path(args.out),
         resume=args.resume,
+        train_options={"certified": "on"} if args.certified == "on" else {},
     ).checked()
 
 

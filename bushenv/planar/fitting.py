@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.identify.narx_options import SWITCH
 from bushenv.identify.options import NoOptions, option, options_of
 from bushenv.planar.base import PlanarModel, PlanarModelError
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
@@ -49,10 +50,34 @@ class PlanarNetworkOptions:
     windows: int = option(32, "free-run windows per step")
     val_fraction: float = option(0.2, "last part of the training history kept for validation")
     eval_every: int = option(25, "free-run steps between two validations")
+    certified: str = option(
+        "off",
+        "on: a loss term holding every fixed point of the held network, over the rig3 box "
+        "(single coordinates, pairs, all three), within a band of the records' static force per "
+        "coordinate and below a spectral radius, and every held run after a step settled "
+        "(planar/certified.py; docs/planar_certified.md)",
+        choices=SWITCH,
+    )
+    certified_weight: float = option(1.0, "weight of the certified-hold term")
+    certified_low: float = option(
+        0.8, "held force at least this fraction of the records' static estimate, same sign"
+    )
+    certified_high: float = option(
+        1.9, "held force at most this multiple of the records' static estimate"
+    )
+    certified_radius: float = option(
+        0.98, "spectral radius of a held fixed point above which the term grows"
+    )
+    certified_holds: int = option(24, "holds per training step")
+    certified_stroke_m: float = option(
+        0.0125, "holds span +-this deflection, m (axial and radial; BushRig3-v0's stroke)"
+    )
+    certified_rotation_rad: float = option(0.15, "holds span +-this rotation, rad (BushRig3-v0's)")
 
     def check(self) -> None:
         small = [n for n in ("hidden", "teacher_steps", "window", "windows", "eval_every")
                  if getattr(self, n) < 1]  # fmt: skip
+        self._check_certified()
         if small or self.free_run_steps < 0 or not 0 < self.val_fraction < 0.9:
             raise PlanarModelError(
                 f"planar network options: {small or 'free_run_steps / val_fraction'} out of "
@@ -61,6 +86,20 @@ class PlanarNetworkOptions:
         if self.hidden % 3:
             raise PlanarModelError(f"hidden must be a multiple of 3 (one group per axis), got "
                                    f"{self.hidden}")  # fmt: skip
+
+    def _check_certified(self) -> None:
+        bad = []
+        if not 0.0 <= self.certified_low < 1.0 < self.certified_high:
+            bad.append(f"certified_low {self.certified_low} and certified_high "
+                       f"{self.certified_high} (need 0 <= low < 1 < high)")  # fmt: skip
+        if not 0.0 < self.certified_radius < 1.0:
+            bad.append(f"certified_radius {self.certified_radius} (need 0 < radius < 1)")
+        if not (self.certified_stroke_m > 0 and self.certified_rotation_rad > 0):
+            bad.append("certified_stroke_m and certified_rotation_rad (need > 0)")
+        if self.certified_weight < 0 or self.certified_holds < 1:
+            bad.append("certified_weight >= 0 and certified_holds >= 1")
+        if bad:
+            raise PlanarModelError(f"planar network options: {'; '.join(bad)}")
 
     def train_options(self) -> Any:
         from bushenv.planar.train import TrainOptions
@@ -80,6 +119,11 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
     def check(self) -> None:
         super().check()
         self.backbone_options().check()
+        if self.certified == "on":
+            raise PlanarModelError(
+                "--certified on is for nn, nn-axis and hybrid: hybrid-bw's Bouc-Wen backbone "
+                "holds a hysteretic force the certified term does not model"
+            )
 
     def backbone_options(self) -> PlanarBoucWenOptions:
         return PlanarBoucWenOptions(self.evaluations, time_limit_s=self.time_limit_s)
@@ -120,9 +164,26 @@ def _network(kind: str):
         f = np.vstack([h[1] for h in histories])
         model = fit_planar_network(q, f, dt, kind, opts.train_options(), seed, quiet=say is None)
         info = {"note": "records joined end to end"} if len(histories) > 1 else {}
+        info.update(certified_info(model))
         return model, info
 
     return fit
+
+
+def certified_info(model: Any) -> dict[str, str]:
+    """The certified training's verdict on the weights kept, one line for the card."""
+    check = getattr(model, "training", {}).get("certified")
+    if check is None:
+        return {}
+    verdict = "admitted" if check["admitted"] else "NOT admitted (best of all weights kept)"
+    return {
+        "certified": (
+            f"{verdict}: {check['holds']} holds, {check['unstable']} unstable and "
+            f"{check['out_of_band']} out-of-band fixed points, max spectral radius "
+            f"{check['max_spectral_radius']:.3f}, {check['unsettled_holds']} unsettled holds, "
+            f"{check['holds_without_one_fixed_point']} holds without exactly one fixed point"
+        )
+    }
 
 
 def _boucwen(histories, dt, opts, seed, say):

@@ -5,6 +5,11 @@ scaled to [-1, 1] over the training records (seed 000 §4.2), full-batch Adam on
 measured force lags, then Adam on free-run windows (the network fed with its own outputs from a
 measured start), keeping the weights with the lowest free-run error on a held-out tail. Torch
 only trains; the arrays go to ``narx.PlanarNarx`` whose numpy loop does every run in use.
+
+``certified="on"`` adds the certified-hold term (``certified.py``) to both stages' loss, and
+the weights kept are the best admitted ones (``PlanarCertifiedHolds.admits`` on its fixed grid,
+checked at every validation), or the best of all when none was admitted; the returned model's
+``training`` attribute says which, with the check of the weights kept.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ from bushenv.planar.narx import (
 )
 from bushenv.progress import Progress
 
+TEACHER_CHECK_EVERY = 50  # certified: teacher steps between two checks (they pick hard holds)
 KINDS = {"nn": PlanarNarx, "nn-axis": PlanarNarxPerAxis, "hybrid": PlanarHybrid}
 
 
@@ -44,6 +50,29 @@ class TrainOptions:
     windows: int = 32  # windows per step
     val_fraction: float = 0.2
     eval_every: int = 25
+    certified: str = "off"  # "on": the certified-hold loss term (certified.py)
+    certified_weight: float = 1.0
+    certified_low: float = 0.8
+    certified_high: float = 1.9
+    certified_radius: float = 0.98
+    certified_holds: int = 24
+    certified_stroke_m: float = 12.5e-3
+    certified_rotation_rad: float = 0.15
+
+    def certified_term(self):
+        """The certified-hold term the options ask for, or None."""
+        if self.certified != "on":
+            return None
+        from bushenv.planar.certified import PlanarCertifiedHolds
+
+        return PlanarCertifiedHolds(
+            weight=self.certified_weight,
+            low=self.certified_low,
+            high=self.certified_high,
+            radius=self.certified_radius,
+            stroke=(self.certified_stroke_m, self.certified_stroke_m, self.certified_rotation_rad),
+            holds=self.certified_holds,
+        )
 
 
 def _lags(a: np.ndarray, n: int, t0: int) -> np.ndarray:
@@ -147,6 +176,19 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
     n_tr = qz_all.shape[0] - n_val
     gen = torch.Generator().manual_seed(seed)
     net = _Net(opt.hidden, kind == "nn-axis", gen)
+    term = opt.certified_term()
+    if term is not None:
+        from bushenv.planar.certified import PlanarProblem
+        from bushenv.planar.static_estimate import planar_static_estimate
+
+        n_fit = q.shape[0] - n_val  # the static estimate from the training part, total force
+        estimate = planar_static_estimate([(q[:n_fit], f_total[:n_fit])], dt)
+        k = extra.get("k_matrix", np.zeros((3, 3)))
+        problem = PlanarProblem(q_off, q_sc, f_off, f_sc, k, dt, estimate)
+
+    def extra_loss(stage: str) -> torch.Tensor | float:
+        return term(net, problem) if term is not None and stage in term.stages else 0.0
+
     rng = np.random.default_rng(seed)
     progress = Progress(opt.teacher_steps + opt.free_run_steps, quiet=quiet, label=f"planar {kind}")
 
@@ -154,13 +196,6 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
     tgt = torch.tensor(tgt_all[:n_tr])
     adam = torch.optim.Adam(net.parameters(), lr=opt.teacher_lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(adam, opt.teacher_steps)
-    for i in range(opt.teacher_steps):
-        adam.zero_grad()
-        loss = torch.mean((net(z) - tgt) ** 2)
-        loss.backward()
-        adam.step()
-        sched.step()
-        progress.update(i + 1, f"teacher forcing, one-step MSE {loss.item():.3e}")
 
     def build() -> PlanarNarx:
         return KINDS[kind](
@@ -173,6 +208,16 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
             **extra,
         )
 
+    for i in range(opt.teacher_steps):
+        adam.zero_grad()
+        loss = torch.mean((net(z) - tgt) ** 2)
+        (loss + extra_loss("teacher")).backward()
+        adam.step()
+        sched.step()
+        progress.update(i + 1, f"teacher forcing, one-step MSE {loss.item():.3e}")
+        if term is not None and (i + 1) % TEACHER_CHECK_EVERY == 0:
+            term.check(build(), problem.estimate)  # the grid's failing holds join the term
+
     def val_error() -> float:
         """Sum over the axes of the free-run RMS ratio on the held-out tail (total force)."""
         pred = build().simulate(q_val)
@@ -180,7 +225,13 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
 
     q_val, f_val_total = q[-n_val:], f_total[-n_val:]
     f_val_rms = np.maximum(np.sqrt(np.mean(f_val_total**2, axis=0)), 1e-12)
-    best, best_state = val_error(), {k: v.detach().clone() for k, v in net.state_dict().items()}
+
+    def judged() -> tuple[bool, float]:
+        """(not admitted, validation error): the order the kept weights win by."""
+        admitted = term is None or term.admits(build(), problem.estimate)
+        return (not admitted, val_error())
+
+    best, best_state = judged(), {k: v.detach().clone() for k, v in net.state_dict().items()}
     qz_t, yl_t, tgt_t = (torch.tensor(a[:n_tr]) for a in (qz_all, yl_all, tgt_all))
     adam = torch.optim.Adam(net.parameters(), lr=opt.free_run_lr)
     L = opt.window
@@ -190,13 +241,19 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
         adam.zero_grad()
         pred = net.unroll(qz_t[idx], yl_t[torch.tensor(starts)])
         loss = torch.mean((pred - tgt_t[idx]) ** 2)
-        loss.backward()
+        (loss + extra_loss("free-run")).backward()
         adam.step()
-        progress.update(opt.teacher_steps + it + 1, f"free run, best validation {best:.4f}")
+        progress.update(opt.teacher_steps + it + 1, f"free run, best validation {best[1]:.4f}")
         if (it + 1) % opt.eval_every == 0 or it + 1 == opt.free_run_steps:
-            err = val_error()
+            err = judged()
             if err < best:
                 best, best_state = err, {k: v.detach().clone() for k, v in net.state_dict().items()}
     net.load_state_dict(best_state)
-    progress.update(None, f"done, validation sum of RMS ratios {best:.4f}", force=True)
-    return build()
+    progress.update(None, f"done, validation sum of RMS ratios {best[1]:.4f}", force=True)
+    model = build()
+    if term is not None:
+        model.training = {
+            "certified": term.check(model, problem.estimate),
+            "static_estimate": problem.estimate.as_dict(),
+        }
+    return model

@@ -11,6 +11,8 @@ the same searchers and the same budget per search:
   coordinate at a time, the others at rest; random search draws the coordinate, CMA-ES searches
   it). A member passes when no profile fails in the coordinate it drives, on any axis: that is
   all a single-axis rig measures. A failure in a coordinate at rest is counted apart;
+- its hold check (``planar.certified.check``, certified or not): fixed points over a 7^3 grid
+  of the rig3 box, out of the records' static band, unstable, or not settling after a step;
 - the attack across axes: each searcher over the planar families (``campaign_planar``'s search);
   its failures in a coordinate the profile moves are counted apart too (a member whose only
   failures are force in a coordinate held at rest has wrong coupling, not a runaway).
@@ -42,7 +44,23 @@ PLANAR_RECIPES = {"teacher-forcing": {"free_run_steps": 0}, "free-run": {}}
 
 
 def planar_cell_name(cell: dict[str, Any]) -> str:
-    return f"planar-{cell['recipe']}-{cell['model']}-s{cell['seed']}"
+    extra = "".join(f"-{k}" for k, v in sorted(cell.get("train_options", {}).items()) if v == "on")
+    return f"planar-{cell['recipe']}{extra}-{cell['model']}-s{cell['seed']}"
+
+
+def _certificate(model, train) -> dict[str, Any]:
+    """The planar hold check (``planar.certified.check``: fixed points over the 7^3 grid of the
+    rig3 box, their static force against the training record's estimate, their spectral
+    radius, the run after a step) of any member, certified or not."""
+    from bushenv.planar.certified import PlanarCertifiedHolds
+    from bushenv.planar.static_estimate import planar_static_estimate
+
+    q, f = train
+    n = q.shape[0] - int(0.2 * q.shape[0])  # the training part (the default val_fraction)
+    estimate = planar_static_estimate([(q[:n], f[:n])], PAPER_DT)
+    out = PlanarCertifiedHolds(1.0).check(model, estimate)
+    out["failing_holds"] = len(out["failing_holds"])
+    return out
 
 
 def planar_records(seed: int):
@@ -64,6 +82,21 @@ def _accuracy(model, unseen) -> dict[str, dict[str, float]]:
         pred = model.simulate(q)
         out[name] = {c: metrics.rms_ratio(f[:, i], pred[:, i]) for i, c in enumerate(COORDS)}
     return out
+
+
+def _network_share(model, unseen) -> dict[str, float] | None:
+    """A hybrid's network part (its force less the linear backbone's) as an RMS ratio of the
+    measured force on the unseen correlated record, per coordinate: how much of the model is
+    network (None for the pure networks, all network). A certified hybrid whose share is ~0
+    is its backbone."""
+    from bushenv.models.base import velocity_of
+
+    if not hasattr(model, "k_matrix"):
+        return None
+    q, f = unseen["correlated"]
+    part = model.simulate(q) - q @ model.k_matrix.T - velocity_of(q, model.dt) @ model.c_matrix.T
+    rms = np.sqrt(np.mean(f**2, axis=0))
+    return {c: float(np.sqrt(np.mean(part[:, i] ** 2)) / rms[i]) for i, c in enumerate(COORDS)}
 
 
 def driven_failed(candidate) -> bool:
@@ -125,6 +158,7 @@ def run_planar_cell(cell: dict[str, Any]) -> dict[str, Any]:
     path = model.save(Path(cell["out"]) / "models" / f"{planar_cell_name(cell)}.npz")
     reference = resolve_planar_spec(DEFAULT_REFERENCE, model.dt, "--reference")
     t1 = time.perf_counter()
+    certificate = _certificate(model, train)
     searchers = cell["searchers"].split(",")
     single = {s: _single_axis(model, reference, s, budget, seed) for s in searchers}
     attacks = {s: _attack(model, reference, s, budget, seed) for s in searchers}
@@ -133,6 +167,10 @@ def run_planar_cell(cell: dict[str, Any]) -> dict[str, Any]:
         "model_file": str(path.relative_to(cell["out"])),
         "train_s": fit.seconds,
         "accuracy": _accuracy(model, unseen),
+        "network_share": _network_share(model, unseen),
+        "certificate": certificate,
+        # the certified training's own verdict on the weights it kept (None: not certified)
+        "certified_admitted": getattr(model, "training", {}).get("certified", {}).get("admitted"),
         "single_axis": single,
         "attacks": attacks,
         "passed_single_axis": all(v["passed"] for v in single.values()),

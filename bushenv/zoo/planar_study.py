@@ -25,12 +25,14 @@ from bushenv.search.targets import TARGETS
 from bushenv.zoo.planar_cell import PLANAR_RECIPES, run_planar_cell
 from bushenv.zoo.planar_summary import write
 from bushenv.zoo.study import ZooError
+from bushenv.zoo.summary import recipe_label
 
 PLANAR_CELL_KEYS = ("env", "recipe", "model", "seed", "budget", "searchers", "train_options")
 PLANAR_RESULT_KEYS = ("accuracy", "single_axis", "attacks")
 # A member's wall time relative to teacher forcing, for the time left only (60 members at
 # budget 256, one worker: 5.0 s teacher forcing, 7.1 s with the free-run stage).
 PLANAR_EFFORT = {"teacher-forcing": 1.0, "free-run": 1.4}
+CERTIFIED_EFFORT = 4.0  # the certified term's fixed points and step runs at every step (seed 0)
 
 
 @dataclass(frozen=True)
@@ -99,7 +101,7 @@ def _describe(row: dict[str, Any]) -> str:
     single = "passes single-axis" if row["passed_single_axis"] else "fails single-axis"
     broken = "BROKEN across axes" if row["diverged"] else "bounded across axes"
     return (
-        f"{row['recipe']:15s} {row['model']:7s} seed {row['seed']}: {single}, {broken} "
+        f"{recipe_label(row):15s} {row['model']:7s} seed {row['seed']}: {single}, {broken} "
         f"(trained in {row['train_s']:.0f} s)"
     )
 
@@ -120,7 +122,10 @@ def run_planar_study(config: PlanarZooConfig, backend, progress: Progress) -> li
             progress,
             _describe,
             "zoo rig3",
-            weight=lambda cell: PLANAR_EFFORT.get(cell["recipe"], 1.4),
+            weight=lambda cell: (
+                PLANAR_EFFORT.get(cell["recipe"], 1.4)
+                * (CERTIFIED_EFFORT if cell["train_options"].get("certified") == "on" else 1.0)
+            ),
         )
     write(config.out, rows)
     return rows

@@ -48,7 +48,6 @@ def test_env_rig3_builds_the_mimo_population_and_refuses_what_does_not_apply():
     assert len(cells) == 2 * 3 * 2 and {x["env"] for x in cells} == {"rig3"}
     for argv, fragment in (
         (("--axes", "axial"), "--axes"),
-        (("--certified", "on"), "certified"),
         (("--models", "boucwen"), "--models: unknown"),
         (("--searchers", "certificate"), "--searchers: unknown"),
         (("--recipes", "adam"), "--recipes: unknown"),
@@ -116,7 +115,7 @@ def test_the_summary_counts_broken_among_those_passing_with_wilson_intervals():
     pooled = s["mimo_pooled"]
     assert (pooled["broken_of_passed"]["failed"], pooled["broken_of_passed"]["of"]) == (10, 11)
     assert not pooled["target_met"]  # 10/11 is above 90 %, its interval's lower end is not
-    assert "no certified MIMO hybrid" in markdown(s)
+    assert "Certified MIMO hybrids: none in this study" in markdown(s)
     none_passed = markdown(summarise([_row("nn", False, True)]))
     assert "| free-run/nn | 1 | 0/1 (0-79 %) | - | - | 1/1 (21-100 %) |" in none_passed
 
