@@ -128,7 +128,15 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     others = {"control": resolve_planar_spec(c.control or DEFAULT_CONTROL, model.dt, "--control")}
     if c.hybrid and c.hybrid != "none":
         others["hybrid"] = resolve_planar_spec(c.hybrid, model.dt, "--hybrid")
-    judge = _vetted_judge(c, model, reference, target, progress)
+    judge = vetted_judge(
+        reference,
+        str(c.reference or DEFAULT_REFERENCE),
+        target,
+        progress,
+        model=model,
+        model_file=c.model if str(c.model).endswith(".npz") else None,
+        trust=c.trust_reference,
+    )
     threads = max(1, int(c.threads or 1))
     t0 = time.perf_counter()
     searches, failing = [], []
@@ -183,13 +191,21 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     return PlanarAttack(report, report_path, flagged)
 
 
-def _vetted_judge(c: CampaignConfig, model, reference, target, progress: Progress) -> dict:
-    """The reference checked before it judges (``planar.vetting``): refused when it fails,
-    unless ``trust_reference``; what judged (reference, floors, stroke) for the report."""
+def vetted_judge(
+    reference,
+    ref_spec: str,
+    target,
+    progress: Progress,
+    model=None,
+    model_file=None,
+    trust: bool = False,
+    error: type[Exception] = SearchError,
+) -> dict:
+    """The reference checked before it judges (``planar.vetting``): ``error`` when it fails,
+    unless ``trust``; what judged (the vetting, floors, stroke) for a report."""
     from bushenv.planar.vetting import vet_planar_reference
     from bushenv.search.target_rig3 import axis_scales
 
-    ref_spec = str(c.reference or DEFAULT_REFERENCE)
     stroke, _ = target.profile_bounds()
     floors = np.array([s.force_floor_n for s in axis_scales()])
     vetting = vet_planar_reference(
@@ -199,12 +215,12 @@ def _vetted_judge(c: CampaignConfig, model, reference, target, progress: Progres
         floors,
         reference_file=ref_spec if ref_spec.endswith(".npz") else None,
         model=model,
-        model_file=c.model if str(c.model).endswith(".npz") else None,
+        model_file=model_file,
     )
     for line in vetting.lines():
         progress.say(f"reference {ref_spec}: {line}")
-    if not vetting.passed and not c.trust_reference:
-        raise SearchError(
+    if not vetting.passed and not trust:
+        raise error(
             f"the reference {ref_spec} failed its vetting ({vetting.summary()}): it cannot judge; "
             "give another --reference, or pass --trust-reference to judge with it anyway "
             "(every verdict is then marked)"

@@ -109,6 +109,7 @@ def _describe(row: dict[str, Any]) -> str:
 def run_planar_study(config: PlanarZooConfig, backend, progress: Progress) -> list[dict[str, Any]]:
     """Every member of ``config`` not yet in ``config.out/cells.jsonl``, on ``backend``; the
     summary written; all rows returned."""
+    judge = _vetted_reference(progress)
     log = RunLog(
         config.out / "cells.jsonl", PLANAR_CELL_KEYS, PLANAR_RESULT_KEYS, ZooError, progress.say
     )
@@ -127,5 +128,15 @@ def run_planar_study(config: PlanarZooConfig, backend, progress: Progress) -> li
                 * (CERTIFIED_EFFORT if cell["train_options"].get("certified") == "on" else 1.0)
             ),
         )
-    write(config.out, rows)
+    write(config.out, rows, judge)
     return rows
+
+
+def _vetted_reference(progress: Progress) -> dict[str, Any]:
+    """Every member is judged by the coupled reference: it is vetted once, before any member."""
+    from bushenv.models.base import PAPER_DT
+    from bushenv.search.campaign_planar import DEFAULT_REFERENCE, vetted_judge
+    from bushenv.search.planar_models import resolve_planar_spec
+
+    reference = resolve_planar_spec(DEFAULT_REFERENCE, PAPER_DT, "reference")
+    return vetted_judge(reference, DEFAULT_REFERENCE, TARGETS["rig3"], progress, error=ZooError)

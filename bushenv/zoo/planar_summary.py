@@ -142,8 +142,18 @@ def summarise(rows: list[dict]) -> dict[str, Any]:
     }
 
 
+def _judge_line(judge: dict | None) -> list[str]:
+    if not judge:
+        return []
+    mark = {True: "ok", False: "FAILED", None: "undecided"}
+    v = judge["vetting"]
+    checks = "; ".join(f"{c['check']} {mark[c['passed']]}" for c in v["checks"])
+    return [f"Judged by the reference {v['reference']}, vetted first ({checks}).", ""]
+
+
 def markdown(summary: dict[str, Any]) -> str:
     lines = [
+        *_judge_line(summary.get("judge")),
         "| recipe / model | members | pass every single-axis check | of those, broken across "
         "axes | of those, broken in a moving coordinate | all broken across axes | by searcher "
         "(of those passing; median evals to failure) | pass single-axis in all three channels "
@@ -207,8 +217,12 @@ def _share(share: dict) -> str:
     return " / ".join(vals) + " %"
 
 
-def write(out: Path, rows: list[dict]) -> dict[str, Any]:
+def write(out: Path, rows: list[dict], judge: dict | None = None) -> dict[str, Any]:
+    """``summary.json`` and ``summary.md``; ``judge``: what judged every member (the vetted
+    reference, ``campaign_planar.vetted_judge``)."""
     summary = summarise(rows)
+    if judge is not None:
+        summary["judge"] = judge
     write_json(out / "summary.json", summary, indent=2)
     write_text(out / "summary.md", markdown(summary))
     return summary

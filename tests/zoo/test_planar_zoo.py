@@ -192,6 +192,10 @@ def test_a_small_mimo_population_runs_summarises_and_resumes(tmp_path):
     assert set(summary["groups"]) == {"teacher-forcing/nn", "teacher-forcing/hybrid"}
     assert "broken_of_passed" in summary["mimo_pooled"]
     assert "| teacher-forcing/hybrid | 1 |" in (tmp_path / "summary.md").read_text()
+    judge = summary["judge"]  # the reference every member was judged by, vetted first
+    assert judge["vetting"]["passed"] is True and judge["vetting"]["reference"] == "reference"
+    assert [c["check"] for c in judge["vetting"]["checks"]][0] == "holds"
+    assert "vetted first (holds ok" in (tmp_path / "summary.md").read_text()
 
 
 def test_resuming_the_other_kind_of_study_is_refused_and_its_file_kept(tmp_path, capsys):
