@@ -123,6 +123,8 @@ class PlanarRubber(PlanarModel):
 
     name = "reference"
     EFFECTS: ClassVar[tuple[str, ...]] = EFFECTS
+    # beyond it the quartic coupling is an extrapolation (docs/planar.md): a judge out of range
+    calibrated_rotation_rad: ClassVar[float] = MAX_ROTATION_RAD
     param_names = (
         "stiffness",
         "damping",

@@ -53,6 +53,19 @@ def resolve_arm(p, kwargs: dict[str, Any]) -> None:
     p.reference_name = f"planar {twin.name}"
 
 
+def reference_range_reason(reference, theta: float) -> str:
+    """Why the twin's arm bushing judges by extrapolation at rotation ``theta`` ("" if it does
+    not): beyond the rotation its law is calibrated for (a reference's
+    ``calibrated_rotation_rad``, when it states one)."""
+    r = getattr(reference, "calibrated_rotation_rad", None)
+    if r is not None and abs(theta) > r:
+        return (
+            f"the reference arm bushing's rotation {theta:+.3g} rad is beyond its calibrated "
+            f"+-{r:g} rad: its forces there are an extrapolation"
+        )
+    return ""
+
+
 def sample_planar(p, car, model, motion):
     """(forces, why) of a planar arm bushing at t_k: (radial N, axial N, moment N m), judged and
     held as ``CarPair.sample`` does the one-axis forces, the moment by ``arm_moment_limit_nm``."""

@@ -28,6 +28,7 @@ from bushenv.rigs.car import (
     check_road,
     out_of_bounds,
 )
+from bushenv.rigs.car_planar import reference_range_reason
 from bushenv.rigs.common import (
     ForceDeviationReward,
     RigError,
@@ -380,11 +381,14 @@ class QuarterCarEnv(gym.Env):
             **(self._planar_info(force_m, force_r) if p.planar else {}),
         }
 
-    def _planar_info(self, force_m, force_r) -> dict[str, float]:
-        """The arm's rotation and the planar bushing's moments (``arm_bushing`` set)."""
+    def _planar_info(self, force_m, force_r) -> dict[str, Any]:
+        """The arm's rotation and the planar bushing's moments (``arm_bushing`` set), and why
+        the twin's bushing judges outside the range its law is calibrated for ("" if not)."""
+        theta_r = self.twin.bushing_rotation()[0]
         return {
             "arm_rotation_rad": self.car.bushing_rotation()[0],
-            "reference_arm_rotation_rad": self.twin.bushing_rotation()[0],
+            "reference_arm_rotation_rad": theta_r,
+            "reference_outside_range": reference_range_reason(self.references["arm"], theta_r),
             "moment_model_nm": force_m[2],
             "moment_reference_nm": force_r[2],
         }

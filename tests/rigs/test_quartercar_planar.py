@@ -134,3 +134,24 @@ def test_the_coupling_keeps_linear_and_reference_stable_on_the_worst_roads_withi
         for key in ("force_radial_model_n", "force_axial_model_n", "moment_model_nm"):
             x = np.array([r[4][key] for r in rows])
             assert np.isfinite(x).all() and np.ptp(x[-100:]) < 0.01 * np.abs(x).max(), key
+
+
+def test_info_says_when_the_reference_arm_bushing_judges_beyond_its_calibrated_rotation():
+    """The coupled reference is calibrated to +-0.15 rad; the arm turns further on harsh roads
+    (up to 0.26 rad on these): info names the steps its forces are an extrapolation."""
+    from test_quartercar import LOOSE, worst_roads
+
+    from bushenv.planar.reference import MAX_ROTATION_RAD
+
+    roads = worst_roads(600, np.random.default_rng(0))
+    loose = dict(LOOSE, arm_moment_limit_nm=1e12)
+    rows = replay(make(arm_bushing="linear", arm_bushing_reference="reference", **loose),
+                  roads[:, 15])  # fmt: skip
+    theta = np.array([r[4]["reference_arm_rotation_rad"] for r in rows])
+    said = np.array([bool(r[4]["reference_outside_range"]) for r in rows])
+    assert np.abs(theta).max() > MAX_ROTATION_RAD  # the road takes the arm beyond the range
+    np.testing.assert_array_equal(said, np.abs(theta) > MAX_ROTATION_RAD)
+    first = next(r[4]["reference_outside_range"] for r in rows if r[4]["reference_outside_range"])
+    assert "calibrated +-0.15 rad" in first and "extrapolation" in first
+    lin = replay(make(arm_bushing="linear", arm_bushing_reference="linear", **loose), roads[:, 15])
+    assert not any(r[4]["reference_outside_range"] for r in lin)  # a law with no stated range
