@@ -172,18 +172,27 @@ def card_records(card: dict | None, card_file: Any) -> tuple[list[Path], list[st
     return found, missing
 
 
+def record_errors(paths: list[Path], dt: float, load, error) -> list[tuple[str, float]]:
+    """(file name, ``error(record)``) per record file (``load`` reads one); NaN for a record at
+    another sample time than ``dt`` (not comparable)."""
+    out = []
+    for p in paths:
+        rec = load(p)
+        if abs(rec.dt - dt) > 1e-6 * dt:
+            out.append((p.name, float("nan")))
+            continue
+        out.append((p.name, float(error(rec))))
+    return out
+
+
 def _record_errors(reference: BushingModel, paths: list[Path]) -> list[tuple[str, float]]:
     from bushenv.records import load_csv
 
-    out = []
-    for p in paths:
-        rec = load_csv(p)
-        if abs(rec.dt - reference.dt) > 1e-6 * reference.dt:
-            out.append((p.name, float("nan")))
-            continue
+    def error(rec) -> float:
         f = reference.copy().simulate(rec.displacement)
-        out.append((p.name, float(rms_ratio(rec.force, f)) if np.all(np.isfinite(f)) else np.inf))
-    return out
+        return float(rms_ratio(rec.force, f)) if np.all(np.isfinite(f)) else np.inf
+
+    return record_errors(paths, reference.dt, load_csv, error)
 
 
 def records_check(reference: BushingModel, card: dict | None, card_file: Any, what: str) -> Check:

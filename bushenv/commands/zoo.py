@@ -65,34 +65,29 @@ def config_from(args: argparse.Namespace) -> ZooConfig | PlanarZooConfig:
     if getattr(args, "env", "rig") == "rig3":
         return planar_config_from(args)
     d = ZooConfig()
-    return ZooConfig(
-        recipes=_names(args.recipes),
-        models=_names(args.models),
-        axes=_names(args.axes) if args.axes is not None else d.axes,
-        seeds=tuple(parse_seeds(args.seeds)),
-        searchers=_names(args.searchers) if args.searchers is not None else d.searchers,
-        budget=args.budget,
-        out=Path(args.out),
-        resume=args.resume,
-        train_options={"certified": "on"} if args.certified == "on" else {},
-    ).checked()
+    axes = _names(args.axes) if args.axes is not None else d.axes
+    return ZooConfig(axes=axes, **_shared(args, d.searchers)).checked()
+
+
+def _shared(args: argparse.Namespace, default_searchers: tuple[str, ...]) -> dict:
+    """The arguments both studies take, as config fields."""
+    return {
+        "recipes": _names(args.recipes),
+        "models": _names(args.models),
+        "seeds": tuple(parse_seeds(args.seeds)),
+        "searchers": _names(args.searchers) if args.searchers is not None else default_searchers,
+        "budget": args.budget,
+        "out": Path(args.out),
+        "resume": args.resume,
+        "train_options": {"certified": "on"} if args.certified == "on" else {},
+    }
 
 
 def planar_config_from(args: argparse.Namespace) -> PlanarZooConfig:
     """The MIMO population the arguments describe (checked)."""
     if args.axes is not None:
         raise ZooError("--axes: --env rig3 drives all three coordinates; leave --axes out")
-    d = PlanarZooConfig()
-    return PlanarZooConfig(
-        recipes=_names(args.recipes),
-        models=_names(args.models),
-        seeds=tuple(parse_seeds(args.seeds)),
-        searchers=_names(args.searchers) if args.searchers is not None else d.searchers,
-        budget=args.budget,
-        out=Path(args.out),
-        resume=args.resume,
-        train_options={"certified": "on"} if args.certified == "on" else {},
-    ).checked()
+    return PlanarZooConfig(**_shared(args, PlanarZooConfig().searchers)).checked()
 
 
 def run(args: argparse.Namespace) -> int:

@@ -46,6 +46,7 @@ from bushenv.vetting import (
     Vetting,
     card_records,
     judged_errors,
+    record_errors,
 )
 
 LEVELS = (-1.0, -0.6, -0.3, -0.1, 0.1, 0.3, 0.6, 1.0)
@@ -155,19 +156,13 @@ def _read_card(path: Any) -> tuple[dict | None, Path | None]:
 def _record_errors(reference: PlanarModel, paths: list[Path]) -> list[tuple[str, float]]:
     from bushenv.planar.records import load_planar_csv
 
-    out = []
-    for p in paths:
-        rec = load_planar_csv(p)
-        if abs(rec.dt - reference.dt) > 1e-6 * reference.dt:
-            out.append((p.name, float("nan")))
-            continue
+    def worst(rec) -> float:  # the worst coordinate's RMS ratio
         f = _run(reference, rec.q)
         if not np.all(np.isfinite(f)):
-            out.append((p.name, float("inf")))
-            continue
-        worst = max(float(rms_ratio(rec.f[:, i], f[:, i])) for i in range(3) if np.any(rec.f[:, i]))
-        out.append((p.name, worst))
-    return out
+            return float("inf")
+        return max(float(rms_ratio(rec.f[:, i], f[:, i])) for i in range(3) if np.any(rec.f[:, i]))
+
+    return record_errors(paths, reference.dt, load_planar_csv, worst)
 
 
 def records_check(reference: PlanarModel, reference_file: Any) -> Check:
