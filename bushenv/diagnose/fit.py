@@ -92,6 +92,7 @@ class Run:
             "shrink_vs_null": 1.0 - gap / self.gap_null if self.gap_null > 0 else 0.0,
             "n_extra_parameters": j.n_extra,
             "_dissipative": any(get_effect(n).shows_dissipation for n in j.combo.names),
+            "_elastic": any(get_effect(n).holds_its_law for n in j.combo.names),
             "shape": describe_shapes(j.fits[0]),
             "gap_train": j.gap_train,
             "_mse": j.mse,
@@ -209,7 +210,11 @@ def diagnose(
     say(f"delay: {lag.text}")
     null_pred = run.stack(run.null.predictions)
     dx = np.concatenate([p.signals.v * p.dt for p in run.judged])
-    ctx = rule.Context(run.force, null_pred, run.edges, run.gap_null, run.gap_noise, lag, dx)
+    x = np.concatenate([p.signals.x for p in run.judged])
+    records = rule.record_edges([p.n for p in run.judged])
+    ctx = rule.Context(
+        run.force, null_pred, run.edges, run.gap_null, run.gap_noise, lag, dx, x, records
+    )
     singles, pairs = _judge_all(run, eff, say, ctx)
     ans = rule.answer(singles, pairs, ctx)
     say(f"answer: {ans.effect}" + (f" ({' or '.join(ans.between)})" if ans.between else ""))

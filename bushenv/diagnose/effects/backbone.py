@@ -82,6 +82,7 @@ class Hardening(Effect):
         "deflection, without a loop)"
     )
     replaces_spring = True
+    holds_its_law = True
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         x = s.x

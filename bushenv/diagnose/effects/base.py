@@ -121,7 +121,9 @@ class Effect(ABC):
     ``telling_test`` (a programme that shows what only this effect does, offered when an
     answer cannot tell two effects apart). ``shows_dissipation``: the effect's own evidence is
     the energy it dissipates (a hysteresis loop): it is named only when the records show the
-    dissipation it claims (``rule.dissipation_evidence``). ``replaces_spring``: the columns
+    dissipation it claims (``rule.dissipation_evidence``). ``holds_its_law``: the effect is a
+    force law of the deflection alone (elastic): it is named only when that law holds through
+    each record (``rule.law_drift``). ``replaces_spring``: the columns
     replace the linear spring ``k x`` (a backbone of its own); ``continuous_shape``: the best
     grid shape is refined by a 1-D search on the fitting error.
 
@@ -139,6 +141,7 @@ class Effect(ABC):
     shape_text: ClassVar[str] = "none"
     telling_test: ClassVar[str] = "a programme that excites it alone"
     shows_dissipation: ClassVar[bool] = False
+    holds_its_law: ClassVar[bool] = False
     replaces_spring: ClassVar[bool] = False
     continuous_shape: ClassVar[bool] = False
 
