@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 from bushenv.excitation import random_rpc
+from bushenv.identify.options import options_of
 from bushenv.metrics import rms_ratio
 from bushenv.planar import PlanarModelError
-from bushenv.planar.fitting import PLANAR_FITS
+from bushenv.planar.fitting import CERTIFIED_HYBRID_TRAINING, PLANAR_FITS
 from bushenv.planar.train import (
     HYBRID_TRAINING,
     TrainOptions,
@@ -69,6 +70,14 @@ def test_the_hybrid_alone_gets_the_new_defaults_and_the_flags_agree():
     assert PLANAR_FITS["hybrid-bw"].options().train_options() == TrainOptions()
 
 
+def test_a_certified_hybrid_keeps_the_old_recipe_unless_told_otherwise():
+    opts = options_of(PLANAR_FITS["hybrid"].options, {"certified": "on"}, "hybrid")
+    assert opts.train_options() == TrainOptions(certified="on")  # the recipe it was measured with
+    assert {k: getattr(opts, k) for k in CERTIFIED_HYBRID_TRAINING} == CERTIFIED_HYBRID_TRAINING
+    given = options_of(PLANAR_FITS["hybrid"].options, {"certified": "on", "hidden": 54}, "hybrid")
+    assert given.hidden == 54 and given.teacher_batch == 0
+
+
 def test_mini_batch_training_is_deterministic_given_the_seed():
     q = _drive(1500, 3)
     f = _bushing(q)
@@ -85,7 +94,5 @@ def test_mini_batch_training_is_deterministic_given_the_seed():
     "given", [{"teacher_batch": -1}, {"feedback_noise": -0.1}, {"feedback_noise": 20.0}]
 )
 def test_bad_batch_or_noise_is_refused_naming_it(given):
-    from bushenv.identify.options import options_of
-
     with pytest.raises(PlanarModelError, match="teacher_batch .* feedback_noise"):
         options_of(PLANAR_FITS["hybrid"].options, given, "hybrid")
