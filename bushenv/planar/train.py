@@ -31,6 +31,13 @@ from bushenv.planar.narx import (
     PlanarNarxPerAxis,
     axis_masks,
 )
+from bushenv.planar.structure import (
+    StructuredNet,
+    fit_diagonal_linear,
+    increment_gain,
+    is_mirror,
+    symmetric_scale,
+)
 from bushenv.progress import Progress
 
 TEACHER_CHECK_EVERY = 50  # certified: teacher steps between two checks (they pick hard holds)
@@ -58,6 +65,7 @@ class TrainOptions:
     certified_holds: int = 24
     certified_stroke_m: float = 12.5e-3
     certified_rotation_rad: float = 0.15
+    structure: str = "free"  # weights tied by construction (structure.py), "free": none
 
     def certified_term(self):
         """The certified-hold term the options ask for, or None."""
@@ -153,6 +161,11 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
     if kind not in KINDS:
         raise PlanarModelError(f"unknown planar network kind {kind!r}; known: {list(KINDS)}")
     opt = options or TrainOptions()
+    if opt.structure != "free" and kind == "nn-axis":
+        raise PlanarModelError(
+            f"structure {opt.structure!r} ties the MIMO network's weights; nn-axis takes "
+            "structure 'free' only (use nn or hybrid)"
+        )
     q = np.asarray(q, dtype=np.float64)
     f = np.asarray(f, dtype=np.float64)
     if q.shape != f.shape or q.ndim != 2 or q.shape[1] != 3 or q.shape[0] < 20 * opt.window:
@@ -161,12 +174,13 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
             f"got {q.shape} and {f.shape}"
         )
     extra, f_total = {}, f
+    mirror = is_mirror(opt.structure)  # mirror-symmetric: diagonal backbone, scaled about 0
     if kind == "hybrid":
-        lin = fit_linear(q, velocity_of(q, dt), f, dt)
+        lin = fit_diagonal_linear(q, f, dt) if mirror else fit_linear(q, velocity_of(q, dt), f, dt)
         extra = {"k_matrix": lin.k_matrix, "c_matrix": lin.c_matrix}
         f = f - lin.simulate(q)
-    q_off, q_sc = _scale(q)
-    f_off, f_sc = _scale(f)
+    q_off, q_sc = symmetric_scale(q) if mirror else _scale(q)
+    f_off, f_sc = symmetric_scale(f) if mirror else _scale(f)
     qs, ys = (q - q_off) / q_sc, (f - f_off) / f_sc
     n_val = int(opt.val_fraction * q.shape[0])
     t0 = max(N_PAST_Q, N_PAST_F)
@@ -175,7 +189,10 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
     tgt_all = ys[t0:]
     n_tr = qz_all.shape[0] - n_val
     gen = torch.Generator().manual_seed(seed)
-    net = _Net(opt.hidden, kind == "nn-axis", gen)
+    if opt.structure == "free":
+        net = _Net(opt.hidden, kind == "nn-axis", gen)
+    else:
+        net = StructuredNet(opt.structure, opt.hidden, gen, increment_gain(qs))
     term = opt.certified_term()
     if term is not None:
         from bushenv.planar.certified import PlanarProblem
