@@ -170,3 +170,25 @@ def test_a_certified_mirror_hybrid_keeps_its_network_where_the_free_one_falls_si
     assert mirror.training["certified"]["admitted"]
     assert np.all(_share(mirror, qu, fu) > 0.04)
     assert np.all(_share(free, qu, fu) < 0.03)
+
+
+def test_bushenv_fit_takes_structure_mirror_for_3_axis_records(tmp_path, capsys):
+    from bushenv.cli import main
+    from bushenv.planar.registry import load_planar_model
+
+    rec = tmp_path / "rec"
+    assert main(["measure", "--axes", "3", "--programme", "random", "--duration", "6",
+                 "--out", str(rec), "--quiet"]) == 0  # fmt: skip
+    train = sorted(map(str, rec.glob("*.csv")))
+    args = ["fit", *train, "--model", "hybrid", "--hidden", "6", "--teacher-steps", "8",
+            "--free-run-steps", "0", "--window", "16", "--quiet"]  # fmt: skip
+    assert main([*args, "--structure", "mirror", "--out", str(tmp_path / "m.npz")]) == 0
+    model = load_planar_model(tmp_path / "m.npz")
+    assert model.w1.shape[0] == 8 and np.all(model.k_matrix == np.diag(np.diag(model.k_matrix)))
+    q = random_independent(1.0, 2.0, PAPER_DT, 3)
+    q[:, 1] = 0.0
+    assert np.abs(model.simulate(q)[:, 1]).max() < 1e-6
+    capsys.readouterr()
+    assert main([*args, "--structure", "odd", "--out", str(tmp_path / "o.npz")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "structure must be one of free, mirror" in err[0]
