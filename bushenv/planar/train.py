@@ -9,7 +9,9 @@ only trains; the arrays go to ``narx.PlanarNarx`` whose numpy loop does every ru
 ``certified="on"`` adds the certified-hold term (``certified.py``) to both stages' loss, and
 the weights kept are the best admitted ones (``PlanarCertifiedHolds.admits`` on its fixed grid,
 checked at every validation), or the best of all when none was admitted; the returned model's
-``training`` attribute says which, with the check of the weights kept.
+``training`` attribute says which, with the check of the weights kept. ``structure`` other than
+"free" trains a network whose weights are tied by construction (``structure.py``: mirror-
+symmetric, displacement increments, or both).
 """
 
 from __future__ import annotations
