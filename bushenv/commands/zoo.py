@@ -7,6 +7,7 @@ import argparse
 from pathlib import Path
 
 from bushenv.execution import get_backend
+from bushenv.planar.structure import STRUCTURES
 from bushenv.progress import Progress
 from bushenv.search.matrix import parse_seeds
 from bushenv.zoo.planar_study import PlanarZooConfig, refuse_other_kind, run_planar_study
@@ -48,6 +49,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="train every model with the certified-holds loss term (bushenv fit --certified on; "
         "rig3: the planar term, planar/certified.py)",
     )
+    p.add_argument(
+        "--structure",
+        choices=STRUCTURES,
+        default="free",
+        help="rig3: the planar network's weights tied by construction (bushenv fit --structure; "
+        "mirror: odd in each coordinate, planar/structure.py)",
+    )
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--resume", action="store_true", help="continue an interrupted study")
     p.add_argument("--workers", type=int, default=None, help="local worker processes")
@@ -65,6 +73,8 @@ def config_from(args: argparse.Namespace) -> ZooConfig | PlanarZooConfig:
     if getattr(args, "env", "rig") == "rig3":
         return planar_config_from(args)
     d = ZooConfig()
+    if _structure(args):
+        raise ZooError("--structure: the planar networks' option; use it with --env rig3")
     axes = _names(args.axes) if args.axes is not None else d.axes
     return ZooConfig(axes=axes, **_shared(args, d.searchers)).checked()
 
@@ -83,11 +93,19 @@ def _shared(args: argparse.Namespace, default_searchers: tuple[str, ...]) -> dic
     }
 
 
+def _structure(args: argparse.Namespace) -> dict:
+    """``--structure`` as a planar training option (none for the default)."""
+    structure = getattr(args, "structure", "free")
+    return {} if structure == "free" else {"structure": structure}
+
+
 def planar_config_from(args: argparse.Namespace) -> PlanarZooConfig:
     """The MIMO population the arguments describe (checked)."""
     if args.axes is not None:
         raise ZooError("--axes: --env rig3 drives all three coordinates; leave --axes out")
-    return PlanarZooConfig(**_shared(args, PlanarZooConfig().searchers)).checked()
+    shared = _shared(args, PlanarZooConfig().searchers)
+    shared["train_options"] = {**shared["train_options"], **_structure(args)}
+    return PlanarZooConfig(**shared).checked()
 
 
 def run(args: argparse.Namespace) -> int:

@@ -32,6 +32,7 @@ from bushenv.identify.options import NoOptions, option, options_of
 from bushenv.planar.base import PlanarModel, PlanarModelError
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
 from bushenv.planar.registry import PLANAR_MODELS
+from bushenv.planar.structure import STRUCTURES
 from bushenv.registry import Registry
 
 History = tuple[np.ndarray, np.ndarray]
@@ -79,6 +80,13 @@ class PlanarNetworkOptions:
         0.0125, "holds span +-this deflection, m (axial and radial; BushRig3-v0's stroke)"
     )
     certified_rotation_rad: float = option(0.15, "holds span +-this rotation, rad (BushRig3-v0's)")
+    structure: str = option(
+        "free",
+        "weights tied by construction (nn, hybrid): mirror (odd in each coordinate, diagonal "
+        "backbone), rate (displacement as increments: one held fixed point), mirror-rate "
+        "(planar/structure.py; docs/planar_certified.md)",
+        choices=STRUCTURES,
+    )
 
     def check(self) -> None:
         small = [n for n in ("hidden", "teacher_steps", "window", "windows", "eval_every")

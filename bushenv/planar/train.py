@@ -17,7 +17,9 @@ units, 6000 steps at a lower rate for the large deflections, where the hardening
 fit`` then trains the hybrid the old way, ``fitting.CERTIFIED_HYBRID_TRAINING``), and the weights
 kept are the best admitted ones (``PlanarCertifiedHolds.admits`` on its fixed grid,
 checked at every validation), or the best of all when none was admitted; the returned model's
-``training`` attribute says which, with the check of the weights kept.
+``training`` attribute says which, with the check of the weights kept. ``structure`` other than
+"free" trains a network whose weights are tied by construction (``structure.py``: mirror-
+symmetric, displacement increments, or both).
 """
 
 from __future__ import annotations
@@ -38,6 +40,13 @@ from bushenv.planar.narx import (
     PlanarNarx,
     PlanarNarxPerAxis,
     axis_masks,
+)
+from bushenv.planar.structure import (
+    StructuredNet,
+    fit_diagonal_linear,
+    increment_gain,
+    is_mirror,
+    symmetric_scale,
 )
 from bushenv.progress import Progress
 
@@ -68,6 +77,7 @@ class TrainOptions:
     certified_holds: int = 24
     certified_stroke_m: float = 12.5e-3
     certified_rotation_rad: float = 0.15
+    structure: str = "free"  # weights tied by construction (structure.py), "free": none
 
     def certified_term(self):
         """The certified-hold term the options ask for, or None."""
@@ -179,6 +189,11 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
     if kind not in KINDS:
         raise PlanarModelError(f"unknown planar network kind {kind!r}; known: {list(KINDS)}")
     opt = options or default_options(kind)
+    if opt.structure != "free" and kind == "nn-axis":
+        raise PlanarModelError(
+            f"structure {opt.structure!r} ties the MIMO network's weights; nn-axis takes "
+            "structure 'free' only (use nn or hybrid)"
+        )
     q = np.asarray(q, dtype=np.float64)
     f = np.asarray(f, dtype=np.float64)
     if q.shape != f.shape or q.ndim != 2 or q.shape[1] != 3 or q.shape[0] < 20 * opt.window:
@@ -187,12 +202,13 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
             f"got {q.shape} and {f.shape}"
         )
     extra, f_total = {}, f
+    mirror = is_mirror(opt.structure)  # mirror-symmetric: diagonal backbone, scaled about 0
     if kind == "hybrid":
-        lin = fit_linear(q, velocity_of(q, dt), f, dt)
+        lin = fit_diagonal_linear(q, f, dt) if mirror else fit_linear(q, velocity_of(q, dt), f, dt)
         extra = {"k_matrix": lin.k_matrix, "c_matrix": lin.c_matrix}
         f = f - lin.simulate(q)
-    q_off, q_sc = _scale(q)
-    f_off, f_sc = _scale(f)
+    q_off, q_sc = symmetric_scale(q) if mirror else _scale(q)
+    f_off, f_sc = symmetric_scale(f) if mirror else _scale(f)
     qs, ys = (q - q_off) / q_sc, (f - f_off) / f_sc
     n_val = int(opt.val_fraction * q.shape[0])
     t0 = max(N_PAST_Q, N_PAST_F)
@@ -201,7 +217,10 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
     tgt_all = ys[t0:]
     n_tr = qz_all.shape[0] - n_val
     gen = torch.Generator().manual_seed(seed)
-    net = _Net(opt.hidden, kind == "nn-axis", gen)
+    if opt.structure == "free":
+        net = _Net(opt.hidden, kind == "nn-axis", gen)
+    else:
+        net = StructuredNet(opt.structure, opt.hidden, gen, increment_gain(qs))
     term = opt.certified_term()
     if term is not None:
         from bushenv.planar.certified import PlanarProblem

@@ -44,7 +44,8 @@ PLANAR_RECIPES = {"teacher-forcing": {"free_run_steps": 0}, "free-run": {}}
 
 
 def planar_cell_name(cell: dict[str, Any]) -> str:
-    extra = "".join(f"-{k}" for k, v in sorted(cell.get("train_options", {}).items()) if v == "on")
+    opts = sorted(cell.get("train_options", {}).items())
+    extra = "".join(f"-{k if v == 'on' else v}" for k, v in opts if v == "on" or k == "structure")
     return f"planar-{cell['recipe']}{extra}-{cell['model']}-s{cell['seed']}"
 
 

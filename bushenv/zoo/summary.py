@@ -37,7 +37,8 @@ def rate(k: int, n: int) -> dict[str, Any]:
 
 def recipe_label(row: dict) -> str:
     """The recipe with the training switches that are on (``free-run +certified``)."""
-    extra = [k for k, v in sorted(row.get("train_options", {}).items()) if v == "on"]
+    opts = sorted(row.get("train_options", {}).items())
+    extra = [k if v == "on" else v for k, v in opts if v == "on" or k == "structure"]
     return " +".join([row["recipe"], *extra])
 
 

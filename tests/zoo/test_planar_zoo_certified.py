@@ -31,6 +31,23 @@ def test_certified_on_trains_the_planar_networks_with_the_term():
     assert len(names) == 2
 
 
+def test_structure_trains_the_planar_networks_tied_and_names_them_apart():
+    import pytest
+
+    from bushenv.zoo.study import ZooError
+    from bushenv.zoo.summary import recipe_label
+
+    args = ("--env", "rig3", "--seeds", "0", "--certified", "on", "--structure", "mirror")
+    mirror = config_from(_parse(*args)).cells()[0]
+    assert mirror["train_options"] == {"certified": "on", "structure": "mirror"}
+    free = config_from(_parse(*args[:-2])).cells()[0]
+    assert planar_cell_name(mirror) != planar_cell_name(free)
+    assert recipe_label(mirror) == "free-run +certified +mirror"
+    assert recipe_label(free) == "free-run +certified"
+    with pytest.raises(ZooError, match="--structure.*--env rig3"):
+        config_from(_parse("--seeds", "0", "--structure", "mirror"))
+
+
 def _row(certified, diverged, admitted=True, passed=True):
     attack = {
         "diverged": diverged,
