@@ -208,8 +208,16 @@ def _certified_lines(c: dict | str) -> list[str]:
         f"{_pct(c['bounded_of_passed'])}**, broken {_pct(c['broken_of_passed'])} (by searcher: "
         f"{per or '-'}), broken in a moving coordinate {_pct(c['broken_moving_of_passed'])}. "
         f"Their networks' part of the force (median RMS ratio a / r / rot, unseen correlated): "
-        f"{_share(c['median_network_share_correlated'])} (near 0: the backbone alone)."
+        f"{_share(c['median_network_share_correlated'])}{_silent(c)}."
     ]
+
+
+SILENT_SHARE = 0.03  # a network below this part of the force is its backbone in practice
+
+
+def _silent(c: dict) -> str:
+    vals = [v for v in c["median_network_share_correlated"].values() if v is not None]
+    return " (near 0: the backbone alone)" if vals and max(vals) < SILENT_SHARE else ""
 
 
 def _share(share: dict) -> str:

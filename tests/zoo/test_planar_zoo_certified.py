@@ -137,3 +137,11 @@ def test_the_network_share_of_a_silent_hybrid_is_zero_and_of_a_live_one_is_not()
     assert min(_network_share(live, unseen).values()) > 0.01
     assert _network_share(object(), unseen) is None
     assert np.isfinite(list(_network_share(live, unseen).values())).all()
+
+
+def test_certified_hybrids_whose_network_carries_force_are_not_called_silent():
+    row = _row(True, False)
+    row["network_share"] = dict.fromkeys(("axial", "radial", "rotation"), 0.07)
+    text = markdown(summarise([row] * 3))
+    assert "7.0 / 7.0 / 7.0 %." in text
+    assert "near 0" not in text
