@@ -70,6 +70,20 @@ def test_top_level_help_lists_every_command_without_importing_them():
     assert "LOADED []" in done.stdout
 
 
+@pytest.mark.parametrize("command", ["fit", "diagnose", "attack"])
+def test_a_command_that_trains_networks_shows_its_help_without_importing_torch(command):
+    """Torch costs over a second to import: the options' lists are kept out of its modules."""
+    code = (
+        "import sys; from bushenv.cli import main\n"
+        f"try:\n    main([{command!r}, '--help'])\n"
+        "except SystemExit as e:\n    assert e.code == 0\n"
+        "print('TORCH', 'torch' in sys.modules)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "TORCH False" in done.stdout
+
+
 def test_no_command_prints_help_and_exits_2(capsys):
     code, out, _ = run_cli([], capsys)
     assert code == 2

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from bushenv.execution import get_backend
-from bushenv.planar.structure import STRUCTURES
+from bushenv.planar.narx import STRUCTURES
 from bushenv.progress import Progress
 from bushenv.search.matrix import parse_seeds
 from bushenv.zoo.planar_study import PlanarZooConfig, refuse_other_kind, run_planar_study

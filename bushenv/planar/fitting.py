@@ -31,8 +31,8 @@ from bushenv.identify.narx_options import SWITCH
 from bushenv.identify.options import NoOptions, option, options_of
 from bushenv.planar.base import PlanarModel, PlanarModelError
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
+from bushenv.planar.narx import STRUCTURES
 from bushenv.planar.registry import PLANAR_MODELS
-from bushenv.planar.structure import STRUCTURES
 from bushenv.registry import Registry
 
 History = tuple[np.ndarray, np.ndarray]

@@ -32,6 +32,9 @@ N_PAST_Q = 5  # seed 000 §4.2
 N_PAST_F = 5
 N_IN = 3 * (N_PAST_Q + 1) + 3 * N_PAST_F
 HIDDEN_PER_AXIS = 9  # seed 000 §4.2
+# the ways training may tie the network's weights (``structure.py``); here, without torch, so
+# that the command line lists them without importing it
+STRUCTURES = ("free", "mirror", "rate", "mirror-rate")
 
 
 def input_axes() -> np.ndarray:

@@ -34,9 +34,8 @@ import torch
 from bushenv.models.base import velocity_of
 from bushenv.planar.base import PlanarModelError
 from bushenv.planar.linear import PlanarLinear
-from bushenv.planar.narx import N_PAST_F, N_PAST_Q, input_axes
+from bushenv.planar.narx import N_PAST_F, N_PAST_Q, STRUCTURES, input_axes
 
-STRUCTURES = ("free", "mirror", "rate", "mirror-rate")
 SIGNS = np.array([[a, b, c] for a in (1, -1) for b in (1, -1) for c in (1, -1)], dtype=float)
 NQ = 3 * (N_PAST_Q + 1)
 
