@@ -6,16 +6,17 @@ measured force lags, then Adam on free-run windows (the network fed with its own
 measured start), keeping the weights with the lowest free-run error on a held-out tail. Torch
 only trains; the arrays go to ``narx.PlanarNarx`` whose numpy loop does every run in use.
 
-The hybrid trains differently one step ahead (``HYBRID_TRAINING``, docs/planar_fit_unseen.md):
-mini-batches instead of the full batch (many more, cheaper Adam steps: the full-batch budget left
-the network's one-step error at 4-11 % of the force), and Gaussian noise on the fed-back past
-outputs, so the network leans on the displacement inputs rather than on its own last output (a
-network fitted one step ahead on clean feedback ran away in free run, 200-440 % RMS); and 54
-units, 6000 steps at a lower rate for the large deflections, where the hardening is.
+The hybrid trains differently one step ahead (``train_options.HYBRID_TRAINING``,
+docs/planar_fit_unseen.md): mini-batches instead of the full batch (many more, cheaper Adam
+steps: the full-batch budget left the network's one-step error at 4-11 % of the force), and
+Gaussian noise on the fed-back past outputs, so the network leans on the displacement inputs
+rather than on its own last output (a network fitted one step ahead on clean feedback ran away
+in free run, 200-440 % RMS); and 54 units, 6000 steps at a lower rate for the large
+deflections, where the hardening is.
 
-``certified="on"`` adds the certified-hold term (``certified.py``) to both stages' loss (``bushenv
-fit`` then trains the hybrid the old way, ``fitting.CERTIFIED_HYBRID_TRAINING``), and the weights
-kept are the best admitted ones (``PlanarCertifiedHolds.admits`` on its fixed grid,
+``certified="on"`` adds the certified-hold term (``certified.py``) to both stages' loss
+(``bushenv fit`` then trains the hybrid the old way, ``train_options.CERTIFIED_HYBRID_TRAINING``),
+and the weights kept are the best admitted ones (``PlanarCertifiedHolds.admits`` on its fixed grid,
 checked at every validation), or the best of all when none was admitted; the returned model's
 ``training`` attribute says which, with the check of the weights kept. ``structure`` other than
 "free" trains a network whose weights are tied by construction (``structure.py``: mirror-
@@ -24,8 +25,6 @@ symmetric, displacement increments, or both).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import torch
 
@@ -33,7 +32,6 @@ from bushenv.models.base import velocity_of
 from bushenv.planar.base import PlanarModelError
 from bushenv.planar.linear import fit_linear
 from bushenv.planar.narx import (
-    HIDDEN_PER_AXIS,
     N_PAST_F,
     N_PAST_Q,
     PlanarHybrid,
@@ -48,67 +46,12 @@ from bushenv.planar.structure import (
     is_mirror,
     symmetric_scale,
 )
+from bushenv.planar.train_options import PlanarNetworkOptions as TrainOptions
+from bushenv.planar.train_options import default_options
 from bushenv.progress import Progress
 
 TEACHER_CHECK_EVERY = 50  # certified: teacher steps between two checks (they pick hard holds)
 KINDS = {"nn": PlanarNarx, "nn-axis": PlanarNarxPerAxis, "hybrid": PlanarHybrid}
-
-
-@dataclass(frozen=True)
-class TrainOptions:
-    """Budgets of the two stages (defaults: a few tens of seconds on one core)."""
-
-    hidden: int = 3 * HIDDEN_PER_AXIS  # the per-axis kind: 9 units per axis (seed 000 §4.2)
-    teacher_steps: int = 400
-    teacher_lr: float = 1e-2
-    free_run_steps: int = 200
-    free_run_lr: float = 2e-3
-    window: int = 64  # samples per free-run window (0.31 s at 204.8 Hz)
-    windows: int = 32  # windows per step
-    val_fraction: float = 0.2
-    eval_every: int = 25
-    teacher_batch: int = 0  # samples per teacher step, drawn at random; 0: the full batch
-    feedback_noise: float = 0.0  # std of the noise on the fed-back scaled outputs, one step ahead
-    certified: str = "off"  # "on": the certified-hold loss term (certified.py)
-    certified_weight: float = 1.0
-    certified_low: float = 0.8
-    certified_high: float = 1.9
-    certified_radius: float = 0.98
-    certified_holds: int = 24
-    certified_stroke_m: float = 12.5e-3
-    certified_rotation_rad: float = 0.15
-    structure: str = "free"  # weights tied by construction (structure.py), "free": none
-
-    def certified_term(self):
-        """The certified-hold term the options ask for, or None."""
-        if self.certified != "on":
-            return None
-        from bushenv.planar.certified import PlanarCertifiedHolds
-
-        return PlanarCertifiedHolds(
-            weight=self.certified_weight,
-            low=self.certified_low,
-            high=self.certified_high,
-            radius=self.certified_radius,
-            stroke=(self.certified_stroke_m, self.certified_stroke_m, self.certified_rotation_rad),
-            holds=self.certified_holds,
-        )
-
-
-# the hybrid's defaults (``default_options``; measured in docs/planar_fit_unseen.md): twice the
-# units, 6000 steps of 2048 samples at a lower rate, about 2x the old fit's time
-HYBRID_TRAINING = {
-    "hidden": 54,
-    "teacher_steps": 6000,
-    "teacher_lr": 3e-3,
-    "teacher_batch": 2048,
-    "feedback_noise": 0.1,
-}
-
-
-def default_options(kind: str) -> TrainOptions:
-    """The training options a network ``kind`` gets when none are given."""
-    return TrainOptions(**HYBRID_TRAINING) if kind == "hybrid" else TrainOptions()
 
 
 def _lags(a: np.ndarray, n: int, t0: int) -> np.ndarray:

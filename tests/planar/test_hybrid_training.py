@@ -7,12 +7,12 @@ from bushenv.excitation import random_rpc
 from bushenv.identify.options import options_of
 from bushenv.metrics import rms_ratio
 from bushenv.planar import PlanarModelError
-from bushenv.planar.fitting import CERTIFIED_HYBRID_TRAINING, PLANAR_FITS
-from bushenv.planar.train import (
+from bushenv.planar.fitting import PLANAR_FITS
+from bushenv.planar.train import TrainOptions, fit_planar_network
+from bushenv.planar.train_options import (
+    CERTIFIED_HYBRID_TRAINING,
     HYBRID_TRAINING,
-    TrainOptions,
     default_options,
-    fit_planar_network,
 )
 
 DT = 1 / 250
@@ -62,6 +62,11 @@ def test_noisy_feedback_halves_the_free_run_error_on_an_unseen_record():
 
 
 def test_the_hybrid_alone_gets_the_new_defaults_and_the_flags_agree():
+    assert HYBRID_TRAINING["hidden"] == 54 and HYBRID_TRAINING["feedback_noise"] == 0.1
+    assert (
+        CERTIFIED_HYBRID_TRAINING["hidden"] == 27
+        and CERTIFIED_HYBRID_TRAINING["teacher_batch"] == 0
+    )
     assert default_options("hybrid") == TrainOptions(**HYBRID_TRAINING)
     for kind in ("nn", "nn-axis"):
         assert default_options(kind) == TrainOptions()
