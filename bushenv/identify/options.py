@@ -20,6 +20,14 @@ def option(default: Any, help: str, choices: tuple[str, ...] | None = None) -> A
     return dataclasses.field(default=default, metadata={"help": help, "choices": choices})
 
 
+def option_like(cls: type, name: str, default: Any = dataclasses.MISSING) -> Any:
+    """Option ``name`` of the options class ``cls`` again, with its help and choices, at
+    ``default`` when given (another method's same option, or a subclass's own default)."""
+    f = cls.__dataclass_fields__[name]
+    value = f.default if default is dataclasses.MISSING else default
+    return option(value, f.metadata["help"], f.metadata.get("choices"))
+
+
 def option_fields(cls: type) -> list[dataclasses.Field]:
     return [f for f in dataclasses.fields(cls) if "help" in f.metadata]
 

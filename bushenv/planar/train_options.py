@@ -8,8 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from bushenv.identify.narx_options import SWITCH
-from bushenv.identify.options import option
+from bushenv.identify.narx_options import SWITCH, NarxOptions
+from bushenv.identify.options import option, option_like
 from bushenv.planar.base import PlanarModelError
 from bushenv.planar.narx import STRUCTURES
 
@@ -42,16 +42,11 @@ class PlanarNetworkOptions:
         "(planar/certified.py; docs/planar_certified.md)",
         choices=SWITCH,
     )
-    certified_weight: float = option(1.0, "weight of the certified-hold term")
-    certified_low: float = option(
-        0.8, "held force at least this fraction of the records' static estimate, same sign"
-    )
-    certified_high: float = option(
-        1.9, "held force at most this multiple of the records' static estimate"
-    )
-    certified_radius: float = option(
-        0.98, "spectral radius of a held fixed point above which the term grows"
-    )
+    # the same as the one-axis network's term (``identify.narx_options``)
+    certified_weight: float = option_like(NarxOptions, "certified_weight")
+    certified_low: float = option_like(NarxOptions, "certified_low")
+    certified_high: float = option_like(NarxOptions, "certified_high")
+    certified_radius: float = option_like(NarxOptions, "certified_radius")
     certified_holds: int = option(24, "holds per training step")
     certified_stroke_m: float = option(
         0.0125, "holds span +-this deflection, m (axial and radial; BushRig3-v0's stroke)"
@@ -124,15 +119,11 @@ class PlanarHybridOptions(PlanarNetworkOptions):
     """The matrix-backbone hybrid's network: mini-batches one step ahead, noisy feedback
     (docs/planar_fit_unseen.md, "The matrix-backbone hybrid")."""
 
-    hidden: int = option(54, "hidden tanh units (the per-axis kind: a third per axis)")
-    teacher_steps: int = option(6000, "Adam steps one step ahead")
-    teacher_lr: float = option(3e-3, "learning rate one step ahead (cosine decay to 0)")
-    teacher_batch: int = option(
-        2048, "samples per one-step-ahead step, drawn at random (0: the full batch)"
-    )
-    feedback_noise: float = option(
-        0.1, "std of the noise on the fed-back scaled past outputs one step ahead (0: none)"
-    )
+    hidden: int = option_like(PlanarNetworkOptions, "hidden", 54)
+    teacher_steps: int = option_like(PlanarNetworkOptions, "teacher_steps", 6000)
+    teacher_lr: float = option_like(PlanarNetworkOptions, "teacher_lr", 3e-3)
+    teacher_batch: int = option_like(PlanarNetworkOptions, "teacher_batch", 2048)
+    feedback_noise: float = option_like(PlanarNetworkOptions, "feedback_noise", 0.1)
 
     @staticmethod
     def implied(given: dict) -> dict:
