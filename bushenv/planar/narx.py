@@ -187,3 +187,7 @@ class PlanarHybrid(PlanarNarx):
 
     def _backbone_matrices(self) -> tuple[np.ndarray, np.ndarray]:
         return self.k_matrix, self.c_matrix
+
+
+# the network kinds ``train.fit_planar_network`` trains, by file name; here, without torch
+KINDS = {"nn": PlanarNarx, "nn-axis": PlanarNarxPerAxis, "hybrid": PlanarHybrid}

@@ -31,14 +31,7 @@ import torch
 from bushenv.models.base import velocity_of
 from bushenv.planar.base import PlanarModelError
 from bushenv.planar.linear import fit_linear
-from bushenv.planar.narx import (
-    N_PAST_F,
-    N_PAST_Q,
-    PlanarHybrid,
-    PlanarNarx,
-    PlanarNarxPerAxis,
-    axis_masks,
-)
+from bushenv.planar.narx import KINDS, N_PAST_F, N_PAST_Q, PlanarNarx, axis_masks
 from bushenv.planar.structure import (
     StructuredNet,
     fit_diagonal_linear,
@@ -51,7 +44,6 @@ from bushenv.planar.train_options import default_options
 from bushenv.progress import Progress
 
 TEACHER_CHECK_EVERY = 50  # certified: teacher steps between two checks (they pick hard holds)
-KINDS = {"nn": PlanarNarx, "nn-axis": PlanarNarxPerAxis, "hybrid": PlanarHybrid}
 
 
 def _lags(a: np.ndarray, n: int, t0: int) -> np.ndarray:

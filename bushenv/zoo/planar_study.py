@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from bushenv.planar.fitting import PlanarNetworkOptions
-from bushenv.planar.train import KINDS
+from bushenv.planar.narx import KINDS
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
 from bushenv.search.campaign_planar import HELD_TO
