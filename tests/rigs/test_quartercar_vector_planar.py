@@ -11,6 +11,7 @@ from test_quartercar_planar import diagonal_linear3
 from test_quartercar_vector import bump_then_rough_road
 
 from bushenv import excitation
+from bushenv.planar.hybrid_bw import PlanarBoucWenHybrid
 from bushenv.planar.linear import PlanarLinear
 from bushenv.rigs.quartercar_batch import QuarterCarBatch
 from bushenv.rigs.quartercar_vector import QuarterCarVectorEnv
@@ -248,19 +249,26 @@ def test_a_planar_model_giving_nan_or_raising_ends_the_column_as_in_the_pymunk_e
     assert ("not finite" in reason) if mode == "nan" else reason.startswith("model raised Zero")
 
 
-def test_autoreset_restarts_a_planar_column_from_rest():
-    venv = make_vec(2, arm_bushing="reference", max_episode_steps=4)
+@pytest.mark.parametrize("arm", ["reference", "hybrid-bw"])
+def test_autoreset_restarts_a_planar_column_from_rest(arm):
+    """The models' histories too: the hybrid's Bouc-Wen backbone keeps its own state."""
+    if arm == "hybrid-bw":
+        arm = PlanarBoucWenHybrid.untrained()
+    kw = dict(arm_bushing=arm, arm_bushing_reference=arm)
+    venv = make_vec(2, max_episode_steps=4, **kw)
     venv.reset(seed=0)
     a = np.full((2, 1), 0.5, np.float32)
     for _ in range(5):  # four steps, then the step that resets
         obs, *_ = venv.step(a)
     assert (obs == 0).all()
-    obs, *_, info = venv.step(a)
-    fresh = make_vec(2, arm_bushing="reference")
+    fresh = make_vec(2, **kw)
     fresh.reset(seed=0)
-    f_obs, *_, f_info = fresh.step(a)
-    assert np.array_equal(obs, f_obs)
-    assert np.array_equal(info["moment_reference_nm"], f_info["moment_reference_nm"])
+    for _ in range(2):
+        obs, *_, info = venv.step(a)
+        f_obs, *_, f_info = fresh.step(a)
+        assert np.array_equal(obs, f_obs)
+        for k in ("moment_model_nm", "moment_reference_nm", "force_radial_model_n"):
+            assert np.array_equal(info[k], f_info[k]), k
 
 
 def test_planar_batch_columns_equal_the_same_roads_run_one_by_one():
