@@ -795,6 +795,48 @@ def _env_steps_per_s(env, n: int) -> float:
     return n / (time.perf_counter() - t0)
 
 
+def _vector_env_steps_per_s(venv, steps: int) -> float:
+    """Env-steps per second of a vector env over ``steps`` steps of bulk-drawn actions."""
+    venv.reset(seed=0)
+    acts = np.random.default_rng(0).uniform(-0.3, 0.3, (16, venv.num_envs, 1)).astype(np.float32)
+    for i in range(5):  # warm-up: compiled kernels, caches
+        venv.step(acts[i])
+    t0 = time.perf_counter()
+    for i in range(steps):
+        venv.step(acts[i % 16])
+    return steps * venv.num_envs / (time.perf_counter() - t0)
+
+
+def _bench_planar_car(fig: Figures, quick: bool) -> None:
+    """QuarterCar-v0's vector env with a planar arm bushing beside the two axis models (same
+    law in model car and twin for both: linear/linear, and the planar reference beside the
+    one-axis rubber), N = 256, interleaved, best of three."""
+    import gymnasium as gym
+
+    import bushenv  # noqa: F401  registers the envs
+
+    n, steps = 256, (20 if quick else 200)
+    for label, axes, arm in (("linear", "linear", "linear"), ("reference", "rubber", "reference")):
+        made = [
+            gym.make_vec("QuarterCar-v0", num_envs=n, vectorization_mode="vector_entry_point",
+                         **kw)
+            for kw in ({"model": axes, "reference": axes},
+                       {"arm_bushing": arm, "arm_bushing_reference": arm})
+        ]  # fmt: skip
+        rates = [0.0, 0.0]
+        for _ in range(3):
+            for k, venv in enumerate(made):
+                rates[k] = max(rates[k], _vector_env_steps_per_s(venv, steps))
+        fig.add(f"planar.QuarterCar-v0.{label}.vector{n}", rates[1], "env-steps/s")
+        fig.add(
+            f"planar.QuarterCar-v0.{label}.vector{n}.step_time_over_axes",
+            rates[0] / rates[1],
+            "ratio",
+            note=f"arm_bushing={arm} (twin too) beside model=reference={axes}: the planar "
+            "model's batched step and the rotary term against two axis models",
+        )
+
+
 def bench_planar(fig: Figures, quick: bool) -> None:
     """Issue 25 item 8: a BushRig3-v0 step within 3x a BushRig-v0 step, and the MIMO network's
     batched free run per axis at least a third of the one-axis network's."""
@@ -827,6 +869,7 @@ def bench_planar(fig: Figures, quick: bool) -> None:
                 better="lower",
                 note="nn: a planar MIMO network file (33-27-3) beside the one-axis nn preset",
             )
+    _bench_planar_car(fig, quick)
     T, B = (512 if quick else 4096), 1024
     min_time = 0.05 if quick else 0.5
     dt = 1 / 204.8

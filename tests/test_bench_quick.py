@@ -84,6 +84,8 @@ EXPECTED = [
             "BushRig3-v0.nn.step_time_over_bushrig",
             "free_run.nn.B1024",
             "free_run.nn.B1024.per_axis_over_one_axis",
+            "QuarterCar-v0.linear.vector256.step_time_over_axes",
+            "QuarterCar-v0.reference.vector256.step_time_over_axes",
         )
     ),
 ]

@@ -66,6 +66,15 @@ def reference_range_reason(reference, theta: float) -> str:
     return ""
 
 
+def moment_reason(moment_nm: float, limit_nm: float) -> str:
+    """Why a sampled bushing moment cannot be applied ("" if it can)."""
+    if not math.isfinite(moment_nm):
+        return f"bushing moment {moment_nm!r} N m is not finite"
+    if abs(moment_nm) > limit_nm:
+        return f"|bushing moment| = {abs(moment_nm):.6g} N m exceeds {limit_nm:.6g} N m"
+    return ""
+
+
 def sample_planar(p, car, model, motion):
     """(forces, why) of a planar arm bushing at t_k: (radial N, axial N, moment N m), judged and
     held as ``CarPair.sample`` does the one-axis forces, the moment by ``arm_moment_limit_nm``."""
@@ -78,11 +87,7 @@ def sample_planar(p, car, model, motion):
         return (math.nan,) * 3, f"model raised {type(exc).__name__}: {exc}"
     except Exception as exc:
         return (math.nan,) * 3, MODEL_ERROR_PREFIX + model_error_text(exc)
-    why = force_reason(*forces[:2], p.force_limit)
-    if not why and not math.isfinite(forces[2]):
-        why = f"bushing moment {forces[2]!r} N m is not finite"
-    elif not why and abs(forces[2]) > p.moment_limit:
-        why = f"|bushing moment| = {abs(forces[2]):.6g} N m exceeds {p.moment_limit:.6g} N m"
+    why = force_reason(*forces[:2], p.force_limit) or moment_reason(forces[2], p.moment_limit)
     if not why:
         car.radial.hold(forces[0], xr, vr)
         car.axial.hold(forces[1], xa, va)

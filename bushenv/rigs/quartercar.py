@@ -173,8 +173,9 @@ class QuarterCarEnv(gym.Env):
     ``gym.make_vec("QuarterCar-v0", num_envs=N, vectorization_mode="vector_entry_point")``
     gives ``QuarterCarVectorEnv``: N car pairs as arrays through ``QuarterCarBatch`` (the same
     car as one compiled integrator, within 1 % of each signal's peak of this env; ~40x cheaper
-    per car-step). ``bushenv.rigs.sb3.make_sb3_vec_env("QuarterCar-v0", N)`` gives it to
-    stable-baselines3. ``vectorization_mode="sync"`` runs N of these pymunk envs.
+    per car-step; with ``arm_bushing`` too, within 0.1 % of the peaks, docs/planar.md).
+    ``bushenv.rigs.sb3.make_sb3_vec_env("QuarterCar-v0", N)`` gives it to stable-baselines3.
+    ``vectorization_mode="sync"`` runs N of these pymunk envs.
 
     ## Rendering
 

@@ -5,7 +5,9 @@ model car and its reference twin per column); actions, observations, rewards, ho
 reset options and the episode's end (``car.car_verdict``) are ``QuarterCarEnv``'s, on (N,)
 arrays. The integrator solves the three dampers together where pymunk solves them one by one,
 so a column follows the pymunk env within 1 % of each signal's peak over an episode
-(tests/rigs/test_quartercar_vector.py; docs/envs.md), not bit for bit.
+(tests/rigs/test_quartercar_vector.py; docs/envs.md), not bit for bit. With ``arm_bushing``
+(one planar model per car) info adds the pymunk env's planar keys as arrays (docs/planar.md
+gives that agreement).
 """
 
 from __future__ import annotations
@@ -27,9 +29,11 @@ from bushenv.rigs.car import (
     force_reason,
     out_of_bounds,
 )
+from bushenv.rigs.car_planar import moment_reason, reference_range_reason
 from bushenv.rigs.common import ForceDeviationReward, RigError, call_reset, check_hook
 from bushenv.rigs.quartercar import ENV_ID, OBS_SIZE, QuarterCarEnv, observation_values
 from bushenv.rigs.quartercar_batch import TH, X_U, Y_C, Y_U, QuarterCarBatch
+from bushenv.rigs.quartercar_batch_planar import PLANAR_KEYS
 from bushenv.rigs.vector_base import ArrayVectorEnv
 
 TEXT_KEYS = ("model_out_of_bounds", "reference_out_of_bounds", "divergence_reason", "model_error")
@@ -90,6 +94,8 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
         n = self.num_envs
         self.batch = QuarterCarBatch(n, with_reference=True, **spec_overrides)
         self.params = p = self.batch.params
+        self._batch_keys = BATCH_KEYS + (PLANAR_KEYS if p.planar else ())
+        self._text_keys = TEXT_KEYS + (("reference_outside_range",) if p.planar else ())
         self.metadata = {**self.metadata, "render_fps": 1.0 / p.dt}
         self._overrides = dict(spec_overrides)
         self.render_mode = render_mode
@@ -162,7 +168,7 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
         """The step's info arrays from the batch's outputs (verdict fields still at rest)."""
         p, n = self.params, self.num_envs
         info: dict[str, Any] = {"time_s": self._t * p.dt, "step": self._t.copy()}
-        info.update({k: out[k] for k in BATCH_KEYS})
+        info.update({k: out[k] for k in self._batch_keys})
         for prefix in ("", "reference_"):
             yc, yw = info[prefix + "chassis_y_m"], info[prefix + "wheel_y_m"]
             info[prefix + "suspension_travel_m"] = yw - yc
@@ -170,10 +176,16 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
                 p.k_t * (info["road_height_m"] - yw), -p.tyre_static_n
             )
         info["chassis_y_error_m"] = info["chassis_y_m"] - info["reference_chassis_y_m"]
-        for key in TEXT_KEYS:
+        for key in self._text_keys:
             info[key] = np.full(n, "", dtype=object)
         for key in FLAG_KEYS:
             info[key] = np.zeros(n, dtype=bool)
+        if p.planar:  # where the twin's bushing judges beyond its calibrated rotation
+            reference = self.batch.references["arm"]
+            theta = info["reference_arm_rotation_rad"]
+            limit = getattr(reference, "calibrated_rotation_rad", None)
+            for i in np.flatnonzero(np.abs(theta) > limit) if limit is not None else ():
+                info["reference_outside_range"][i] = reference_range_reason(reference, theta[i])
         return info
 
     def _verdict(self, info: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -182,11 +194,16 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
         p = self.params
         sides = {}
         for side, prefix in (("model", ""), ("reference", "reference_")):
-            forces = np.stack([info[f"force_{axis}_{side}_n"] for axis in AXES])
+            forces = np.stack(
+                [info[f"force_{axis}_{side}_n"] for axis in AXES]
+                + ([info[f"moment_{side}_nm"]] if p.planar else [])
+            )
             motion = [info[f"{prefix}{k}"] for k in ("chassis_y_m", "wheel_y_m")]
             motion += [info[f"{prefix}{axis}_deflection_m"] for axis in AXES]
             with np.errstate(invalid="ignore"):
-                own = ~(np.abs(forces) <= p.force_limit).all(axis=0)
+                own = ~(np.abs(forces[:2]) <= p.force_limit).all(axis=0)
+                if p.planar:
+                    own |= ~(np.abs(forces[2]) <= p.moment_limit)
             sides[side] = (forces, motion, beyond_bounds(p, *motion))
             for i in np.flatnonzero(own | sides[side][2]):
                 info[f"{side}_out_of_bounds"][i] = self._why(side, i, forces[:, i], motion)
@@ -201,10 +218,12 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
         """Why car ``side`` of column ``i`` is out, in ``QuarterCarEnv``'s words."""
         yc, yw, xr, xa = (float(m[i]) for m in motion)
         fr, fa = float(forces[0]), float(forces[1])
+        p = self.params
         return (
             self.batch.raised[side]
-            or force_reason(fr, fa, self.params.force_limit)
-            or out_of_bounds(self.params, yc, yw, xr, xa, fr, fa)
+            or force_reason(fr, fa, p.force_limit)
+            or (moment_reason(float(forces[2]), p.moment_limit) if p.planar else "")
+            or out_of_bounds(p, yc, yw, xr, xa, fr, fa)
         )
 
     def _reset_columns(self, mask: np.ndarray) -> None:
@@ -213,12 +232,12 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
 
     def _rest_info(self) -> dict[str, Any]:
         rest: dict[str, Any] = {"time_s": 0.0, "step": 0}
-        rest.update(dict.fromkeys(BATCH_KEYS, 0.0))
+        rest.update(dict.fromkeys(self._batch_keys, 0.0))
         for prefix in ("", "reference_"):
             rest[prefix + "suspension_travel_m"] = 0.0
             rest[prefix + "tyre_force_n"] = 0.0
         rest["chassis_y_error_m"] = 0.0
-        rest.update(dict.fromkeys(TEXT_KEYS, ""))
+        rest.update(dict.fromkeys(self._text_keys, ""))
         rest.update(dict.fromkeys(FLAG_KEYS, False))
         return rest
 
@@ -228,7 +247,7 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
             return None
         if self._render_env is None:
             models = {"radial": "linear", "axial": "linear"}  # drawing only; labels below
-            kwargs = {**self._overrides, "model": models, "reference": models}
+            kwargs = {**self._overrides, "model": models, "reference": models, "arm_bushing": ""}
             self._render_env = QuarterCarEnv(render_mode="rgb_array", **kwargs)
             self._render_env.params.model_name = self.params.model_name
             self._render_env.params.reference_name = self.params.reference_name
@@ -237,7 +256,7 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
             _place(car, s[:, col], float(self.batch.road[col]))
         env._t, env._road = int(self._t[0]), float(self._h[0])
         last = self._last_info or {}
-        env._info_last = {k: float(last[k][0]) for k in BATCH_KEYS if k in last}
+        env._info_last = {k: float(last[k][0]) for k in self._batch_keys if k in last}
         return (env.render(),)
 
     def close_extras(self, **kwargs: Any) -> None:

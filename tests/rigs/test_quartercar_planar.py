@@ -105,14 +105,6 @@ def test_a_model_moment_beyond_the_limit_terminates_while_the_twin_stays_within(
     assert "bushing moment" in info["model_out_of_bounds"]
 
 
-def test_the_array_integrator_refuses_a_planar_arm_bushing_with_a_hint():
-    with pytest.raises(RigError, match="sync"):
-        gym.make_vec(
-            "QuarterCar-v0", num_envs=2, vectorization_mode="vector_entry_point",
-            arm_bushing="linear",
-        )  # fmt: skip
-
-
 def test_an_unknown_arm_bushing_name_lists_the_planar_models():
     with pytest.raises(RigError, match="QuarterCar-v0: arm_bushing 'nope'.*reference"):
         make(arm_bushing="nope")
