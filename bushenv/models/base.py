@@ -68,7 +68,7 @@ class SavedParameters:
 
     @classmethod
     def from_params(cls, params: dict[str, np.ndarray], dt: float, extra: dict[str, Any]):
-        return cls(dt=dt, **{k: params[k] for k in cls.param_names}, **extra)
+        return cls(dt=dt, **{k: params[k] for k in cls.param_names if k in params}, **extra)
 
     def copy(self):
         """A fresh model with the same parameters (own state, at rest)."""

@@ -47,6 +47,7 @@ class PlanarModel(SavedParameters):
 
     name: ClassVar[str] = ""
     param_names: ClassVar[tuple[str, ...]] = ()
+    optional_params: ClassVar[tuple[str, ...]] = ()  # may be absent from older files
 
     def __init__(self, dt: float = PAPER_DT) -> None:
         if not (np.isfinite(dt) and dt > 0):

@@ -1,6 +1,6 @@
 """Vector Bouc-Wen bushing: one hysteretic state on the deflection vector, 3x3 K, C and G.
 
-    f = K q + C v + h (.) z + G3(q)            (N, N, N m; ``h`` one force scale per axis)
+    f = K q + C v + h (.) z + G3(q) [+ sum_m R_m p_m]   (N, N, N m; ``h`` one force scale per axis)
     G3(q)_i = sum_j G_ij q_i q_j^2             (cubic stiffness: hardening on the diagonal,
                                                 stiffening of axis i by a deflection in j off it)
     u = q / d                                  (scaled deflection, d = yield deflection m, m, rad)
@@ -28,7 +28,11 @@ substeps (shorter ones where eta (beta + |gamma|) > 5, for stability; at most
 Bouc-Wen elements, a box of yield limits, no shared surface): the per-axis kind of the same
 model, for measuring what the shared surface is worth.
 
-State (6, B): z (3) and the previous deflection (3), at rest zero.
+Optionally a relaxation (``relax_tau`` (M,) s, ``relax_gain`` (M, 3, 3)): the Prony series of
+``relaxation.py`` on the deflection vector. Files written before it existed have none.
+
+State (6 + 3 M, B): z (3), the previous deflection (3), the branches' deflections (3 M), at
+rest zero.
 """
 
 from __future__ import annotations
@@ -39,6 +43,7 @@ import numba as nb
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
+from bushenv.planar import relaxation
 from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
 
 SUBSTEP = 0.1  # path length of one RK4 substep in scaled deflection (accurate: |h lambda| < 0.5)
@@ -130,7 +135,11 @@ class PlanarBoucWen(PlanarModel):
     """Vector Bouc-Wen + 3x3 stiffness, damping and cubic stiffness; see the module docstring."""
 
     name = "boucwen"
-    param_names = ("k_matrix", "c_matrix", "h_force", "d_yield", "shape", "g_cubic")
+    param_names = (
+        "k_matrix", "c_matrix", "h_force", "d_yield", "shape", "g_cubic", "relax_tau",
+        "relax_gain",
+    )  # fmt: skip
+    optional_params = ("relax_tau", "relax_gain")  # files from before the relaxation lack them
 
     def __init__(
         self,
@@ -142,7 +151,10 @@ class PlanarBoucWen(PlanarModel):
         g_cubic: Any = None,
         yield_surface: str = "vector",
         dt: float = PAPER_DT,
+        relax_tau: Any = None,
+        relax_gain: Any = None,
     ) -> None:
+        self.relax_tau, self.relax_gain = relaxation.check(relax_tau, relax_gain)
         if yield_surface not in YIELD_SURFACES:
             raise PlanarModelError(
                 f"boucwen: yield_surface {yield_surface!r}; known: {list(YIELD_SURFACES)}"
@@ -186,7 +198,7 @@ class PlanarBoucWen(PlanarModel):
 
     @property
     def n_state(self) -> int:
-        return 6
+        return 6 + 3 * self.relax_tau.shape[0]
 
     def extra_meta(self) -> dict[str, Any]:
         return {"yield_surface": self.yield_surface}
@@ -197,11 +209,15 @@ class PlanarBoucWen(PlanarModel):
                 f"boucwen: state for {self.state.shape[1]} histories, input has {q.shape[1]}"
             )
         beta, gamma, eta = (float(x) for x in self.shape)
+        q_before = self.state[3:6].copy()
         vector_boucwen_kernel(
             q, v, self.state, self.k_matrix, self.c_matrix, self.g_cubic, self.h_force,
             self.d_yield,
             beta, gamma, eta, self.yield_surface == "vector", out,
         )  # fmt: skip
+        if self.relax_tau.shape[0]:
+            a, b = relaxation.coefficients(self.relax_tau, self.dt)
+            relaxation.relaxation_kernel(q, q_before, self.state[6:], a, b, self.relax_gain, out)
 
     def hysteretic_state(self, q: np.ndarray) -> np.ndarray:
         """z along ``q`` ((T, 3) -> (T, 3)) from rest: the run with K = C = 0 and h = 1."""

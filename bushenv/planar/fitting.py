@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.identify.options import NoOptions, option, options_of
+from bushenv.identify.options import NoOptions, option, option_like, options_of
 from bushenv.planar.base import PlanarModel, PlanarModelError
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
 from bushenv.planar.registry import PLANAR_MODELS
@@ -46,6 +46,7 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
 
     evaluations: int = option(200, "shape evaluations of the bounded Powell search (after 8)")
     time_limit_s: float = option(120.0, "wall-time limit of the backbone's search, s (0: none)")
+    relaxation_times: str = option_like(PlanarBoucWenOptions, "relaxation_times")
 
     def check(self) -> None:
         super().check()
@@ -57,7 +58,11 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
             )
 
     def backbone_options(self) -> PlanarBoucWenOptions:
-        return PlanarBoucWenOptions(self.evaluations, time_limit_s=self.time_limit_s)
+        return PlanarBoucWenOptions(
+            self.evaluations,
+            time_limit_s=self.time_limit_s,
+            relaxation_times=self.relaxation_times,
+        )
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,7 @@ class PlanarBoucWenHybrid(PlanarNarx):
 
     name = "hybrid-bw"
     param_names = (*BACKBONE_PARAMS, *PlanarNarx.param_names)
+    optional_params = PlanarBoucWen.optional_params
 
     def __init__(self, **params: Any) -> None:  # noqa: D107
         dt = params.get("dt", PAPER_DT)

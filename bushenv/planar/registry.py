@@ -50,7 +50,8 @@ def load_planar_model(path: str | os.PathLike, dt: float | None = None) -> Plana
         if not isinstance(shapes, dict) or not isinstance(extra, dict):
             raise ModelError(f"{path}: corrupt __meta__ entry ('shapes', 'extra' must be objects)")
         for key in cls.param_names:
-            _check_parameter(path, name, key, files, shapes.get(key))
+            if key in files or key not in cls.optional_params:
+                _check_parameter(path, name, key, files, shapes.get(key))
     except ModelError as exc:
         raise PlanarModelError(str(exc)) from None
     try:

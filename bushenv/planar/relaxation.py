@@ -1,0 +1,74 @@
+"""Relaxation on the deflection vector: a Prony series of Maxwell branches (generalised Maxwell).
+
+    f_relax = sum_m R_m p_m          p_m' = v - p_m / tau_m        (p_m in m, m, rad)
+
+Each branch is a spring R_m (3x3, N/m ... N m/rad) in series with a dashpot of time constant
+tau_m: p_m is the branch spring's deflection, which follows a fast motion and relaxes to zero
+under a held one. This is the linear viscoelastic solid of rubber (the Prony series of finite
+element codes), here with matrix moduli so a branch can couple the coordinates. A backbone
+needs it because a NARX network's 5 lags (10 ms at 500 Hz) cannot carry a 200 ms relaxation
+except through its own fed-back outputs (docs/planar_fit_unseen.md).
+
+Discrete law (exact when q moves on a straight line within a sample, as the Bouc-Wen kernel
+assumes): p_m,t = a_m p_m,t-1 + b_m (q_t - q_t-1), a_m = exp(-dt / tau_m),
+b_m = tau_m (1 - a_m) / dt. With R_m symmetric positive semidefinite (a fit gives diagonal,
+non-negative ones) every branch stores and dissipates energy only: its loss matrix adds
+R_m w tau / (1 + w^2 tau^2) >= 0 at every frequency, so it keeps the element passive.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+from scipy.signal import lfilter
+
+from bushenv.planar.base import PlanarModelError, as_matrix
+
+
+def coefficients(tau: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """(a, b) of the discrete branches, each (M,)."""
+    a = np.exp(-dt / tau)
+    return a, tau * (1.0 - a) / dt
+
+
+def check(tau, gain) -> tuple[np.ndarray, np.ndarray]:
+    """``tau`` (M,) s > 0 and ``gain`` (M, 3, 3) as arrays, or ``PlanarModelError``."""
+    tau = np.atleast_1d(np.asarray(tau if tau is not None else [], dtype=np.float64))
+    m = tau.shape[0]
+    tau = as_matrix("relax_tau", tau, (m,))
+    gain = as_matrix("relax_gain", np.zeros((0, 3, 3)) if gain is None else gain, (m, 3, 3))
+    if np.any(tau <= 0):
+        raise PlanarModelError(f"relax_tau: time constants must be > 0 s, got {tau.tolist()}")
+    return tau, gain
+
+
+def branch_deflections(q: np.ndarray, dt: float, tau: np.ndarray) -> np.ndarray:
+    """(T, 3 M) p_m of a record ``q`` (T, 3) run from rest, branch by branch (the fit's
+    columns; the kernel's recursion, so a fitted model reproduces them)."""
+    if tau.shape[0] == 0:
+        return np.zeros((q.shape[0], 0))
+    dq = np.diff(q, axis=0, prepend=np.zeros((1, 3)))
+    a, b = coefficients(tau, dt)
+    return np.hstack([lfilter([bm], [1.0, -am], dq, axis=0) for am, bm in zip(a, b, strict=True)])
+
+
+@nb.njit(cache=True)
+def relaxation_kernel(q, q_before, state, a, b, gain, out):  # pragma: no cover - compiled
+    """Add sum_m R_m p_m to ``out`` (T, B, 3); ``state`` (3 M, B) the branches' p_m, updated;
+    ``q_before`` (3, B) the deflection before the first sample."""
+    T, B, _ = q.shape
+    M = a.shape[0]
+    for b_ in range(B):
+        for t in range(T):
+            for i in range(3):
+                prev = q_before[i, b_] if t == 0 else q[t - 1, b_, i]
+                dq = q[t, b_, i] - prev
+                for m in range(M):
+                    r = 3 * m + i
+                    state[r, b_] = a[m] * state[r, b_] + b[m] * dq
+            for i in range(3):
+                acc = 0.0
+                for m in range(M):
+                    for j in range(3):
+                        acc += gain[m, i, j] * state[3 * m + j, b_]
+                out[t, b_, i] += acc

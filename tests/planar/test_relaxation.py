@@ -1,0 +1,100 @@
+"""The relaxation (Prony series) on the deflection vector: its law, its passivity, its files and
+its identification inside the vector Bouc-Wen."""
+
+import numpy as np
+import pytest
+
+from bushenv.models.base import PAPER_DT
+from bushenv.planar import load_planar_model
+from bushenv.planar.base import PlanarModelError
+from bushenv.planar.boucwen import PlanarBoucWen
+from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
+from bushenv.planar.programme import random_independent
+
+K = np.diag([4.0e5, 1.5e6, 3.0e3])
+C = np.diag([4.0e2, 1.0e3, 2.0])
+D = np.array([0.4e-3, 0.5e-3, 0.012])
+
+
+def relaxing(tau, gain, h=(100.0, 500.0, 40.0), dt=PAPER_DT) -> PlanarBoucWen:
+    return PlanarBoucWen(K, C, h, D, (0.5, 0.5, 2.0), dt=dt, relax_tau=tau, relax_gain=gain)
+
+
+def test_a_held_deflection_relaxes_with_each_branch_time_constant():
+    tau, dt = 0.2, 1e-3
+    gain = np.array([[[2.0e5, 0, 0], [0, 0, 0], [0, 0, 0]]])
+    model = relaxing([tau], gain, h=(0.0, 0.0, 0.0), dt=dt)
+    plain = relaxing(None, None, h=(0.0, 0.0, 0.0), dt=dt)
+    T = 2000
+    q = np.zeros((T, 3))
+    q[:10, 0] = np.linspace(0.1, 1.0, 10) * 1e-3  # 1 mm at a constant rate over 10 dt, held
+    q[10:, 0] = 1e-3
+    extra = model.simulate(q, np.zeros_like(q)) - plain.simulate(q, np.zeros_like(q))
+    t = np.arange(T) * dt
+    want = extra[9, 0] * np.exp(-(t[9:] - t[9]) / tau)
+    assert np.allclose(extra[9:, 0], want, rtol=1e-9, atol=1e-9)
+    rate = 1e-3 / (10 * dt)  # a Maxwell branch at constant rate V: R V tau (1 - e^(-t / tau))
+    assert extra[9, 0] == pytest.approx(2.0e5 * rate * tau * (1 - np.exp(-10 * dt / tau)))
+    assert np.all(extra[:, 1:] == 0)
+
+
+def test_steps_equal_a_batched_run_and_the_state_carries_the_branches():
+    gain = np.stack([np.diag([1e5, 3e5, 500.0]), np.ones((3, 3)) * 2e4])  # one couples the axes
+    model = relaxing([0.02, 0.5], gain)
+    q = random_independent(1.0, 2.0, PAPER_DT, 3)
+    v = np.gradient(q, PAPER_DT, axis=0)
+    whole = model.simulate(q, v)
+    assert model.state.shape == (12, 1)
+    model.reset()
+    stepped = np.array([model.step(q[t], v[t]) for t in range(q.shape[0])])
+    assert np.array_equal(whole, stepped)
+
+
+def test_a_file_from_before_the_relaxation_loads_without_it(tmp_path):
+    old = relaxing(None, None)
+    path = old.save(tmp_path / "bw.npz")
+    with np.load(path) as z:
+        arrays = {k: z[k] for k in z.files if not k.startswith("relax_")}
+    np.savez(path, **arrays)  # the layout files had before the relaxation
+    back = load_planar_model(path)
+    q = random_independent(1.0, 1.0, PAPER_DT, 1)
+    assert back.relax_tau.shape == (0,) and np.array_equal(back.simulate(q), old.simulate(q))
+    new = relaxing([0.05], np.diag([1e5, 2e5, 300.0])[None])
+    again = load_planar_model(new.save(tmp_path / "relaxing.npz"))
+    assert np.array_equal(again.simulate(q), new.simulate(q))
+
+
+def test_identification_recovers_a_relaxing_vector_boucwen():
+    gain = np.stack([np.diag([1.5e5, 4e5, 800.0]), np.zeros((3, 3))])
+    truth = relaxing([0.02, 0.2], gain)
+    q = random_independent(1.0, 8.0, PAPER_DT, 0)
+    f = truth.simulate(q)
+    opts = PlanarBoucWenOptions(evaluations=40, time_limit_s=0.0, relaxation_times="0.02,0.2")
+    model, _ = fit_planar_boucwen([(q, f)], PAPER_DT, opts)
+    plain, _ = fit_planar_boucwen(
+        [(q, f)], PAPER_DT, PlanarBoucWenOptions(evaluations=40, time_limit_s=0.0)
+    )
+    q_new = random_independent(1.3, 6.0, PAPER_DT, 7)
+    f_new = truth.simulate(q_new)
+
+    def err(m):
+        return np.sqrt(np.mean((m.simulate(q_new) - f_new) ** 2, axis=0) / np.mean(f_new**2, 0))
+
+    assert np.all(err(model) < 0.01), err(model)
+    assert np.max(err(plain)) > 3 * np.max(err(model))  # the relaxation is what it adds
+    assert np.all(np.linalg.eigvalsh(model.relax_gain) >= -1e-9)  # kept passive
+    assert np.all(model.relax_gain[:, ~np.eye(3, dtype=bool)] == 0)  # each axis on its own
+    assert model.relax_gain[0, 2, 2] == pytest.approx(800.0, rel=0.1)
+
+
+@pytest.mark.parametrize("text", ["0.1,abc", "0,1", "-0.1", "0.1,0.1", "nan"])
+def test_bad_relaxation_times_are_refused_by_name(text):
+    with pytest.raises(PlanarModelError, match="relaxation_times"):
+        PlanarBoucWenOptions(relaxation_times=text).check()
+
+
+def test_a_bad_relaxation_array_is_refused_by_name():
+    with pytest.raises(PlanarModelError, match="relax_gain"):
+        relaxing([0.1], np.zeros((2, 3, 3)))
+    with pytest.raises(PlanarModelError, match="relax_tau"):
+        relaxing([0.0], np.zeros((1, 3, 3)))
