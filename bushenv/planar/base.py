@@ -83,6 +83,12 @@ class PlanarModel(SavedParameters):
         self._v1 = np.zeros((1, self.batch_size, 3))
         self._f1 = np.zeros((1, self.batch_size, 3))
 
+    def reset_columns(self, mask: np.ndarray) -> None:
+        """Histories ``mask`` (B,) bool back to rest, the others kept (a vector env's autoreset)."""
+        n = int(np.sum(mask))
+        if n:
+            self.state[:, mask] = self.initial_state(n)
+
     def step(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Advance one sample: (3,) in -> (3,) out (B == 1), (B, 3) in -> (B, 3) out."""
         q = np.asarray(q, dtype=np.float64)

@@ -57,6 +57,10 @@ class PlanarBoucWenHybrid(PlanarNarx):
         if hasattr(self, "backbone"):
             self.backbone.reset(batch_size)
 
+    def reset_columns(self, mask: np.ndarray) -> None:
+        super().reset_columns(mask)
+        self.backbone.reset_columns(mask)
+
     def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         super()._advance(q, v, out)  # the network alone (no linear backbone)
         f_bw = np.empty_like(out)

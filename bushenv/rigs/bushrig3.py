@@ -97,7 +97,7 @@ class Rig3Core:
             self._q1, self._v1 = np.zeros((1, self.batch, 3)), np.zeros((1, self.batch, 3))
             self._fm1, self._fr1 = np.zeros((1, self.batch, 3)), np.zeros((1, self.batch, 3))
         for m in (self.model, self.reference):
-            m.state[:, mask] = m.initial_state(self.batch)[:, mask]
+            m.reset_columns(mask)  # a hybrid-bw's backbone too
         self.q[mask] = 0.0
         self.obs[mask] = 0.0
 

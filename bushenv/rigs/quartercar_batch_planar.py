@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv.errors import ModelRaised
-from bushenv.planar.base import PlanarModel
 from bushenv.rigs.common import MODEL_ERRORS
 from bushenv.rigs.quartercar_kernels import (
     F_AXIAL,
@@ -35,20 +34,6 @@ PLANAR_KEYS = (
 )
 
 
-def reset_planar_columns(model: PlanarModel, mask: np.ndarray) -> None:
-    """Histories ``mask`` of a batched planar model (and of a part it holds, as the hybrid's
-    backbone) back to rest; a model with its own ``reset_columns(mask)`` is asked to do it."""
-    own = getattr(model, "reset_columns", None)
-    if callable(own):
-        own(mask)
-        return
-    n = int(mask.sum())
-    if not n:
-        return
-    for m in (model, *(v for v in vars(model).values() if isinstance(v, PlanarModel))):
-        m.state[:, mask] = m.initial_state(n)
-
-
 class PlanarArm:
     """The planar models of ``cars`` groups of ``n`` columns (the model cars, then their twins),
     and each column's rotary split ``rotation`` (2, cars n): k_in N m/rad, c_in N m s/rad."""
@@ -66,7 +51,7 @@ class PlanarArm:
 
     def reset_columns(self, mask: np.ndarray) -> None:
         for _, _, model in self.groups:
-            reset_planar_columns(model, mask)
+            model.reset_columns(mask)
 
     def sample(self, state, motion, forces, held, raised) -> None:
         """Step every car's model at t_k: ``forces`` rows radial, axial N, the deflections m and

@@ -97,3 +97,26 @@ def test_bad_models_and_actions_are_refused_with_the_fix():
 def test_the_docstring_example_runs():
     result = doctest.testmod(bushrig3)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_a_column_reset_takes_a_hybrid_bw_backbone_to_rest_too():
+    """The vector env's autoreset: the Bouc-Wen backbone's hysteresis and relaxation of the
+    reset column go back to rest, the other column's stay."""
+    from bushenv.planar.hybrid_bw import PlanarBoucWenHybrid
+
+    model = PlanarBoucWenHybrid.untrained(seed=0)
+    gain = np.diag([1e5, 3e5, 500.0])[None]
+    backbone = dict(model.backbone.params, relax_tau=[0.05], relax_gain=gain)
+    model = PlanarBoucWenHybrid(**{**model.params, **backbone})
+    core = bushrig3.Rig3Core(
+        {**gym.spec("BushRig3-v0").kwargs, "model": model, "reference": "linear"}, 2
+    )
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        core.step(rng.uniform(-0.2, 0.2, (2, 3)).astype(np.float32))
+    run = core.model
+    assert run.backbone.relax_tau.shape == (1,) and np.all(run.backbone.state[:, 1] != 0)
+    core.reset(np.array([False, True]))
+    assert np.all(run.backbone.state[:, 1] == 0)
+    assert np.array_equal(run.state[:, 1], run.initial_state(1)[:, 0])
+    assert np.any(run.backbone.state[:, 0] != 0)
