@@ -289,6 +289,7 @@ def _check_time(path: Path, t: np.ndarray) -> None:
 
 START_S = 0.01  # the start a record is judged on
 OFFSET_SHARE = 0.03  # force at rest above this share of the record's largest |f|: an offset
+NOISE_SIGMAS = 5  # a column within this many noise sigmas carries sensor noise only
 REST_SHARE = 0.02  # at rest: |q| over the start below this share of its largest value
 DEFLECTED_SHARE = 0.05  # start deflection above this share of the record's largest |q|
 
@@ -304,9 +305,9 @@ def start_notes(record: PlanarRecord) -> list[str]:
     """
     n = max(2, int(round(START_S / record.dt)))
     q0, f0 = record.q[:n].mean(axis=0), record.f[:n].mean(axis=0)
-    # a floor of 5 noise sigmas (from sample-to-sample steps) keeps an axis that only
+    # a floor of NOISE_SIGMAS noise sigmas (from sample-to-sample steps) keeps an axis that only
     # carries sensor noise from counting as deflected or loaded
-    q_floor, f_floor = 5 * _noise(record.q), 5 * _noise(record.f)
+    q_floor, f_floor = NOISE_SIGMAS * noise_sigma(record.q), NOISE_SIGMAS * noise_sigma(record.f)
     q_peak = np.abs(record.q).max(axis=0)
     name = record.source or "record"
     deflected = np.abs(q0) > np.maximum(DEFLECTED_SHARE * q_peak, q_floor)
@@ -332,7 +333,7 @@ def start_notes(record: PlanarRecord) -> list[str]:
     return notes
 
 
-def _noise(a: np.ndarray) -> np.ndarray:
+def noise_sigma(a: np.ndarray) -> np.ndarray:
     """Per column, the white-noise sigma a smooth record's sample-to-sample steps show."""
     return np.std(np.diff(a, axis=0), axis=0) / np.sqrt(2.0)
 

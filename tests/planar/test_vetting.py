@@ -73,3 +73,26 @@ def test_the_attack_refuses_a_reference_that_fails_its_vetting_unless_trusted(tm
     assert report["judge"]["trusted_despite_failed_vetting"] is True
     assert report["judge"]["vetting"]["passed"] is False
     assert "FAILED ITS VETTING" in (tmp_path / "b" / "report.md").read_text()
+
+
+def test_a_coordinate_held_at_rest_whose_force_is_noise_is_not_judged_by_a_ratio(tmp_path):
+    """A preload sweep holds the axial coordinate at zero: its load cell reads only noise, and
+    a ratio to noise would refuse the very bushing that made the record."""
+    from bushenv.planar.records import save_planar_csv
+    from bushenv.planar.vetting import RECORD_LIMIT, _record_errors
+
+    ref = _linear()
+    t = np.arange(4000) * ref.dt
+    q = np.zeros((t.size, 3))
+    q[:, 1] = 2e-3 * np.sin(2 * np.pi * 1.3 * t)
+    q[:, 2] = 0.05 * np.sin(2 * np.pi * 0.7 * t)
+    rng = np.random.default_rng(0)
+    noise = rng.normal(0, 1, q.shape) * np.array([2.0, 5.0, 0.05])
+    path = save_planar_csv(tmp_path / "sweep.csv", t, q, ref.simulate(q) + noise)
+    [(_, worst)] = _record_errors(ref, [path])
+    assert worst < 0.05 < RECORD_LIMIT
+    # an axis at rest that carries a real force (coupling) is still judged
+    coupled = _linear(radial_into_axial=0.3)
+    path = save_planar_csv(tmp_path / "coupled.csv", t, q, coupled.simulate(q) + noise)
+    [(_, worst)] = _record_errors(ref, [path])
+    assert worst > RECORD_LIMIT
