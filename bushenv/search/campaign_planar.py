@@ -204,10 +204,10 @@ def vetted_judge(
     """The reference checked before it judges (``planar.vetting``): ``error`` when it fails,
     unless ``trust``; what judged (the vetting, floors, stroke) for a report."""
     from bushenv.planar.vetting import vet_planar_reference
-    from bushenv.search.target_rig3 import axis_scales
+    from bushenv.search.target_rig3 import reference_floors
 
     stroke, _ = target.profile_bounds()
-    floors = np.array([s.force_floor_n for s in axis_scales()])
+    floors, floors_source = reference_floors(reference)
     vetting = vet_planar_reference(
         reference,
         ref_spec,
@@ -229,6 +229,7 @@ def vetted_judge(
         "vetting": vetting.describe(),
         "trusted_despite_failed_vetting": bool(not vetting.passed),
         "force_floors": dict(zip(target.coords, floors.tolist(), strict=True)),
+        "force_floors_source": floors_source,
         "stroke": dict(zip(target.coords, np.asarray(stroke).tolist(), strict=True)),
     }
 
@@ -297,11 +298,12 @@ def _judge_lines(judge: dict | None) -> list[str]:
     v = judge["vetting"]
     mark = {True: "ok", False: "FAILED", None: "undecided"}
     checks = "; ".join(f"{c['check']} {mark[c['passed']]}" for c in v["checks"])
-    floors = ", ".join(f"{k} {x:g}" for k, x in judge["force_floors"].items())
+    floors = ", ".join(f"{k} {x:.4g}" for k, x in judge["force_floors"].items())
+    source = judge.get("force_floors_source")
     head = "JUDGED BY A REFERENCE THAT FAILED ITS VETTING (--trust-reference): " if (
         judge["trusted_despite_failed_vetting"]) else ""  # fmt: skip
     return [f"{head}judge: reference {v['reference']} vetted ({checks}); force floors {floors} "
-            "(N, N, N m)", ""]  # fmt: skip
+            f"(N, N, N m){': ' + source if source else ''}", ""]  # fmt: skip
 
 
 def format_planar_table(report: dict) -> str:

@@ -44,6 +44,7 @@ from bushenv.search.families import pad_batch
 from bushenv.search.targets import Responses, Target, get_target, simulate_or_nan
 
 REFERENCE_CACHE_SIZE = 4096
+KEPT = ("static curve", "rig3 floors")  # cache entries every profile uses: never evicted
 
 
 @dataclass
@@ -88,6 +89,16 @@ class ReferenceRuns:
             xs, fs = self._cache["static curve"]
         return np.interp(x, xs, fs)
 
+    def cached(self, key: str, make):
+        """``make(model)`` once per reference (kept with the static curve), e.g. the rig3
+        target's floors; None without a reference."""
+        if self.model is None:
+            return None
+        with self._lock:
+            if key not in self._cache:
+                self._cache[key] = make(self.model.copy())
+            return self._cache[key]
+
     def forces(self, x: np.ndarray, lengths: np.ndarray) -> np.ndarray | None:
         """Reference force for each column; only the first ``lengths[b]`` samples are real."""
         if self.model is None:
@@ -105,8 +116,8 @@ class ReferenceRuns:
                 while len(self._cache) > REFERENCE_CACHE_SIZE:
                     oldest = next(iter(self._cache))
                     curve = self._cache.pop(oldest)
-                    if oldest == "static curve":  # kept: it serves every profile
-                        self._cache["static curve"] = curve
+                    if oldest in KEPT:  # kept: they serve every profile
+                        self._cache[oldest] = curve
         out = np.empty_like(x)
         for b, cached in found.items():
             out[: lengths[b], b] = cached

@@ -8,26 +8,31 @@ of that coordinate from the env's spec, and a force floor per coordinate. A prof
 any coordinate fails; the verdict names the coordinate (``PlanarVerdict.first_axis``: the one
 that failed first, or, when none failed, the closest to failing).
 
-The force floor of the rotation (``ROTATION_FLOOR_NM``) is the one-axis 200 N floor scaled by
-the moment cell's range over the force cell's (2500 N m / 25 kN): the floor's reason is the
-load cell's resolution, which scales with its range. The static criterion does not run here
+The force floors are the papers' bushing's (``MACHINE_FLOORS``: the one-axis 200 N, and for the
+rotation that floor scaled by the moment cell's range over the force cell's, 2500 N m / 25 kN)
+scaled per coordinate by the judging reference's static stiffness over the built-in
+reference's (``reference_floors``): a stiffer bushing's forces are judged at a higher floor, as
+the one-axis judge sets the floor from its reference (``scales.scales_of_reference``); the
+built-in reference gets exactly the papers' floors. The static criterion does not run here
 (the planar reference has no static curve yet), nor does RL.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
 from bushenv.divergence import Verdict, judge
 from bushenv.errors import DIVERGENCE_RAISES, ModelRaised
-from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
+from bushenv.scales import FORCE_FLOOR_N, MACHINE, STATIC_HOLD_S, STATIC_PROBE_M, BushingScales
 from bushenv.search.base import SearchError
 from bushenv.search.families_planar import COORDS, ENV_ID, clip3, rig3_limits
 from bushenv.search.target_base import Responses, Target
 
 ROTATION_FLOOR_NM = FORCE_FLOOR_N * 2500.0 / 25000.0
+MACHINE_FLOORS = np.array([FORCE_FLOOR_N, FORCE_FLOOR_N, ROTATION_FLOOR_NM])
 
 
 @dataclass
@@ -58,13 +63,12 @@ def _json_float(v) -> float | None:
     return v if np.isfinite(v) else None
 
 
-def axis_scales() -> list[BushingScales]:
+def axis_scales(floors: np.ndarray = MACHINE_FLOORS) -> list[BushingScales]:
     """One ``BushingScales`` per coordinate: its force floor and BushRig3-v0's force limit
     (``judge`` reads only those two; the stroke and rate are the target's, not a scale's)."""
     from bushenv.rigs.specs import load_spec
 
     kw = load_spec(ENV_ID)["kwargs"]
-    floors = (FORCE_FLOOR_N, FORCE_FLOOR_N, ROTATION_FLOOR_NM)
     return [
         BushingScales(
             force_floor_n=floors[i],
@@ -78,6 +82,48 @@ def axis_scales() -> list[BushingScales]:
 # metres per radian when a rotation counts as motion (any positive lever arm would do: a hold
 # is a run of samples where no coordinate moves)
 ROTATION_LEVER_M = 0.04
+# holds of the static stiffness per coordinate: the one-axis probe, the rotation at the lever arm
+STIFFNESS_PROBE = np.array([STATIC_PROBE_M, STATIC_PROBE_M, STATIC_PROBE_M / ROTATION_LEVER_M])
+
+
+def static_stiffness3(model) -> np.ndarray:
+    """(3,) secant static stiffness per coordinate (N/m, N/m, N m/rad): each alone ramped in
+    0.2 s to +-``STIFFNESS_PROBE`` and held ``STATIC_HOLD_S`` (``scales.static_force``'s hold),
+    the others at rest; NaN where the model is not finite."""
+    dt = model.dt
+    n_ramp, n_hold = max(2, int(round(0.2 / dt))), int(round(STATIC_HOLD_S / dt))
+    shape = np.concatenate([np.linspace(0.0, 1.0, n_ramp), np.ones(n_hold)])
+    q = np.zeros((shape.size, 6, 3))
+    for i in range(3):
+        q[:, 2 * i, i] = shape * STIFFNESS_PROBE[i]
+        q[:, 2 * i + 1, i] = -shape * STIFFNESS_PROBE[i]
+    try:
+        f = model.copy().simulate(q)[-1]
+    except DIVERGENCE_RAISES:
+        return np.full(3, np.nan)
+    return np.array([(f[2 * i, i] - f[2 * i + 1, i]) / (2 * STIFFNESS_PROBE[i]) for i in range(3)])
+
+
+@lru_cache(maxsize=8)
+def _builtin_stiffness(dt: float) -> np.ndarray:
+    from bushenv.rigs.bushrig3 import resolve_planar
+
+    return static_stiffness3(resolve_planar("reference", dt, "reference"))
+
+
+def reference_floors(reference) -> tuple[np.ndarray, str]:
+    """(floors (3,) N, N, N m; where they come from): ``MACHINE_FLOORS`` times the reference's
+    static stiffness over the built-in reference's, per coordinate. A coordinate whose
+    stiffness is not a positive number keeps the machine's floor (the vetting's holds then
+    say why the reference cannot judge)."""
+    k, k0 = static_stiffness3(reference), _builtin_stiffness(reference.dt)
+    ratio = np.where(np.isfinite(k) & (k > 0), k / k0, 1.0)
+    floors = MACHINE_FLOORS * ratio
+    text = ", ".join(f"{c} x{r:.3g}" for c, r in zip(COORDS, ratio, strict=True))
+    return (
+        floors,
+        f"the papers' floors times the reference's static stiffness over the built-in's ({text})",
+    )
 
 
 def held_vector(x: np.ndarray) -> np.ndarray:
@@ -88,7 +134,7 @@ def held_vector(x: np.ndarray) -> np.ndarray:
     return np.cumsum(step.max(axis=-1), axis=0)
 
 
-def judge_axes(x, fm, fr, dt, lengths) -> PlanarVerdict:
+def judge_axes(x, fm, fr, dt, lengths, floors: np.ndarray = MACHINE_FLOORS) -> PlanarVerdict:
     """``judge`` on each coordinate of (T, B, 3) arrays, combined: fails if any fails.
 
     A hold is a hold of the whole deflection vector: a coordinate held while another moves is
@@ -98,7 +144,7 @@ def judge_axes(x, fm, fr, dt, lengths) -> PlanarVerdict:
     hold = held_vector(x)
     parts = [
         judge(x[..., i], fm[..., i], fr[..., i], dt, lengths=lengths, hold_input=hold, scales=s)
-        for i, s in enumerate(axis_scales())
+        for i, s in enumerate(axis_scales(floors))
     ]
     rob = np.stack([p.robustness for p in parts])  # (3, B)
     first = np.stack([p.first_time_s for p in parts])
@@ -192,7 +238,8 @@ class Rig3Target(Target):
             raise SearchError(f"the rig3 target takes (T, B, 3) profiles, got {x.shape}")
         fm = simulate_planar_or_nan(model, x)
         fr = reference.forces(x, lengths)
-        verdict = judge_axes(x, fm, fr, dt, lengths)
+        floors = reference.cached("rig3 floors", lambda m: reference_floors(m)[0])
+        verdict = judge_axes(x, fm, fr, dt, lengths, floors)
         return Responses(verdict, x, fm, fr)
 
     def check_models(self, kind: str):

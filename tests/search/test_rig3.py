@@ -205,3 +205,38 @@ def test_a_coordinate_held_while_another_moves_is_not_in_a_hold():
     v = judge_axes(q[:, None, :], model.simulate(q)[:, None, :], ref.simulate(q)[:, None, :],
                    dt, np.array([q.shape[0]]))  # fmt: skip
     assert not v.flags["self_sustained"][0] and not v.diverged[0]
+
+
+def test_the_floors_follow_the_judging_references_stiffness_and_the_builtin_keeps_the_papers():
+    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.search.target_rig3 import MACHINE_FLOORS, reference_floors
+
+    builtin, why = reference_floors(resolve_planar("reference", DT, "reference"))
+    assert np.array_equal(builtin, MACHINE_FLOORS) and "x1," in why
+    lin = PlanarLinear.preset()
+    stiff = PlanarLinear(lin.k_matrix * np.array([1.0, 3.0, 1.0])[:, None], lin.c_matrix, lin.dt)
+    ratio = reference_floors(stiff)[0] / reference_floors(lin)[0]
+    assert ratio == pytest.approx([1.0, 3.0, 1.0], rel=1e-6)
+
+
+def test_a_stiffer_reference_judges_at_its_own_floor():
+    """A 300 N axial force under a radial preload (the axial coordinate at rest) fails against
+    the linear preset's floor (240 N), not against that of a reference four times as stiff
+    (960 N): the floor is the judging bushing's."""
+    lin = PlanarLinear.preset()
+
+    class Offset(PlanarLinear):
+        def _advance(self, q, v, out):
+            super()._advance(q, v, out)
+            out[..., 0] += 300.0 * (np.abs(q[..., 1]) > 1e-3)
+
+    u = np.array([0.5, 0.0, 1.0, 0.5, 0.0, 1.0])  # a radial preload step, the others at rest
+    q = FAMILIES["preload_step"].profile(u, DT)
+    rows = {}
+    for name, k_scale in (("preset", 1.0), ("stiff", 4.0)):
+        ref = PlanarLinear(lin.k_matrix * k_scale, lin.c_matrix, lin.dt)
+        model = Offset(ref.k_matrix, ref.c_matrix, ref.dt)
+        with BatchEvaluator(model, ref, "rig3") as ev:
+            rows[name] = ev.evaluate([q]).verdict.row(0)
+    assert rows["preset"]["diverged"] and rows["preset"]["axis"] == "axial"
+    assert not rows["stiff"]["diverged"]
