@@ -11,7 +11,9 @@
   ``metrics`` per axis (``axial``, ``radial``, ``rotation``) of the model's free run from rest:
   ``bushenv.metrics.all_metrics`` (RMS ratio and ESR of seed 000 eqs 8-9, MAX as max error
   over max |f| as in Table 3, max error in N or N m; fractions). An axis whose measured force
-  is zero throughout has null ratios there (its max error is the force the model invents);
+  is zero throughout, or held at rest with only its sensor's noise measured
+  (``records.only_noise``), has null ratios there (its max error is the force the model
+  invents);
 - ``notes``: what the records hold that the models cannot follow (a start away from rest, a
   force offset at rest, ``bushenv.planar.records.start_notes``).
 """
@@ -30,18 +32,24 @@ from bushenv.identify.options import as_dict
 from bushenv.metrics import all_metrics
 from bushenv.persist import plain, write_json, write_text
 from bushenv.planar.base import COORDS, FORCE_UNITS
+from bushenv.planar.records import only_noise
 
 CARD_FORMAT = "bushenv-planar-model-card"
 CARD_VERSION = 1
 RATIOS = ("rms_ratio", "esr", "max_error_ratio", "nrmse", "fit_index")  # all_metrics' ratios
 
 
-def axis_metrics(f_exp: np.ndarray, f_pre: np.ndarray) -> dict[str, dict[str, float | None]]:
-    """Per axis, every metric of ``bushenv.metrics`` ((T, 3) arrays); non-finite ratios None."""
+def axis_metrics(
+    f_exp: np.ndarray, f_pre: np.ndarray, q: np.ndarray | None = None
+) -> dict[str, dict[str, float | None]]:
+    """Per axis, every metric of ``bushenv.metrics`` ((T, 3) arrays); non-finite ratios None,
+    and none for a coordinate ``q`` holds at rest with only noise measured (``only_noise``):
+    there the largest error in N (N m) is what says how much force the model invents."""
     out = {}
+    noise = np.zeros(3, dtype=bool) if q is None else only_noise(q, f_exp)
     with np.errstate(divide="ignore", invalid="ignore"):
         for i, c in enumerate(COORDS):
-            if not np.any(f_exp[:, i]):  # nothing measured: no ratio (metrics divide by it)
+            if not np.any(f_exp[:, i]) or noise[i]:  # no ratio to nothing or to noise
                 err = float(np.max(np.abs(f_pre[:, i])))
                 out[c] = {k: None for k in RATIOS} | {"max_error": err, "peak_error": err}
                 continue
@@ -63,7 +71,7 @@ def record_entry(record: Any, role: str, model: Any, card_dir: Path) -> dict[str
         "duration_s": float(record.time[-1] - record.time[0] + record.dt),
         "max_abs": {c: float(np.abs(record.f[:, i]).max()) for i, c in enumerate(COORDS)},
     }
-    entry["metrics"] = axis_metrics(record.f, model.simulate(record.q))
+    entry["metrics"] = axis_metrics(record.f, model.simulate(record.q), record.q)
     return entry
 
 

@@ -333,6 +333,15 @@ def start_notes(record: PlanarRecord) -> list[str]:
     return notes
 
 
+def only_noise(q: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """(3,) per coordinate of a record (T, 3): held at rest (its deflection moves within
+    ``NOISE_SIGMAS`` noise sigmas) and its force within that of its sensor's noise, as a preload
+    sweep's axial axis: a ratio to noise judges nothing, so such a coordinate gets none."""
+    still = np.ptp(q, axis=0) <= NOISE_SIGMAS * noise_sigma(q)
+    quiet = np.sqrt(np.mean(f**2, axis=0)) <= NOISE_SIGMAS * noise_sigma(f)
+    return still & quiet
+
+
 def noise_sigma(a: np.ndarray) -> np.ndarray:
     """Per column, the white-noise sigma a smooth record's sample-to-sample steps show."""
     return np.std(np.diff(a, axis=0), axis=0) / np.sqrt(2.0)

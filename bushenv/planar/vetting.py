@@ -153,24 +153,14 @@ def _read_card(path: Any) -> tuple[dict | None, Path | None]:
         return None, None
 
 
-def _only_noise(rec, i: int) -> bool:
-    """Coordinate ``i`` of a record held at rest whose force is its sensor's noise (a preload
-    sweep's axial axis): a ratio to noise judges nothing, so it has none."""
-    from bushenv.planar.records import NOISE_SIGMAS, noise_sigma
-
-    q, f = rec.q[:, i : i + 1], rec.f[:, i : i + 1]
-    still = np.ptp(q) <= NOISE_SIGMAS * noise_sigma(q)[0]
-    return bool(still and np.sqrt(np.mean(f**2)) <= NOISE_SIGMAS * noise_sigma(f)[0])
-
-
 def _record_errors(reference: PlanarModel, paths: list[Path]) -> list[tuple[str, float]]:
-    from bushenv.planar.records import load_planar_csv
+    from bushenv.planar.records import load_planar_csv, only_noise
 
     def worst(rec) -> float:  # the worst coordinate's RMS ratio
         f = _run(reference, rec.q)
         if not np.all(np.isfinite(f)):
             return float("inf")
-        judged = [i for i in range(3) if not _only_noise(rec, i)]
+        judged = np.flatnonzero(~only_noise(rec.q, rec.f))
         return max((float(rms_ratio(rec.f[:, i], f[:, i])) for i in judged), default=0.0)
 
     return record_errors(paths, reference.dt, load_planar_csv, worst)

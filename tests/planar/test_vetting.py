@@ -96,3 +96,20 @@ def test_a_coordinate_held_at_rest_whose_force_is_noise_is_not_judged_by_a_ratio
     path = save_planar_csv(tmp_path / "coupled.csv", t, q, coupled.simulate(q) + noise)
     [(_, worst)] = _record_errors(ref, [path])
     assert worst > RECORD_LIMIT
+
+
+def test_a_card_gives_no_ratio_on_an_axis_at_rest_reading_noise(tmp_path):
+    """The card says how much force the model invents there (N), not a ratio to noise."""
+    from bushenv.planar.card import axis_metrics
+
+    ref = _linear()
+    t = np.arange(3000) * ref.dt
+    q = np.zeros((t.size, 3))
+    q[:, 1] = 2e-3 * np.sin(2 * np.pi * 1.3 * t)
+    noise = np.random.default_rng(1).normal(0, 1, q.shape) * np.array([2.0, 5.0, 0.05])
+    f = ref.simulate(q) + noise
+    pred = ref.simulate(q) + np.array([30.0, 0.0, 0.0])
+    m = axis_metrics(f, pred, q)
+    assert m["axial"]["rms_ratio"] is None and m["axial"]["max_error"] > 25.0
+    assert m["rotation"]["rms_ratio"] is None and m["radial"]["rms_ratio"] < 0.01
+    assert axis_metrics(f, pred)["axial"]["rms_ratio"] > 1.0  # without q: a ratio to noise
