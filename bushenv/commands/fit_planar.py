@@ -104,7 +104,7 @@ def run_planar(args: argparse.Namespace, out: Path, given: dict[str, Any]) -> in
         say(f"fit {args.model} (3-axis) on {len(train)} record(s), {seconds:.1f} s at "
             f"{1 / dt:.6g} Hz")  # fmt: skip
     result = fit_planar([(r.q, r.f) for r in train], args.model, given, dt, args.seed, say)
-    card = save_planar_fit(result, out, train, held, notes)
+    card = save_planar_fit(result, out, train, held, notes, plots=not args.no_plots)
     print(summary(card, out))
     return 0
 
@@ -120,6 +120,8 @@ def summary(card: dict[str, Any], out: Path) -> str:
         f"model {card['model']} (3-axis) -> {out} (card {json_path.name}, {md_path.name})",
         f"identified in {src['wall_time_s']:.1f} s, seed {src['seed']}",
     ]
+    if card.get("plots"):
+        lines.append(f"figures: {', '.join(card['plots'])}")
     lines += [f"{k}: {v}" for k, v in src["info"].items()]
     if card.get("notes"):
         lines.append(f"{len(card['notes'])} note(s) on the records, in the card (shown above)")

@@ -15,7 +15,9 @@
   (``records.only_noise``), has null ratios there (its max error is the force the model
   invents);
 - ``notes``: what the records hold that the models cannot follow (a start away from rest, a
-  force offset at rest, ``bushenv.planar.records.start_notes``).
+  force offset at rest, ``bushenv.planar.records.start_notes``);
+- ``plots``: the figures beside the model file (``plots.fit_figures3``; none with
+  ``--no-plots``).
 """
 
 from __future__ import annotations
@@ -76,10 +78,16 @@ def record_entry(record: Any, role: str, model: Any, card_dir: Path) -> dict[str
 
 
 def save_planar_fit(
-    result: Any, model_path: Path, train: list, held_out: list, notes: list[str] | None = None
+    result: Any,
+    model_path: Path,
+    train: list,
+    held_out: list,
+    notes: list[str] | None = None,
+    plots: bool = True,
 ) -> dict[str, Any]:
-    """Write the model file, then its card (JSON + markdown); returns the card. ``notes``:
-    what the user should know about the records (``records.start_notes``)."""
+    """Write the model file, its figures (``plots.fit_figures3``) and its card (JSON +
+    markdown); returns the card. ``notes``: what the user should know about the records
+    (``records.start_notes``)."""
     from bushenv import __version__
 
     model = result.model
@@ -106,6 +114,10 @@ def save_planar_fit(
         + [record_entry(r, "held-out", model, here) for r in held_out],
         "notes": list(notes or []),
     }
+    if plots:
+        from bushenv.planar.plots import fit_figures3
+
+        card["plots"] = fit_figures3(model, model_path, train, held_out)
     card = plain(card)
     json_path, md_path = card_paths(model_path)
     write_json(json_path, card, indent=1)
@@ -144,6 +156,8 @@ def card_markdown(card: dict[str, Any]) -> str:
                 f"| {r['file'] or r['name']} | {r['role']} | {c} | {_pct(m['rms_ratio'])} | "
                 f"{_pct(m['esr'])} | {_pct(m['max_error_ratio'])} | {m['max_error']:.4g} {unit} |"
             )
+    if card.get("plots"):
+        lines += ["", "## Figures", ""] + [f"![{p}]({p})" for p in card["plots"]]
     lines += ["", "## Options", "", "| option | value |", "|---|---|"]
     lines += [f"| {k} | {v} |" for k, v in src["options"].items()]
     return "\n".join(lines) + "\n"

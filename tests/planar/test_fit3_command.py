@@ -163,3 +163,18 @@ def test_bushrig3_with_a_fit_at_another_rate_names_the_dt_s_to_pass(tmp_path):
     env = gym.make("BushRig3-v0", model=str(tmp_path / "m.npz"), dt_s=0.002, reference="linear")
     env.reset(seed=0)
     env.close()
+
+
+def test_a_fit_draws_forces_and_loops_per_coordinate_of_each_held_out_record(tmp_path):
+    t, q, f = bushing()
+    train = save_planar_csv(tmp_path / "train.csv", t, q, f)
+    held = save_planar_csv(tmp_path / "held.csv", t, q * 0.8, f * 0.8)
+    assert fit([train], tmp_path / "m.npz", "--model", "linear", "--validate", str(held)) == 0
+    card = json.loads((tmp_path / "m.card.json").read_text())
+    assert card["plots"] == ["m.1-held.time.png", "m.1-held.loops.png"]
+    for name in card["plots"]:
+        assert (tmp_path / name).read_bytes()[:4] == b"\x89PNG"
+        assert f"![{name}]({name})" in (tmp_path / "m.card.md").read_text()
+    assert fit([train], tmp_path / "n.npz", "--model", "linear", "--no-plots") == 0
+    assert "plots" not in json.loads((tmp_path / "n.card.json").read_text())
+    assert not list(tmp_path.glob("n.*.png"))
