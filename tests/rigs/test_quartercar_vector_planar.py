@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from stable_baselines3.common.vec_env import VecCheckNan
 from test_quartercar_planar import diagonal_linear3
-from test_quartercar_vector import bump_then_rough_road
+from test_quartercar_vector import bump_then_rough_road, make_vec
 
 from bushenv import excitation
 from bushenv.planar.hybrid_bw import PlanarBoucWenHybrid
@@ -47,10 +47,6 @@ PLANAR_KEYS = (
     "moment_model_nm",
     "moment_reference_nm",
 )
-
-
-def make_vec(n, **kw):
-    return gym.make_vec("QuarterCar-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
 
 
 def pothole():
