@@ -120,6 +120,10 @@ def summary(card: dict[str, Any], out: Path) -> str:
         f"model {card['model']} (3-axis) -> {out} (card {json_path.name}, {md_path.name})",
         f"identified in {src['wall_time_s']:.1f} s, seed {src['seed']}",
     ]
+    if card.get("holds"):
+        from bushenv.planar.range_holds import describe
+
+        lines += describe(card["holds"])
     if card.get("plots"):
         lines.append(f"figures: {', '.join(card['plots'])}")
     lines += [f"{k}: {v}" for k, v in src["info"].items()]

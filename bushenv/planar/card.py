@@ -16,6 +16,7 @@
   invents);
 - ``notes``: what the records hold that the models cannot follow (a start away from rest, a
   force offset at rest, ``bushenv.planar.records.start_notes``);
+- ``holds`` (networks): their fixed points over the training range (``range_holds``);
 - ``plots``: the figures beside the model file (``plots.fit_figures3``; none with
   ``--no-plots``).
 """
@@ -114,6 +115,11 @@ def save_planar_fit(
         + [record_entry(r, "held-out", model, here) for r in held_out],
         "notes": list(notes or []),
     }
+    from bushenv.planar.range_holds import range_holds
+
+    holds = range_holds(model, np.max([np.abs(r.q).max(axis=0) for r in train], axis=0))
+    if holds is not None:
+        card["holds"] = holds
     if plots:
         from bushenv.planar.plots import fit_figures3
 
@@ -156,6 +162,10 @@ def card_markdown(card: dict[str, Any]) -> str:
                 f"| {r['file'] or r['name']} | {r['role']} | {c} | {_pct(m['rms_ratio'])} | "
                 f"{_pct(m['esr'])} | {_pct(m['max_error_ratio'])} | {m['max_error']:.4g} {unit} |"
             )
+    if card.get("holds"):
+        from bushenv.planar.range_holds import describe
+
+        lines += ["", "## Holds over the training range", ""] + describe(card["holds"])
     if card.get("plots"):
         lines += ["", "## Figures", ""] + [f"![{p}]({p})" for p in card["plots"]]
     lines += ["", "## Options", "", "| option | value |", "|---|---|"]
