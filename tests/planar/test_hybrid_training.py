@@ -9,11 +9,7 @@ from bushenv.metrics import rms_ratio
 from bushenv.planar import PlanarModelError
 from bushenv.planar.fitting import PLANAR_FITS
 from bushenv.planar.train import TrainOptions, fit_planar_network
-from bushenv.planar.train_options import (
-    CERTIFIED_HYBRID_TRAINING,
-    HYBRID_TRAINING,
-    default_options,
-)
+from bushenv.planar.train_options import NOISY_FEEDBACK_TRAINING, default_options
 
 DT = 1 / 250
 PEAKS = np.array([3e-3, 3e-3, 0.1])
@@ -61,26 +57,22 @@ def test_noisy_feedback_halves_the_free_run_error_on_an_unseen_record():
     assert _unseen_error(0.1) < 0.06
 
 
-def test_the_hybrid_alone_gets_the_new_defaults_and_the_flags_agree():
-    assert HYBRID_TRAINING["hidden"] == 54 and HYBRID_TRAINING["feedback_noise"] == 0.1
-    assert (
-        CERTIFIED_HYBRID_TRAINING["hidden"] == 27
-        and CERTIFIED_HYBRID_TRAINING["teacher_batch"] == 0
-    )
-    assert default_options("hybrid") == TrainOptions(**HYBRID_TRAINING)
-    for kind in ("nn", "nn-axis"):
+def test_every_network_gets_the_plain_recipe_unless_the_hybrid_asks_for_noisy_feedback():
+    for kind in ("nn", "nn-axis", "hybrid"):
         assert default_options(kind) == TrainOptions()
         assert PLANAR_FITS[kind].options().train_options() == TrainOptions()
-    assert PLANAR_FITS["hybrid"].options().train_options() == default_options("hybrid")
     assert PLANAR_FITS["hybrid-bw"].options().train_options() == TrainOptions()
+    noisy = options_of(PLANAR_FITS["hybrid"].options, {"recipe": "noisy-feedback"}, "hybrid")
+    assert noisy.train_options() == TrainOptions(**NOISY_FEEDBACK_TRAINING)
+    assert NOISY_FEEDBACK_TRAINING["hidden"] == 54 and NOISY_FEEDBACK_TRAINING["feedback_noise"]
 
 
-def test_a_certified_hybrid_keeps_the_old_recipe_unless_told_otherwise():
-    opts = options_of(PLANAR_FITS["hybrid"].options, {"certified": "on"}, "hybrid")
-    assert opts.train_options() == TrainOptions(certified="on")  # the recipe it was measured with
-    assert {k: getattr(opts, k) for k in CERTIFIED_HYBRID_TRAINING} == CERTIFIED_HYBRID_TRAINING
-    given = options_of(PLANAR_FITS["hybrid"].options, {"certified": "on", "hidden": 54}, "hybrid")
-    assert given.hidden == 54 and given.teacher_batch == 0
+def test_a_flag_given_beside_the_recipe_wins():
+    given = {"recipe": "noisy-feedback", "hidden": 81, "certified": "on"}
+    opts = options_of(PLANAR_FITS["hybrid"].options, given, "hybrid")
+    assert opts.hidden == 81 and opts.teacher_batch == 2048 and opts.certified == "on"
+    with pytest.raises(Exception, match="recipe"):
+        options_of(PLANAR_FITS["hybrid"].options, {"recipe": "fast"}, "hybrid")
 
 
 def test_mini_batch_training_is_deterministic_given_the_seed():
