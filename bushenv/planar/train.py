@@ -6,7 +6,7 @@ measured force lags, then Adam on free-run windows (the network fed with its own
 measured start), keeping the weights with the lowest free-run error on a held-out tail. Torch
 only trains; the arrays go to ``narx.PlanarNarx`` whose numpy loop does every run in use.
 
-The hybrid's accurate recipe (``train_options.NOISY_FEEDBACK_TRAINING``, ``--recipe
+The hybrid's accurate recipe (``train_options.NOISY_FEEDBACK_TRAINING``, ``--training
 noisy-feedback``, docs/planar_fit_unseen.md) trains differently one step ahead: mini-batches
 instead of the full batch (many more, cheaper Adam steps), Gaussian noise on the fed-back past
 outputs, so the network leans on the displacement inputs rather than on its own last output,

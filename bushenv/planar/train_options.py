@@ -124,26 +124,26 @@ NOISY_FEEDBACK_TRAINING = {
     "teacher_batch": 2048,
     "feedback_noise": 0.1,
 }
-HYBRID_RECIPES = ("plain", "noisy-feedback")
+HYBRID_TRAININGS = ("plain", "noisy-feedback")
 
 
 @dataclass(frozen=True)
 class PlanarHybridOptions(PlanarNetworkOptions):
     """The matrix-backbone hybrid's network: the plain recipe, or the accurate one."""
 
-    recipe: str = option(
+    training: str = option(
         "plain",
         "plain: the networks' own training (one stable fixed point at every hold of the "
         "training range where measured); noisy-feedback: 54 units, 6000 mini-batch steps one "
         "step ahead with noise 0.1 on the fed-back outputs, 3x as accurate on unseen records "
         "but with more than one fixed point at some holds (the card warns); flags given win",
-        choices=HYBRID_RECIPES,
+        choices=HYBRID_TRAININGS,
     )
 
     @staticmethod
     def implied(given: dict) -> dict:
-        """``recipe="noisy-feedback"``: its settings, where not given."""
-        if given.get("recipe") == "noisy-feedback":
+        """``training="noisy-feedback"``: its settings, where not given."""
+        if given.get("training") == "noisy-feedback":
             return {**NOISY_FEEDBACK_TRAINING, **given}
         return given
 

@@ -57,22 +57,22 @@ def test_noisy_feedback_halves_the_free_run_error_on_an_unseen_record():
     assert _unseen_error(0.1) < 0.06
 
 
-def test_every_network_gets_the_plain_recipe_unless_the_hybrid_asks_for_noisy_feedback():
+def test_every_network_gets_the_plain_training_unless_the_hybrid_asks_for_noisy_feedback():
     for kind in ("nn", "nn-axis", "hybrid"):
         assert default_options(kind) == TrainOptions()
         assert PLANAR_FITS[kind].options().train_options() == TrainOptions()
     assert PLANAR_FITS["hybrid-bw"].options().train_options() == TrainOptions()
-    noisy = options_of(PLANAR_FITS["hybrid"].options, {"recipe": "noisy-feedback"}, "hybrid")
+    noisy = options_of(PLANAR_FITS["hybrid"].options, {"training": "noisy-feedback"}, "hybrid")
     assert noisy.train_options() == TrainOptions(**NOISY_FEEDBACK_TRAINING)
     assert NOISY_FEEDBACK_TRAINING["hidden"] == 54 and NOISY_FEEDBACK_TRAINING["feedback_noise"]
 
 
-def test_a_flag_given_beside_the_recipe_wins():
-    given = {"recipe": "noisy-feedback", "hidden": 81, "certified": "on"}
+def test_a_flag_given_beside_the_training_wins():
+    given = {"training": "noisy-feedback", "hidden": 81, "certified": "on"}
     opts = options_of(PLANAR_FITS["hybrid"].options, given, "hybrid")
     assert opts.hidden == 81 and opts.teacher_batch == 2048 and opts.certified == "on"
-    with pytest.raises(Exception, match="recipe"):
-        options_of(PLANAR_FITS["hybrid"].options, {"recipe": "fast"}, "hybrid")
+    with pytest.raises(Exception, match="training"):
+        options_of(PLANAR_FITS["hybrid"].options, {"training": "fast"}, "hybrid")
 
 
 def test_mini_batch_training_is_deterministic_given_the_seed():
