@@ -8,6 +8,7 @@ from pathlib import Path
 
 from bushenv.execution import get_backend
 from bushenv.planar.narx import STRUCTURES
+from bushenv.planar.train_options import HYBRID_TRAININGS
 from bushenv.progress import Progress
 from bushenv.search.matrix import parse_seeds
 from bushenv.zoo.planar_study import PlanarZooConfig, refuse_other_kind, run_planar_study
@@ -56,6 +57,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="rig3: the planar network's weights tied by construction (bushenv fit --structure; "
         "mirror: odd in each coordinate, planar/structure.py)",
     )
+    p.add_argument(
+        "--training",
+        choices=HYBRID_TRAININGS,
+        default="plain",
+        help="rig3, --models hybrid: the hybrid's training (bushenv fit --training; "
+        "noisy-feedback: 3x as accurate, more than one fixed point at some holds)",
+    )
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--resume", action="store_true", help="continue an interrupted study")
     p.add_argument("--workers", type=int, default=None, help="local worker processes")
@@ -73,6 +81,8 @@ def config_from(args: argparse.Namespace) -> ZooConfig | PlanarZooConfig:
     if getattr(args, "env", "rig") == "rig3":
         return planar_config_from(args)
     d = ZooConfig()
+    if getattr(args, "training", "plain") != "plain":
+        raise ZooError("--training: the planar hybrid's option; use it with --env rig3")
     if _structure(args):
         raise ZooError("--structure: the planar networks' option; use it with --env rig3")
     axes = _names(args.axes) if args.axes is not None else d.axes
@@ -94,9 +104,13 @@ def _shared(args: argparse.Namespace, default_searchers: tuple[str, ...]) -> dic
 
 
 def _structure(args: argparse.Namespace) -> dict:
-    """``--structure`` as a planar training option (none for the default)."""
+    """``--structure`` and ``--training`` as planar training options (none for the defaults)."""
     structure = getattr(args, "structure", "free")
-    return {} if structure == "free" else {"structure": structure}
+    training = getattr(args, "training", "plain")
+    return {
+        **({} if structure == "free" else {"structure": structure}),
+        **({} if training == "plain" else {"training": training}),
+    }
 
 
 def planar_config_from(args: argparse.Namespace) -> PlanarZooConfig:

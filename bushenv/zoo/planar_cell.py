@@ -36,6 +36,7 @@ from bushenv.planar.reference import PlanarRubber
 from bushenv.search.campaign_planar import DEFAULT_REFERENCE, planar_search, tally
 from bushenv.search.families_planar import COORDS
 from bushenv.search.planar_models import resolve_planar_spec
+from bushenv.zoo.summary import shown_options
 
 TRAIN_S, UNSEEN_S = 60.0, 20.0
 # The planar training's two stages (``planar.train``): one step ahead only, or then free-run
@@ -44,8 +45,7 @@ PLANAR_RECIPES = {"teacher-forcing": {"free_run_steps": 0}, "free-run": {}}
 
 
 def planar_cell_name(cell: dict[str, Any]) -> str:
-    opts = sorted(cell.get("train_options", {}).items())
-    extra = "".join(f"-{k if v == 'on' else v}" for k, v in opts if v == "on" or k == "structure")
+    extra = "".join(f"-{x}" for x in shown_options(cell.get("train_options", {})))
     return f"planar-{cell['recipe']}{extra}-{cell['model']}-s{cell['seed']}"
 
 

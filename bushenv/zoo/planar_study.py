@@ -16,8 +16,8 @@ from itertools import product
 from pathlib import Path
 from typing import Any
 
-from bushenv.planar.fitting import PlanarNetworkOptions
 from bushenv.planar.narx import KINDS
+from bushenv.planar.train_options import PlanarHybridOptions
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
 from bushenv.search.campaign_planar import HELD_TO
@@ -59,9 +59,11 @@ class PlanarZooConfig:
                 )
         if self.budget < 1:
             raise ZooError(f"--budget must be >= 1 evaluation, got {self.budget}")
-        unknown = sorted(set(self.train_options) - set(PlanarNetworkOptions.__dataclass_fields__))
+        unknown = sorted(set(self.train_options) - set(PlanarHybridOptions.__dataclass_fields__))
         if unknown:
             raise ZooError(f"planar training options: unknown {unknown}")
+        if "training" in self.train_options and set(self.models) != {"hybrid"}:
+            raise ZooError("--training is the hybrid's option: give it with --models hybrid")
         return replace(self, out=Path(self.out))
 
     def cells(self) -> list[dict[str, Any]]:

@@ -35,11 +35,17 @@ def rate(k: int, n: int) -> dict[str, Any]:
     return {"failed": k, "of": n, "rate": k / n if n else None, "ci95": [lo, hi]}
 
 
+def shown_options(train_options: dict) -> list[str]:
+    """The training switches that name a member's group: those on, and the planar structure
+    and hybrid training when not the default (``certified``, ``mirror-rate``,
+    ``noisy-feedback``)."""
+    opts = sorted(train_options.items())
+    return [k if v == "on" else v for k, v in opts if v == "on" or k in ("structure", "training")]
+
+
 def recipe_label(row: dict) -> str:
     """The recipe with the training switches that are on (``free-run +certified``)."""
-    opts = sorted(row.get("train_options", {}).items())
-    extra = [k if v == "on" else v for k, v in opts if v == "on" or k == "structure"]
-    return " +".join([row["recipe"], *extra])
+    return " +".join([row["recipe"], *shown_options(row.get("train_options", {}))])
 
 
 def _groups(rows: list[dict]) -> dict[tuple[str, str], list[dict]]:

@@ -145,3 +145,20 @@ def test_certified_hybrids_whose_network_carries_force_are_not_called_silent():
     text = markdown(summarise([row] * 3))
     assert "7.0 / 7.0 / 7.0 %." in text
     assert "near 0" not in text
+
+
+def test_training_noisy_feedback_is_the_hybrids_and_names_its_members_apart():
+    import pytest
+
+    from bushenv.zoo.study import ZooError
+
+    args = ("--env", "rig3", "--seeds", "0", "--models", "hybrid")
+    noisy = config_from(_parse(*args, "--training", "noisy-feedback")).cells()[0]
+    assert noisy["train_options"] == {"training": "noisy-feedback"}
+    plain = config_from(_parse(*args)).cells()[0]
+    assert plain["train_options"] == {}
+    assert planar_cell_name(noisy) != planar_cell_name(plain)
+    with pytest.raises(ZooError, match="--training.*--models hybrid"):
+        config_from(_parse("--env", "rig3", "--seeds", "0", "--training", "noisy-feedback"))
+    with pytest.raises(ZooError, match="--training.*--env rig3"):
+        config_from(_parse("--seeds", "0", "--training", "noisy-feedback"))
