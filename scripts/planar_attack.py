@@ -21,6 +21,7 @@ from bushenv.models.base import PAPER_DT
 from bushenv.planar.programme import random_independent
 from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.train import fit_planar_network
+from bushenv.planar.train_options import NOISY_FEEDBACK_TRAINING, PlanarNetworkOptions
 from bushenv.progress import Progress
 from bushenv.search.campaign_config import CampaignConfig
 from bushenv.search.campaign_planar import run_planar_attack
@@ -28,16 +29,19 @@ from bushenv.search.campaign_planar import run_planar_attack
 KINDS = ("nn", "nn-axis", "hybrid")
 
 
-def train(out: Path, seed: int, progress: Progress) -> dict[str, Path]:
+def train(out: Path, seed: int, progress: Progress, training: str = "plain") -> dict[str, Path]:
     dt = PAPER_DT
     q = random_independent(1.0, 60.0, dt, seed)
     f = PlanarRubber.preset(seed=seed).simulate(q)
     paths = {}
     for kind in KINDS:
-        path = out / "models" / f"planar-{kind}-seed{seed}.npz"
+        noisy = kind == "hybrid" and training == "noisy-feedback"
+        tag = "-noisy-feedback" if noisy else ""
+        path = out / "models" / f"planar-{kind}{tag}-seed{seed}.npz"
         if not path.is_file():
             t0 = time.perf_counter()
-            fit_planar_network(q, f, dt, kind=kind, seed=seed).save(path)
+            opts = PlanarNetworkOptions(**NOISY_FEEDBACK_TRAINING) if noisy else None
+            fit_planar_network(q, f, dt, kind=kind, options=opts, seed=seed).save(path)
             progress.say(f"{kind} trained in {time.perf_counter() - t0:.0f} s")
         paths[kind] = path
     return paths
@@ -47,6 +51,10 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--budget", type=int, default=128)
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--training", choices=("plain", "noisy-feedback"), default="plain",
+        help="the hybrid's training (bushenv fit --training)",
+    )  # fmt: skip
     p.add_argument("--out", default="runs/planar_attack")
     p.add_argument("--quiet", action="store_true")
     args = p.parse_args()
@@ -54,7 +62,7 @@ def main() -> None:
     out = Path(args.out)
     progress = Progress(quiet=args.quiet)
     t0 = time.perf_counter()
-    paths = train(out, args.seed, progress)
+    paths = train(out, args.seed, progress, args.training)
     rows = {}
     for kind, path in paths.items():
         config = CampaignConfig(

@@ -40,7 +40,7 @@ def hold_text(q) -> str:
     return f"({q[0] * 1e3:.0f} mm, {q[1] * 1e3:.0f} mm, {q[2]:.2f} rad)"
 
 
-def build_models(names: list[str], seed: int, progress: Progress) -> dict:
+def build_models(names: list[str], seed: int, progress: Progress, training: str = "plain") -> dict:
     dt = PAPER_DT
     need_data = any(n in TRAINED or n == "linear" for n in names)
     if need_data:
@@ -59,7 +59,15 @@ def build_models(names: list[str], seed: int, progress: Progress) -> dict:
         elif name in TRAINED:
             from bushenv.planar.train import fit_planar_network
 
-            models[name] = fit_planar_network(q, f, dt, kind=name, seed=seed)
+            opts = None
+            if name == "hybrid" and training == "noisy-feedback":
+                from bushenv.planar.train_options import (
+                    NOISY_FEEDBACK_TRAINING,
+                    PlanarNetworkOptions,
+                )
+
+                opts = PlanarNetworkOptions(**NOISY_FEEDBACK_TRAINING)
+            models[name] = fit_planar_network(q, f, dt, kind=name, options=opts, seed=seed)
         else:
             raise PlanarModelError(
                 f"--models {name!r}: {PLANAR_MODELS.unknown_message(name)}, linear-preset, or "
@@ -154,12 +162,16 @@ def main(argv: list[str] | None = None) -> int:
         "--models", nargs="+", default=["linear-preset", "linear", "reference", *TRAINED]
     )
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--training", choices=("plain", "noisy-feedback"), default="plain",
+        help="the hybrid's training (bushenv fit --training)",
+    )  # fmt: skip
     p.add_argument("--png", type=Path, default=Path("docs/img/planar_passivity.png"))
     p.add_argument("--quiet", action="store_true")
     args = p.parse_args(argv)
     progress = Progress(len(args.models) * 2, quiet=args.quiet, label="planar passivity")
     try:
-        models = build_models(args.models, args.seed, progress)
+        models = build_models(args.models, args.seed, progress, args.training)
     except PlanarModelError as exc:  # a bad name or file: one line, exit 2
         print(f"planar_passivity.py: {exc}", file=sys.stderr)
         return 2
