@@ -39,6 +39,8 @@ START_D_SHARE = (0.05, 0.1, 0.2, 0.4)  # start yield deflections, share of each 
 # two per decade over the band a vehicle bushing is driven in (corners 0.16 Hz to 50 Hz): fixed,
 # not fitted, so the force stays linear in every gain
 RELAXATION_TIMES = "0.003,0.01,0.03,0.1,0.3,1"
+EXTRAPOLATION_SHARE = 0.1  # the largest deflections held out to choose the relaxation branches
+SELECTION_TIE = 0.01  # scores closer than this (relative) are a tie: the fuller grid kept
 
 
 @dataclass(frozen=True)
@@ -53,14 +55,23 @@ class PlanarBoucWenOptions:
     )
     time_limit_s: float = option(
         120.0,
-        "wall-time limit of the search, s (0: none); evaluations decide below it, so a seed "
-        "reproduces the parameters; a stop by the clock is reported on the card",
+        "wall-time limit of the search, s (0: none; a second search after a relaxation "
+        "selection has its own); evaluations decide below it, so a seed reproduces the "
+        "parameters; a stop by the clock is reported on the card",
     )
 
     relaxation_times: str = option(
         RELAXATION_TIMES,
         "time constants of the relaxation branches (Prony series, one per coordinate each, "
         "gains >= 0), s, comma-separated; '' for none",
+    )
+
+    relaxation_selection: str = option(
+        "all",
+        "all: keep every relaxation branch; extrapolation: drop the shortest ones when that "
+        "predicts the training records' largest tenth of deflections clearly better from the "
+        "rest (measured to help on one bushing and hurt on another: docs/planar_fit_unseen.md)",
+        choices=("all", "extrapolation"),
     )
 
     def taus(self) -> np.ndarray:
@@ -93,6 +104,71 @@ class _OutOfTime(Exception):
     pass
 
 
+class _Problem:
+    """The training records' regressors, and the least squares of the force rows given a
+    hysteretic shape and the relaxation branches kept (indices into ``taus``)."""
+
+    def __init__(self, qs: list[np.ndarray], fs: list[np.ndarray], dt: float,
+                 taus: np.ndarray, yield_surface: str) -> None:  # fmt: skip
+        self.qs, self.dt, self.taus, self.surface = qs, dt, taus, yield_surface
+        self.q = np.vstack(qs)
+        self.f = np.vstack(fs)
+        v = np.vstack([velocity_of(q, dt) for q in qs])
+        self.p = np.vstack([relaxation.branch_deflections(q, dt, taus) for q in qs])  # (N, 3 M)
+        self.peak = np.maximum(np.abs(self.q).max(axis=0), 1e-12)
+        self.lin = np.hstack([self.q, v])
+        self.cubic = [self.q[:, i : i + 1] * self.q**2 for i in range(3)]  # q_i q_j^2
+        self.col = np.maximum(np.abs(self.lin).max(axis=0), 1e-300)
+        self.cub_col = [np.maximum(np.abs(c).max(axis=0), 1e-300) for c in self.cubic]
+        self.p_col = np.maximum(np.abs(self.p).max(axis=0), 1e-300)
+
+    def hysteretic(self, p: np.ndarray) -> np.ndarray:
+        d, beta, eta = np.exp(p[:3]), float(p[3]), float(p[4])
+        unit = PlanarBoucWen(np.zeros((3, 3)), np.zeros((3, 3)), np.ones(3), d,
+                             (beta, 1.0 - beta, eta), yield_surface=self.surface,
+                             dt=self.dt)  # fmt: skip
+        return np.vstack([unit.hysteretic_state(q) for q in self.qs])
+
+    def solve(
+        self, z: np.ndarray, keep: np.ndarray, fit: Any = slice(None), judged: Any = None
+    ) -> tuple[float, np.ndarray]:
+        """Coefficients fitted on rows ``fit`` (row i: K_i (3), C_i (3), G_i (3), R_i (3 K),
+        h_i for the K branches kept) and the sum over the axes of the RMS ratio on rows
+        ``judged`` (default: the fitted ones)."""
+        judged = fit if judged is None else judged
+        n_p = 3 * len(keep)
+        coef = np.zeros((3, 10 + n_p))
+        score = 0.0
+        for i in range(3):
+            a = np.hstack([self.lin / self.col, self.cubic[i] / self.cub_col[i], z[:, i : i + 1]])
+            y = self.f[:, i]
+            if n_p:  # the branches on coordinate i, R_m[i, i] >= 0, and h_i >= 0
+                cols = 3 * keep + i
+                held = np.hstack([self.p[:, cols] / self.p_col[cols], a[:, 9:]])
+                c, r = _bounded_lstsq(a[fit, :9], held[fit], y[fit])
+                error = a[judged, :9] @ c + held[judged] @ r - y[judged]
+                rows = np.zeros(n_p)
+                rows[i::3] = r[:-1] / self.p_col[cols]
+                coef[i] = np.concatenate([c[:6] / self.col, c[6:9] / self.cub_col[i], rows,
+                                          r[-1:]])  # fmt: skip
+            else:
+                c, *_ = np.linalg.lstsq(a[fit], y[fit], rcond=None)
+                if c[9] < 0:  # a hysteresis giving energy: refit without it
+                    c = np.append(np.linalg.lstsq(a[fit, :9], y[fit], rcond=None)[0], 0.0)
+                error = a[judged] @ c - y[judged]
+                coef[i] = np.concatenate([c[:6] / self.col, c[6:9] / self.cub_col[i], c[9:]])
+            score += float(np.linalg.norm(error) / max(np.linalg.norm(y[judged]), 1e-300))
+        return score, coef
+
+    def beyond(self) -> np.ndarray | None:
+        """Rows whose deflection vector (each coordinate over its peak) is among the largest
+        ``EXTRAPOLATION_SHARE``; None when the rest are too few to fit every column."""
+        size = np.linalg.norm(self.q / self.peak, axis=1)
+        rows = size > np.quantile(size, 1.0 - EXTRAPOLATION_SHARE)
+        columns = 10 + len(self.taus)
+        return rows if rows.any() and (~rows).sum() >= 20 * columns else None
+
+
 def fit_planar_boucwen(
     histories: Sequence[tuple[np.ndarray, np.ndarray]],
     dt: float,
@@ -102,7 +178,7 @@ def fit_planar_boucwen(
     """Identify from records ``[(q (T, 3), f (T, 3)), ...]`` (each run from rest).
 
     Returns the model and a summary: evaluations, score (sum of the three RMS ratios on the
-    training records), whether the clock stopped the search.
+    training records), whether the clock stopped the search, the relaxation branches kept.
     """
     opt = options or PlanarBoucWenOptions()
     qs = [np.asarray(q, dtype=np.float64) for q, _ in histories]
@@ -113,97 +189,100 @@ def fit_planar_boucwen(
                 f"fit_planar_boucwen: records must be (T, 3) q and f with T >= 20, got "
                 f"{q.shape} and {f.shape}"
             )
-    q_all = np.vstack(qs)
-    v_all = np.vstack([velocity_of(q, dt) for q in qs])
-    f_all = np.vstack(fs)
     taus = opt.taus()
-    p_all = np.vstack([relaxation.branch_deflections(q, dt, taus) for q in qs])  # (N, 3 M)
-    peak = np.maximum(np.abs(q_all).max(axis=0), 1e-12)
-    f_norm = np.maximum(np.sqrt(np.sum(f_all**2, axis=0)), 1e-300)
-    lin = np.hstack([q_all, v_all])
-    cubic = [q_all[:, i : i + 1] * q_all**2 for i in range(3)]  # row i: q_i q_j^2, j = 0..2
-    col = np.maximum(np.abs(lin).max(axis=0), 1e-300)
-    cub_col = [np.maximum(np.abs(c).max(axis=0), 1e-300) for c in cubic]
-    p_col = np.maximum(np.abs(p_all).max(axis=0), 1e-300)
-    n_p = p_all.shape[1]
-    lo = np.concatenate([np.log(peak * SEARCH_D_SHARE[0]), [SEARCH_BETA[0], SEARCH_ETA[0]]])
-    hi = np.concatenate([np.log(peak * SEARCH_D_SHARE[1]), [SEARCH_BETA[1], SEARCH_ETA[1]]])
-    t0 = time.perf_counter()
-    best: dict[str, Any] = {"score": np.inf}
+    prob = _Problem(qs, fs, dt, taus, opt.yield_surface)
+    lo = np.concatenate([np.log(prob.peak * SEARCH_D_SHARE[0]), [SEARCH_BETA[0], SEARCH_ETA[0]]])
+    hi = np.concatenate([np.log(prob.peak * SEARCH_D_SHARE[1]), [SEARCH_BETA[1], SEARCH_ETA[1]]])
+    t_start = time.perf_counter()
     count = [0]
 
-    def hysteretic(p: np.ndarray) -> np.ndarray:
-        d, beta, eta = np.exp(p[:3]), float(p[3]), float(p[4])
-        unit = PlanarBoucWen(np.zeros((3, 3)), np.zeros((3, 3)), np.ones(3), d,
-                             (beta, 1.0 - beta, eta), yield_surface=opt.yield_surface,
-                             dt=dt)  # fmt: skip
-        return np.vstack([unit.hysteretic_state(q) for q in qs])
+    def search(keep: np.ndarray, starts: list[np.ndarray]) -> tuple[dict[str, Any], bool]:
+        best: dict[str, Any] = {"score": np.inf}
+        t0, first = time.perf_counter(), count[0]  # each search its own clock
 
-    def solve(p: np.ndarray) -> tuple[float, np.ndarray]:
-        """Score and coefficients, row i: K_i (3), C_i (3), G_i (3), R_i (3 M), h_i."""
-        z = hysteretic(p)
-        coef = np.zeros((3, 10 + n_p))
-        score = 0.0
-        for i in range(3):
-            a = np.hstack([lin / col, cubic[i] / cub_col[i], z[:, i : i + 1]])
-            if n_p:  # the branches on coordinate i, R_m[i, i] >= 0, and h_i >= 0
-                own = p_all[:, i::3] / p_col[i::3]
-                c, r = _bounded_lstsq(a[:, :9], np.hstack([own, a[:, 9:]]), f_all[:, i])
-                fitted = a[:, :9] @ c + np.hstack([own, a[:, 9:]]) @ r
-                rows = np.zeros(n_p)
-                rows[i::3] = r[:-1] / p_col[i::3]
-                coef[i] = np.concatenate([c[:6] / col, c[6:9] / cub_col[i], rows, r[-1:]])
-            else:
-                c, *_ = np.linalg.lstsq(a, f_all[:, i], rcond=None)
-                if c[9] < 0:  # a hysteresis giving energy: refit without it
-                    c = np.append(np.linalg.lstsq(a[:, :9], f_all[:, i], rcond=None)[0], 0.0)
-                fitted = a @ c
-                coef[i] = np.concatenate([c[:6] / col, c[6:9] / cub_col[i], c[9:]])
-            score += float(np.linalg.norm(fitted - f_all[:, i]) / f_norm[i])
-        return score, coef
+        budget = opt.evaluations + len(starts)
 
-    def score_of(p: np.ndarray) -> float:
-        if count[0] and opt.time_limit_s and time.perf_counter() - t0 > opt.time_limit_s:
-            raise _OutOfTime
-        p = np.clip(p, lo, hi)
-        s, coef = solve(p)
-        count[0] += 1
-        if s < best["score"]:
-            best.update(score=s, p=p.copy(), coef=coef)
-        if say and count[0] % 50 == 0:
+        def score_of(p: np.ndarray) -> float:
             spent = time.perf_counter() - t0
-            left = spent / count[0] * max(opt.evaluations + 8 - count[0], 0)
-            say(f"boucwen: {count[0]} evaluations, score {best['score']:.4f}, ~{left:.0f} s left")
-        return s
+            if count[0] > first and opt.time_limit_s and spent > opt.time_limit_s:
+                raise _OutOfTime
+            p = np.clip(p, lo, hi)
+            s, coef = prob.solve(prob.hysteretic(p), keep)
+            count[0] += 1
+            if s < best["score"]:
+                best.update(score=s, p=p.copy(), coef=coef)
+            done = count[0] - first
+            if say and done % 50 == 0:
+                left = spent / done * max(budget - done, 0)
+                score = best["score"]
+                say(f"boucwen: {count[0]} evaluations, score {score:.4f}, ~{left:.0f} s left")
+            return s
 
-    stopped = False
-    try:
-        for share in START_D_SHARE:
-            for eta in (1.0, 2.0):
-                score_of(np.concatenate([np.log(peak * share), [0.5, eta]]))
-        from scipy.optimize import minimize
+        try:
+            for p in starts:
+                score_of(p)
+            from scipy.optimize import minimize
 
-        minimize(
-            score_of,
-            best["p"],
-            method="Powell",
-            bounds=list(zip(lo, hi, strict=True)),
-            options={"maxfev": opt.evaluations, "xtol": 1e-4, "ftol": 1e-7},
-        )
-    except _OutOfTime:
-        stopped = True
+            minimize(
+                score_of,
+                best["p"],
+                method="Powell",
+                bounds=list(zip(lo, hi, strict=True)),
+                options={"maxfev": opt.evaluations, "xtol": 1e-4, "ftol": 1e-7},
+            )
+        except _OutOfTime:
+            return best, True
+        return best, False
+
+    every = np.argsort(taus)
+    starts = [np.concatenate([np.log(prob.peak * share), [0.5, eta]])
+              for share in START_D_SHARE for eta in (1.0, 2.0)]  # fmt: skip
+    best, stopped = search(every, starts)
+    keep, note = every, "every branch (no selection)"
+    if len(taus) and opt.relaxation_selection == "extrapolation":
+        keep, note = _select(prob, best["p"], every)
+        if len(keep) < len(taus):
+            if say:
+                say(f"boucwen: relaxation: {note}; the shape searched again with them")
+            best, again = search(keep, [best["p"], *starts])
+            stopped = stopped or again
     p, coef = best["p"], best["coef"]
-    gain = coef[:, 9:-1].reshape(3, len(taus), 3).transpose(1, 0, 2)  # R_m[i, j]: 3 m + j
+    kept = taus[keep]
+    gain = coef[:, 9:-1].reshape(3, len(kept), 3).transpose(1, 0, 2)  # R_m[i, j]: 3 m + j
     model = PlanarBoucWen(coef[:, :3], coef[:, 3:6], coef[:, -1], np.exp(p[:3]),
                           (p[3], 1.0 - p[3], p[4]), coef[:, 6:9], opt.yield_surface,
-                          dt=dt, relax_tau=taus, relax_gain=gain)  # fmt: skip
+                          dt=dt, relax_tau=kept, relax_gain=gain)  # fmt: skip
     info = {
         "evaluations": count[0],
         "score_sum_rms_ratio": best["score"],
         "time_limited": stopped,
-        "wall_time_s": time.perf_counter() - t0,
+        "wall_time_s": time.perf_counter() - t_start,
     }
+    if len(taus):
+        info["relaxation"] = note
     return model, info
+
+
+def _select(prob: _Problem, p: np.ndarray, every: np.ndarray) -> tuple[np.ndarray, str]:
+    """The relaxation branches kept: of the grids that drop the shortest branches one by one
+    (down to none), the one whose fit on the smaller deflections best predicts the largest
+    (``_Problem.beyond``) at the shape ``p``; the fullest grid within ``SELECTION_TIE`` of the
+    best score. Short branches can
+    imitate an amplitude-dependent friction loop at the training amplitude and not beyond it
+    (docs/planar_fit_unseen.md); this asks the training records, not held-out ones."""
+    beyond = prob.beyond()
+    if beyond is None:
+        return every, "every branch (too few samples to test extrapolation)"
+    z = prob.hysteretic(p)
+    scores = [prob.solve(z, every[k:], ~beyond, beyond)[0] for k in range(len(every) + 1)]
+    k = int(np.flatnonzero(np.array(scores) <= min(scores) * (1.0 + SELECTION_TIE))[0])
+    shown = ", ".join(f"{s:.3f}" for s in scores)
+    kept = ", ".join(f"{t:g}" for t in np.sort(prob.taus[every[k:]]))
+    kept = f"{kept} s" if kept else "no branch"
+    return every[k:], (
+        f"kept {kept} (sum of RMS ratios on the largest {EXTRAPOLATION_SHARE:.0%} of "
+        f"deflections, fitted on the rest, dropping the shortest branches one by one: {shown})"
+    )
 
 
 def _bounded_lstsq(free: np.ndarray, held: np.ndarray, y: np.ndarray):

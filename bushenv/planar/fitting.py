@@ -47,6 +47,7 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
     evaluations: int = option(200, "shape evaluations of the bounded Powell search (after 8)")
     time_limit_s: float = option(120.0, "wall-time limit of the backbone's search, s (0: none)")
     relaxation_times: str = option_like(PlanarBoucWenOptions, "relaxation_times")
+    relaxation_selection: str = option_like(PlanarBoucWenOptions, "relaxation_selection")
 
     def check(self) -> None:
         super().check()
@@ -62,6 +63,7 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
             self.evaluations,
             time_limit_s=self.time_limit_s,
             relaxation_times=self.relaxation_times,
+            relaxation_selection=self.relaxation_selection,
         )
 
 

@@ -69,7 +69,12 @@ def test_identification_recovers_a_relaxing_vector_boucwen():
     truth = relaxing([0.02, 0.2], gain)
     q = random_independent(1.0, 8.0, PAPER_DT, 0)
     f = truth.simulate(q)
-    opts = PlanarBoucWenOptions(evaluations=40, time_limit_s=0.0, relaxation_times="0.02,0.2")
+    opts = PlanarBoucWenOptions(
+        evaluations=40,
+        time_limit_s=0.0,
+        relaxation_times="0.02,0.2",
+        relaxation_selection="extrapolation",
+    )
     model, _ = fit_planar_boucwen([(q, f)], PAPER_DT, opts)
     plain, _ = fit_planar_boucwen(
         [(q, f)], PAPER_DT, PlanarBoucWenOptions(evaluations=40, time_limit_s=0.0)
@@ -85,6 +90,50 @@ def test_identification_recovers_a_relaxing_vector_boucwen():
     assert np.all(np.linalg.eigvalsh(model.relax_gain) >= -1e-9)  # kept passive
     assert np.all(model.relax_gain[:, ~np.eye(3, dtype=bool)] == 0)  # each axis on its own
     assert model.relax_gain[0, 2, 2] == pytest.approx(800.0, rel=0.1)
+    assert 0.02 in model.relax_tau  # the selection keeps the short branch the truth has
+
+
+def test_the_selection_drops_short_branches_that_do_not_carry_beyond_the_training_amplitude():
+    """bushenv's reference slips in small steps (Iwan friction) whose loops the 3-30 ms
+    branches imitate at the training amplitude: kept, they under-predict the radial force at
+    1.5x that amplitude; the selection, judging on the training records' largest deflections,
+    drops them."""
+    from bushenv.planar.programme import random_correlated
+    from bushenv.planar.reference import PlanarRubber
+
+    ref = PlanarRubber.preset(seed=0)
+    train = [(q, ref.simulate(q)) for q in (random_independent(1.0, 5.0, PAPER_DT, 0),
+                                            random_correlated(1.0, 5.0, PAPER_DT, 0))]  # fmt: skip
+    q_new = random_correlated(1.5, 10.0, PAPER_DT, 1)
+    f_new = ref.simulate(q_new)
+    fits = {
+        selection: fit_planar_boucwen(
+            train,
+            PAPER_DT,
+            PlanarBoucWenOptions(20, time_limit_s=0.0, relaxation_selection=selection),
+        )
+        for selection in ("extrapolation", "all")
+    }
+    (chosen, info), (every, every_info) = fits["extrapolation"], fits["all"]
+    longest = np.sort(every.relax_tau)[-len(chosen.relax_tau) :]
+    assert 0 < len(chosen.relax_tau) < len(every.relax_tau)
+    assert np.array_equal(np.sort(chosen.relax_tau), longest)  # the shortest dropped
+    assert info["relaxation"].startswith("kept " + ", ".join(f"{t:g}" for t in longest))
+    assert every_info["relaxation"] == "every branch (no selection)"
+
+    def radial_max(m):
+        return np.abs(m.simulate(q_new) - f_new)[:, 1].max() / np.abs(f_new[:, 1]).max()
+
+    assert radial_max(chosen) < 0.7 * radial_max(every), (radial_max(chosen), radial_max(every))
+
+
+def test_records_too_short_to_test_extrapolation_keep_every_branch():
+    q = random_independent(1.0, 0.5, PAPER_DT, 0)
+    truth = relaxing([0.05], np.diag([1e5, 2e5, 300.0])[None])
+    opts = PlanarBoucWenOptions(10, time_limit_s=0.0, relaxation_selection="extrapolation")
+    model, info = fit_planar_boucwen([(q, truth.simulate(q))], PAPER_DT, opts)
+    assert len(model.relax_tau) == len(PlanarBoucWenOptions().taus())
+    assert "too few samples" in info["relaxation"]
 
 
 @pytest.mark.parametrize("text", ["0.1,abc", "0,1", "-0.1", "0.1,0.1", "nan"])
