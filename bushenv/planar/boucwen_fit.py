@@ -29,7 +29,7 @@ import numpy as np
 from bushenv.identify.options import option
 from bushenv.models.base import velocity_of
 from bushenv.planar import relaxation
-from bushenv.planar.base import PlanarModelError
+from bushenv.planar.base import COORDS, PlanarModelError
 from bushenv.planar.boucwen import PlanarBoucWen
 
 SEARCH_ETA = (1.0, 6.0)
@@ -260,7 +260,30 @@ def fit_planar_boucwen(
     }
     if len(taus):
         info["relaxation"] = note
+    if len(kept):
+        cols = (3 * keep[:, None] + np.arange(3)).ravel()
+        lost = relaxation.inseparable(prob.q, prob.lin[:, 3:], prob.p[:, cols], kept)
+        if any(lost):
+            info["relaxation warning"] = _not_identified(lost)
     return model, info
+
+
+def _not_identified(lost: list[list[float]]) -> str:
+    """The card's warning for branches the records cannot tell from the static stiffness."""
+    shown = "; ".join(
+        f"{c} {', '.join(f'{t:g}' for t in taus)} s"
+        for c, taus in zip(COORDS, lost, strict=True)
+        if taus
+    )
+    slowest = max(t for taus in lost for t in taus)
+    return (
+        f"the records hold too little motion slower than these branches to tell them from the "
+        f"static stiffness ({shown}; variance inflation >= {relaxation.SEPARABLE_INFLATION:g}): "
+        f"the force under a held deflection is not identified (a branch of tau s needs motion "
+        f"below 1/(2 pi tau), {1 / (2 * np.pi * slowest):.2g} Hz for {slowest:g} s); add a "
+        "record with holds or slow motion (the preload sweeps of bushenv measure --axes 3) or "
+        "leave them out (--relaxation-times)"
+    )
 
 
 def _select(prob: _Problem, p: np.ndarray, every: np.ndarray) -> tuple[np.ndarray, str]:

@@ -147,3 +147,41 @@ def test_a_bad_relaxation_array_is_refused_by_name():
         relaxing([0.1], np.zeros((2, 3, 3)))
     with pytest.raises(PlanarModelError, match="relax_tau"):
         relaxing([0.0], np.zeros((1, 3, 3)))
+
+
+def test_branches_slower_than_the_records_are_warned_of_and_a_hold_separates_them():
+    """The programme's random drives have no motion below 1 Hz: a 1 s branch moves with the
+    deflection and its gain cannot be told from the static stiffness. A held preload (the
+    sweep holds radial and swings rotation) separates it on those two coordinates only."""
+    from bushenv.models.base import velocity_of
+    from bushenv.planar import relaxation
+    from bushenv.planar.programme import preload_sweep, random_correlated
+
+    taus = PlanarBoucWenOptions().taus()
+
+    def lost(records):
+        q = np.vstack(records)
+        v = np.vstack([velocity_of(r, PAPER_DT) for r in records])
+        p = np.vstack([relaxation.branch_deflections(r, PAPER_DT, taus) for r in records])
+        return relaxation.inseparable(q, v, p, taus)
+
+    rand = [random_independent(1.0, 10.0, PAPER_DT, 0), random_correlated(1.0, 10.0, PAPER_DT, 0)]
+    assert all(1.0 in each for each in lost(rand))
+    axial, radial, rotation = lost([*rand, preload_sweep(1, 2e-3, 0.05, 10.0, PAPER_DT)])
+    assert 1.0 in axial and radial == [] and rotation == []  # the axial coordinate stays at rest
+
+    truth = relaxing([0.05], np.diag([1e5, 2e5, 300.0])[None])
+    _, info = fit_planar_boucwen([(q, truth.simulate(q)) for q in rand], PAPER_DT,
+                                 PlanarBoucWenOptions(5, time_limit_s=0.0))  # fmt: skip
+    warning = info["relaxation warning"]
+    assert "axial" in warning and "1 s" in warning and "not identified" in warning
+    sep = [
+        *rand,
+        preload_sweep(1, 2e-3, 0.05, 10.0, PAPER_DT),
+        preload_sweep(2, 0.03, 2e-3, 10.0, PAPER_DT),
+    ]
+    axial_sweep = np.zeros_like(sep[0])
+    axial_sweep[:, 0] = preload_sweep(1, 2e-3, 0.05, 10.0, PAPER_DT)[:, 1]
+    _, info = fit_planar_boucwen([(q, truth.simulate(q)) for q in [*sep, axial_sweep]],
+                                 PAPER_DT, PlanarBoucWenOptions(5, time_limit_s=0.0))  # fmt: skip
+    assert "relaxation warning" not in info, info
