@@ -13,6 +13,8 @@ EXAMPLE = "bushenv reproduce --out runs/reproduce"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    from bushenv.planar.machine import IDENTIFICATIONS
+
     p.add_argument("--out", required=True, help="output folder (refused if it holds a report)")
     p.add_argument("--axes", default="axial,radial", help="comma list of axes")
     p.add_argument("--seed", type=int, default=0, help="seed for records and training")
@@ -34,6 +36,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default="off",
         help="the 3-axis table beside seed 000 Table 3 (planar models on unseen coupled "
         "records, DIR/planar.json and planar.md): add it to the papers' tables, or run only it",
+    )
+    p.add_argument(
+        "--planar-identification",
+        choices=IDENTIFICATIONS,
+        default="programme",
+        help="the 3-axis table's identification records: programme = random at n = 1 and the "
+        "coupled sine sets at n = 1 (holds a preload); random = random n = 1 only, as seed 000",
     )
     p.add_argument("--force", action="store_true", help="overwrite an existing report in --out")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
@@ -76,7 +85,14 @@ def _planar(out: Path, args: argparse.Namespace, progress: Progress) -> None:
     from bushenv.persist import json_text, write_text
     from bushenv.planar.reproduce3 import format_planar, planar_table
 
-    report = planar_table(args.seed, args.identification_s, args.verification_s, PAPER_DT, progress)
+    report = planar_table(
+        args.seed,
+        args.identification_s,
+        args.verification_s,
+        PAPER_DT,
+        progress,
+        identification=args.planar_identification,
+    )
     text = format_planar(report)
     write_text(out / "planar.json", json_text(report, indent=2))
     write_text(out / "planar.md", "# The 3-axis table\n\n```\n" + text + "\n```\n")

@@ -5,8 +5,11 @@ items)`` runs each from rest. ``kind``:
 
 - ``"papers"``: what the seeds measure, in three axes: random on all axes at n = 1 (40 s,
   ``seed``), independent and correlated; the same at n = 1.5 (20 s, ``seed + 1``); the coupled
-  sine sets (a 3 mm radial preload under a 0.5-5 Hz rotation sweep of 1.5 x 0.05 rad, and a
-  0.075 rad rotation preload under a radial sweep of 3 mm; 20 s each);
+  sine sets (``coupled_sets``) at n = 1.5 (a 3 mm radial preload under a 0.5-5 Hz rotation sweep
+  of 0.075 rad, and a 0.075 rad rotation preload under a 3 mm radial sweep; 20 s each) and at
+  n = 1 (2 mm, 0.05 rad): n = 1 identifies, n = 1.5 verifies. The n = 1 sets hold a preload,
+  which random motion with nothing below 1 Hz never does: without them a fit cannot tell its
+  slow relaxation from its static stiffness (docs/planar_fit_unseen.md);
 - ``"random"``: random on all axes at ``n_index``, independent and correlated.
 
 The planar reference (``reference`` with its load cell) measures each record with its own
@@ -20,12 +23,20 @@ from collections.abc import Callable
 import numpy as np
 
 from bushenv.planar.base import PlanarModel, PlanarModelError
-from bushenv.planar.programme import preload_sweep, random_correlated, random_independent
+from bushenv.planar.programme import (
+    PEAK_AT_N1,
+    preload_sweep,
+    random_correlated,
+    random_independent,
+)
 from bushenv.planar.reference import THETA_N1_RAD, PlanarRubber
 
 KINDS = ("papers", "random")
+# what a 3-axis identification uses of the papers' programme at n = 1 (``bushenv reproduce
+# --planar-identification``): the random records and the coupled sets, or the random only
+IDENTIFICATIONS = ("programme", "random")
 N_VERIFY = 1.5
-PRELOAD_M = 3.0e-3
+PRELOAD_M = N_VERIFY * PEAK_AT_N1[1]  # the verification sets' radial preload, 3 mm
 
 
 def _random(n: float, duration_s: float, dt: float, seed: int) -> list[tuple[str, np.ndarray]]:
@@ -51,17 +62,27 @@ def items(
                 f"{duration_s} s"
             )
         return _random(n_index, duration_s, dt, seed)
-    theta = N_VERIFY * THETA_N1_RAD
     return [
         *_random(1.0, 40.0, dt, seed),
         *_random(N_VERIFY, 20.0, dt, seed + 1),
+        *coupled_sets(N_VERIFY, dt),
+        *coupled_sets(1.0, dt),  # last, so the records before keep their noise seeds
+    ]
+
+
+def coupled_sets(n_index: float, dt: float, duration_s: float = 20.0) -> list:
+    """The coupled sine sets at amplitude index n: a radial preload of n x 2 mm under a
+    0.5-5 Hz rotation sweep of n x 0.05 rad, and a rotation preload of n x 0.05 rad under a
+    radial sweep of n x 2 mm; named by their preloads."""
+    radial, theta = n_index * PEAK_AT_N1[1], n_index * THETA_N1_RAD
+    return [
         (
-            f"radial_preload_{PRELOAD_M * 1e3:g}mm_rotation_sweep",
-            preload_sweep(1, PRELOAD_M, theta, 20.0, dt),
+            f"radial_preload_{radial * 1e3:g}mm_rotation_sweep",
+            preload_sweep(1, radial, theta, duration_s, dt),
         ),
         (
             f"rotation_preload_{theta:g}rad_radial_sweep",
-            preload_sweep(2, theta, PRELOAD_M, 20.0, dt),
+            preload_sweep(2, theta, radial, duration_s, dt),
         ),
     ]
 

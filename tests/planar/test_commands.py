@@ -45,10 +45,21 @@ def test_measure_writes_independent_and_correlated_3_axis_records(records):
 def test_measure_papers_programme_has_the_coupled_sine_sets(tmp_path):
     from bushenv.planar.machine import items
 
-    names = [n for n, _ in items("papers", 1 / 204.8)]
+    motions = dict(items("papers", 1 / 204.8))
+    names = list(motions)
     assert "radial_preload_3mm_rotation_sweep" in names
     assert "rotation_preload_0.075rad_radial_sweep" in names
     assert sum(n.startswith("random_") for n in names) == 4
+    # the n = 1 sets identify: 2 mm and 0.05 rad held, each under the other's sweep; they come
+    # last, so the records before keep the noise seeds they had
+    assert names[-2:] == [
+        "radial_preload_2mm_rotation_sweep",
+        "rotation_preload_0.05rad_radial_sweep",
+    ]
+    for name, held, level, swept_peak in ((names[-2], 1, 2e-3, 0.05), (names[-1], 2, 0.05, 2e-3)):
+        q = motions[name]
+        assert np.allclose(q[int(2 * 204.8) :, held], level) and np.all(q[:, 0] == 0)
+        assert np.abs(q[:, 3 - held]).max() == pytest.approx(swept_peak, rel=0.02)
 
 
 @pytest.mark.parametrize("model", ["linear", "boucwen"])

@@ -54,6 +54,30 @@ def test_the_table_carries_what_the_fits_could_not_identify(tmp_path, monkeypatc
     assert f"boucwen: {said}" in capsys.readouterr().out
 
 
+def test_the_programme_identification_adds_the_n1_coupled_sets_and_random_leaves_them_out():
+    programme = r3.identification_records(PAPER_DT, 0, 8.0)
+    random = r3.identification_records(PAPER_DT, 0, 8.0, "random")
+    assert len(random) == 2 and len(programme) == 4
+    for (q, f), (q0, f0) in zip(programme[:2], random, strict=True):
+        assert np.array_equal(q, q0) and np.array_equal(f, f0)  # the random records unchanged
+    radial_held, rotation_held = (q for q, _ in programme[2:])
+    assert radial_held.shape[0] == int(round(4.0 / PAPER_DT))  # half the random records' length
+    assert radial_held[-1, 1] == pytest.approx(2e-3) and rotation_held[-1, 2] == pytest.approx(0.05)
+    with pytest.raises(ValueError, match="identification 'sweeps'"):
+        r3.identification_records(PAPER_DT, 0, 8.0, "sweeps")
+
+
+def test_the_table_says_what_it_was_identified_on(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(r3, "MODELS", ("linear",))
+    args = ["reproduce", "--planar", "only", "--identification-s", "8", "--verification-s", "7"]
+    assert (
+        main([*args, "--planar-identification", "random", "--out", str(tmp_path), "--quiet"]) == 0
+    )
+    report = json.loads((tmp_path / "planar.json").read_text())
+    assert report["settings"]["identification"] == "random"
+    assert "identified on random n = 1 only (as seed 000)" in capsys.readouterr().out
+
+
 @pytest.mark.slow
 def test_hybrid_bw_on_unseen_random_coupled_records_holds_its_documented_figures():
     # docs/planar.md, "The 3-axis table in bushenv reproduce": seed 0, default options (30-150 s).
