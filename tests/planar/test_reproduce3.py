@@ -79,15 +79,12 @@ def test_the_table_says_what_it_was_identified_on(tmp_path, monkeypatch, capsys)
 
 
 @pytest.mark.slow
-def test_hybrid_bw_on_unseen_random_coupled_records_holds_its_documented_figures():
-    # docs/planar.md, "The 3-axis table in bushenv reproduce": seed 0, default options (30-150 s).
-    # The target (3 % RMS, 6 % MAX) holds on every cell but the correlated n = 1.5 record's
-    # radial force and moment, whose MAX the relaxation raised to 8.0 % and 5.6-7.3 %
-    # (docs/planar_fit_unseen.md): a guard on that, not the target met
+def test_hybrid_bw_meets_the_target_on_unseen_random_coupled_records():
+    # docs/planar.md, "The 3-axis table in bushenv reproduce": seed 0, default options and the
+    # programme's identification (random and the coupled sets at n = 1; about 5 min). Not on the
+    # preload sets: radial 4.3-5.0 % RMS there, as the docs say
     report = r3.planar_table(0, 40.0, 20.0, PAPER_DT, models=("hybrid-bw",))
     for rec, row in report["records"].items():
         if rec.startswith("random"):
             for axis, m in row["hybrid-bw"].items():
-                known = rec == "random correlated n=1.5" and axis != "axial"
-                assert m["rms_ratio"] <= 0.03, (rec, axis, m)
-                assert m["max_error_ratio"] <= (0.085 if known else 0.06), (rec, axis, m)
+                assert m["rms_ratio"] <= 0.03 and m["max_error_ratio"] <= 0.06, (rec, axis, m)
