@@ -14,7 +14,10 @@ A row whose best h is negative (a hysteresis that would give energy) is refitted
 With a relaxation, its branches act on each coordinate alone (R_m diagonal) with R_m[i, i] >= 0
 and h_i >= 0, by non-negative least squares: every branch stores and dissipates energy only,
 so the element stays passive (a free 3x3 R_m, fitted and then made semidefinite, was measured
-worse: docs/planar_fit_unseen.md).
+worse: docs/planar_fit_unseen.md). ``relaxation_selection="extrapolation"`` then drops the
+shortest branches when that predicts the training records' largest deflections better
+(``_select``; an option: measured to help on one bushing and hurt on another). The summary warns
+of branches the records cannot tell from the static stiffness (``relaxation.inseparable``).
 """
 
 from __future__ import annotations
