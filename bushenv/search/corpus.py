@@ -39,7 +39,7 @@ from bushenv.search.case_file import (  # noqa: F401 (the case file, as corpus g
 )
 from bushenv.search.corpus_files import KeptFileError, locate
 from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.targets import TARGETS
+from bushenv.search.targets import TARGETS, get_target
 
 
 # ----- model and reference identity -------------------------------------------------------------
@@ -165,6 +165,8 @@ def make_case(
     ``reference_identity``, which hashes its file)."""
     x = decode_profile(encode_profile(profile))
     rows = judge_profile(x, models, env, axis, reference, scales, static)
+    if reference is not None:  # what else of the judge follows from the reference (floors)
+        judge = {**(judge or {}), **get_target(env).judging_facts(reference)} or judge
     shas = shas or {}
     expect = {
         name: {
@@ -296,6 +298,9 @@ def check(
     results = replayed(resolved)
     ref_now = None if resolved.reference is None else params_sha(resolved.reference.model)
     ref_changed = case.reference.get("params_sha256") not in (None, ref_now)
+    judge_changes = judge_changed(case, resolved)
+    if judge_changes and notes is not None and all(r.ok for r in results):
+        notes.append(f"case {case.name}: {'; '.join(judge_changes)}; its verdicts hold")
     for r in results:
         changed = bool(r.sha_recorded and r.sha_now and r.sha_recorded != r.sha_now)
         if r.ok:
@@ -322,5 +327,34 @@ def check(
             msg += f"; the {r.model} model file is the one the case was recorded with"
         if ref_changed:
             msg += "; the reference's parameters changed since the case was recorded"
+        msg += "".join(f"; {c}" for c in judge_changes)
         problems.append(msg)
     return problems
+
+
+def judge_changed(case: Case, resolved: ResolvedCase) -> list[str]:
+    """What of the judge, beyond the reference's parameters, differs today from what the case
+    recorded (``Target.judging_facts``: the rig3 force floors), or was not recorded."""
+    if resolved.reference is None:
+        return []
+    now = get_target(case.env).judging_facts(resolved.reference.model)
+    out = []
+    for key, value in now.items():
+        then = (case.judge or {}).get(key)
+        if then is None:
+            out.append(f"the case does not record the judge's {key} (recorded before they "
+                       f"were kept); judged at today's: {_shown(value)}")  # fmt: skip
+        else:
+            moved = [
+                f"{k} {then.get(k)} -> {v:.4g}"
+                for k, v in value.items()
+                if then.get(k) is None or not np.isclose(then[k], v, rtol=1e-9, atol=0.0)
+            ]
+            if moved:
+                out.append(f"the judge's {key} changed since the case was recorded: "
+                           f"{', '.join(moved)}")  # fmt: skip
+    return out
+
+
+def _shown(value: dict[str, float]) -> str:
+    return ", ".join(f"{k} {v:.4g}" for k, v in value.items())

@@ -75,6 +75,12 @@ class Target:
     def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
         raise NotImplementedError
 
+    def judging_facts(self, reference) -> dict[str, dict[str, float]]:
+        """What of this target's judge follows from ``reference`` beyond its parameters, by
+        name, each a number per coordinate, for a case to record and a replay to compare (the
+        rig3 target: its force floors)."""
+        return {}
+
     def check_models(self, kind: str):
         """(model, reference) the contract checks (``checks.py``) run: ``active`` fails on some
         profiles (negative damping vs Table 1), ``passive`` on none (a softer spring)."""

@@ -226,6 +226,10 @@ class Rig3Target(Target):
     def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
         return clip3(x, dt)
 
+    def judging_facts(self, reference) -> dict[str, dict[str, float]]:
+        floors = reference_floors(reference)[0]
+        return {"force_floors": dict(zip(COORDS, floors.tolist(), strict=True))}
+
     def profile_bounds(self, limits=MACHINE) -> tuple[np.ndarray, np.ndarray]:
         """Per coordinate (3,) arrays: BushRig3-v0's stroke and rate (``limits``, a one-axis
         bushing's, do not apply)."""

@@ -58,6 +58,37 @@ def test_a_planar_case_whose_model_changed_no_longer_replays(tmp_path):
     assert problems and "expected to diverge but stayed bounded" in problems[0]
 
 
+def test_a_planar_case_records_its_floors_and_a_replay_says_when_they_changed(tmp_path):
+    """The rig3 judge's force floors follow from the reference (target_rig3.reference_floors):
+    a case keeps the floors it was judged at, and a replay at other floors says so, verdicts
+    holding or not, as it does for a reference whose parameters changed."""
+    model = _rotation_active(tmp_path / "active.npz")
+    out = tmp_path / "run"
+    argv = ["attack", "--env", "rig3", "--model", str(model), "--budget", "16", "--quiet",
+            "--searchers", "random", "--out", str(out), "--max-shrink", "1",
+            "--shrink-budget", "20"]  # fmt: skip
+    assert main(argv) == 0
+    (path,) = case_files(out / "cases")
+    raw = json.loads(path.read_text())
+    # the built-in reference judges at the papers' floors exactly
+    assert raw["judge"]["force_floors"] == {"axial": 200.0, "radial": 200.0, "rotation": 20.0}
+    notes = []
+    assert check(load_case(path), notes=notes) == [] and notes == []
+
+    raw["judge"]["force_floors"]["radial"] = 150.0  # as if judged at other floors
+    path.write_text(json.dumps(raw))
+    notes = []
+    assert check(load_case(path), notes=notes) == []  # the verdicts hold at today's floors
+    (note,) = notes
+    assert "force_floors changed since the case was recorded: radial 150.0 -> 200" in note
+
+    del raw["judge"]  # a case from before the floors were kept
+    path.write_text(json.dumps(raw))
+    notes = []
+    assert check(load_case(path), notes=notes) == []
+    assert "does not record the judge's force_floors" in notes[0]
+
+
 def test_a_one_axis_model_name_on_rig3_is_refused_in_one_line(tmp_path, capsys):
     argv = ["attack", "--env", "rig3", "--model", "nn-paper", "--budget", "4", "--quiet",
             "--out", str(tmp_path / "run")]  # fmt: skip
