@@ -124,6 +124,10 @@ def summary(card: dict[str, Any], out: Path) -> str:
         from bushenv.planar.range_holds import describe
 
         lines += describe(card["holds"])
+    if card.get("backbone"):
+        from bushenv.planar.card import backbone_lines
+
+        lines += backbone_lines(card)
     if card.get("plots"):
         lines.append(f"figures: {', '.join(card['plots'])}")
     lines += [f"{k}: {v}" for k, v in src["info"].items()]

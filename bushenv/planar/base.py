@@ -83,6 +83,11 @@ class PlanarModel(SavedParameters):
         self._v1 = np.zeros((1, self.batch_size, 3))
         self._f1 = np.zeros((1, self.batch_size, 3))
 
+    def backbone_alone(self) -> PlanarModel | None:
+        """A hybrid's backbone as a model of its own (a fresh one, at rest), for judging what
+        its network adds; None for a model without one."""
+        return None
+
     def reset_columns(self, mask: np.ndarray) -> None:
         """Histories ``mask`` (B,) bool back to rest, the others kept (a vector env's autoreset)."""
         n = int(np.sum(mask))

@@ -17,6 +17,8 @@
 - ``notes``: what the records hold that the models cannot follow (a start away from rest, a
   force offset at rest, ``bushenv.planar.records.start_notes``);
 - ``holds`` (networks): their fixed points over the training range (``range_holds``);
+- ``backbone`` (hybrids, with held-out records): the backbone alone (``backbone_alone``), its
+  per-axis metrics on each held-out record, so the card says what the network adds;
 - ``plots``: the figures beside the model file (``plots.fit_figures3``; none with
   ``--no-plots``).
 """
@@ -120,6 +122,18 @@ def save_planar_fit(
     holds = range_holds(model, np.max([np.abs(r.q).max(axis=0) for r in train], axis=0))
     if holds is not None:
         card["holds"] = holds
+    backbone = model.backbone_alone()
+    if backbone is not None and held_out:  # what the network adds where it was not trained
+        card["backbone"] = {
+            "model": backbone.name,
+            "records": [
+                {
+                    "name": Path(r.source).stem if r.source else "",
+                    "metrics": axis_metrics(r.f, backbone.copy().simulate(r.q), r.q),
+                }
+                for r in held_out
+            ],
+        }
     if plots:
         from bushenv.planar.plots import fit_figures3
 
@@ -129,6 +143,47 @@ def save_planar_fit(
     write_json(json_path, card, indent=1)
     write_text(md_path, card_markdown(card))
     return card
+
+
+def backbone_lines(card: dict[str, Any]) -> list[str]:
+    """The model and its backbone alone on the held-out records, worst RMS (MAX) per axis,
+    and the axes where the network makes the worst case worse."""
+    held = [r for r in card["records"] if r["role"] == "held-out"]
+    mine, theirs = (
+        _worst(r["metrics"] for r in held),
+        _worst(r["metrics"] for r in card["backbone"]["records"]),
+    )
+    line = (
+        f"held-out records, worst RMS ratio (MAX) % axial / radial / rotation: {card['model']} "
+        f"{_cells(mine)}; its backbone alone ({card['backbone']['model']}) {_cells(theirs)}"
+    )
+    worse = [
+        c for c in COORDS if None not in (mine[c][0], theirs[c][0]) and mine[c][0] > theirs[c][0]
+    ]
+    if not worse:
+        return [line]
+    return [
+        line,
+        f"warning: on records it never saw the network makes the {', '.join(worse)} worse "
+        f"than its backbone alone: the backbone ({card['backbone']['model']}) may be the "
+        "better model there",
+    ]
+
+
+def _worst(metrics) -> dict[str, list[float | None]]:
+    """Per axis [worst RMS ratio, worst MAX] over per-record ``axis_metrics``."""
+    out: dict[str, list[float | None]] = {c: [None, None] for c in COORDS}
+    for m in metrics:
+        for c in COORDS:
+            for k, key in enumerate(("rms_ratio", "max_error_ratio")):
+                v = m[c][key]
+                if v is not None and (out[c][k] is None or v > out[c][k]):
+                    out[c][k] = v
+    return out
+
+
+def _cells(worst: dict[str, list[float | None]]) -> str:
+    return " / ".join(f"{_pct(worst[c][0])} ({_pct(worst[c][1])})" for c in COORDS)
 
 
 def _pct(v: float | None) -> str:
@@ -166,6 +221,8 @@ def card_markdown(card: dict[str, Any]) -> str:
         from bushenv.planar.range_holds import describe
 
         lines += ["", "## Holds over the training range", ""] + describe(card["holds"])
+    if card.get("backbone"):
+        lines += ["", "## The network against its backbone alone", ""] + backbone_lines(card)
     if card.get("plots"):
         lines += ["", "## Figures", ""] + [f"![{p}]({p})" for p in card["plots"]]
     lines += ["", "## Options", "", "| option | value |", "|---|---|"]

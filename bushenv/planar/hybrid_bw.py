@@ -52,6 +52,9 @@ class PlanarBoucWenHybrid(PlanarNarx):
     def extra_meta(self) -> dict[str, Any]:
         return self.backbone.extra_meta()
 
+    def backbone_alone(self) -> PlanarBoucWen:
+        return PlanarBoucWen(**self.backbone.params, **self.backbone.extra_meta(), dt=self.dt)
+
     def reset(self, batch_size: int = 1) -> None:
         super().reset(batch_size)
         if hasattr(self, "backbone"):

@@ -188,6 +188,11 @@ class PlanarHybrid(PlanarNarx):
     def _backbone_matrices(self) -> tuple[np.ndarray, np.ndarray]:
         return self.k_matrix, self.c_matrix
 
+    def backbone_alone(self) -> PlanarModel:
+        from bushenv.planar.linear import PlanarLinear
+
+        return PlanarLinear(self.k_matrix, self.c_matrix, dt=self.dt)
+
 
 # the network kinds ``train.fit_planar_network`` trains, by file name; here, without torch
 KINDS = {"nn": PlanarNarx, "nn-axis": PlanarNarxPerAxis, "hybrid": PlanarHybrid}

@@ -144,3 +144,51 @@ def test_3_axis_records_at_two_rates_are_refused_naming_both(records, tmp_path, 
     line = _fails([*args[:2], "--model", "linear", "--resample", "204.8", "--out",
                    str(tmp_path / "x.npz")], capsys)  # fmt: skip
     assert "--resample is for one-axis records" in line
+
+
+def test_a_hybrid_card_sets_its_network_against_its_backbone_alone(records, tmp_path, capsys):
+    from bushenv.metrics import rms_ratio
+
+    train, held = records
+    out = tmp_path / "hbw.npz"
+    args = ["fit", *map(str, train), "--model", "hybrid-bw", "--validate", *map(str, held),
+            "--evaluations", "1", "--teacher-steps", "20", "--free-run-steps", "0",
+            "--out", str(out), "--quiet", "--no-plots"]  # fmt: skip
+    assert main(args) == 0
+    card = json.loads(out.with_name("hbw.card.json").read_text())
+    assert card["backbone"]["model"] == "boucwen"
+    assert [r["name"] for r in card["backbone"]["records"]] == [p.stem for p in held]
+    rec = load_planar_csv(held[0])  # the figures are the backbone's own free run
+    alone = load_planar_model(out).backbone_alone().simulate(rec.q)
+    got = card["backbone"]["records"][0]["metrics"]["radial"]["rms_ratio"]
+    assert got == pytest.approx(rms_ratio(rec.f[:, 1], alone[:, 1]), rel=1e-12)
+    assert "its backbone alone (boucwen)" in capsys.readouterr().out
+    md = out.with_name("hbw.card.md").read_text()
+    assert "## The network against its backbone alone" in md
+
+    linear = tmp_path / "lin.npz"  # no backbone, no entry
+    assert main(["fit", *map(str, train), "--model", "linear", "--validate", *map(str, held),
+                 "--out", str(linear), "--quiet", "--no-plots"]) == 0  # fmt: skip
+    assert "backbone" not in json.loads(linear.with_name("lin.card.json").read_text())
+
+
+def test_the_card_warns_where_the_network_is_worse_than_its_backbone_on_unseen_records():
+    from bushenv.planar.base import COORDS
+    from bushenv.planar.card import backbone_lines
+
+    def metrics(rms):
+        return {
+            c: {"rms_ratio": r, "max_error_ratio": 2 * r} for c, r in zip(COORDS, rms, strict=True)
+        }
+
+    card = {
+        "model": "hybrid-bw",
+        "records": [{"role": "train", "metrics": metrics([9, 9, 9])},
+                    {"role": "held-out", "metrics": metrics([0.01, 0.03, 0.02])}],
+        "backbone": {"model": "boucwen", "records": [{"metrics": metrics([0.02, 0.02, 0.02])}]},
+    }  # fmt: skip
+    line, warning = backbone_lines(card)
+    assert "hybrid-bw 1.00 (2.00) / 3.00 (6.00) / 2.00 (4.00)" in line  # held-out only
+    assert "makes the radial worse" in warning and "axial" not in warning
+    card["backbone"]["records"][0]["metrics"] = metrics([0.02, 0.04, 0.02])
+    assert len(backbone_lines(card)) == 1  # better or equal everywhere: no warning
