@@ -42,6 +42,7 @@ from bushenv.planar.records import only_noise
 CARD_FORMAT = "bushenv-planar-model-card"
 CARD_VERSION = 1
 RATIOS = ("rms_ratio", "esr", "max_error_ratio", "nrmse", "fit_index")  # all_metrics' ratios
+WORSE_BY = 0.05  # a network worse than its backbone alone by more than this share is warned of
 
 
 def axis_metrics(
@@ -147,7 +148,7 @@ def save_planar_fit(
 
 def backbone_lines(card: dict[str, Any]) -> list[str]:
     """The model and its backbone alone on the held-out records, worst RMS (MAX) per axis,
-    and the axes where the network makes the worst case worse."""
+    and the axes where the network makes the worst RMS ratio worse by more than ``WORSE_BY``."""
     held = [r for r in card["records"] if r["role"] == "held-out"]
     mine, theirs = (
         _worst(r["metrics"] for r in held),
@@ -158,7 +159,9 @@ def backbone_lines(card: dict[str, Any]) -> list[str]:
         f"{_cells(mine)}; its backbone alone ({card['backbone']['model']}) {_cells(theirs)}"
     )
     worse = [
-        c for c in COORDS if None not in (mine[c][0], theirs[c][0]) and mine[c][0] > theirs[c][0]
+        c
+        for c in COORDS
+        if None not in (mine[c][0], theirs[c][0]) and mine[c][0] > (1 + WORSE_BY) * theirs[c][0]
     ]
     if not worse:
         return [line]

@@ -190,5 +190,5 @@ def test_the_card_warns_where_the_network_is_worse_than_its_backbone_on_unseen_r
     line, warning = backbone_lines(card)
     assert "hybrid-bw 1.00 (2.00) / 3.00 (6.00) / 2.00 (4.00)" in line  # held-out only
     assert "makes the radial worse" in warning and "axial" not in warning
-    card["backbone"]["records"][0]["metrics"] = metrics([0.02, 0.04, 0.02])
-    assert len(backbone_lines(card)) == 1  # better or equal everywhere: no warning
+    card["backbone"]["records"][0]["metrics"] = metrics([0.02, 0.0289, 0.02])
+    assert len(backbone_lines(card)) == 1  # within 5 % of the backbone (3.8 %): no warning
