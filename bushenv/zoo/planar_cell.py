@@ -86,16 +86,15 @@ def _accuracy(model, unseen) -> dict[str, dict[str, float]]:
 
 
 def _network_share(model, unseen) -> dict[str, float] | None:
-    """A hybrid's network part (its force less the linear backbone's) as an RMS ratio of the
-    measured force on the unseen correlated record, per coordinate: how much of the model is
-    network (None for the pure networks, all network). A certified hybrid whose share is ~0
-    is its backbone."""
-    from bushenv.models.base import velocity_of
-
-    if not hasattr(model, "k_matrix"):
+    """A hybrid's network part (its force less its backbone's alone, ``backbone_alone``) as an
+    RMS ratio of the measured force on the unseen correlated record, per coordinate: how much of
+    the model is network (None for the pure networks, all network). A certified hybrid whose
+    share is ~0 is its backbone."""
+    backbone = model.backbone_alone()
+    if backbone is None:
         return None
     q, f = unseen["correlated"]
-    part = model.simulate(q) - q @ model.k_matrix.T - velocity_of(q, model.dt) @ model.c_matrix.T
+    part = model.simulate(q) - backbone.simulate(q)
     rms = np.sqrt(np.mean(f**2, axis=0))
     return {c: float(np.sqrt(np.mean(part[:, i] ** 2)) / rms[i]) for i, c in enumerate(COORDS)}
 

@@ -126,7 +126,7 @@ def test_a_tiny_certified_study_runs_end_to_end(tmp_path):
 def test_the_network_share_of_a_silent_hybrid_is_zero_and_of_a_live_one_is_not():
     import numpy as np
 
-    from bushenv.planar.narx import PlanarHybrid
+    from bushenv.planar.narx import PlanarHybrid, PlanarNarx
     from bushenv.zoo.planar_cell import _network_share, planar_records
 
     live = PlanarHybrid.untrained(seed=0)
@@ -135,7 +135,7 @@ def test_the_network_share_of_a_silent_hybrid_is_zero_and_of_a_live_one_is_not()
     _, unseen = planar_records(0)
     assert max(_network_share(silent, unseen).values()) < 1e-12
     assert min(_network_share(live, unseen).values()) > 0.01
-    assert _network_share(object(), unseen) is None
+    assert _network_share(PlanarNarx.untrained(seed=0), unseen) is None  # all network
     assert np.isfinite(list(_network_share(live, unseen).values())).all()
 
 
