@@ -42,7 +42,8 @@ def test_a_planar_attack_finds_shrinks_and_keeps_the_axis_that_fails(tmp_path, c
     assert check(case) == []
 
 
-def test_a_planar_case_whose_model_changed_no_longer_replays(tmp_path):
+def _one_case(tmp_path):
+    """(the rotation-active model's file, the one case a short attack on it keeps)."""
     model = _rotation_active(tmp_path / "active.npz")
     out = tmp_path / "run"
     argv = ["attack", "--env", "rig3", "--model", str(model), "--budget", "16", "--quiet",
@@ -50,6 +51,11 @@ def test_a_planar_case_whose_model_changed_no_longer_replays(tmp_path):
             "--shrink-budget", "20"]  # fmt: skip
     assert main(argv) == 0
     (path,) = case_files(out / "cases")
+    return model, path
+
+
+def test_a_planar_case_whose_model_changed_no_longer_replays(tmp_path):
+    model, path = _one_case(tmp_path)
     PlanarLinear.preset().save(model)  # the model fixed: the case's verdict changes
     kept = path.parent / "models"
     for f in kept.glob("*.npz"):
@@ -62,13 +68,7 @@ def test_a_planar_case_records_its_floors_and_a_replay_says_when_they_changed(tm
     """The rig3 judge's force floors follow from the reference (target_rig3.reference_floors):
     a case keeps the floors it was judged at, and a replay at other floors says so, verdicts
     holding or not, as it does for a reference whose parameters changed."""
-    model = _rotation_active(tmp_path / "active.npz")
-    out = tmp_path / "run"
-    argv = ["attack", "--env", "rig3", "--model", str(model), "--budget", "16", "--quiet",
-            "--searchers", "random", "--out", str(out), "--max-shrink", "1",
-            "--shrink-budget", "20"]  # fmt: skip
-    assert main(argv) == 0
-    (path,) = case_files(out / "cases")
+    _, path = _one_case(tmp_path)
     raw = json.loads(path.read_text())
     # the built-in reference judges at the papers' floors exactly
     assert raw["judge"]["force_floors"] == {"axial": 200.0, "radial": 200.0, "rotation": 20.0}
