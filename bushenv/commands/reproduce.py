@@ -39,10 +39,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--planar-identification",
-        choices=IDENTIFICATIONS,
+        choices=tuple(IDENTIFICATIONS),
         default="programme",
-        help="the 3-axis table's identification records: programme = random at n = 1 and the "
-        "coupled sine sets at n = 1 (holds a preload); random = random n = 1 only, as seed 000",
+        help="the 3-axis table's identification records: "
+        + "; ".join(f"{k}: {v}" for k, v in IDENTIFICATIONS.items()),
     )
     p.add_argument("--force", action="store_true", help="overwrite an existing report in --out")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")

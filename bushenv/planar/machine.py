@@ -34,7 +34,10 @@ from bushenv.planar.reference import THETA_N1_RAD, PlanarRubber
 KINDS = ("papers", "random")
 # what a 3-axis identification uses of the papers' programme at n = 1 (``bushenv reproduce
 # --planar-identification``): the random records and the coupled sets, or the random only
-IDENTIFICATIONS = ("programme", "random")
+IDENTIFICATIONS = {
+    "programme": "random and the coupled sine sets at n = 1",
+    "random": "random n = 1 only (as seed 000)",
+}
 N_VERIFY = 1.5
 PRELOAD_M = N_VERIFY * PEAK_AT_N1[1]  # the verification sets' radial preload, 3 mm
 

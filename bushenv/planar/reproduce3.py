@@ -62,7 +62,7 @@ def identification_records(
     """[(q, f)] of random motion at n = 1, independent and correlated, then (``"programme"``)
     the coupled sine sets at n = 1 of ``ident_s`` / 2 each; each record its noise seed."""
     if identification not in IDENTIFICATIONS:
-        raise ValueError(f"identification {identification!r}; known: {IDENTIFICATIONS}")
+        raise ValueError(f"identification {identification!r}; known: {', '.join(IDENTIFICATIONS)}")
     motions = [drive(1.0, ident_s, dt, seed) for drive in (random_independent, random_correlated)]
     if identification == "programme":
         motions += [q for _, q in coupled_sets(1.0, dt, ident_s / 2)]
@@ -156,9 +156,7 @@ def format_planar(report: dict[str, Any]) -> str:
     records = report["records"]
     models = list(next(iter(records.values())))
     head = f"{'record':32s} {'axis':9s}" + "".join(f"{m + ' RMS/MAX %':>22s}" for m in models)
-    on = {"programme": "random and the coupled sine sets at n = 1",
-          "random": "random n = 1 only (as seed 000)"}  # fmt: skip
-    what = on.get(report["settings"].get("identification", "random"))
+    what = IDENTIFICATIONS[report["settings"].get("identification", "random")]
     lines = [
         f"3-axis table (seed 000 Table 3 beside): planar models identified on {what},",
         "free run on unseen coupled records; RMS ratio / MAX (% of max |f|)",
