@@ -14,8 +14,8 @@ one; records are ``(q (T, 3), f (T, 3))`` pairs at one sample time.
 | boucwen   | variable projection: bounded Powell on the shape, least squares K, C, G, h |
 | hybrid-bw | the boucwen fit as backbone, then the MIMO network on its residual  |
 
-The networks train on one history: several records are joined end to end (the joint is a
-jump the training sees once per record; the card says so).
+The networks train on every record's first 80 % and choose their weights by the free run on
+every record's last 20 % (``--val-fraction``); no lag or window reaches across two records.
 """
 
 from __future__ import annotations
@@ -34,6 +34,7 @@ from bushenv.planar.registry import PLANAR_MODELS
 from bushenv.planar.train_options import (
     PlanarHybridOptions,
     PlanarNetworkOptions,
+    record_problem,
 )
 from bushenv.registry import Registry
 
@@ -98,11 +99,9 @@ def _network(kind: str):
     def fit(histories, dt, opts, seed, say):
         from bushenv.planar.train import fit_planar_network
 
-        q = np.vstack([h[0] for h in histories])
-        f = np.vstack([h[1] for h in histories])
+        q, f = [h[0] for h in histories], [h[1] for h in histories]
         model = fit_planar_network(q, f, dt, kind, opts.train_options(), seed, quiet=say is None)
-        info = {"note": "records joined end to end"} if len(histories) > 1 else {}
-        info.update(certified_info(model))
+        info = certified_info(model)
         return model, info
 
     return fit
@@ -141,13 +140,10 @@ def _hybrid_bw(histories, dt, opts, seed, say):
     from bushenv.planar.train import fit_planar_network
 
     backbone, info = fit_planar_boucwen(histories, dt, opts.backbone_options(), say=say)
-    q = np.vstack([h[0] for h in histories])
-    residual = np.vstack([h[1] - backbone.simulate(h[0]) for h in histories])
+    q = [h[0] for h in histories]
+    residual = [h[1] - backbone.simulate(h[0]) for h in histories]
     net = fit_planar_network(q, residual, dt, "nn", opts.train_options(), seed, quiet=say is None)
-    info = {f"backbone {k}": v for k, v in info.items()}
-    if len(histories) > 1:
-        info["note"] = "the network's records joined end to end"
-    return compose(backbone, net), info
+    return compose(backbone, net), {f"backbone {k}": v for k, v in info.items()}
 
 
 PLANAR_FITS.add("hybrid-bw", PlanarFit(PlanarHybridBWOptions, _hybrid_bw))
@@ -170,13 +166,17 @@ def length_problem(name: str, options: Any, lengths: dict[str, int]) -> str | No
                 f"{BOUCWEN_MIN_SAMPLES} per record: give longer records"
             )
     if isinstance(opts, PlanarNetworkOptions):
+        for label, n in lengths.items():
+            problem = record_problem(n, opts.val_fraction)
+            if problem:
+                return f"{label}: {problem}, as the {name} network needs: give a longer record"
         need, total = NETWORK_MIN_WINDOWS * opts.window, sum(lengths.values())
         if total < need:
             shown = ", ".join(f"{k}: {n}" for k, n in lengths.items())
             return (
                 f"{total} training samples ({shown}); the {name} network trains on at least "
                 f"{NETWORK_MIN_WINDOWS} x --window {opts.window} = {need} samples (all training "
-                "records joined): give longer records"
+                "records together): give longer records"
                 + (f" or --window {total // NETWORK_MIN_WINDOWS}" if total >= 160 else "")
             )
     return None

@@ -6,10 +6,11 @@ items)`` runs each from rest. ``kind``:
 - ``"papers"``: what the seeds measure, in three axes: random on all axes at n = 1 (40 s,
   ``seed``), independent and correlated; the same at n = 1.5 (20 s, ``seed + 1``); the coupled
   sine sets (``coupled_sets``) at n = 1.5 (a 3 mm radial preload under a 0.5-5 Hz rotation sweep
-  of 0.075 rad, and a 0.075 rad rotation preload under a 3 mm radial sweep; 20 s each) and at
-  n = 1 (2 mm, 0.05 rad): n = 1 identifies, n = 1.5 verifies. The n = 1 sets hold a preload,
-  which random motion with nothing below 1 Hz never does: without them a fit cannot tell its
-  slow relaxation from its static stiffness (docs/planar_fit_unseen.md);
+  of 0.075 rad, a 0.075 rad rotation preload under a 3 mm radial sweep, and a 3 mm axial preload
+  under a 3 mm radial sweep; 20 s each) and at n = 1 (2 mm, 0.05 rad): n = 1 identifies,
+  n = 1.5 verifies. The n = 1 sets hold a preload, which random motion with nothing below 1 Hz
+  never does: without them a fit cannot tell its slow relaxation from its static stiffness
+  (docs/planar_fit_unseen.md). The axial sets came last, after the others;
 - ``"random"``: random on all axes at ``n_index``, independent and correlated.
 
 The planar reference (``reference`` with its load cell) measures each record with its own
@@ -29,7 +30,7 @@ from bushenv.planar.programme import (
     random_correlated,
     random_independent,
 )
-from bushenv.planar.reference import THETA_N1_RAD, PlanarRubber
+from bushenv.planar.reference import PlanarRubber
 
 KINDS = ("papers", "random")
 # what a 3-axis identification uses of the papers' programme at n = 1 (``bushenv reproduce
@@ -65,19 +66,25 @@ def items(
                 f"{duration_s} s"
             )
         return _random(n_index, duration_s, dt, seed)
+    verify, identify = coupled_sets(N_VERIFY, dt), coupled_sets(1.0, dt)
+    # each addition last, so the records before keep their noise seeds (and their files)
     return [
         *_random(1.0, 40.0, dt, seed),
         *_random(N_VERIFY, 20.0, dt, seed + 1),
-        *coupled_sets(N_VERIFY, dt),
-        *coupled_sets(1.0, dt),  # last, so the records before keep their noise seeds
+        *verify[:2],
+        *identify[:2],
+        verify[2],
+        identify[2],
     ]
 
 
 def coupled_sets(n_index: float, dt: float, duration_s: float = 20.0) -> list:
-    """The coupled sine sets at amplitude index n: a radial preload of n x 2 mm under a
-    0.5-5 Hz rotation sweep of n x 0.05 rad, and a rotation preload of n x 0.05 rad under a
-    radial sweep of n x 2 mm; named by their preloads."""
-    radial, theta = n_index * PEAK_AT_N1[1], n_index * THETA_N1_RAD
+    """The coupled sine sets at amplitude index n, named by their preloads: a radial preload of
+    n x 2 mm under a 0.5-5 Hz rotation sweep of n x 0.05 rad, a rotation preload of n x 0.05 rad
+    under a radial sweep of n x 2 mm, and an axial preload of n x 2 mm under a radial sweep of
+    n x 2 mm (without it no record holds the axial coordinate, and its slow relaxation is not
+    told from its static stiffness)."""
+    axial, radial, theta = n_index * PEAK_AT_N1
     return [
         (
             f"radial_preload_{radial * 1e3:g}mm_rotation_sweep",
@@ -86,6 +93,10 @@ def coupled_sets(n_index: float, dt: float, duration_s: float = 20.0) -> list:
         (
             f"rotation_preload_{theta:g}rad_radial_sweep",
             preload_sweep(2, theta, radial, duration_s, dt),
+        ),
+        (
+            f"axial_preload_{axial * 1e3:g}mm_radial_sweep",
+            preload_sweep(0, axial, radial, duration_s, dt),
         ),
     ]
 

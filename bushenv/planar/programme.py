@@ -1,6 +1,7 @@
 """The 3-axis test programme: random on all axes with the amplitude index n per axis
 (independent and correlated), and the coupled sine sets (radial preload under a rotation
-sweep, and the reverse). Pure functions: (T, 3) profiles in m, m, rad, deterministic per seed.
+sweep, the reverse, and an axial preload under a radial sweep). Pure functions: (T, 3)
+profiles in m, m, rad, deterministic per seed.
 
 Amplitude index (seed 001 §3.2.2, as ``bushenv.excitation.random_rpc``): the peak of each
 coordinate is n times its peak at n = 1, ``PEAK_AT_N1`` = (2 mm, 2 mm, 0.05 rad; the rotation
@@ -54,15 +55,19 @@ def preload_sweep(
     duration_s: float,
     dt: float,
     f_hz: tuple[float, float] = (0.5, 5.0),
+    swept: int | None = None,
 ) -> np.ndarray:
-    """Coordinate ``held`` ramped (1 s, half-cosine) to ``held_value`` and held; the other of
-    (radial, rotation) swept from 1.5 s on (linear chirp ``f_hz``, ``swept_amplitude``); axial
-    at rest. ``held=1``: radial preload with a rotation sweep; ``held=2``: the reverse."""
+    """Coordinate ``held`` ramped (1 s, half-cosine) to ``held_value`` and held; coordinate
+    ``swept`` swept from 1.5 s on (linear chirp ``f_hz``, ``swept_amplitude``); the third at
+    rest. ``held=1``: radial preload with a rotation sweep; ``held=2``: the reverse; ``held=0``:
+    axial preload with a radial sweep. ``swept`` defaults to those pairs."""
+    swept = {0: 1, 1: 2, 2: 1}[held] if swept is None else swept
+    if held == swept or {held, swept} - {0, 1, 2}:
+        raise ValueError(f"preload_sweep: held {held} and swept {swept} must be two of 0, 1, 2")
     T = int(round(duration_s / dt))
     q = np.zeros((T, 3))
     q[:, held] = _hold(held_value, T, int(round(1.0 / dt)))
     start = int(round(1.5 / dt))
-    swept = 2 if held == 1 else 1
     q[start:, swept] = chirp(f_hz[0], f_hz[1], swept_amplitude, (T - start) * dt, dt)[: T - start]
     return q
 

@@ -4,7 +4,8 @@ axes, judged free-running on unseen coupled records (``bushenv reproduce --plana
 1. The planar reference (with its load cell) is driven by random motion at n = 1 on all axes,
    independent and correlated (``identification_s`` each, ``seed``), and (``identification=
    "programme"``, the default) by the coupled sine sets at n = 1 (a 2 mm radial preload under
-   a rotation sweep and the reverse, ``identification_s`` / 2 each), as ``bushenv measure
+   a rotation sweep, the reverse, and a 2 mm axial preload under a radial sweep,
+   ``identification_s`` / 2 each), as ``bushenv measure
    --axes 3`` records them: the identification records. ``"random"`` leaves the sets out, as
    seed 000 identified on random motion only; then nothing in the records holds a deflection
    and a fit cannot tell its slow relaxation from its static stiffness (its card says so).
@@ -16,12 +17,14 @@ axes, judged free-running on unseen coupled records (``bushenv reproduce --plana
 3. Each runs free on records it never saw, measured with other noise seeds: random motion
    with the axes correlated (one common drive, weight 0.8) at n = 1 and at n = 1.5, random
    independent at n = 1.5, and the coupled sine sets (a 3 mm radial preload under a rotation
-   sweep, and a rotation preload under a radial sweep). RMS ratio (seed 000 eq. 8), ESR
-   (eq. 9) and MAX (largest error over the largest measured |f|, as Table 3) per axis.
+   sweep, a rotation preload under a radial sweep, a 3 mm axial preload under a radial
+   sweep). RMS ratio (seed 000 eq. 8), ESR (eq. 9) and MAX (largest error over the largest
+   measured |f|, as Table 3) per axis.
 
 Seed 000 Table 3's "NN" is the per-axis kind, so its rows sit beside ``nn-axis``. Where an
-axis is at rest (the axial force of the preload sets), its force is load-cell noise only and
-the table gives the largest force the model invents there, in N.
+axis is at rest (the axial force of the radial and rotation sets, the moment of the axial
+set), its force is load-cell noise only and the table gives the largest force the model
+invents there, in N (N m).
 
 ``planar.json`` layout: {"settings": {...}, "paper": TABLE3, "records": {record: {model:
 {axis: {"rms_ratio", "esr", "max_error_ratio", "max_error", "at_rest"}}}}, "identification_s":
@@ -41,6 +44,7 @@ from bushenv.planar.base import COORDS
 from bushenv.planar.fitting import PLANAR_FITS, fit_planar
 from bushenv.planar.machine import IDENTIFICATIONS, N_VERIFY, PRELOAD_M, coupled_sets
 from bushenv.planar.programme import (
+    PEAK_AT_N1,
     preload_sweep,
     random_correlated,
     random_independent,
@@ -74,13 +78,14 @@ def identification_records(
 
 def unseen_records(dt: float, seed: int, verif_s: float) -> dict[str, np.ndarray]:
     """The coupled records the models never saw, (T, 3) each, by name."""
-    theta = N_VERIFY * THETA_N1_RAD
+    axial, theta = N_VERIFY * PEAK_AT_N1[0], N_VERIFY * THETA_N1_RAD
     return {
         "random correlated n=1": random_correlated(1.0, verif_s, dt, 4000 + seed),
         "random correlated n=1.5": random_correlated(N_VERIFY, verif_s, dt, 2000 + seed),
         "random independent n=1.5": random_independent(N_VERIFY, verif_s, dt, 1000 + seed),
         "radial preload + rotation sweep": preload_sweep(1, PRELOAD_M, theta, verif_s, dt),
         "rotation preload + radial sweep": preload_sweep(2, theta, PRELOAD_M, verif_s, dt),
+        "axial preload + radial sweep": preload_sweep(0, axial, PRELOAD_M, verif_s, dt),
     }
 
 
@@ -100,8 +105,9 @@ def planar_table(
     progress.total = sum(EFFORT[m] for m in models)
     progress.done = 0
     histories = identification_records(dt, seed, ident_s, identification)
+    n_sets = len(histories) - 2
     shown = f"2 x {ident_s:g} s of random motion" + (
-        f" and the 2 coupled sine sets, {ident_s / 2:g} s each" if len(histories) > 2 else ""
+        f" and the {n_sets} coupled sine sets, {ident_s / 2:g} s each" if n_sets else ""
     )
     fitted, seconds, warnings = {}, {}, {}
     for name in models:
@@ -168,7 +174,8 @@ def format_planar(report: dict[str, Any]) -> str:
             for m in models:
                 r = row[m][c]
                 if r["at_rest"]:
-                    cells.append(f"at rest: {r['max_error']:.0f} N".rjust(22))
+                    unit = "N m" if c == "rotation" else "N"
+                    cells.append(f"at rest: {r['max_error']:.0f} {unit}".rjust(22))
                 else:
                     cells.append(f"{100 * r['rms_ratio']:.1f} / {100 * r['max_error_ratio']:.1f}"
                                  .rjust(22))  # fmt: skip

@@ -23,6 +23,8 @@ symmetric, displacement increments, or both).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import torch
 
@@ -38,7 +40,7 @@ from bushenv.planar.structure import (
     symmetric_scale,
 )
 from bushenv.planar.train_options import PlanarNetworkOptions as TrainOptions
-from bushenv.planar.train_options import default_options
+from bushenv.planar.train_options import default_options, record_problem
 from bushenv.progress import Progress
 
 TEACHER_CHECK_EVERY = 50  # certified: teacher steps between two checks (they pick hard holds)
@@ -96,29 +98,82 @@ def _scale(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fit_planar_network(
-    q: np.ndarray,
-    f: np.ndarray,
+    q: np.ndarray | Sequence[np.ndarray],
+    f: np.ndarray | Sequence[np.ndarray],
     dt: float,
     kind: str = "nn",
     options: TrainOptions | None = None,
     seed: int = 0,
     quiet: bool = True,
 ) -> PlanarNarx:
-    """Identify a planar network from one record ``q`` (T, 3) m/rad, ``f`` (T, 3) N/N m.
+    """Identify a planar network from a record ``q`` (T, 3) m/rad, ``f`` (T, 3) N/N m, or from
+    several: equal-length lists of such arrays.
 
     ``kind``: "nn" (MIMO), "nn-axis" (three single-axis networks) or "hybrid" (3x3 linear
     backbone by least squares, then the MIMO network on the residual). Deterministic given
-    ``seed``. The last ``val_fraction`` of the record selects the weights (free-run error).
+    ``seed``. Each record is split as in ``bushenv.identify.narx_data``: its first 1 -
+    ``val_fraction`` trains, its last ``val_fraction`` selects the weights (free-run error over
+    every record's tail), and no lag or free-run window reaches across two records.
     """
     threads = torch.get_num_threads()
     torch.set_num_threads(1)  # these nets are tiny: threads only add contention (15 s vs 0.2 s)
     try:
-        return _fit(q, f, dt, kind, options, seed, quiet)
+        return _fit(_records(q, f), dt, kind, options, seed, quiet)
     finally:
         torch.set_num_threads(threads)
 
 
-def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
+def _records(q, f) -> list[tuple[np.ndarray, np.ndarray]]:
+    """[(q, f)] as float arrays: one record when given arrays, else the pairs of the lists."""
+    single = isinstance(q, np.ndarray) or isinstance(f, np.ndarray)
+    qs, fs = ([q], [f]) if single else (list(q), list(f))
+    if len(qs) != len(fs) or not qs:
+        raise PlanarModelError(
+            f"fit_planar_network: give one (q, f) pair of arrays or two lists of equal length, "
+            f"got {len(qs)} and {len(fs)} records"
+        )
+    return [(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
+            for a, b in zip(qs, fs, strict=True)]  # fmt: skip
+
+
+def _split(records, opt) -> list[int]:
+    """Validation-tail length of each record; refuses records that cannot be split."""
+    t0 = max(N_PAST_Q, N_PAST_F)
+    tails = []
+    for k, (q, f) in enumerate(records):
+        label = "the record" if len(records) == 1 else f"record {k + 1}"
+        if q.shape != f.shape or q.ndim != 2 or q.shape[1] != 3:
+            raise PlanarModelError(
+                f"fit_planar_network: {label}: q and f must be equal (T, 3) arrays, got "
+                f"{q.shape} and {f.shape}"
+            )
+        problem = record_problem(q.shape[0], opt.val_fraction)
+        if problem:
+            raise PlanarModelError(f"fit_planar_network: {label}: {problem}: give a longer record")
+        n_val = int(opt.val_fraction * q.shape[0])
+        tails.append(n_val)
+    total = sum(q.shape[0] for q, _ in records)
+    if total < 20 * opt.window or not any(
+        q.shape[0] - n - t0 > opt.window for (q, _), n in zip(records, tails, strict=True)
+    ):
+        raise PlanarModelError(
+            f"fit_planar_network: {total} samples in {len(records)} record(s); training needs "
+            f"T >= {20 * opt.window} in all and one training part longer than the free-run "
+            f"window ({opt.window} samples)"
+        )
+    return tails
+
+
+def _window_starts(lengths: list[int], window: int) -> np.ndarray:
+    """The rows (in the training parts stacked) where a free-run window of ``window`` rows
+    starts and stays inside one record's training part of ``lengths`` rows."""
+    ends = np.cumsum(lengths)
+    return np.concatenate(
+        [np.arange(e - n, e - window) for n, e in zip(lengths, ends, strict=True)]
+    ).astype(np.int64)
+
+
+def _fit(records, dt, kind, options, seed, quiet) -> PlanarNarx:
     if kind not in KINDS:
         raise PlanarModelError(f"unknown planar network kind {kind!r}; known: {list(KINDS)}")
     opt = options or default_options(kind)
@@ -127,40 +182,41 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
             f"structure {opt.structure!r} ties the MIMO network's weights; nn-axis takes "
             "structure 'free' only (use nn or hybrid)"
         )
-    q = np.asarray(q, dtype=np.float64)
-    f = np.asarray(f, dtype=np.float64)
-    if q.shape != f.shape or q.ndim != 2 or q.shape[1] != 3 or q.shape[0] < 20 * opt.window:
-        raise PlanarModelError(
-            f"fit_planar_network: q and f must be equal (T, 3) arrays with T >= {20 * opt.window}, "
-            f"got {q.shape} and {f.shape}"
-        )
-    extra, f_total = {}, f
+    tails = _split(records, opt)
+    q = np.vstack([r[0] for r in records])  # scales and backbone over every record, as before
+    f_total = np.vstack([r[1] for r in records])
+    extra, targets = {}, [r[1] for r in records]
     mirror = is_mirror(opt.structure)  # mirror-symmetric: diagonal backbone, scaled about 0
     if kind == "hybrid":
-        lin = fit_diagonal_linear(q, f, dt) if mirror else fit_linear(q, velocity_of(q, dt), f, dt)
+        v = np.vstack([velocity_of(r[0], dt) for r in records])
+        lin = fit_diagonal_linear(q, f_total, dt) if mirror else fit_linear(q, v, f_total, dt)
         extra = {"k_matrix": lin.k_matrix, "c_matrix": lin.c_matrix}
-        f = f - lin.simulate(q)
+        targets = [r[1] - lin.simulate(r[0]) for r in records]
+    f = np.vstack(targets)
     q_off, q_sc = symmetric_scale(q) if mirror else _scale(q)
     f_off, f_sc = symmetric_scale(f) if mirror else _scale(f)
-    qs, ys = (q - q_off) / q_sc, (f - f_off) / f_sc
-    n_val = int(opt.val_fraction * q.shape[0])
     t0 = max(N_PAST_Q, N_PAST_F)
-    qz_all = np.hstack([qs[t0:], _lags(qs, N_PAST_Q, t0)])  # (T - t0, 18)
-    yl_all = _lags(ys, N_PAST_F, t0)  # (T - t0, 15)
-    tgt_all = ys[t0:]
-    n_tr = qz_all.shape[0] - n_val
+    parts = []  # per record: (displacement inputs, past outputs, targets) of its training part
+    for (qr, _), fr, n_val in zip(records, targets, tails, strict=True):
+        n = qr.shape[0] - n_val
+        qs, ys = (qr[:n] - q_off) / q_sc, (fr[:n] - f_off) / f_sc
+        parts.append((np.hstack([qs[t0:], _lags(qs, N_PAST_Q, t0)]), _lags(ys, N_PAST_F, t0),
+                      ys[t0:]))  # fmt: skip
+    qz_tr, yl_tr, tgt_tr = (np.vstack(a) for a in zip(*parts, strict=True))
+    window_starts = _window_starts([len(p[0]) for p in parts], opt.window)
     gen = torch.Generator().manual_seed(seed)
     if opt.structure == "free":
         net = _Net(opt.hidden, kind == "nn-axis", gen)
     else:
-        net = StructuredNet(opt.structure, opt.hidden, gen, increment_gain(qs))
+        net = StructuredNet(opt.structure, opt.hidden, gen, increment_gain((q - q_off) / q_sc))
     term = opt.certified_term()
     if term is not None:
         from bushenv.planar.certified import PlanarProblem
         from bushenv.planar.static_estimate import planar_static_estimate
 
-        n_fit = q.shape[0] - n_val  # the static estimate from the training part, total force
-        estimate = planar_static_estimate([(q[:n_fit], f_total[:n_fit])], dt)
+        fitted = [(r[0][: len(r[0]) - n], r[1][: len(r[1]) - n])
+                  for r, n in zip(records, tails, strict=True)]  # fmt: skip
+        estimate = planar_static_estimate(fitted, dt)  # the training parts, total force
         k = extra.get("k_matrix", np.zeros((3, 3)))
         problem = PlanarProblem(q_off, q_sc, f_off, f_sc, k, dt, estimate)
 
@@ -170,10 +226,10 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
     rng = np.random.default_rng(seed)
     progress = Progress(opt.teacher_steps + opt.free_run_steps, quiet=quiet, label=f"planar {kind}")
 
-    z = torch.tensor(np.hstack([qz_all[:n_tr], yl_all[:n_tr]]))
-    n_q = qz_all.shape[1]  # z's displacement columns; the fed-back outputs follow
+    z = torch.tensor(np.hstack([qz_tr, yl_tr]))
+    n_q = qz_tr.shape[1]  # z's displacement columns; the fed-back outputs follow
     noise = torch.Generator().manual_seed(seed + 1)
-    tgt = torch.tensor(tgt_all[:n_tr])
+    tgt = torch.tensor(tgt_tr)
     adam = torch.optim.Adam(net.parameters(), lr=opt.teacher_lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(adam, opt.teacher_steps)
 
@@ -207,11 +263,13 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
             term.check(build(), problem.estimate)  # the grid's failing holds join the term
 
     def val_error() -> float:
-        """Sum over the axes of the free-run RMS ratio on the held-out tail (total force)."""
-        pred = build().simulate(q_val)
+        """Sum over the axes of the free-run RMS ratio on every record's tail (total force),
+        each tail run from rest."""
+        model = build()
+        pred = np.vstack([model.simulate(r[0][-n:]) for r, n in zip(records, tails, strict=True)])
         return float(np.sum(np.sqrt(np.mean((pred - f_val_total) ** 2, axis=0)) / f_val_rms))
 
-    q_val, f_val_total = q[-n_val:], f_total[-n_val:]
+    f_val_total = np.vstack([r[1][-n:] for r, n in zip(records, tails, strict=True)])
     f_val_rms = np.maximum(np.sqrt(np.mean(f_val_total**2, axis=0)), 1e-12)
 
     def judged() -> tuple[bool, float]:
@@ -220,11 +278,11 @@ def _fit(q, f, dt, kind, options, seed, quiet) -> PlanarNarx:
         return (not admitted, val_error())
 
     best, best_state = judged(), {k: v.detach().clone() for k, v in net.state_dict().items()}
-    qz_t, yl_t, tgt_t = (torch.tensor(a[:n_tr]) for a in (qz_all, yl_all, tgt_all))
+    qz_t, yl_t, tgt_t = (torch.tensor(a) for a in (qz_tr, yl_tr, tgt_tr))
     adam = torch.optim.Adam(net.parameters(), lr=opt.free_run_lr)
     L = opt.window
     for it in range(opt.free_run_steps):
-        starts = rng.integers(0, n_tr - L, size=opt.windows)
+        starts = window_starts[rng.integers(0, len(window_starts), size=opt.windows)]
         idx = torch.tensor(starts[:, None] + np.arange(L)[None, :])
         adam.zero_grad()
         pred = net.unroll(qz_t[idx], yl_t[torch.tensor(starts)])

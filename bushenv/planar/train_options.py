@@ -10,7 +10,21 @@ from dataclasses import dataclass
 from bushenv.identify.narx_options import SWITCH, NarxOptions
 from bushenv.identify.options import option, option_like
 from bushenv.planar.base import PlanarModelError
-from bushenv.planar.narx import STRUCTURES
+from bushenv.planar.narx import N_PAST_F, N_PAST_Q, STRUCTURES
+
+VAL_MIN_SAMPLES = 10  # a validation tail shorter than this says nothing (as bushenv.identify)
+
+
+def record_problem(samples: int, val_fraction: float) -> str | None:
+    """Why a record of ``samples`` cannot be split for a network's training, or None."""
+    n_val, lags = int(val_fraction * samples), max(N_PAST_Q, N_PAST_F)
+    if n_val < VAL_MIN_SAMPLES or samples - n_val <= lags:
+        return (
+            f"{samples} samples cannot be split into a training part longer than the {lags} "
+            f"lags and a validation tail of at least {VAL_MIN_SAMPLES} samples "
+            f"({val_fraction:.0%} of each record)"
+        )
+    return None
 
 
 @dataclass(frozen=True)
@@ -25,7 +39,7 @@ class PlanarNetworkOptions:
     free_run_lr: float = option(2e-3, "free-run learning rate")
     window: int = option(64, "samples per free-run window")
     windows: int = option(32, "free-run windows per step")
-    val_fraction: float = option(0.2, "last part of the training history kept for validation")
+    val_fraction: float = option(0.2, "last part of each training record kept for validation")
     eval_every: int = option(25, "free-run steps between two validations")
     teacher_batch: int = option(
         0, "samples per one-step-ahead step, drawn at random (0: the full batch)"

@@ -50,16 +50,23 @@ def test_measure_papers_programme_has_the_coupled_sine_sets(tmp_path):
     assert "radial_preload_3mm_rotation_sweep" in names
     assert "rotation_preload_0.075rad_radial_sweep" in names
     assert sum(n.startswith("random_") for n in names) == 4
-    # the n = 1 sets identify: 2 mm and 0.05 rad held, each under the other's sweep; they come
-    # last, so the records before keep the noise seeds they had
-    assert names[-2:] == [
+    # the n = 1 sets identify: 2 mm and 0.05 rad held, each under the other's sweep, then a
+    # 2 mm axial hold under a radial sweep; each addition comes last, so the records before
+    # keep the noise seeds they had
+    assert names[6:] == [
         "radial_preload_2mm_rotation_sweep",
         "rotation_preload_0.05rad_radial_sweep",
+        "axial_preload_3mm_radial_sweep",
+        "axial_preload_2mm_radial_sweep",
     ]
-    for name, held, level, swept_peak in ((names[-2], 1, 2e-3, 0.05), (names[-1], 2, 0.05, 2e-3)):
+    at_rest = {1: 0, 2: 0, 0: 2}  # held coordinate -> the one at rest
+    sets = ((names[6], 1, 2e-3, 2, 0.05), (names[7], 2, 0.05, 1, 2e-3),
+            (names[9], 0, 2e-3, 1, 2e-3))  # fmt: skip
+    for name, held, level, swept, swept_peak in sets:
         q = motions[name]
-        assert np.allclose(q[int(2 * 204.8) :, held], level) and np.all(q[:, 0] == 0)
-        assert np.abs(q[:, 3 - held]).max() == pytest.approx(swept_peak, rel=0.02)
+        assert np.allclose(q[int(2 * 204.8) :, held], level) and np.all(q[:, at_rest[held]] == 0)
+        assert np.abs(q[:, swept]).max() == pytest.approx(swept_peak, rel=0.02)
+    assert np.allclose(motions[names[8]][int(2 * 204.8) :, 0], 3e-3)  # n = 1.5 verifies
 
 
 @pytest.mark.parametrize("model", ["linear", "boucwen"])

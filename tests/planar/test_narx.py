@@ -104,8 +104,56 @@ def test_tiny_training_learns_the_record_and_is_deterministic():
 
 
 def test_training_rejects_short_or_misshapen_records():
-    with pytest.raises(PlanarModelError, match=r"\(T, 3\)"):
+    with pytest.raises(PlanarModelError, match="100 samples in 1 record"):
         fit_planar_network(np.zeros((100, 3)), np.zeros((100, 3)), DT)
+    with pytest.raises(PlanarModelError, match=r"\(T, 3\)"):
+        fit_planar_network(np.zeros((4000, 2)), np.zeros((4000, 2)), DT)
+    with pytest.raises(PlanarModelError, match="record 2: 30 samples cannot be split"):
+        records = [np.zeros((4000, 3)), np.zeros((30, 3))]
+        fit_planar_network(records, records, DT)
+    with pytest.raises(PlanarModelError, match="two lists of equal length"):
+        fit_planar_network([np.zeros((4000, 3))] * 2, [np.zeros((4000, 3))], DT)
+
+
+def test_a_list_of_one_record_is_the_record_and_two_records_keep_their_own_tails():
+    q, f = _record()
+    opt = TrainOptions(hidden=9, teacher_steps=40, free_run_steps=4, windows=8, window=32,
+                       eval_every=2)  # fmt: skip
+    one = fit_planar_network(q, f, DT, kind="nn", options=opt, seed=1)
+    listed = fit_planar_network([q], [f], DT, kind="nn", options=opt, seed=1)
+    np.testing.assert_array_equal(one.w1, listed.w1)
+
+
+def test_each_record_keeps_its_own_tail_out_of_training():
+    q, f = _record()
+    opt = TrainOptions(hidden=9, teacher_steps=40, free_run_steps=0, windows=8, window=32,
+                       eval_every=2)  # fmt: skip
+    half = len(q) // 2
+    qs, fs = [q[:half], q[half:]], [f[:half], f[half:]]
+    n = int(0.2 * half)
+
+    def fit_with(k, rows):  # record k's force reversed in time over ``rows``: same range
+        g = [a.copy() for a in fs]
+        g[k][rows] = fs[k][rows][::-1]
+        return fit_planar_network(qs, g, DT, "nn", opt, seed=1).w1
+
+    plain = fit_planar_network(qs, fs, DT, "nn", opt, seed=1).w1
+    # the first record's tail only validates (joined end to end it would have trained) ...
+    np.testing.assert_array_equal(fit_with(0, slice(half - n, half)), plain)
+    # ... and the second record's head trains (joined, the tail was all of it that counted)
+    assert not np.array_equal(fit_with(1, slice(0, n)), plain)
+
+
+def test_free_run_windows_never_reach_across_two_records():
+    from bushenv.planar.train import _window_starts
+
+    starts = _window_starts([100, 40, 70], 32)
+    ends = np.array([100, 140, 210])
+    assert len(starts) == (100 - 32) + (40 - 32) + (70 - 32)
+    for s in starts:
+        record = np.searchsorted(ends, s, side="right")  # the record the window starts in
+        assert s + 32 <= ends[record]  # its last row is inside the same record
+    assert len(_window_starts([20, 100], 32)) == 100 - 32  # too short for a window: none
     with pytest.raises(PlanarModelError, match="known"):
         fit_planar_network(np.zeros((4000, 3)), np.zeros((4000, 3)), DT, kind="lstm")
 

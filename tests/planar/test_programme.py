@@ -1,6 +1,7 @@
 """The 3-axis programme: amplitude index per axis, correlation, preload sets, machine limits."""
 
 import numpy as np
+import pytest
 
 from bushenv.excitation import MAX_DISPLACEMENT_M, MAX_VELOCITY_M_PER_S
 from bushenv.planar.programme import (
@@ -38,6 +39,11 @@ def test_preload_sweep_holds_one_coordinate_and_sweeps_the_other():
     assert np.abs(q[:, 2]).max() > 0.07 and np.all(q[:, 0] == 0)
     r = preload_sweep(2, 0.075, 3e-3, 10.0, DT)
     assert np.all(r[205:, 2] == 0.075) and np.abs(r[:, 1]).max() > 2.9e-3
+    a = preload_sweep(0, 3e-3, 3e-3, 10.0, DT)  # axial hold under a radial sweep
+    assert np.all(a[205:, 0] == 3e-3) and np.abs(a[:, 1]).max() > 2.9e-3 and np.all(a[:, 2] == 0)
+    for held, swept in ((1, 1), (0, 3)):
+        with pytest.raises(ValueError, match="must be two of 0, 1, 2"):
+            preload_sweep(held, 1e-3, 1e-3, 10.0, DT, swept=swept)
 
 
 def test_every_record_is_within_the_machine_limits():

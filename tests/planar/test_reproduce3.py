@@ -38,7 +38,8 @@ def test_planar_only_writes_its_own_report_and_the_table_beside_table3(
 
 def test_the_table_carries_what_the_fits_could_not_identify(tmp_path, monkeypatch, capsys):
     """The random records have no motion below 1 Hz: the Bouc-Wen fit's 1 s relaxation branch
-    cannot be told from its static stiffness, and the table says so as the card would."""
+    cannot be told from its static stiffness, and the table says so as the card would. The
+    programme's sets hold each coordinate in turn, and the warning is gone."""
     from bushenv.planar.boucwen_fit import PlanarBoucWenOptions
 
     monkeypatch.setattr(r3, "MODELS", ("linear", "boucwen"))
@@ -46,23 +47,27 @@ def test_the_table_carries_what_the_fits_could_not_identify(tmp_path, monkeypatc
     monkeypatch.setattr(r3, "fit_planar", lambda h, name, _, dt, seed: fit_planar(
         h, name, short if name == "boucwen" else None, dt, seed))  # fmt: skip
     args = ["reproduce", "--planar", "only", "--identification-s", "8", "--verification-s", "7"]
-    assert main([*args, "--out", str(tmp_path), "--quiet"]) == 0
-    report = json.loads((tmp_path / "planar.json").read_text())
+    random = ["--planar-identification", "random", "--out", str(tmp_path / "random"), "--quiet"]
+    assert main([*args, *random]) == 0
+    report = json.loads((tmp_path / "random" / "planar.json").read_text())
     assert list(report["fit_warnings"]) == ["boucwen"]  # the linear fit has none
     (said,) = report["fit_warnings"]["boucwen"]
     assert said.startswith("relaxation warning:") and "1 s" in said
     assert f"boucwen: {said}" in capsys.readouterr().out
+    assert main([*args, "--out", str(tmp_path / "programme"), "--quiet"]) == 0
+    assert json.loads((tmp_path / "programme" / "planar.json").read_text())["fit_warnings"] == {}
 
 
 def test_the_programme_identification_adds_the_n1_coupled_sets_and_random_leaves_them_out():
     programme = r3.identification_records(PAPER_DT, 0, 8.0)
     random = r3.identification_records(PAPER_DT, 0, 8.0, "random")
-    assert len(random) == 2 and len(programme) == 4
+    assert len(random) == 2 and len(programme) == 5
     for (q, f), (q0, f0) in zip(programme[:2], random, strict=True):
         assert np.array_equal(q, q0) and np.array_equal(f, f0)  # the random records unchanged
-    radial_held, rotation_held = (q for q, _ in programme[2:])
+    radial_held, rotation_held, axial_held = (q for q, _ in programme[2:])
     assert radial_held.shape[0] == int(round(4.0 / PAPER_DT))  # half the random records' length
     assert radial_held[-1, 1] == pytest.approx(2e-3) and rotation_held[-1, 2] == pytest.approx(0.05)
+    assert axial_held[-1, 0] == pytest.approx(2e-3) and np.all(axial_held[:, 2] == 0)
     with pytest.raises(ValueError, match="identification 'sweeps'"):
         r3.identification_records(PAPER_DT, 0, 8.0, "sweeps")
 
