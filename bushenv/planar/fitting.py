@@ -49,6 +49,7 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
     time_limit_s: float = option(120.0, "wall-time limit of the backbone's search, s (0: none)")
     relaxation_times: str = option_like(PlanarBoucWenOptions, "relaxation_times")
     relaxation_selection: str = option_like(PlanarBoucWenOptions, "relaxation_selection")
+    network: str = option_like(PlanarHybridOptions, "network")
 
     def check(self) -> None:
         super().check()
@@ -100,9 +101,11 @@ def _network(kind: str):
         from bushenv.planar.train import fit_planar_network
 
         q, f = [h[0] for h in histories], [h[1] for h in histories]
-        model = fit_planar_network(q, f, dt, kind, opts.train_options(), seed, quiet=say is None)
-        info = certified_info(model)
-        return model, info
+        gated = getattr(opts, "network", "always") == "if-better"
+        model = fit_planar_network(
+            q, f, dt, kind, opts.train_options(), seed, quiet=say is None, may_drop=gated
+        )
+        return model, {**certified_info(model), **network_info(model)}
 
     return fit
 
@@ -119,6 +122,21 @@ def certified_info(model: Any) -> dict[str, str]:
             f"{check['out_of_band']} out-of-band fixed points, max spectral radius "
             f"{check['max_spectral_radius']:.3f}, {check['unsettled_holds']} unsettled holds, "
             f"{check['holds_without_one_fixed_point']} holds without exactly one fixed point"
+        )
+    }
+
+
+def network_info(model: Any) -> dict[str, str]:
+    """Whether a hybrid kept its network, and the validation figures that chose, for the card."""
+    gate = getattr(model, "training", {}).get("network")
+    if gate is None:
+        return {}
+    verdict = "DROPPED (the backbone alone is the model)" if gate["dropped"] else "kept"
+    return {
+        "network": (
+            f"{verdict}: free run on the training records' validation tails, sum of RMS ratios "
+            f"{gate['with_network']:.4f} with the network, {gate['backbone_alone']:.4f} "
+            "with the backbone alone"
         )
     }
 
@@ -142,8 +160,12 @@ def _hybrid_bw(histories, dt, opts, seed, say):
     backbone, info = fit_planar_boucwen(histories, dt, opts.backbone_options(), say=say)
     q = [h[0] for h in histories]
     residual = [h[1] - backbone.simulate(h[0]) for h in histories]
-    net = fit_planar_network(q, residual, dt, "nn", opts.train_options(), seed, quiet=say is None)
-    return compose(backbone, net), {f"backbone {k}": v for k, v in info.items()}
+    gated = opts.network == "if-better"
+    net = fit_planar_network(
+        q, residual, dt, "nn", opts.train_options(), seed, quiet=say is None, may_drop=gated
+    )
+    info = {f"backbone {k}": v for k, v in info.items()}
+    return compose(backbone, net), {**info, **network_info(net)}
 
 
 PLANAR_FITS.add("hybrid-bw", PlanarFit(PlanarHybridBWOptions, _hybrid_bw))

@@ -105,6 +105,7 @@ def fit_planar_network(
     options: TrainOptions | None = None,
     seed: int = 0,
     quiet: bool = True,
+    may_drop: bool = False,
 ) -> PlanarNarx:
     """Identify a planar network from a record ``q`` (T, 3) m/rad, ``f`` (T, 3) N/N m, or from
     several: equal-length lists of such arrays.
@@ -114,11 +115,16 @@ def fit_planar_network(
     ``seed``. Each record is split as in ``bushenv.identify.narx_data``: its first 1 -
     ``val_fraction`` trains, its last ``val_fraction`` selects the weights (free-run error over
     every record's tail), and no lag or free-run window reaches across two records.
+
+    ``may_drop`` (a backbone's network: "hybrid", or a network on another backbone's residual
+    ``f``): a network adding exactly zero is a candidate too, kept when its validation error is
+    lower (the backbone alone is then the model); ``model.training["network"]`` says which.
+    Not with the certified term, whose admission orders the candidates.
     """
     threads = torch.get_num_threads()
     torch.set_num_threads(1)  # these nets are tiny: threads only add contention (15 s vs 0.2 s)
     try:
-        return _fit(_records(q, f), dt, kind, options, seed, quiet)
+        return _fit(_records(q, f), dt, kind, options, seed, quiet, may_drop)
     finally:
         torch.set_num_threads(threads)
 
@@ -164,6 +170,19 @@ def _split(records, opt) -> list[int]:
     return tails
 
 
+def _gate(model: PlanarNarx, val_error, with_network: float) -> PlanarNarx:
+    """``model``, or the same network adding exactly zero when that validates better."""
+    params = dict(model.params)
+    params["w_out"] = np.zeros_like(params["w_out"])
+    params["b_out"] = -np.asarray(params["f_offset"]) / np.asarray(params["f_scale"])
+    null = type(model)(**params, **model.extra_meta(), dt=model.dt)
+    alone = val_error(null)
+    kept = null if alone < with_network else model
+    kept.training = {"network": {"dropped": kept is null, "with_network": with_network,
+                                 "backbone_alone": alone}}  # fmt: skip
+    return kept
+
+
 def _window_starts(lengths: list[int], window: int) -> np.ndarray:
     """The rows (in the training parts stacked) where a free-run window of ``window`` rows
     starts and stays inside one record's training part of ``lengths`` rows."""
@@ -173,7 +192,7 @@ def _window_starts(lengths: list[int], window: int) -> np.ndarray:
     ).astype(np.int64)
 
 
-def _fit(records, dt, kind, options, seed, quiet) -> PlanarNarx:
+def _fit(records, dt, kind, options, seed, quiet, may_drop=False) -> PlanarNarx:
     if kind not in KINDS:
         raise PlanarModelError(f"unknown planar network kind {kind!r}; known: {list(KINDS)}")
     opt = options or default_options(kind)
@@ -262,10 +281,10 @@ def _fit(records, dt, kind, options, seed, quiet) -> PlanarNarx:
         if term is not None and (i + 1) % TEACHER_CHECK_EVERY == 0:
             term.check(build(), problem.estimate)  # the grid's failing holds join the term
 
-    def val_error() -> float:
+    def val_error(model: PlanarNarx | None = None) -> float:
         """Sum over the axes of the free-run RMS ratio on every record's tail (total force),
         each tail run from rest."""
-        model = build()
+        model = model or build()
         pred = np.vstack([model.simulate(r[0][-n:]) for r, n in zip(records, tails, strict=True)])
         return float(np.sum(np.sqrt(np.mean((pred - f_val_total) ** 2, axis=0)) / f_val_rms))
 
@@ -297,6 +316,8 @@ def _fit(records, dt, kind, options, seed, quiet) -> PlanarNarx:
     net.load_state_dict(best_state)
     progress.update(None, f"done, validation sum of RMS ratios {best[1]:.4f}", force=True)
     model = build()
+    if may_drop and term is None:
+        model = _gate(model, val_error, best[1])
     if term is not None:
         model.training = {
             "certified": term.check(model, problem.estimate),

@@ -139,6 +139,7 @@ NOISY_FEEDBACK_TRAINING = {
     "feedback_noise": 0.1,
 }
 HYBRID_TRAININGS = ("plain", "noisy-feedback")
+NETWORK_KEPT = ("if-better", "always")
 
 
 @dataclass(frozen=True)
@@ -152,6 +153,13 @@ class PlanarHybridOptions(PlanarNetworkOptions):
         "step ahead with noise 0.1 on the fed-back outputs, 3x as accurate on unseen records "
         "but with more than one fixed point at some holds (the card warns); flags given win",
         choices=HYBRID_TRAININGS,
+    )
+    network: str = option(
+        "if-better",
+        "if-better: the network is kept only if its free run on the training records' "
+        "validation tails beats the backbone alone, else the model is the backbone with a "
+        "network that adds exactly zero (the card says which); always: keep the best network",
+        choices=NETWORK_KEPT,
     )
 
     @staticmethod

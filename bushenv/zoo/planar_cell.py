@@ -153,6 +153,8 @@ def run_planar_cell(cell: dict[str, Any]) -> dict[str, Any]:
     seed, budget = int(cell["seed"]), int(cell["budget"])
     train, unseen = planar_records(seed)
     options = {**PLANAR_RECIPES[cell["recipe"]], **cell.get("train_options", {})}
+    if cell["model"] == "hybrid":  # a member is a network under study: never the backbone alone
+        options.setdefault("network", "always")
     fit = fit_planar([train], cell["model"], options, dt=PAPER_DT, seed=seed)
     model = fit.model
     path = model.save(Path(cell["out"]) / "models" / f"{planar_cell_name(cell)}.npz")
