@@ -28,7 +28,8 @@ invents there, in N (N m).
 
 ``planar.json`` layout: {"settings": {...}, "paper": TABLE3, "records": {record: {model:
 {axis: {"rms_ratio", "esr", "max_error_ratio", "max_error", "at_rest"}}}}, "identification_s":
-{model: s}}; fractions, N and N m.
+{model: s}, "fit_notes": {model: [what its fit warned of, and whether a hybrid kept its
+network]}}; fractions, N and N m.
 """
 
 from __future__ import annotations
@@ -116,8 +117,11 @@ def planar_table(
         result = fit_planar(histories, name, _untimed(name), dt, seed)
         fitted[name] = result.model
         seconds[name] = time.perf_counter() - t0
-        # what the fit says its records could not identify, as its card would
-        warnings[name] = [f"{k}: {v}" for k, v in result.info.items() if "warning" in k]
+        # what the fit says its records could not identify, and whether a hybrid kept its
+        # network, as its card would
+        warnings[name] = [
+            f"{k}: {v}" for k, v in result.info.items() if "warning" in k or k == "network"
+        ]
         progress.update(progress.done + EFFORT[name], f"[3-axis] {name} in {seconds[name]:.1f} s")
     out: dict[str, Any] = {}
     for k, (rec, qt) in enumerate(unseen_records(dt, seed, verif_s).items()):
@@ -145,7 +149,7 @@ def planar_table(
         },  # fmt: skip
         "paper": TABLE3,
         "identification_s": seconds,
-        "fit_warnings": {m: w for m, w in warnings.items() if w},
+        "fit_notes": {m: w for m, w in warnings.items() if w},
         "records": out,
     }
 
@@ -187,6 +191,6 @@ def format_planar(report: dict[str, Any]) -> str:
         lines.append(f"{'seed 000 Table 3':32s} {c:9s}" + "".join(cells))
     secs = ", ".join(f"{m} {s:.1f} s" for m, s in report["identification_s"].items())
     lines.append(f"identified in: {secs}")
-    for m, said in report.get("fit_warnings", {}).items():
+    for m, said in report.get("fit_notes", {}).items():
         lines += [f"{m}: {w}" for w in said]
     return "\n".join(lines)

@@ -50,12 +50,12 @@ def test_the_table_carries_what_the_fits_could_not_identify(tmp_path, monkeypatc
     random = ["--planar-identification", "random", "--out", str(tmp_path / "random"), "--quiet"]
     assert main([*args, *random]) == 0
     report = json.loads((tmp_path / "random" / "planar.json").read_text())
-    assert list(report["fit_warnings"]) == ["boucwen"]  # the linear fit has none
-    (said,) = report["fit_warnings"]["boucwen"]
+    assert list(report["fit_notes"]) == ["boucwen"]  # the linear fit has none
+    (said,) = report["fit_notes"]["boucwen"]
     assert said.startswith("relaxation warning:") and "1 s" in said
     assert f"boucwen: {said}" in capsys.readouterr().out
     assert main([*args, "--out", str(tmp_path / "programme"), "--quiet"]) == 0
-    assert json.loads((tmp_path / "programme" / "planar.json").read_text())["fit_warnings"] == {}
+    assert json.loads((tmp_path / "programme" / "planar.json").read_text())["fit_notes"] == {}
 
 
 def test_the_programme_identification_adds_the_n1_coupled_sets_and_random_leaves_them_out():
@@ -93,3 +93,15 @@ def test_hybrid_bw_meets_the_target_on_unseen_random_coupled_records():
         if rec.startswith("random"):
             for axis, m in row["hybrid-bw"].items():
                 assert m["rms_ratio"] <= 0.03 and m["max_error_ratio"] <= 0.06, (rec, axis, m)
+
+
+def test_the_table_says_whether_the_hybrid_kept_its_network(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(r3, "MODELS", ("hybrid",))
+    short = {"hidden": 9, "teacher_steps": 50, "free_run_steps": 25, "windows": 8, "window": 32}
+    monkeypatch.setattr(r3, "fit_planar", lambda h, name, _, dt, seed: fit_planar(
+        h, name, short, dt, seed))  # fmt: skip
+    args = ["reproduce", "--planar", "only", "--identification-s", "8", "--verification-s", "7"]
+    assert main([*args, "--out", str(tmp_path), "--quiet"]) == 0
+    (said,) = json.loads((tmp_path / "planar.json").read_text())["fit_notes"]["hybrid"]
+    assert said.startswith(("network: kept: ", "network: DROPPED")) and "backbone alone" in said
+    assert f"hybrid: {said}" in capsys.readouterr().out
