@@ -132,11 +132,18 @@ def network_info(model: Any) -> dict[str, str]:
     if gate is None:
         return {}
     verdict = "DROPPED (the backbone alone is the model)" if gate["dropped"] else "kept"
+    alone, net = gate["backbone_alone"], gate["with_network"]
     return {
         "network": (
-            f"{verdict}: free run on the training records' validation tails, sum of RMS ratios "
-            f"{gate['with_network']:.4f} with the network, {gate['backbone_alone']:.4f} "
-            "with the backbone alone"
+            f"{verdict}: on the training records' validation tails the network "
+            + (
+                f"adds {100 * (net - alone) / alone:.1f} % to"
+                if net >= alone
+                else f"takes {100 * (alone - net) / alone:.1f} % off"
+            )  # fmt: skip
+            + " the error of the backbone alone (sum over "
+            f"the axes of the free run's RMS ratio to what the network is trained on, the force "
+            f"or a backbone's residual: {net:.4f} with it, {alone:.4f} without)"
         )
     }
 
