@@ -40,7 +40,6 @@ IDENTIFICATIONS = {
     "random": "random n = 1 only (as seed 000)",
 }
 N_VERIFY = 1.5
-PRELOAD_M = N_VERIFY * PEAK_AT_N1[1]  # the verification sets' radial preload, 3 mm
 
 
 def _random(n: float, duration_s: float, dt: float, seed: int) -> list[tuple[str, np.ndarray]]:

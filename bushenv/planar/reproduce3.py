@@ -43,14 +43,9 @@ from bushenv.identify.options import option_fields
 from bushenv.metrics import esr, max_error, max_error_ratio, rms_ratio
 from bushenv.planar.base import COORDS
 from bushenv.planar.fitting import PLANAR_FITS, fit_planar
-from bushenv.planar.machine import IDENTIFICATIONS, N_VERIFY, PRELOAD_M, coupled_sets
-from bushenv.planar.programme import (
-    PEAK_AT_N1,
-    preload_sweep,
-    random_correlated,
-    random_independent,
-)
-from bushenv.planar.reference import THETA_N1_RAD, PlanarRubber
+from bushenv.planar.machine import IDENTIFICATIONS, N_VERIFY, coupled_sets
+from bushenv.planar.programme import programme, random_correlated, random_independent
+from bushenv.planar.reference import PlanarRubber
 from bushenv.progress import Progress
 
 MODELS = ("linear", "nn-axis", "hybrid", "boucwen", "hybrid-bw")
@@ -78,15 +73,15 @@ def identification_records(
 
 
 def unseen_records(dt: float, seed: int, verif_s: float) -> dict[str, np.ndarray]:
-    """The coupled records the models never saw, (T, 3) each, by name."""
-    axial, theta = N_VERIFY * PEAK_AT_N1[0], N_VERIFY * THETA_N1_RAD
+    """The coupled records the models never saw, (T, 3) each, by name: ``programme``'s, but
+    the random independent one at n = 1, with the verification amplitude in the names."""
+    rec = programme(dt, seed, N_VERIFY, verif_s)
+    shown = f"n={N_VERIFY:g}"
     return {
-        "random correlated n=1": random_correlated(1.0, verif_s, dt, 4000 + seed),
-        "random correlated n=1.5": random_correlated(N_VERIFY, verif_s, dt, 2000 + seed),
-        "random independent n=1.5": random_independent(N_VERIFY, verif_s, dt, 1000 + seed),
-        "radial preload + rotation sweep": preload_sweep(1, PRELOAD_M, theta, verif_s, dt),
-        "rotation preload + radial sweep": preload_sweep(2, theta, PRELOAD_M, verif_s, dt),
-        "axial preload + radial sweep": preload_sweep(0, axial, PRELOAD_M, verif_s, dt),
+        "random correlated n=1": rec["random correlated n=1"],
+        f"random correlated {shown}": rec["random correlated"],
+        f"random independent {shown}": rec["random independent"],
+        **{k: q for k, q in rec.items() if not k.startswith("random")},
     }
 
 

@@ -105,3 +105,15 @@ def test_the_table_says_whether_the_hybrid_kept_its_network(tmp_path, monkeypatc
     (said,) = json.loads((tmp_path / "planar.json").read_text())["fit_notes"]["hybrid"]
     assert said.startswith(("network: kept: ", "network: DROPPED")) and "backbone alone" in said
     assert f"hybrid: {said}" in capsys.readouterr().out
+
+
+def test_the_unseen_records_are_the_programmes_one_list():
+    from bushenv.planar.programme import programme
+
+    unseen = r3.unseen_records(PAPER_DT, 2, 7.0)
+    listed = programme(PAPER_DT, 2, 1.5, 7.0)
+    assert np.array_equal(unseen["random correlated n=1.5"], listed["random correlated"])
+    for name in ("random correlated n=1", *(k for k in listed if not k.startswith("random"))):
+        assert np.array_equal(unseen[name], listed[name]), name
+    axial = listed["axial preload + radial sweep"]
+    assert axial[-1, 0] == pytest.approx(3e-3) and np.all(axial[:, 2] == 0)
