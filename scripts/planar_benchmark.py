@@ -136,8 +136,9 @@ def table(results: dict[int, dict]) -> str:
         for c in COORDS:
             if results[seeds[0]][rec]["linear"][c]["at_rest"]:
                 # only load-cell noise to compare with: the force the model invents, in N
+                unit = "N m" if c == "rotation" else "N"
                 cells = [
-                    f"{np.mean([results[s][rec][k][c]['max_abs'] for s in seeds]):.0f} N"
+                    f"{np.mean([results[s][rec][k][c]['max_abs'] for s in seeds]):.0f} {unit}"
                     for k in MODELS
                 ]
                 lines.append(f"| {rec} | {c} at rest: max error | " + " | ".join(cells) + " | - |")

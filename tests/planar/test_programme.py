@@ -71,4 +71,6 @@ def test_benchmark_table_reports_ratio_and_axes_at_rest_in_newtons():
     }
     lines = mod.table({0: {"set": row}}).splitlines()
     assert "axial at rest: max error | 7 N" in lines[2]
+    row["rotation"] = cell(1.0, rest=True)  # the axial set: the moment at rest, in N m
+    assert "rotation at rest: max error | 7 N m" in mod.table({0: {"set": row}})
     assert lines[3].endswith("| 2.00 |")  # nn-axis 8 % over nn 4 %
