@@ -71,6 +71,7 @@ def test_benchmark_table_reports_ratio_and_axes_at_rest_in_newtons():
     }
     lines = mod.table({0: {"set": row}}).splitlines()
     assert "axial at rest: max error | 7 N" in lines[2]
-    row["rotation"] = cell(1.0, rest=True)  # the axial set: the moment at rest, in N m
+    for k in mod.MODELS:  # the axial set: the moment at rest, in N m
+        row[k]["rotation"] = cell(1.0, rest=True)
     assert "rotation at rest: max error | 7 N m" in mod.table({0: {"set": row}})
     assert lines[3].endswith("| 2.00 |")  # nn-axis 8 % over nn 4 %
