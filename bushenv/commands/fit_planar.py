@@ -128,6 +128,9 @@ def summary(card: dict[str, Any], out: Path) -> str:
         from bushenv.planar.card import backbone_lines
 
         lines += backbone_lines(card)
+    from bushenv.planar.card import coverage_lines
+
+    lines += coverage_lines(card)
     if card.get("plots"):
         lines.append(f"figures: {', '.join(card['plots'])}")
     lines += [f"{k}: {v}" for k, v in src["info"].items()]

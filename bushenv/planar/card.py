@@ -19,6 +19,9 @@
 - ``holds`` (networks): their fixed points over the training range (``range_holds``);
 - ``backbone`` (hybrids, with held-out records): the backbone alone (``backbone_alone``), its
   per-axis metrics on each held-out record, so the card says what the network adds;
+- ``training_range``: the training records' largest |deflection| per coordinate, m / rad;
+  each record's ``peak_deflection`` beside it; held-out records beyond it by more than
+  ``BEYOND`` are named (``coverage_lines``): their figures judge extrapolation;
 - ``plots``: the figures beside the model file (``plots.fit_figures3``; none with
   ``--no-plots``).
 """
@@ -43,6 +46,7 @@ CARD_FORMAT = "bushenv-planar-model-card"
 CARD_VERSION = 1
 RATIOS = ("rms_ratio", "esr", "max_error_ratio", "nrmse", "fit_index")  # all_metrics' ratios
 WORSE_BY = 0.05  # a network worse than its backbone alone by more than this share is warned of
+BEYOND = 0.05  # a held-out record past the training deflection by more than this share is named
 
 
 def axis_metrics(
@@ -76,6 +80,7 @@ def record_entry(record: Any, role: str, model: Any, card_dir: Path) -> dict[str
         "sample_rate_hz": 1.0 / record.dt,
         "duration_s": float(record.time[-1] - record.time[0] + record.dt),
         "max_abs": {c: float(np.abs(record.f[:, i]).max()) for i, c in enumerate(COORDS)},
+        "peak_deflection": {c: float(np.abs(record.q[:, i]).max()) for i, c in enumerate(COORDS)},
     }
     entry["metrics"] = axis_metrics(record.f, model.simulate(record.q), record.q)
     return entry
@@ -120,7 +125,9 @@ def save_planar_fit(
     }
     from bushenv.planar.range_holds import range_holds
 
-    holds = range_holds(model, np.max([np.abs(r.q).max(axis=0) for r in train], axis=0))
+    span = np.max([np.abs(r.q).max(axis=0) for r in train], axis=0)
+    card["training_range"] = {c: float(span[i]) for i, c in enumerate(COORDS)}
+    holds = range_holds(model, span)
     if holds is not None:
         card["holds"] = holds
     backbone = model.backbone_alone()
@@ -173,6 +180,32 @@ def backbone_lines(card: dict[str, Any]) -> list[str]:
     ]
 
 
+def coverage_lines(card: dict[str, Any]) -> list[str]:
+    """The held-out records that go beyond the training records' largest deflection in some
+    coordinate by more than ``BEYOND``: their figures judge extrapolation, not the fit's range."""
+    span = card.get("training_range")
+    if not span:
+        return []
+    out = []
+    for r in card["records"]:
+        if r["role"] != "held-out" or "peak_deflection" not in r:
+            continue
+        ratios = {c: r["peak_deflection"][c] / span[c] for c in COORDS if span[c] > 0}
+        beyond = {c: x for c, x in ratios.items() if x > 1 + BEYOND}
+        beyond |= {c: None for c in COORDS if span[c] == 0 and r["peak_deflection"][c] > 0}
+        if beyond:
+            shown = ", ".join(
+                f"{c} {x:.2f}x" if x is not None else f"{c} (never moved in training)"
+                for c, x in beyond.items()
+            )
+            out.append(
+                f"extrapolation: {r['file'] or r['name']} goes beyond the training records' "
+                f"largest deflection ({shown}): its figures judge the model outside the range it "
+                "was identified on, where a fit's error grows fast (docs/planar.md)"
+            )
+    return out
+
+
 def _worst(metrics) -> dict[str, list[float | None]]:
     """Per axis [worst RMS ratio, worst MAX] over per-record ``axis_metrics``."""
     out: dict[str, list[float | None]] = {c: [None, None] for c in COORDS}
@@ -220,6 +253,9 @@ def card_markdown(card: dict[str, Any]) -> str:
                 f"| {r['file'] or r['name']} | {r['role']} | {c} | {_pct(m['rms_ratio'])} | "
                 f"{_pct(m['esr'])} | {_pct(m['max_error_ratio'])} | {m['max_error']:.4g} {unit} |"
             )
+    if coverage_lines(card):
+        lines += ["", "## Held-out records beyond the training range", ""]
+        lines += [f"- {line}" for line in coverage_lines(card)]
     if card.get("holds"):
         from bushenv.planar.range_holds import describe
 

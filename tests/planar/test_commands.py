@@ -90,7 +90,27 @@ def test_fit_on_3_axis_records_writes_model_and_per_axis_card(records, tmp_path,
         assert m["rms_ratio"] == pytest.approx(want, rel=1e-9)
         assert set(m) >= {"rms_ratio", "esr", "max_error_ratio", "max_error"}
     assert "| held-out | rotation |" in out.with_name(f"{model}.card.md").read_text()
-    assert "rotation" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "rotation" in printed
+    # the held-out records are at n = 1.5: the card names them as extrapolation
+    span = card["training_range"]
+    assert span["radial"] == pytest.approx(2e-3, rel=1e-6)
+    for r in card["records"][2:]:
+        assert r["peak_deflection"]["radial"] / span["radial"] == pytest.approx(1.5, rel=1e-6)
+        assert f"extrapolation: {r['file']} goes beyond" in printed
+        assert "axial 1.50x, radial 1.50x, rotation 1.50x" in printed
+    assert (
+        "## Held-out records beyond the training range"
+        in out.with_name(f"{model}.card.md").read_text()
+    )
+
+
+def test_a_held_out_record_within_the_training_range_is_not_named(records, tmp_path, capsys):
+    train, _ = records
+    out = tmp_path / "lin.npz"
+    args = ["fit", str(train[0]), "--model", "linear", "--validate", str(train[1])]
+    assert main([*args, "--out", str(out), "--quiet", "--no-plots"]) == 0
+    assert "extrapolation:" not in capsys.readouterr().out
 
 
 def _fails(args, capsys) -> str:
