@@ -131,6 +131,8 @@ def network_info(model: Any) -> dict[str, str]:
     gate = getattr(model, "training", {}).get("network")
     if gate is None:
         return {}
+    if gate.get("gated") is False:
+        return {"network": "kept without the gate: --certified on keeps the best admitted weights"}
     verdict = "DROPPED (the backbone alone is the model)" if gate["dropped"] else "kept"
     alone, net = gate["backbone_alone"], gate["with_network"]
     return {

@@ -323,4 +323,6 @@ def _fit(records, dt, kind, options, seed, quiet, may_drop=False) -> PlanarNarx:
             "certified": term.check(model, problem.estimate),
             "static_estimate": problem.estimate.as_dict(),
         }
+        if may_drop:  # admission ordered the weights: the network is kept, and the card says so
+            model.training["network"] = {"dropped": False, "gated": False}
     return model

@@ -247,6 +247,8 @@ def test_bushenv_fit_takes_certified_on_for_3_axis_records(tmp_path, capsys):
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "certified: " in out and "343 holds" in out
+    # admission ordered the weights, so the network gate did not judge: the card says so
+    assert "network: kept without the gate: --certified on" in out
     bad = [*args[:-3], "--certified-low", "1.5", "--out", str(tmp_path / "d.npz"), "--quiet"]
     assert main(bad) == 2
     err = capsys.readouterr().err.strip().splitlines()
