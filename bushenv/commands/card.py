@@ -50,6 +50,11 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"  {r['role']:9s} {r['file'] or r['name']}  {r['duration_s']:.1f} s  {score}{checked}"
         )
+    if d.get("format") == PLANAR_FORMAT:  # held-out records that judged extrapolation
+        from bushenv.planar.card import coverage_lines
+
+        for line in coverage_lines(d):
+            print(f"  {line}")
     if args.records:
         print(f"{len(args.records)} record file(s) match the card")
     return 0

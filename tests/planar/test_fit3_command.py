@@ -146,6 +146,12 @@ def test_bushenv_card_reads_a_planar_card_checks_its_records_and_shows_ratios_pe
     assert "model linear in m.npz (sha256 matches)" in out
     assert "train.csv" in out and "(checked)" in out and "axial" in out and "rotation" in out
     assert "1 record file(s) match the card" in out
+    assert "extrapolation:" not in out  # the held-out record moves as the training one
+    wide = save_planar_csv(tmp_path / "wide.csv", t, 1.5 * q, f)
+    assert fit([rec], tmp_path / "w.npz", "--model", "linear", "--validate", str(wide)) == 0
+    capsys.readouterr()
+    assert main(["card", str(tmp_path / "w.npz")]) == 0
+    assert "extrapolation: wide.csv goes beyond" in capsys.readouterr().out
     held.write_text(held.read_text().replace("0", "1", 5))  # the held-out record changed
     line = fails(["card", str(tmp_path / "m.npz"), str(held)], capsys)
     assert "held.csv does not match the card" in line
