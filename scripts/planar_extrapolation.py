@@ -27,6 +27,7 @@ import numpy as np
 
 from bushenv.metrics import max_error_ratio, rms_ratio
 from bushenv.models.base import PAPER_DT
+from bushenv.persist import write_figure
 from bushenv.planar import reproduce3 as r3
 from bushenv.planar.fitting import fit_planar
 from bushenv.planar.machine import coupled_sets
@@ -148,8 +149,7 @@ def _plot(curves: dict, png: str) -> None:
     ax.set_title("boucwen identified at n = 1, judged on the coupled sets")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(png, dpi=120)
-    plt.close(fig)
+    write_figure(fig, png, dpi=120)  # atomic, and closed
 
 
 if __name__ == "__main__":
