@@ -32,7 +32,17 @@ VOLATILE = {
     "elapsed_s",
     "time_s",
     "files",
+    "backbone wall_time_s",
 }
+
+
+def relative(obj: Any, out: Path) -> Any:
+    """``obj`` with the run's temporary folder written as ``<out>`` in every string."""
+    if isinstance(obj, dict):
+        return {k: relative(v, out) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [relative(v, out) for v in obj]
+    return obj.replace(str(out), "<out>") if isinstance(obj, str) else obj
 
 
 # The entries the goldens were recorded on; registering another must not change them.
@@ -133,6 +143,93 @@ def corpus_run() -> dict[str, Any]:
     return rows
 
 
+# The three-axis side, recorded before it became a dimension of the one-axis code: the same
+# commands must say the same on the same records.
+PLANAR_NET = ["--teacher-steps", "40", "--free-run-steps", "20"]
+
+
+def _planar_records(out: Path) -> list[str]:
+    from bushenv.cli import main
+
+    code = main(["measure", "--axes", "3", "--programme", "random", "--duration", "8",
+                 "--out", str(out / "rec3"), "--quiet", "--force"])  # fmt: skip
+    if code != 0:
+        raise RuntimeError(f"measure exited {code}")
+    return [str(out / "rec3" / f"random_{k}_n1_8s_seed0.csv") for k in ("independent", "correlated")]
+
+
+def _planar_fit(out: Path, model: str, extra: list[str]) -> dict[str, Any]:
+    from bushenv.cli import main
+    from bushenv.identify.card import card_paths
+
+    train, held = _planar_records(out) if not (out / "rec3").exists() else [
+        str(out / "rec3" / f"random_{k}_n1_8s_seed0.csv") for k in ("independent", "correlated")
+    ]
+    path = out / f"{model}3.npz"
+    code = main(["fit", train, "--validate", held, "--model", model, "--out", str(path),
+                 "--no-plots", "--quiet", "--force", *extra])  # fmt: skip
+    if code != 0:
+        raise RuntimeError(f"fit exited {code}")
+    card = json.loads(card_paths(path)[0].read_text())
+    for key in ("model_sha256", "params_sha256", "created", "bushenv_version"):
+        card.pop(key, None)
+    for rec in card.get("records", []):
+        rec.pop("sha256", None)
+    card.get("source", {}).pop("wall_time_s", None)
+    return relative(strip(card), out)
+
+
+def planar_fit_run(out: Path) -> dict[str, Any]:
+    """``bushenv fit`` on 3-axis records: linear, a short MIMO network, a short hybrid-bw."""
+    return {
+        "linear": _planar_fit(out, "linear", []),
+        "nn": _planar_fit(out, "nn", PLANAR_NET),
+        "hybrid-bw": _planar_fit(out, "hybrid-bw", ["--evaluations", "12", *PLANAR_NET]),
+    }
+
+
+def planar_attack_run(out: Path) -> dict[str, Any]:
+    """``bushenv attack --env rig3`` on a fitted network judged by a fitted hybrid-bw."""
+    from bushenv.cli import main
+
+    planar_fit_run(out)
+    args = ["attack", "--env", "rig3", "--model", str(out / "nn3.npz"), "--reference",
+            str(out / "hybrid-bw3.npz"), "--trust-reference", "--budget", "16", "--max-shrink",
+            "1", "--shrink-budget", "20", "--threads", "1", "--no-plots", "--quiet", "--force", "--out",
+            str(out / "att3")]  # fmt: skip
+    if main(args) != 0:
+        raise RuntimeError("attack --env rig3 failed")
+    report = json.loads((out / "att3" / "report.json").read_text())
+    for entry in report.get("models", {}).values():
+        if isinstance(entry, dict):
+            entry.pop("sha256", None)
+    return relative(strip(report), out)
+
+
+def planar_certificate_run(out: Path) -> dict[str, Any]:
+    """A three-axis network's holds over its range and the linear fit's passivity matrix."""
+    from bushenv.planar.passivity import passivity
+    from bushenv.planar.range_holds import range_holds
+    from bushenv.planar.registry import load_planar_model
+
+    planar_fit_run(out)
+    nn = load_planar_model(out / "nn3.npz")
+    holds = range_holds(nn, np.array([0.004, 0.004, 0.05]))
+    holds.pop("seconds", None)
+    lin = load_planar_model(out / "linear3.npz")
+    rep = passivity(lin, np.zeros(3), np.array([1.0, 5.0, 20.0]))
+    rows = {k: (v if isinstance(v, str) else np.asarray(v).tolist()) for k, v in vars(rep).items()}
+    return strip({"holds": holds, "passivity": rows})
+
+
+def planar_reproduce_run(out: Path) -> dict[str, Any]:
+    """``bushenv reproduce --planar only``'s table, the linear model on short records."""
+    from bushenv.models.base import PAPER_DT
+    from bushenv.planar.reproduce3 import planar_table
+
+    return strip(planar_table(0, 6.0, 6.0, PAPER_DT, models=("linear",)))
+
+
 RUNS = {
     "attack": attack_run,
     "attack_rl": attack_rl_run,
@@ -140,6 +237,10 @@ RUNS = {
     "reproduce": reproduce_run,
     "diagnose": diagnose_run,
     "corpus": lambda out: corpus_run(),
+    "planar_fit": planar_fit_run,
+    "planar_attack": planar_attack_run,
+    "planar_certificate": planar_certificate_run,
+    "planar_reproduce": planar_reproduce_run,
 }
 
 
