@@ -80,6 +80,20 @@ class Certificate:
     passivity: list[dict] = field(default_factory=list)
 
 
+def wrong_sign(x_m: float, static_n: float | None, reference_n: float = float("nan")) -> bool:
+    """Whether a held static force has the wrong sign: against the reference's static force
+    when there is one (both beyond ``SIGN_FLOOR_N``); without one (``reference_n`` NaN),
+    against the deflection itself -- a passive bushing's relaxed force pushes back, so it has
+    the sign of x (beyond ``SIGN_FLOOR_N``; x = 0 has no sign)."""
+    if static_n is None:
+        return False
+    if np.isfinite(reference_n):
+        return bool(
+            static_n * reference_n < 0 and min(abs(static_n), abs(reference_n)) > SIGN_FLOOR_N
+        )
+    return bool(static_n * x_m < 0 and abs(static_n) > SIGN_FLOOR_N)
+
+
 # ----- cheap pieces for searchers ------------------------------------------------------------
 def stability_margin(fp: FixedPoints) -> np.ndarray:
     """(M,) 1 - spectral radius of each hold's least stable attractor: the largest radius
@@ -124,7 +138,7 @@ def _hold_entry(net, fp, gh, run, i, ref_n, bands) -> dict:
     idx = fp.of_hold(i)
     static = None if run.reached is None else float(fp.force_n[idx[run.reached]])
     ref = float(ref_n[i])
-    wrong = static is not None and static * ref < 0 and min(abs(static), abs(ref)) > SIGN_FLOOR_N
+    wrong = wrong_sign(float(fp.x_m[i]), static, ref)
     off = static is not None and float(static_margin(static, ref, FORCE_FLOOR_N)) < 0
     g = gh.hold == i
     return {
@@ -272,7 +286,7 @@ def certify(
     bands = _reached_bands(net, fp, runs, opts.velocity)
     timing["free_runs_s"], done = time.perf_counter() - t, done + units["free runs"]
     t = stage("reference holds")
-    ref_static = (  # no reference: no static comparison (wrong sign, off band) is made
+    ref_static = (  # no reference: no comparison (off band); wrong sign against x itself
         np.full(x.size, np.nan)
         if reference is None
         else reference_static_force(reference, x, opts.hold_s)
@@ -286,6 +300,11 @@ def certify(
     timing["energy_scan_s"] = time.perf_counter() - t
     holds = [_hold_entry(net, fp, gh, r, i, ref_static, bands[i]) for i, r in enumerate(runs)]
     doc = _document(net, opts, holds, fo, pas, scan, timing)
+    doc["settings"]["wrong_sign_against"] = (
+        "the deflection (no reference: a passive bushing's static force has the sign of x)"
+        if reference is None
+        else "the reference's static force"
+    )
     return Certificate(doc, net, fp, gh, fo, runs, ref_static, pas)
 
 

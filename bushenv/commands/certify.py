@@ -211,8 +211,9 @@ def _summary(doc: dict, paths: list[Path], judge) -> None:
     )
     if judge.reference is None:
         print(
-            "no reference: the static comparison (wrong sign, static force off the reference's) "
-            "needs one and was not made; pass --reference NAME|FILE"
+            "no reference: wrong sign is judged against the deflection (a passive bushing's "
+            "static force has the sign of x); the static force's size (off the reference's) "
+            "needs one and was not compared; pass --reference NAME|FILE"
         )
     print(
         f"holds: {s['holds']}, settling stably {s['holds_settling_stably']}, departing "

@@ -130,3 +130,23 @@ def random_narx(rng: np.random.Generator, hidden=(6,), n_past_x=3, n_past_f=4, g
         n_past_x=n_past_x,
         n_past_f=n_past_f,
     )
+
+
+def pulling_nn(f_scale_n=500.0, beta=0.5) -> NarxBushing:
+    """A NARX network that pulls: y_t = tanh(-beta (xs_t + xs_{t-1}) / 2 + 0.2 y_{t-1}),
+    F = f_scale y, so a
+    held +4 mm gives about -460 N (the sign against the deflection, no reference needed)."""
+    return NarxBushing(
+        x_offset_m=0.0,
+        x_scale_m=X_SCALE_M,
+        f_offset_n=0.0,
+        f_scale_n=f_scale_n,
+        w1=np.array([[-beta / 2, -beta / 2, 0.2]]),
+        b1=np.zeros(1),
+        w2=np.zeros((0, 1)),
+        b2=np.zeros(0),
+        w_out=np.ones(1),
+        b_out=0.0,
+        n_past_x=1,
+        n_past_f=1,
+    )
