@@ -155,16 +155,20 @@ def _planar_records(out: Path) -> list[str]:
                  "--out", str(out / "rec3"), "--quiet", "--force"])  # fmt: skip
     if code != 0:
         raise RuntimeError(f"measure exited {code}")
-    return [str(out / "rec3" / f"random_{k}_n1_8s_seed0.csv") for k in ("independent", "correlated")]
+    return _record_paths(out)
+
+
+def _record_paths(out: Path) -> list[str]:
+    return [
+        str(out / "rec3" / f"random_{k}_n1_8s_seed0.csv") for k in ("independent", "correlated")
+    ]
 
 
 def _planar_fit(out: Path, model: str, extra: list[str]) -> dict[str, Any]:
     from bushenv.cli import main
     from bushenv.identify.card import card_paths
 
-    train, held = _planar_records(out) if not (out / "rec3").exists() else [
-        str(out / "rec3" / f"random_{k}_n1_8s_seed0.csv") for k in ("independent", "correlated")
-    ]
+    train, held = _record_paths(out) if (out / "rec3").exists() else _planar_records(out)
     path = out / f"{model}3.npz"
     code = main(["fit", train, "--validate", held, "--model", model, "--out", str(path),
                  "--no-plots", "--quiet", "--force", *extra])  # fmt: skip
@@ -195,8 +199,8 @@ def planar_attack_run(out: Path) -> dict[str, Any]:
     planar_fit_run(out)
     args = ["attack", "--env", "rig3", "--model", str(out / "nn3.npz"), "--reference",
             str(out / "hybrid-bw3.npz"), "--trust-reference", "--budget", "16", "--max-shrink",
-            "1", "--shrink-budget", "20", "--threads", "1", "--no-plots", "--quiet", "--force", "--out",
-            str(out / "att3")]  # fmt: skip
+            "1", "--shrink-budget", "20", "--threads", "1", "--no-plots", "--quiet", "--force",
+            "--out", str(out / "att3")]  # fmt: skip
     if main(args) != 0:
         raise RuntimeError("attack --env rig3 failed")
     report = json.loads((out / "att3" / "report.json").read_text())
