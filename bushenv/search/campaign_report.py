@@ -16,6 +16,8 @@
 from __future__ import annotations
 
 import json
+import textwrap
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -139,43 +141,123 @@ def _search_row(key: str, role: str, name: str, s: dict[str, Any]) -> str:
     )
 
 
+@dataclass(frozen=True)
+class Column:
+    """One column of the attack table: its header, width, alignment and meaning."""
+
+    name: str
+    width: int
+    align: str  # "<" or ">"
+    meaning: str
+
+
+# The table's columns in order: the header, the legend under the table and report.md's column
+# table are all made from this (docs may reuse ``legend_lines``).
 COLUMNS = (
-    ("model", "the model's report key (a registered name or a model file's stem)"),
-    (
+    Column("model", 12, "<", "the model's report key (a registered name or a file's stem)"),
+    Column(
         "role",
-        "target (under attack), hybrid (rechecked on its failures, then attacked), "
-        "control (must stay clean: a flagged control means the criteria are at fault)",
+        8,
+        "<",
+        "target: under attack; hybrid: rechecked on the target's failures, then attacked; "
+        "control: must stay clean (if flagged, the criteria are at fault); also: rechecked",
     ),
-    ("searcher", "the search that produced the row (``SEARCHERS``)"),
-    ("evals", "model evaluations spent (profiles simulated; an RL episode is one)"),
-    ("diverged", "whether any profile made the model diverge"),
-    ("evals->fail", "evaluations until the first failing profile"),
-    ("s->fail", "wall-clock seconds until the first failing profile (this machine, this load)"),
-    (
+    Column("searcher", 11, "<", "the search that made the row (cert-holds: the hold stage)"),
+    Column("evals", 6, ">", "profiles simulated by that search (an RL episode is one)"),
+    Column("diverged", 8, ">", "YES when at least one profile made the model diverge"),
+    Column("evals->fail", 11, ">", "evaluations spent until the first failing profile"),
+    Column("s->fail", 8, ">", "wall-clock seconds until the first failure (this machine and load)"),
+    Column(
         "worst dev",
-        "largest |F_model - F_reference| over the worst profile, as a multiple of the "
-        "reference's peak force (dimensionless; 1.0 = an error as large as the whole force)",
+        9,
+        ">",
+        "on the row's worst profile (lowest robustness): max over time of |F_model - "
+        "F_reference|, over the reference's peak force on it (or the force floor, if larger); "
+        "1 = an error as large as the whole force; '-' or nan without a reference",
     ),
-    (
+    Column(
         "robustness",
-        "STL robustness of the worst profile: the margin to the nearest criterion, "
-        "in units of that criterion's scale (negative = diverged)",
+        10,
+        ">",
+        "STL margin of that worst profile to the nearest divergence criterion, in units of "
+        "the criterion's own scale: below 0 diverged, near 0 nearly",
+    ),
+    Column(
+        "failing family (criterion)",
+        0,
+        "<",
+        "the excitation family of the first failure and the criterion that fired "
+        "(bushenv/divergence.py); [reference outside its envelope]: on that profile the "
+        "reference left the range its card's records cover",
+    ),
+)
+
+# What the lines around the table say, keyed by the words they start with.
+SECTIONS = (
+    ("reference", "the bushing the verdicts compare with, and the divergence criteria run"),
+    (
+        "judge",
+        "the reference the verdicts compare with, its vetting (every check pass, FAILED or "
+        "not checked) and its envelope (where it is known to hold)",
+    ),
+    ("note", "what the judge could not judge, or judged otherwise, and why"),
+    (
+        "certificate holds",
+        "holds the target's certificate (bushenv certify) lists as oscillating, departing or "
+        "wrong-sign, each stepped to and held 10 s; confirmed ones diverged and join the "
+        "failures. A held force of the right sign but the wrong size is not listed: the "
+        "static criterion judges it in the rows",
     ),
     (
-        "failing family (criterion)",
-        "the excitation family of the first failure and the "
-        "divergence criterion that fired (bushenv/divergence.py)",
+        "covered on",
+        "what the searches against the target tried, per excitation family: profiles, peak "
+        "deflection range, fastest rate; a 'no' above means no divergence among these",
+    ),
+    ("recheck", "the profiles that broke the target, rerun on every other model"),
+    (
+        "shrunk failures",
+        "failures cut to the fewest segments and samples that still diverge, and every "
+        "model's verdict on the shrunk profile",
     ),
 )
 
 
-def format_table(report: dict[str, Any], target_key: str) -> str:
-    """The campaign as a plain-text table, the recheck and the shrunk failures."""
-    head = (
-        f"{'model':<12} {'role':<8} {'searcher':<11} {'evals':>6} {'diverged':>8} "
-        f"{'evals->fail':>11} {'s->fail':>8} {'worst dev':>9} {'robustness':>10} "
-        f"{'failing family (criterion)'}"
-    )
+LEGEND_WIDTH = 100
+
+
+def _header() -> str:
+    return " ".join(f"{c.name:{c.align}{c.width}}" for c in COLUMNS)
+
+
+def _has_section(printed: str, key: str) -> bool:
+    return any(line.startswith(key) for line in printed.splitlines())
+
+
+def legend_lines(printed: str | None = None) -> list[str]:
+    """The legend printed under the table: every column, then every kind of line around the
+    table that ``printed`` holds (all of them when None); wrapped at ``LEGEND_WIDTH``."""
+    width = max(len(c.name) for c in COLUMNS[:-1])
+    pad = " " * (width + 4)
+    lines = ["", "what the columns say:"]
+    for c in COLUMNS:
+        first = f"  {c.name:<{width}}  "
+        if len(c.name) > width:  # the last, long header: its meaning on the lines below
+            lines.append(f"  {c.name}")
+            first = pad
+        lines += textwrap.wrap(c.meaning, LEGEND_WIDTH, initial_indent=first, subsequent_indent=pad)
+    shown = [(k, t) for k, t in SECTIONS if printed is None or _has_section(printed, k)]
+    if shown:
+        lines.append("what the lines around it say:")
+        for k, t in shown:
+            lines += textwrap.wrap(f"{k}: {t}", LEGEND_WIDTH, initial_indent="  ",
+                                   subsequent_indent="      ")  # fmt: skip
+    return lines
+
+
+def format_table(report: dict[str, Any], target_key: str, legend: bool = True) -> str:
+    """The campaign as a plain-text table, the recheck and the shrunk failures; ``legend``:
+    what every column and line means, under it all (``legend_lines``)."""
+    head = _header()
     ref = report["reference"].get("spec")
     lines = [
         f"reference: {ref if ref is not None else 'none'}; criteria run: "
@@ -212,7 +294,8 @@ def format_table(report: dict[str, Any], target_key: str) -> str:
                 f"{fin['samples']} samples, {fin['peak_um'] / 1e3:.2f} mm peak; "
                 f"{_verdicts(e['verdicts'])}"
             )
-    return "\n".join(lines)
+    text = "\n".join(lines)
+    return "\n".join([text, *legend_lines(text)]) if legend else text
 
 
 def _judge_lines(judge: dict | None) -> list[str]:
@@ -278,9 +361,12 @@ def _coverage_lines(report: dict[str, Any], target_key: str) -> list[str]:
 
 def report_markdown(report: dict[str, Any], target_key: str, plots: list[str]) -> str:
     """``report.md``: the table, what each column means with its unit, the scales, the plots."""
-    lines = ["# Adversarial campaign", "", "```", format_table(report, target_key), "```", ""]
+    table = format_table(report, target_key, legend=False)
+    lines = ["# Adversarial campaign", "", "```", table, "```", ""]
     lines += ["## The columns", "", "| column | meaning |", "|---|---|"]
-    lines += [f"| {name} | {text} |" for name, text in COLUMNS]
+    lines += [f"| {c.name} | {c.meaning} |" for c in COLUMNS]
+    lines += ["", "| lines starting | meaning |", "|---|---|"]
+    lines += [f"| {k} | {t} |" for k, t in SECTIONS if _has_section(table, k)]
     lines += ["", "## Criteria", "", report["criteria"]["why"], ""]
     sc = report["scales"]
     lines += [
