@@ -3,7 +3,7 @@
     bushenv diagnose-validate --set reference|widened --cases N --seed S --out DIR
 
 Arguments become a ``ValidationConfig``; the cases, scoring and report are
-``bushenv/diagnose/validate.py`` (docs/diagnose.md).
+``bushenv/diagnose/validation/validate.py`` (docs/diagnose.md).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from bushenv.diagnose.validate import SETS, ValidationConfig, write_validation
+from bushenv.diagnose.validation.validate import SETS, ValidationConfig, write_validation
 
 EXAMPLE = "bushenv diagnose-validate --set widened --cases 60 --seed 0 --out validation/"
 

@@ -2,7 +2,7 @@
 registered effect, made by the effect's own forward form at its typical instance
 (``Effect.forward``, ``Effect.example``), so every registered effect has records without an
 entry here. Forms the candidates do not assume are the widened validation's
-(``bushenv/diagnose/truth_forms.py``)."""
+(``bushenv/diagnose/validation/truth_forms.py``)."""
 
 from __future__ import annotations
 

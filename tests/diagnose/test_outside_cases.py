@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from bushenv.diagnose.candidates import effect_names
-from bushenv.diagnose.outside_cases import FORMS, _play, make_outside_case, outside_force
 from bushenv.diagnose.rule import OUTSIDE
-from bushenv.diagnose.validate import SETS, judge_case
+from bushenv.diagnose.validation.outside_cases import FORMS, _play, make_outside_case, outside_force
+from bushenv.diagnose.validation.validate import SETS, judge_case
 
 
 def test_the_play_operator_moves_only_beyond_its_clearance():

@@ -3,9 +3,9 @@ import json
 import numpy as np
 
 from bushenv.cli import main
-from bushenv.diagnose.reference_cases import case_label, classes, make_case
-from bushenv.diagnose.validate import summarise
-from bushenv.diagnose.widened_cases import make_widened_case
+from bushenv.diagnose.validation.reference_cases import case_label, classes, make_case
+from bushenv.diagnose.validation.validate import summarise
+from bushenv.diagnose.validation.widened_cases import make_widened_case
 
 
 def test_case_mix_cycles_through_all_classes_and_puts_a_pair_in_every_fourth_case():
@@ -78,7 +78,7 @@ def test_each_reference_draw_switches_on_the_reference_effect_named_by_its_label
     # labels of the reference set name candidates, and each draw must set exactly the
     # reference effect of that name, or the scoring would judge against a wrong label
     from bushenv.diagnose.candidates import effect_names
-    from bushenv.diagnose.reference_cases import DRAWS, Draw
+    from bushenv.diagnose.validation.reference_cases import DRAWS, Draw
     from bushenv.reference.rubber import RubberBushing
 
     assert set(DRAWS) <= set(effect_names())

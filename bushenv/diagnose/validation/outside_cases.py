@@ -24,9 +24,9 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from bushenv.diagnose.reference_cases import Case
 from bushenv.diagnose.rule import OUTSIDE
-from bushenv.diagnose.widened_cases import (
+from bushenv.diagnose.validation.reference_cases import Case
+from bushenv.diagnose.validation.widened_cases import (
     BUSHING_RATES_HZ,
     NOISE_FRACTION,
     OVERSAMPLE,
@@ -35,7 +35,7 @@ from bushenv.diagnose.widened_cases import (
     _noisy,
     visible_gap,
 )
-from bushenv.diagnose.widened_programmes import bushing_programmes
+from bushenv.diagnose.validation.widened_programmes import bushing_programmes
 
 FORMS = ("backlash", "mullins", "zero_drift", "hum")
 

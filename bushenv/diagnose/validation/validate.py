@@ -33,11 +33,11 @@ import numpy as np
 from bushenv.diagnose.candidates import effect_names
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import diagnose
-from bushenv.diagnose.outside_cases import make_outside_case
-from bushenv.diagnose.reference_cases import Case, make_case
 from bushenv.diagnose.report import check_out_dir
 from bushenv.diagnose.rule import AMBIGUOUS, OUTSIDE
-from bushenv.diagnose.widened_cases import make_widened_case
+from bushenv.diagnose.validation.outside_cases import make_outside_case
+from bushenv.diagnose.validation.reference_cases import Case, make_case
+from bushenv.diagnose.validation.widened_cases import make_widened_case
 from bushenv.persist import write_text
 from bushenv.progress import Progress, ProgressSpec
 

@@ -20,15 +20,15 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose import truth_forms as tf
 from bushenv.diagnose.effects.backbone import Hardening
 from bushenv.diagnose.effects.delay import Delay
 from bushenv.diagnose.effects.friction import Friction
 from bushenv.diagnose.effects.inertia import Inertia
 from bushenv.diagnose.effects.relaxation import Relaxation
 from bushenv.diagnose.effects.thermal import Thermal
-from bushenv.diagnose.reference_cases import Case
-from bushenv.diagnose.widened_programmes import (
+from bushenv.diagnose.validation import truth_forms as tf
+from bushenv.diagnose.validation.reference_cases import Case
+from bushenv.diagnose.validation.widened_programmes import (
     bushing_programmes,
     quasi_static_programmes,
     regrid,
