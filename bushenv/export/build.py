@@ -35,6 +35,9 @@ from bushenv.models import ModelError, ModelSpec, file_hash, get_model, model_fi
 from bushenv.persist import atomic_write
 
 CFLAGS = ("-shared", "-fPIC", "-O2", "-std=c99", "-ffp-contract=off", "-fvisibility=hidden")
+# The C of an FMU: bushenv's own in c/, the FMI standard's headers vendored unchanged in
+# vendor/fmi/ (2-clause BSD, Modelica Association: vendor/fmi/LICENSE.txt). All of them sit
+# side by side where the compiler runs and under the FMU's sources/.
 HEADERS = ("core.h", "variables.h")
 FMI_HEADERS = {
     "2.0": ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h", "fmi2_me.h"),
@@ -46,6 +49,16 @@ FMI_HEADERS = {
         "fmi3_stubs.h",
     ),
 }
+FMI_STANDARD_HEADERS = frozenset(
+    {
+        "fmi2Functions.h",
+        "fmi2FunctionTypes.h",
+        "fmi2TypesPlatform.h",
+        "fmi3Functions.h",
+        "fmi3FunctionTypes.h",
+        "fmi3PlatformTypes.h",
+    }
+)
 INSTALL_HINT = (
     "install one (Debian/Ubuntu: apt-get install gcc; Fedora: dnf install gcc; macOS: "
     "xcode-select --install) or name it in $CC"
@@ -90,7 +103,10 @@ def platform_folders() -> dict[str, str]:
 
 
 def _c_file(name: str) -> bytes:
-    return (resources.files("bushenv.export") / "c" / name).read_bytes()
+    """One C file of the FMU: an FMI standard header from vendor/fmi/, bushenv's own from c/."""
+    here = resources.files("bushenv.export")
+    folder = here / "vendor" / "fmi" if name in FMI_STANDARD_HEADERS else here / "c"
+    return (folder / name).read_bytes()
 
 
 def _check_out(out: Path) -> None:
