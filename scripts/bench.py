@@ -1,6 +1,7 @@
 """bushenv benchmark: every speed and memory figure, measured side by side in ONE run.
 
-    python scripts/bench.py --write-docs         # full run, writes docs/benchmarks.md
+    python scripts/bench.py --write-docs         # full run, writes docs/benchmarks.{json,md}
+    python scripts/bench.py --from-json docs/benchmarks.json --write-docs   # the page, no run
     python scripts/bench.py --quick              # CI: small sizes, checks each figure is produced
     python scripts/bench.py --json bench.json    # every figure: name, value, unit, target, met
     (nothing in the checkout is written unless asked: --write-docs, or --markdown FILE)
@@ -34,6 +35,7 @@ import numpy as np
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 ROOT = Path(__file__).resolve().parents[1]
+DOCS_JSON = ROOT / "docs" / "benchmarks.json"  # the run docs/benchmarks.md is rendered from
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_compare  # noqa: E402  (the scipy and torch comparisons, beside this file)
 import bench_fmu  # noqa: E402  (the exported FMU's step, beside this file)
@@ -111,8 +113,7 @@ def bench_models(fig: Figures, quick: bool) -> None:
             if B == 1024 and name == "nn":
                 target = 50e6
             if B == 1024 and name == "boucwen":
-                target = 10e6  # issue 18 (issue 6 had asked 30e6)
-                note = "target of issue 18; issue 6 asked 3e7"
+                target = 10e6
             fig.add(f"free_run.{name}.B{B}", T * B / sec, "steps/s")
             if B == 1024:
                 # Both cores: two model copies, each on half of the batch, in two threads (the
@@ -404,7 +405,7 @@ def _option_flags(options: dict) -> list[str]:
     return flags
 
 
-# nn: 3 x its 15.6 s before the network was chosen on validation (docs/benchmarks.md, issue 24);
+# nn: 3 x its 15.6 s before the network was chosen on validation (docs/benchmarks.md);
 # the run with --choose off measures that older path on the same machine, same load.
 FIT_COMMAND_TARGETS_S = {"nn": 46.8, "nn-choose-off": 30.0, "hybrid": 40.0, "boucwen": 120.0}
 CHOICE_TIME_RATIO_TARGET = 3.0
@@ -626,7 +627,7 @@ def bench_float32_verdicts(fig: Figures, quick: bool) -> None:
 
 
 def bench_certify(fig: Figures, quick: bool) -> None:
-    """The certificate of one model over 200 held displacements (issue 17: under 1 s), whole
+    """The certificate of one model over 200 held displacements (target: under 1 s), whole
     (fixed points, folds, free runs, reference holds, passivity, energy scan; no plots) and
     its analysis alone (every fixed point, stability, folds, ghosts)."""
     print("\n== certificates: hold stability and passivity over 200 holds")
@@ -838,7 +839,7 @@ def _bench_planar_car(fig: Figures, quick: bool) -> None:
 
 
 def bench_planar(fig: Figures, quick: bool) -> None:
-    """Issue 25 item 8: a BushRig3-v0 step within 3x a BushRig-v0 step, and the MIMO network's
+    """Targets: a BushRig3-v0 step within 3x a BushRig-v0 step, and the MIMO network's
     batched free run per axis at least a third of the one-axis network's."""
     import tempfile
 
@@ -918,21 +919,38 @@ SECTIONS = {
 }
 
 
-def write_markdown(fig: Figures, path: Path, quick: bool) -> None:
+def run_record(fig: Figures, quick: bool) -> dict:
+    """What one run measured, as docs/benchmarks.json holds it: the page is rendered from this."""
+    return {
+        "quick": quick,
+        "date": time.strftime("%Y-%m-%d"),
+        "cores": os.cpu_count(),
+        "figures": fig.rows,
+    }
+
+
+def markdown(run: dict) -> str:
+    """The benchmarks page of one run (``run_record``); docs/benchmarks.md is exactly this of
+    docs/benchmarks.json (a test checks it), never edited by hand."""
+    quick = run.get("quick", False)
     lines = [
         "# Benchmarks",
         "",
+        "<!-- generated: python scripts/bench.py --write-docs (or --from-json "
+        "docs/benchmarks.json --write-docs); do not edit -->",
+        "",
         f"Measured by `python scripts/bench.py{' --quick' if quick else ''}` in one run on "
-        f"{os.cpu_count()} cores ({time.strftime('%Y-%m-%d')}). Noisy shared machine: "
-        "compare ratios within this table.",
+        f"{run['cores']} cores ({run['date']}). Noisy shared machine: "
+        "compare ratios within this table. The figures of this run: "
+        "[benchmarks.json](benchmarks.json).",
         "",
         "The identification figures are one fit per model (seed 0); how they vary with the "
-        "training seed: `python scripts/fit_seed_spread.py` (docs/fit-seed-spread.md).",
+        "training seed: [the fit-seed-spread study](../studies/2026-11-fit-seed-spread/README.md).",
         "",
         "| figure | value | unit | target | met | value / target | note |",
         "|---|---:|---|---:|---|---:|---|",
     ]
-    for r in fig.rows:
+    for r in run["figures"]:
         tgt = ratio = ""
         if "target" in r:
             tgt = f"{'>=' if r['better'] == 'higher' else '<='} {r['target']:.4g}"
@@ -942,7 +960,7 @@ def write_markdown(fig: Figures, path: Path, quick: bool) -> None:
             f"| {r['name']} | {r['value']:.4g} | {r['unit']} | {tgt} | {met} | {ratio} "
             f"| {r['note']} |"
         )
-    path.write_text("\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -952,9 +970,25 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--only", help="comma list of sections: " + ",".join(SECTIONS))
     p.add_argument("--markdown", type=Path, default=None, help="write the table to this file")
     p.add_argument(
-        "--write-docs", action="store_true", help="write the table to docs/benchmarks.md"
+        "--write-docs",
+        action="store_true",
+        help="write the run to docs/benchmarks.json and its table to docs/benchmarks.md",
+    )
+    p.add_argument(
+        "--from-json",
+        type=Path,
+        default=None,
+        help="measure nothing: render the table of a run's JSON (with --write-docs or --markdown)",
     )
     args = p.parse_args(argv)
+    if args.from_json:
+        run = json.loads(args.from_json.read_text())
+        md = args.markdown or ROOT / "docs" / "benchmarks.md"
+        if args.write_docs and args.from_json.resolve() != (DOCS_JSON).resolve():
+            DOCS_JSON.write_text(json.dumps(run, indent=2) + "\n")
+        md.write_text(markdown(run))
+        print(f"wrote {md}")
+        return 0
     import torch
 
     torch.set_num_threads(1)
@@ -970,13 +1004,16 @@ def main(argv: list[str] | None = None) -> int:
         except Exception as exc:  # a missing figure is a failure, reported by name
             print(f"  section {name} FAILED: {type(exc).__name__}: {exc}")
             failed.append(name)
+    run = run_record(fig, args.quick)
     if args.json:
-        args.json.write_text(json.dumps({"quick": args.quick, "figures": fig.rows}, indent=2))
+        args.json.write_text(json.dumps(run, indent=2) + "\n")
     md = args.markdown or (
         ROOT / "docs" / ("benchmarks-quick.md" if args.quick else "benchmarks.md")
     )
+    if args.write_docs and not args.quick and not failed:
+        DOCS_JSON.write_text(json.dumps(run, indent=2) + "\n")
     if args.markdown or args.write_docs:  # never a side effect of --json or a plain run
-        write_markdown(fig, md, args.quick)
+        md.write_text(markdown(run))
         print(f"\nwrote {md}")
     if failed:
         print(f"sections that produced no figures: {failed}")

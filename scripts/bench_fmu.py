@@ -8,7 +8,7 @@ Three ways of taking one sample of the shipped axial NN on a random n = 1 record
 * compiled, measured in C: a small harness compiled on the fly against the FMU's own sources
   times ``model_step`` alone and the FMI 2 calls (set, get, doStep) per sample, no Python.
 
-Targets (issue 26): the FMPy step at most 10x bushenv's, the compiled step within 2x.
+Targets: the FMPy step at most 10x bushenv's, the compiled step within 2x.
 """
 
 from __future__ import annotations

@@ -4,6 +4,7 @@ Only that each figure is produced (finite, with its unit, and ``met`` wherever a
 set) is checked: speed targets belong to the benchmark's full run, never to a unit test.
 """
 
+import importlib.util
 import json
 import math
 import subprocess
@@ -118,7 +119,7 @@ def test_quick_benchmark_produces_every_figure_with_units_and_targets(tmp_path):
         if "target" in r:
             assert isinstance(r["met"], bool), name
     assert rows["free_run.nn.B1024.threads2"]["target"] == 50e6
-    assert rows["free_run.boucwen.B1024.threads2"]["target"] == 10e6  # issue 18
+    assert rows["free_run.boucwen.B1024.threads2"]["target"] == 10e6
     assert rows["attack.reference_boucwen_over_rubber.time_ratio"]["target"] == 2.0
     # the comparisons are of the same computation: same network, same accuracy
     assert rows["compare.nn.torch_agreement"]["value"] < 1e-9
@@ -153,3 +154,24 @@ def test_quick_certify_benchmark_produces_its_figures(tmp_path):
             assert math.isfinite(rows[f"certify.{name}.{axis}.analysis_holds20"]["value"])
     # --json writes the JSON only: the checkout's docs are written only when asked
     assert {p: p.read_bytes() for p in (ROOT / "docs").glob("benchmarks*.md")} == docs
+
+
+def test_the_benchmarks_page_is_the_render_of_its_run_and_not_edited_by_hand(tmp_path):
+    spec = importlib.util.spec_from_file_location("bench", ROOT / "scripts" / "bench.py")
+    bench = importlib.util.module_from_spec(spec)
+    sys.path.insert(0, str(ROOT / "scripts"))  # bench imports its sibling modules
+    try:
+        spec.loader.exec_module(bench)
+    finally:
+        sys.path.remove(str(ROOT / "scripts"))
+    run = json.loads((ROOT / "docs" / "benchmarks.json").read_text())
+    assert (ROOT / "docs" / "benchmarks.md").read_text() == bench.markdown(run), (
+        "docs/benchmarks.md differs from its run: python scripts/bench.py --from-json "
+        "docs/benchmarks.json --write-docs"
+    )
+    md = tmp_path / "page.md"
+    assert (
+        bench.main(["--from-json", str(ROOT / "docs" / "benchmarks.json"), "--markdown", str(md)])
+        == 0
+    )
+    assert md.read_text() == bench.markdown(run)

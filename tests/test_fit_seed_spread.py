@@ -1,4 +1,5 @@
-"""``scripts/fit_seed_spread.py``: its summary counts, its markdown, and kept notes.
+"""``studies/2026-11-fit-seed-spread/fit_seed_spread.py``: its summary counts, its markdown and
+kept notes.
 
 The fits themselves are the identification's (tested under tests/identify); here one fit is
 replaced by a table lookup so the test is about what the script makes of the rows.
@@ -15,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="module")
 def spread():
     spec = importlib.util.spec_from_file_location(
-        "fit_seed_spread", ROOT / "scripts" / "fit_seed_spread.py"
+        "fit_seed_spread", ROOT / "studies" / "2026-11-fit-seed-spread" / "fit_seed_spread.py"
     )
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)

@@ -1,4 +1,4 @@
-"""The worked run of docs/your-bushing.md: a user's own records, end to end, with the commands.
+"""The worked run of studies/2026-11-bouc-wen-benchmark/README.md: a user's own records, end to end, with the commands.
 
 Records nobody here wrote: the public Bouc-Wen benchmark (../shared/data/bouc-wen-benchmark,
 PROVENANCE.md there). As a user would, it runs the ``bushenv`` commands one after the other:
@@ -13,7 +13,7 @@ PROVENANCE.md there). As a user would, it runs the ``bushenv`` commands one afte
 
 Every figure of the page is in ``OUT/summary.json`` (and the commands' own outputs in OUT).
 
-    python scripts/your_bushing.py --data ../shared/data/bouc-wen-benchmark --out runs/your-bushing
+    python studies/2026-11-bouc-wen-benchmark/your_bushing.py --data ../shared/data/bouc-wen-benchmark --out runs/your-bushing
 """
 
 from __future__ import annotations

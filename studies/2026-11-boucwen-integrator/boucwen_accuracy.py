@@ -5,8 +5,8 @@ relative to the peak and to F_REF (the scale the tolerance refers to), against f
 with 512 sub-steps per sample, and the trial steps per sample it took (both blocks, rejected
 ones included). The cases: ``bushenv.models.boucwen.accuracy``.
 
-    python scripts/boucwen_accuracy.py                 # default rtol
-    python scripts/boucwen_accuracy.py --rtol 1e-7 --md table.md
+    python studies/2026-11-boucwen-integrator/boucwen_accuracy.py                 # default rtol
+    python studies/2026-11-boucwen-integrator/boucwen_accuracy.py --rtol 1e-7 --md table.md
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import argparse
 from pathlib import Path
 
 from bushenv.models.boucwen.accuracy import INPUTS, error_against_converged, parameter_sets
+
 from bushenv.models.boucwen.kernels import BW_RTOL
 
 

@@ -1,7 +1,7 @@
 """How often the diagnosis names an effect that is not there, from validation runs.
 
-    python scripts/diagnose_validate.py --set widened --cases 30 --out v/
-    python scripts/diagnose_false_positives.py v/validation.json [more.json ...]
+    python studies/2026-11-diagnosis-validation/diagnose_validate.py --set widened --cases 30 --out v/
+    python studies/2026-11-diagnosis-validation/diagnose_false_positives.py v/validation.json [more.json ...]
 
 Per candidate effect E: among the cases whose hidden label lacks E, the share whose answer
 names E (alone or in a pair) -- the false-positive rate of naming E, measured on cases without

@@ -1,6 +1,6 @@
-"""Worked example of docs/diagnose.md: pulls and relaxation holds of a simulated acrylic strip.
+"""Worked example of the diagnosis (docs/diagnose.md): pulls and relaxation holds of a simulated acrylic strip.
 
-    python scripts/diagnose_pull_hold.py [--out DIR] [--quiet]
+    python studies/2026-11-diagnosis-validation/diagnose_pull_hold.py [--out DIR] [--quiet]
 
 An 80 mm elastomer strip (Gent backbone, J_m = 30; five relaxation branches 0.5-2000 s whose
 stiffness grows with stretch -- a nonlinear viscoelasticity no candidate assumes) is pulled at

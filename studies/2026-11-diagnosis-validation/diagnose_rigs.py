@@ -1,6 +1,6 @@
-"""Rig-level gap diagnosis over a few cases per rig (the table in docs/diagnose.md "Rig level").
+"""Rig-level gap diagnosis over a few cases per rig (studies/2026-11-diagnosis-validation/README.md).
 
-    python scripts/diagnose_rigs.py [--json FILE]
+    python studies/2026-11-diagnosis-validation/diagnose_rigs.py [--json FILE]
 
 Each case: a reference bushing (``RubberBushing`` preset, measurement effects off) with the
 backbone and at most one effect switched on, the model side a linear bushing identified on the

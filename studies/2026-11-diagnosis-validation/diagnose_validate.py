@@ -1,8 +1,8 @@
-"""Blind validation of the gap diagnosis (the tables in docs/diagnose.md).
+"""Blind validation of the gap diagnosis (studies/2026-11-diagnosis-validation/README.md).
 
-    python scripts/diagnose_validate.py                    # reference set: 200 cases, seed 3
-    python scripts/diagnose_validate.py --set widened      # widened set: 200 cases, seed 11
-    python scripts/diagnose_validate.py --cases 14 --seed 5 --out /tmp/v
+    python studies/2026-11-diagnosis-validation/diagnose_validate.py                    # reference set: 200 cases, seed 3
+    python studies/2026-11-diagnosis-validation/diagnose_validate.py --set widened      # widened set: 200 cases, seed 11
+    python studies/2026-11-diagnosis-validation/diagnose_validate.py --cases 14 --seed 5 --out /tmp/v
 
 Same as ``bushenv diagnose-validate``; defaults to the documented runs (200 cases, out
 validation-diagnose-<set>/). Seeds 0, 1 and 2 were used while developing the diagnosis; seed 3

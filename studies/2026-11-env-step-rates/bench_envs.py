@@ -8,8 +8,8 @@ end are reset inside the timed loop (as a rollout would).
 Each figure is the best of ``--repeats`` runs (other jobs on shared cores only ever slow a run
 down). Prints a table; ``--json FILE`` also writes the rows.
 
-    python scripts/bench_envs.py                      # all models found, defaults
-    python scripts/bench_envs.py --steps 5000 --num-envs 256 --json bench.json
+    python studies/2026-11-env-step-rates/bench_envs.py                      # all models found, defaults
+    python studies/2026-11-env-step-rates/bench_envs.py --steps 5000 --num-envs 256 --json bench.json
 """
 
 from __future__ import annotations

@@ -8,8 +8,8 @@ Table 4: NN 4.5 %, Bouc-Wen 3.7 %; seed 000 Table 2: hybrid 4.6 %). The seed cha
 initial weights and the training windows (NN, hybrid) or the global search's population
 (Bouc-Wen); the records stay fixed.
 
-    python scripts/fit_seed_spread.py                          # nn hybrid boucwen, 8 seeds
-    python scripts/fit_seed_spread.py --models nn --seeds 12 --md docs/fit-seed-spread.md
+    python studies/2026-11-fit-seed-spread/fit_seed_spread.py                          # nn hybrid boucwen, 8 seeds
+    python studies/2026-11-fit-seed-spread/fit_seed_spread.py --models nn --seeds 12 --md studies/2026-11-fit-seed-spread/results.md
 
 Writes a table (and with --md a markdown file beside a strip plot of the RMS ratios; text below
 the notes marker of an existing file is kept).
@@ -23,7 +23,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 from bench import paper_record  # noqa: E402  (the bench's records, not a copy of them)
 
 from bushenv.reproduce import PAPER as PUBLISHED  # noqa: E402
@@ -133,14 +133,12 @@ def main(argv: list[str] | None = None) -> int:
     print("\n".join(table))
     if args.md:
         png = args.md.with_suffix(".png")
-        if args.md.parent.name == "docs":
-            png = args.md.parent / "img" / png.name
         png.parent.mkdir(parents=True, exist_ok=True)
         plot(rows, png)
         head = [
             "# Identified models' accuracy against their training seed",
             "",
-            f"`python scripts/fit_seed_spread.py --models {' '.join(args.models)} --seeds "
+            f"`python studies/2026-11-fit-seed-spread/fit_seed_spread.py --models {' '.join(args.models)} --seeds "
             f"{args.seeds} --md {args.md}` ({time.perf_counter() - t0:.0f} s, {args.workers} "
             "workers; fit times are with the other worker busy). Training record, judged records "
             "and reference: the bench's (`scripts/bench.py`, PAPER_RECORDS, radial).",

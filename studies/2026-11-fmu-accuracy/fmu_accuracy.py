@@ -1,6 +1,6 @@
-"""How closely exported FMUs, run in FMPy, give bushenv's forces: the tables of docs/export.md.
+"""How closely exported FMUs, run in FMPy, give bushenv's forces: studies/2026-11-fmu-accuracy/README.md.
 
-    python scripts/fmu_accuracy.py            # ~1.5 min on the shared 2 cores
+    python studies/2026-11-fmu-accuracy/fmu_accuracy.py            # ~1.5 min on the shared 2 cores
 
 Every error is max |F_fmu - F_bushenv| over the peak |F_bushenv| of the run, worst over the
 inputs (a random n = 1 record of 10 s, a 4 mm step held 1.5 s, two sines). Masters:
@@ -15,14 +15,14 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from bushenv.export.fmpy_master import derivatives_then_step, set_then_read
+from bushenv.models.boucwen.accuracy import converged
 from fmpy import simulate_fmu
 
 from bushenv import excitation as ex
 from bushenv.export import export_fmu
-from bushenv.export.fmpy_master import derivatives_then_step, set_then_read
 from bushenv.models import PAPER_DT, get_model
 from bushenv.models.boucwen import BoucWenBushing
-from bushenv.models.boucwen.accuracy import converged
 
 DT = PAPER_DT
 AXIS = {"linear": "axial", "nn": "axial", "hybrid": "axial", "boucwen": "radial"}

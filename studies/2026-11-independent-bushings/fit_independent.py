@@ -1,11 +1,11 @@
 """Held-out accuracy of every fittable model on bushings bushenv was not tuned on.
 
-``python scripts/fit_independent.py --dir runs/independent`` runs ``bushenv fit TRAIN --model M
+``python studies/2026-11-independent-bushings/fit_independent.py --dir runs/independent`` runs ``bushenv fit TRAIN --model M
 --validate HELD`` (a fresh process each, default options, seed 0) on the records of
-``scripts/independent_bushings.py`` (written first if missing) and on the reference rubber's
+``studies/2026-11-independent-bushings/independent_bushings.py`` (written first if missing) and on the reference rubber's
 radial records of ``bushenv reproduce`` (seed 0: 40 s at n = 1, held out the unseen 20 s n = 1
 record), and prints one markdown table: the held-out free-run RMS ratio, %, per bushing and
-model, the NN over the hybrid, and each fit's wall time. docs/fit.md shows the table.
+model, the NN over the hybrid, and each fit's wall time. studies/2026-11-independent-bushings/README.md shows the table.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ about 1.1 kN/mm, 204.8 Hz, Maxwell branches, smooth hardening, a stiff friction 
 - berg, 204.8 Hz: 0.45 kN/mm, Berg's smooth Coulomb friction (250 N), one Maxwell branch of
   30 ms.
 
-Records: ``python scripts/independent_bushings.py --out runs/independent`` writes, per bushing,
+Records: ``python studies/2026-11-independent-bushings/independent_bushings.py --out runs/independent`` writes, per bushing,
 ``NAME_train.csv`` (40 s) and ``NAME_held.csv`` (20 s, another drive seed), columns
 time,displacement,force in s, m, N. The drive is band-limited Gaussian noise (flat 0.5-20 Hz
 spectrum, RMS 0.8 mm), the force has 0.5 % RMS white sensor noise. The dynamics are integrated

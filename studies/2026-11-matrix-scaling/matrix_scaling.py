@@ -1,11 +1,11 @@
 """How a campaign matrix scales: measured on this machine, projected to a cluster.
 
-    python scripts/matrix_scaling.py [--cells 8] [--budget 256] [--ray] [--json FILE]
+    python studies/2026-11-matrix-scaling/matrix_scaling.py [--cells 8] [--budget 256] [--ray] [--json FILE]
 
 Measures, in one run, the evaluations per second of the same matrix with 1 and 2 local worker
 processes (and on a local Ray instance with --ray), plus Ray's per-task overhead (no-op tasks),
 then projects what a 100-node cluster would give for a matrix of 10,000 runs, splitting the time
-into evaluation, transfer and scheduling. Prints a markdown table (docs/distributed.md).
+into evaluation, transfer and scheduling. Prints a markdown table (studies/2026-11-matrix-scaling/README.md).
 """
 
 from __future__ import annotations

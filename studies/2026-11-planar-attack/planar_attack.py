@@ -1,11 +1,11 @@
-"""The planar attack on trained MIMO networks: ``python scripts/planar_attack.py``.
+"""The planar attack on trained MIMO networks: ``python studies/2026-11-planar-attack/planar_attack.py``.
 
 Trains the MIMO NARX network (``nn``), the seeds' per-axis kind (``nn-axis``) and the MIMO
 hybrid on 60 s of independent random motion on all axes at n = 1 (as
 ``scripts/planar_benchmark.py``, seed 0, default options), saves them under ``--out``/models
 and runs ``bushenv attack --env rig3`` on each (random and CMA-ES over ``any3``, ``--budget``
 evaluations each). Prints one table: evaluations to the first failure, failures per family and
-per axis, the linear control's rechecks. Numbers in docs/planar_search.md.
+per axis, the linear control's rechecks. Numbers in studies/2026-11-planar-attack/README.md.
 """
 
 from __future__ import annotations

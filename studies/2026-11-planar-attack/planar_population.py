@@ -1,7 +1,7 @@
-"""A population of planar networks (issue 25 item 7, a first step): how many of the MIMO
+"""A population of planar networks: how many of the MIMO
 networks that pass single-axis tests does the attack across axes break?
 
-``python scripts/planar_population.py --seeds 4`` trains ``--seeds`` networks of each kind
+``python studies/2026-11-planar-attack/planar_population.py --seeds 4`` trains ``--seeds`` networks of each kind
 (``nn``, ``nn-axis``, ``hybrid``; each on its own seed's 60 s record of independent random
 motion at n = 1, default options, as ``scripts/planar_benchmark.py``), then for each:
 
@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from bushenv.models import load_model
 from bushenv.models.base import PAPER_DT
-from bushenv.planar import load_planar_model
 from bushenv.planar.programme import random_independent
 from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.train import fit_planar_network
@@ -47,7 +47,7 @@ def network(out: Path, kind: str, seed: int):
         q = random_independent(1.0, 60.0, PAPER_DT, seed)
         f = PlanarRubber.preset(seed=seed).simulate(q)
         fit_planar_network(q, f, PAPER_DT, kind=kind, seed=seed).save(path)
-    return load_planar_model(path)
+    return load_model(path)
 
 
 def member(model, seed: int, single_budget: int, budget: int) -> dict:

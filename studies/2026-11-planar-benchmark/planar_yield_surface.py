@@ -1,6 +1,6 @@
 """The vector Bouc-Wen against its per-axis kind (``yield_surface="axis"``) on unseen records.
 
-    python scripts/planar_yield_surface.py [--seeds 0 1] [--uncoupled]
+    python studies/2026-11-planar-benchmark/planar_yield_surface.py [--seeds 0 1] [--uncoupled]
 
 The benchmark's protocol (``planar_benchmark.py``): 60 s of independent random motion at n = 1
 on the planar reference identifies both (default options); each runs free on the random
@@ -23,7 +23,7 @@ from bushenv.planar.programme import programme, random_independent
 from bushenv.progress import Progress
 
 _spec = importlib.util.spec_from_file_location(
-    "planar_benchmark", Path(__file__).with_name("planar_benchmark.py")
+    "planar_benchmark", Path(__file__).resolve().parents[2] / "scripts" / "planar_benchmark.py"
 )
 _bench = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(_bench)

@@ -1,7 +1,7 @@
 """How closely QuarterCar-v0's vector entry point (QuarterCarBatch) follows the pymunk env with a
 planar arm bushing: the largest difference of each signal over a road, relative to its peak.
 
-    python scripts/planar_car_agreement.py [--arms linear reference] [--harsh] [--quiet]
+    python studies/2026-11-planar-car-agreement/planar_car_agreement.py [--arms linear reference] [--harsh] [--quiet]
 
 Replays each road in the pymunk env and in column 0 of the vector env (arm_bushing = each
 planar preset, the twin the default ``reference``) and prints one markdown row per arm and
@@ -61,7 +61,7 @@ def roads() -> dict[str, np.ndarray]:
 
 def harsh_roads() -> tuple[dict[str, np.ndarray], dict]:
     """The rate-limit roads of tests/rigs/test_quartercar.py and its bounds switched off."""
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "rigs"))
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "rigs"))
     from test_quartercar import LOOSE, worst_roads
 
     roads = worst_roads(600, np.random.default_rng(0))

@@ -1,7 +1,7 @@
 """How far a 3-axis Bouc-Wen identification carries: the coupled sets beyond the identified
 amplitude, with and without the reference's coupling, and the force under held deflections.
 
-    python scripts/planar_extrapolation.py [--seed 0] [--png docs/img/planar_extrapolation.png]
+    python studies/2026-11-planar-fit-unseen/planar_extrapolation.py [--seed 0] [--png studies/2026-11-planar-fit-unseen/planar_extrapolation.png]
                                            [--quiet]
 
 Three ``boucwen`` fits, as ``bushenv reproduce --planar`` identifies (random n = 1 and the
@@ -79,7 +79,7 @@ def held(vector: np.ndarray, dt: float) -> np.ndarray:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--png", default="docs/img/planar_extrapolation.png")
+    ap.add_argument("--png", default="studies/2026-11-planar-fit-unseen/planar_extrapolation.png")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
     dt, seed = PAPER_DT, args.seed

@@ -7,7 +7,7 @@ teacher-forcing`` (seed s), judged in free run from rest on both unseen records,
 +4 mm and -4 mm for 10 s: the force over the last second of the hold beside the reference's
 (the rubber without its measurement chain).
 
-    python scripts/fit_recipes.py --seeds 0-3 --axes axial,radial --md docs/fit-recipes.md
+    python studies/2026-11-training-recipes/fit_recipes.py --seeds 0-3 --axes axial,radial --md fit-recipes.md
 """
 
 from __future__ import annotations
@@ -150,7 +150,7 @@ def main(argv: list[str] | None = None) -> int:
             rows += one_cell(axis, seed, args.models.split(","), args.recipes.split(","))
             if args.json:
                 args.json.write_text(json.dumps(rows, indent=1))
-    command = "python scripts/fit_recipes.py " + " ".join(argv or sys.argv[1:])
+    command = "python studies/2026-11-training-recipes/fit_recipes.py " + " ".join(argv or sys.argv[1:])
     text = markdown(rows, command.strip(), time.perf_counter() - t0)
     print(text)
     if args.md:

@@ -1,4 +1,4 @@
-"""Corpus cases from members of the population study (docs/recipes.md) that fail in a kind the
+"""Corpus cases from members of the population study (studies/2026-11-training-recipes/README.md) that fail in a kind the
 shipped models' cases do not show: a hold that departs, a held force of the wrong sign.
 
 The members are kept in ``tests/regressions/models/`` (copied from a ``bushenv zoo`` run's
@@ -9,7 +9,7 @@ models, against the rubber, and written to ``tests/regressions/corpus/``.
     cd runs/zoo/models && M=../../../tests/regressions/models
     cp free-run-nn-radial-s7.npz $M/radial_nn-zoo-free-run-s7.npz
     cp teacher-forcing-nn-axial-s1.npz $M/axial_nn-zoo-teacher-forcing-s1.npz && cd -
-    python scripts/population_cases.py
+    python studies/2026-11-training-recipes/population_cases.py
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import get_searcher
 from bushenv.search.shrink import shrink
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 MODELS_DIR = ROOT / "tests" / "regressions" / "models"
 
 

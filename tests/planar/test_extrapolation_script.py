@@ -1,5 +1,5 @@
-"""scripts/planar_extrapolation.py: its judge reads the truth as right and a model without the
-coupling as wrong, and its holds ramp and hold."""
+"""studies/2026-11-planar-fit-unseen/planar_extrapolation.py: its judge reads the truth as
+right and a model without the coupling as wrong, and its holds ramp and hold."""
 
 import importlib.util
 from pathlib import Path
@@ -13,7 +13,8 @@ from bushenv.planar.reference import PlanarRubber
 
 @pytest.fixture(scope="module")
 def mod():
-    path = Path(__file__).parents[2] / "scripts" / "planar_extrapolation.py"
+    study = Path(__file__).parents[2] / "studies" / "2026-11-planar-fit-unseen"
+    path = study / "planar_extrapolation.py"
     spec = importlib.util.spec_from_file_location("planar_extrapolation", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
