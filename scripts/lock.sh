@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 venv="$(mktemp -d)/venv"
 python3 -m venv "$venv"
 "$venv/bin/pip" install -q torch==2.13.0
-"$venv/bin/pip" install -q ".[test,ray,fmi]"
+"$venv/bin/pip" install -q ".[test,ray,fmi,docs]"
 {
   echo "# Every dependency's version as tested (Python 3.11, x86_64, CPU). Used as pip constraints by the"
   echo "# README's commands and .ci/run. Refresh: bash scripts/lock.sh (docs/contributing.md)."

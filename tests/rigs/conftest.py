@@ -19,6 +19,6 @@ def nan_model():
 
 
 def pytest_runtest_setup(item):
-    # Slow tests run only when asked for: pytest -m slow (scripts/run_slow_tests.sh)
+    # Slow tests run only when asked for: pytest -m slow
     if "slow" in item.keywords and "slow" not in (item.config.getoption("-m") or ""):
         pytest.skip("slow test; run with -m slow")
