@@ -37,6 +37,10 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 ROOT = Path(__file__).resolve().parents[1]
 DOCS_JSON = ROOT / "docs" / "benchmarks.json"  # the run docs/benchmarks.md is rendered from
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+# The yardsticks the tests measure with (tests/models: the converged Bouc-Wen run, the
+# numpy NARX; tests/export: the FMPy masters), for this file, bench_compare and bench_fmu.
+sys.path.insert(0, str(ROOT / "tests" / "models"))
+sys.path.insert(0, str(ROOT / "tests" / "export"))
 import bench_compare  # noqa: E402  (the scipy and torch comparisons, beside this file)
 import bench_fmu  # noqa: E402  (the exported FMU's step, beside this file)
 
@@ -155,8 +159,9 @@ def bench_float32(fig: Figures, name: str, model, x, v, min_time: float, steps: 
 def bench_float32_error(fig: Figures, model, T: int) -> None:
     """What float32 costs the NARX models' accuracy: the compiled float32 run, and an ideal one
     (numpy, libm tanh) that shows how much of it is the kernel's float32 tanh."""
+    from narx_precision import float32_error
+
     from bushenv.excitation import random_rpc
-    from bushenv.models.precision import float32_error
 
     x = np.stack(
         [random_rpc(n, T * model.dt, model.dt, seed=b) for n in (1.0, 1.5) for b in range(32)], 1
@@ -177,14 +182,15 @@ def bench_float32_error(fig: Figures, model, T: int) -> None:
         float32_error(model, x, v),
         "of peak",
         better="lower",
-        note=f"the same in numpy with libm tanh (bushenv/models/precision.py), {what}",
+        note=f"the same in numpy with libm tanh (tests/models/narx_precision.py), {what}",
     )
 
 
 def bench_boucwen_accuracy(fig: Figures, model, T: int) -> None:
     """What the Bouc-Wen throughput buys: error against a converged run, steps per sample."""
+    from boucwen_converged import error_against_converged
+
     from bushenv.excitation import random_rpc
-    from bushenv.models.boucwen.accuracy import error_against_converged
 
     x = random_rpc(1.0, T * model.dt, model.dt, seed=0)
     err_of_peak, _, steps = error_against_converged(model.vector(), x, model.rtol, model.dt)

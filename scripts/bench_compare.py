@@ -68,9 +68,10 @@ def scipy_free_run(p: dict, x: np.ndarray, v: np.ndarray, dt: float, method: str
 
 def bench_scipy(fig, quick: bool) -> None:
     """Bouc-Wen: solve_ivp at bushenv's accuracy, steps/s, as ratios."""
+    from boucwen_converged import converged  # tests/models, on sys.path by bench.py
+
     from bushenv.excitation import random_rpc
     from bushenv.models import get_model
-    from bushenv.models.boucwen.accuracy import converged
 
     print("\n== Bouc-Wen beside scipy's solve_ivp at the same accuracy (one profile, one thread)")
     model = get_model("boucwen", axis="axial")

@@ -108,7 +108,7 @@ def c_step_us(fmu: Path, x: np.ndarray, v: np.ndarray, reps: int) -> tuple[float
 
 def fmpy_step_us(fmu: Path, x: np.ndarray, v: np.ndarray, min_time: float) -> float:
     """setReal, getReal, doStep per sample on FMPy's FMU2Slave, us per sample."""
-    from bushenv.export.fmpy_master import opened
+    from fmu_masters import opened  # tests/export, on sys.path by bench.py
 
     with opened(fmu) as (s, vr, _):
         vx, vf = [vr["deflection"]], [vr["force"]]

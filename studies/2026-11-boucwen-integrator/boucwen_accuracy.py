@@ -3,7 +3,7 @@
 For every pair: the worst force error of the production kernel (ROS34PW2 with error control)
 relative to the peak and to F_REF (the scale the tolerance refers to), against fixed-step RK4
 with 512 sub-steps per sample, and the trial steps per sample it took (both blocks, rejected
-ones included). The cases: ``bushenv.models.boucwen.accuracy``.
+ones included). The cases: ``tests/models/boucwen_converged.py``.
 
     python studies/2026-11-boucwen-integrator/boucwen_accuracy.py                 # default rtol
     python studies/2026-11-boucwen-integrator/boucwen_accuracy.py --rtol 1e-7 --md table.md
@@ -12,11 +12,14 @@ ones included). The cases: ``bushenv.models.boucwen.accuracy``.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
-from bushenv.models.boucwen.accuracy import INPUTS, error_against_converged, parameter_sets
-
 from bushenv.models.boucwen.kernels import BW_RTOL
+
+# The cases and the converged run the tests measure the kernel with.
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "models"))
+from boucwen_converged import INPUTS, error_against_converged, parameter_sets  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:

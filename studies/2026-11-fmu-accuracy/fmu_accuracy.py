@@ -5,7 +5,7 @@
 Every error is max |F_fmu - F_bushenv| over the peak |F_bushenv| of the run, worst over the
 inputs (a random n = 1 record of 10 s, a 4 mm step held 1.5 s, two sines). Masters:
 ``simulate_fmu`` (FMPy's own: reads outputs after doStep, before the next input), the
-set-then-read master (``bushenv.export.fmpy_master``), FMI 2 input derivatives.
+set-then-read master (``tests/export/fmu_masters.py``), FMI 2 input derivatives.
 """
 
 from __future__ import annotations
@@ -15,14 +15,16 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from bushenv.export.fmpy_master import derivatives_then_step, set_then_read
-from bushenv.models.boucwen.accuracy import converged
 from fmpy import simulate_fmu
 
 from bushenv import excitation as ex
 from bushenv.export import export_fmu
 from bushenv.models import PAPER_DT, get_model
 from bushenv.models.boucwen import BoucWenBushing
+
+# The FMPy masters and the converged Bouc-Wen run of the export tests.
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "export"))
+from fmu_masters import converged, derivatives_then_step, set_then_read  # noqa: E402
 
 DT = PAPER_DT
 AXIS = {"linear": "axial", "nn": "axial", "hybrid": "axial", "boucwen": "radial"}

@@ -55,7 +55,7 @@ def test_card_facts_are_in_the_model_description(carded):
     for r in card["records"]:
         assert r["data_sha256"] in xml
     assert 'name="card.record_2"' in xml and "held-out held: sha256=" in xml and "rms_ratio=" in xml
-    from bushenv.export.fmpy_master import opened
+    from .fmu_masters import opened
 
     with opened(done.path) as (s, vr, _):
         got = s.getString([vr["card.record_1"]])[0]

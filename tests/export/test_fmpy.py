@@ -4,9 +4,8 @@ import numpy as np
 import pytest
 
 from bushenv.models import PAPER_DT, get_model
-from bushenv.models.boucwen.accuracy import converged
 
-from .fmu_masters import AXIS, inputs, set_then_read
+from .fmu_masters import AXIS, converged, inputs, set_then_read
 
 MODELS = ("linear", "nn", "hybrid", "boucwen")
 VERSIONS = ("2.0", "3.0")
@@ -141,7 +140,7 @@ def test_fmi2_input_derivatives_give_the_force_on_time_even_read_before_the_next
 ):
     """A master that sets the inputs' slopes (canInterpolateInputs): the FMU extrapolates the
     input along them, so the force read right after doStep is the model's at that time."""
-    from bushenv.export.fmpy_master import derivatives_then_step
+    from .fmu_masters import derivatives_then_step
 
     dt = PAPER_DT
     x = inputs()["random n=1"][:400]
@@ -202,7 +201,7 @@ def test_simulate_fmu_runs_the_papers_programme_as_bushenv_does(fmu):
 def test_boucwen_model_exchange_derivatives_integrate_to_the_converged_run(fmu, version):
     """The ODE as model exchange: RK4 of our own on the FMU's derivatives (through FMPy's
     classes) gives the converged run, as the co-simulation's RK4 does."""
-    from bushenv.export.fmpy_master import model_exchange_rk4
+    from .fmu_masters import model_exchange_rk4
 
     x = inputs()["random n=1"][:150]
     v = np.gradient(x, PAPER_DT)

@@ -4,16 +4,16 @@ import time
 
 import numpy as np
 import pytest
-
-from bushenv import excitation as ex
-from bushenv.models import PAPER_DT, get_model
-from bushenv.models.boucwen import BoucWenBushing, BoucWenError, simulate_population
-from bushenv.models.boucwen.accuracy import (
+from boucwen_converged import (
     INPUTS,
     converged,
     force_scale,
     parameter_sets,
 )
+
+from bushenv import excitation as ex
+from bushenv.models import PAPER_DT, get_model
+from bushenv.models.boucwen import BoucWenBushing, BoucWenError, simulate_population
 from bushenv.models.boucwen.kernels import (
     BW_MAX_SUBSTEPS,
     BW_N_STATE,

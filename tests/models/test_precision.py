@@ -1,11 +1,11 @@
-"""bushenv.models.precision: the numpy NARX free run is the kernels' model, in any dtype."""
+"""narx_precision.py: the numpy NARX free run is the kernels' model, in any dtype."""
 
 import numpy as np
 import pytest
+from narx_precision import float32_error, narx_free_run_numpy
 
 from bushenv.excitation import random_rpc
 from bushenv.models import get_model
-from bushenv.models.precision import float32_error, narx_free_run_numpy
 
 
 def drives(model, n_index, seconds=3.0, batch=4):

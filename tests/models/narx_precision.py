@@ -6,7 +6,8 @@ recurrence written in numpy with every array and constant in ``dtype`` and libm'
 ``float32_error`` is the largest |F32 - F64| over the largest |F64| of a batch. In float64 it
 agrees with the compiled model to rounding (tests/models/test_precision.py), so its float32
 error is what precision alone costs; the kernels' float32 error beyond it is their tanh's.
-Slow (a numpy call per step): for measuring, not for running.
+Slow (a numpy call per step): for measuring, not for running; scripts/bench.py's float32 figure
+uses it too.
 """
 
 from __future__ import annotations

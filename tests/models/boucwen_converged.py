@@ -1,9 +1,11 @@
 """How accurate the Bouc-Wen kernel is: test cases and the error against a converged run.
 
-Used by ``scripts/boucwen_accuracy.py`` (the table in docs/boucwen-integration.md), the
-benchmark's accuracy figure and tests/models/test_boucwen_kernels.py, so all three measure the
-same thing. The reference is ``boucwen_fixed_step``: classical RK4 with a fixed number of equal
-sub-steps per sample on eqs. 1-4 as printed.
+Used by tests/models/test_boucwen_kernels.py, the export tests (tests/export/fmu_masters.py),
+the benchmark's accuracy figure (scripts/bench.py, scripts/bench_compare.py) and the studies
+studies/2026-11-boucwen-integrator/boucwen_accuracy.py and
+studies/2026-11-fmu-accuracy/fmu_accuracy.py, so all of them measure the same thing. The
+reference is ``boucwen_fixed_step``: classical RK4 with a fixed number of equal sub-steps per
+sample on eqs. 1-4 as printed.
 """
 
 from __future__ import annotations
