@@ -65,7 +65,7 @@ made in (T, B) C order, so a batched ``simulate`` and T looped ``step`` calls ag
 The friction element and the Maxwell branches see the deflection increment dx (the specimen's
 own history); the damper and the fixture see the velocity input v.
 
-Calibration (``python -m bushenv.commands.calibration --behaviour``): the drive is
+Calibration (``python scripts/reference_calibration.py --behaviour``): the drive is
 ``bushenv.excitation.random_rpc`` (durability spectrum, 0.5-20 Hz, 204.8 Hz, peak |x| = n * 2 mm);
 linear least-squares fit F ~ k x + c v on n = 1 (40 s, seed s), judged on n = 1.5 (20 s, seed
 s + 1), measurement effects on. Seed 0 (in brackets: the papers), and the range over seeds

@@ -5,12 +5,12 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from papers_calibration import TABLE1, calibration_numbers, linear_fit
 
 from bushenv.excitation import random_band, random_rpc
 from bushenv.metrics import rms_ratio
 from bushenv.models import ModelError, get_model, load_model
 from bushenv.models.base import PAPER_DT, velocity_of
-from bushenv.reference.calibration import TABLE1, calibration_numbers, linear_fit
 from bushenv.reference.rubber import EFFECTS, PHYSICAL_EFFECTS, RubberBushing
 
 LAWS = ("berg", "iwan", "dahl")

@@ -9,8 +9,9 @@ axial, 11.9 % radial). ``calibration_numbers(axis)`` repeats that on the referen
    squares (``linear_fit``), as ``bushenv.machine.papers_programme`` records it;
 2. run that linear model on the unseen n = 1.5 record (20 s, next seed); ``rms_ratio``.
 
-Run ``python -m bushenv.commands.calibration`` to print the numbers for both axes (they are
-recorded in ``rubber.py`` and docs/reference.md).
+tests/reference/test_rubber.py holds the reference to these numbers; ``python
+scripts/reference_calibration.py`` prints them for both axes (they are recorded in
+``bushenv/reference/rubber.py`` and docs/reference.md).
 """
 
 from __future__ import annotations

@@ -1,13 +1,20 @@
-"""``python -m bushenv.commands.calibration``: the reference bushing measured against the
-papers (``bushenv/reference/calibration.py``), printed as the tables of docs/reference.md."""
+"""The reference bushing measured against the papers, printed as the tables of docs/reference.md.
+
+    python scripts/reference_calibration.py [--behaviour]
+
+The measurement is tests/reference/papers_calibration.py, the one tests/reference/test_rubber.py
+holds the reference bushing to.
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
-from bushenv.reference import calibration
-from bushenv.reference.calibration import (
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "reference"))
+import papers_calibration as calibration  # noqa: E402
+from papers_calibration import (  # noqa: E402
     SINE_AMPS_M,
     SINE_FREQS_HZ,
     TABLE1,
