@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from mkdocs.structure.files import File, Files
+from mkdocs.structure.files import File, Files, InclusionLevel
 
 ROOT = Path(__file__).resolve().parents[2]
 STUDIES = ROOT / "studies"
@@ -29,6 +29,7 @@ def on_files(files: Files, config) -> Files:
                     src_dir=str(ROOT),
                     dest_dir=config["site_dir"],
                     use_directory_urls=config["use_directory_urls"],
+                    inclusion=InclusionLevel.NOT_IN_NAV,  # listed by docs/studies.md
                 )
             )
     return files
