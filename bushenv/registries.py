@@ -32,13 +32,15 @@ def markdown() -> str:
     """The page: one table per registry, in registration order."""
     models = [
         (
-            f"`{name}`",
-            e.summary,
-            _where(e.entry_point),
-            "-" if e.fit is None else _where(e.fit),
-            "yes" if e.shipped else "no",
+            f"`{name}`" if c == e.coordinate_counts()[0] else "",
+            e.summary if c == e.coordinate_counts()[0] else "",
+            str(c),
+            _where(e.form(c).entry_point),
+            "-" if e.form(c).fit is None else _where(e.form(c).fit),
+            "yes" if e.shipped and c == 1 else "no",
         )
         for name, e in MODELS.items()
+        for c in e.coordinate_counts()
     ]
     searchers = [
         (f"`{name}`", e.summary, _where(e.factory), "episodes" if e.episodes else "evaluations")
@@ -69,7 +71,13 @@ def markdown() -> str:
         "",
         "## Models (`bushenv/models/registry.py: MODELS`)",
         "",
-        *_table(("name", "what", "class", "identification", "shipped defaults"), models),
+        "One kind of model per name, with a form for each number of coordinates it exists for "
+        "(1: a deflection; 3: axial, radial, rotation).",
+        "",
+        *_table(
+            ("name", "what", "coordinates", "class", "identification", "shipped defaults"),
+            models,
+        ),
         "",
         "## Searchers (`bushenv/search/searchers.py: SEARCHERS`)",
         "",

@@ -40,6 +40,19 @@ class Registry(Generic[T]):
         self.kind = kind
         self.error = error
         self._entries: dict[str, T] = {}
+        self._aliases: dict[str, str] = {}
+
+    def alias(self, old: str, name: str) -> None:
+        """Let ``old`` (a name files or users wrote before) find ``name``'s entry; it is not
+        listed among the names."""
+        self._known(name)
+        if old in self._entries:
+            raise self.error(f"{self.kind} {old!r} is registered already")
+        self._aliases[old] = name
+
+    def canonical(self, name: str) -> str:
+        """The registered name ``name`` stands for (itself, or what its alias points to)."""
+        return self._aliases.get(name, name) if isinstance(name, str) else name
 
     def add(self, name: str, entry: T, *, replace: bool = False) -> T:
         """Register ``entry`` under ``name``; refuses a taken name unless ``replace``."""
@@ -63,6 +76,7 @@ class Registry(Generic[T]):
             self._entries.pop(name, None)
 
     def _known(self, name: Any) -> str:
+        name = self.canonical(name)
         if not isinstance(name, str) or name not in self._entries:
             raise self.error(self.unknown_message(name))
         return name
@@ -74,7 +88,7 @@ class Registry(Generic[T]):
         return self._entries[self._known(name)]
 
     def get(self, name: str, default: Any = None) -> T | Any:
-        return self._entries.get(name, default)
+        return self._entries.get(self.canonical(name), default)
 
     def names(self) -> tuple[str, ...]:
         return tuple(self._entries)
@@ -86,7 +100,7 @@ class Registry(Generic[T]):
         return self._entries.values()
 
     def __contains__(self, name: object) -> bool:
-        return name in self._entries
+        return name in self._entries or name in self._aliases
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._entries)

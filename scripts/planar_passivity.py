@@ -21,8 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
+from bushenv.models import MODELS, load_model
 from bushenv.models.base import PAPER_DT, velocity_of
-from bushenv.planar import PLANAR_MODELS, PlanarModelError, load_planar_model, model_class
+from bushenv.planar import PlanarModelError
 from bushenv.planar.fixed_points import fixed_points, fold_crossings, grid
 from bushenv.planar.linear import fit_linear
 from bushenv.planar.narx import PlanarNarx
@@ -45,17 +46,17 @@ def build_models(names: list[str], seed: int, progress: Progress, training: str 
     need_data = any(n in TRAINED or n == "linear" for n in names)
     if need_data:
         q = random_independent(1.0, 60.0, dt, seed)
-        f = model_class("reference").preset(seed=seed).simulate(q)
+        f = MODELS["reference"].model_class(3).preset(seed=seed).simulate(q)
     models = {}
     for k, name in enumerate(names):
         if name.endswith(".npz"):
-            models[Path(name).name] = load_planar_model(name)
+            models[Path(name).name] = load_model(name, coords=3, wanted_by="planar_passivity.py")
         elif name == "linear":
             models["linear (fitted)"] = fit_linear(q, velocity_of(q, dt), f, dt)
         elif name == "linear-preset":
-            models[name] = model_class("linear").preset()
+            models[name] = MODELS["linear"].model_class(3).preset()
         elif name == "reference":
-            models[name] = model_class("reference").preset(measurement=False)
+            models[name] = MODELS["reference"].model_class(3).preset(measurement=False)
         elif name in TRAINED:
             from bushenv.planar.train import fit_planar_network
 
@@ -70,8 +71,8 @@ def build_models(names: list[str], seed: int, progress: Progress, training: str 
             models[name] = fit_planar_network(q, f, dt, kind=name, options=opts, seed=seed)
         else:
             raise PlanarModelError(
-                f"--models {name!r}: {PLANAR_MODELS.unknown_message(name)}, linear-preset, or "
-                "a .npz planar model file"
+                f"--models {name!r}: unknown three-axis model; known: linear, linear-preset, "
+                f"reference, {', '.join(sorted(TRAINED))}, or a three-axis .npz model file"
             )
         progress.update(k + 1, f"{name} ready")
     return models

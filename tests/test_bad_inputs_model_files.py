@@ -149,12 +149,13 @@ def _meta_case(linear_file, **changes):
     [
         ({"version": 2}, "format version 2, this bushenv reads version 1"),
         ({"version": "1"}, "format version '1'"),
-        ({"format": "other"}, r"not a bushenv model file \(format tag missing\)"),
+        ({"format": "other"}, r"not a bushenv model file \(format tag 'other', expected"),
         (
             {"model": "lstm"},
             r"unknown model 'lstm'; known names: "
-            r"linear, nn, hybrid, nn-paper, hybrid-paper, boucwen",
+            r"linear, nn, nn-axis, hybrid, nn-paper, hybrid-paper, boucwen, hybrid-bw, rubber",
         ),
+        ({"coords": "axial"}, r"corrupt __meta__ entry \(coords 'axial', expected names\)"),
         ({"model": ["linear"]}, r"unknown model \['linear'\]"),
         ({"dt": "fast"}, r"invalid dt 'fast' in the header"),
         ({"dt": -0.1}, r"invalid dt -0\.1"),
@@ -178,7 +179,7 @@ def test_bad_header_is_refused_naming_file_and_field(tmp_path, linear_file, chan
         (np.array(b"{}"), r"corrupt __meta__ entry \(a \|S2 array"),
         (np.array(["{}", "{}"]), r"corrupt __meta__ entry \(a <U2 array of shape \[2\]"),
         (np.array("{not json"), r"corrupt __meta__ entry: Expecting property name"),
-        (np.array("[1, 2]"), r"not a bushenv model file \(format tag missing\)"),
+        (np.array("[1, 2]"), r"not a bushenv model file \(format tag missing"),
     ],
 )
 def test_corrupt_meta_entry_is_refused(tmp_path, meta_value, message):

@@ -54,7 +54,8 @@ def test_entry_points_are_module_colon_attribute():
 def test_every_registered_model_class_has_the_registered_name():
     # a preset of another class (nn-paper: an nn network trained the papers' way) names it
     for name, entry in MODELS.items():
-        assert entry.model_class().name == (entry.kind or name)
+        for c in entry.coordinate_counts():
+            assert entry.model_class(c).name == (entry.kind or name), (name, c)
         if entry.kind is not None:
             assert entry.kind in MODELS and MODELS[entry.kind].kind is None
 

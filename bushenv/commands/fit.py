@@ -28,24 +28,24 @@ def model_options() -> dict[str, list[tuple[str, Any]]]:
     """Option name -> [(model, dataclass field)] for every model with an identification; the
     planar (3-axis) models' owners read "NAME (3-axis)"."""
     from bushenv.commands.fit_planar import PLANAR_LABEL
-    from bushenv.planar.fitting import PLANAR_FITS
+    from bushenv.models import MODELS, names_for
 
     table: dict[str, list[tuple[str, Any]]] = defaultdict(list)
     for name in fittable_models():
         for f in option_fields(options_class(name)):
             table[f.name].append((name, f))
-    for name, entry in PLANAR_FITS.items():
-        for f in option_fields(entry.options):
+    for name in names_for(3, fittable=True):
+        for f in option_fields(MODELS[name].options_class(3)):
             table[f.name].append((name + PLANAR_LABEL, f))
     return dict(table)
 
 
 def model_choices() -> list[str]:
     """``--model``: the one-axis fittable models, then the planar ones not named alike."""
-    from bushenv.planar.fitting import PLANAR_FITS
+    from bushenv.models import names_for
 
     one = fittable_models()
-    return one + [n for n in PLANAR_FITS.names() if n not in one]
+    return one + [n for n in names_for(3, fittable=True) if n not in one]
 
 
 def _option_help(owners: list[tuple[str, Any]]) -> str:

@@ -1,7 +1,8 @@
 """``bushenv fit`` on 3-axis records: the records' header decides, the planar models fit.
 
 A record whose header names the planar columns (``bushenv.planar.records.HEADER``) is a 3-axis
-record; ``bushenv fit`` then takes ``--model`` from ``PLANAR_FITS`` and writes the planar model
+record; ``bushenv fit`` then takes ``--model`` among the kinds ``MODELS`` can identify over three
+coordinates and writes the model
 file and its per-axis card (``bushenv.planar.card``). Training and held-out records must all
 be of one kind.
 """
@@ -54,9 +55,9 @@ def planar_options(args: argparse.Namespace, given: dict[str, str]) -> dict[str,
     """The given options, checked against the planar model's own (CliError naming the flag)."""
     from bushenv.cli import CliError
     from bushenv.identify.options import flag_of, option_fields
-    from bushenv.planar.fitting import PLANAR_FITS
+    from bushenv.planar.fitting import options_class
 
-    own = [f.name for f in option_fields(PLANAR_FITS[args.model].options)]
+    own = [f.name for f in option_fields(options_class(args.model))]
     for name in given:
         if name not in own:
             raise CliError(
@@ -69,15 +70,16 @@ def planar_options(args: argparse.Namespace, given: dict[str, str]) -> dict[str,
 def run_planar(args: argparse.Namespace, out: Path, given: dict[str, Any]) -> int:
     """Load the 3-axis records, identify, write the model and its card, print the summary."""
     from bushenv.cli import CliError
+    from bushenv.models import names_for
     from bushenv.planar.card import save_planar_fit
-    from bushenv.planar.fitting import PLANAR_FITS, fit_planar, length_problem
+    from bushenv.planar.fitting import fit_planar, length_problem
     from bushenv.planar.records import load_planar_csv, start_notes
     from bushenv.records import STEP_RTOL
 
-    if args.model not in PLANAR_FITS:
+    if args.model not in names_for(3, fittable=True):
         raise CliError(
             f"model {args.model} has no 3-axis identification; for 3-axis records choose "
-            f"one of: {', '.join(PLANAR_FITS.names())}"
+            f"one of: {', '.join(names_for(3, fittable=True))}"
         )
     if args.resample is not None:
         raise CliError("--resample is for one-axis records; give 3-axis records at one rate")

@@ -14,28 +14,29 @@ def _model_for(args: argparse.Namespace, dt: float):
     """The planar model measured: the reference (default, with load-cell noise), a registered
     planar name with a preset, or a planar ``.npz`` file."""
     from bushenv.cli import CliError
+    from bushenv.models import MODELS, get_model, has_preset, names_for
     from bushenv.models.base import DT_TOLERANCE
-    from bushenv.planar import PLANAR_MODELS, load_planar_model, model_class
     from bushenv.planar.machine import reference_for
 
     spec = "reference" if args.model in ("rubber", "reference") else args.model
     if spec == "reference":
         return spec, reference_for(args.seed, dt)
     if spec.endswith(".npz"):
-        model = load_planar_model(spec)
+        model = get_model(spec, coords=3, wanted_by="bushenv measure --axes 3")
         if abs(model.dt - dt) > DT_TOLERANCE * dt:  # a fitted model runs only at its rate
             raise CliError(
                 f"{spec}: model sampled at {1 / model.dt:.6g} Hz, --rate is {1 / dt:.6g} Hz: "
                 f"pass --rate {1 / model.dt:.6g}"
             )
         return spec, lambda k: model.copy()
-    if spec in PLANAR_MODELS and hasattr(model_class(spec), "preset"):
-        cls = model_class(spec)
+    presets = [n for n in names_for(3) if has_preset(MODELS[n].model_class(3))]
+    if spec in presets:
+        cls = MODELS[spec].model_class(3)
         return spec, lambda k: cls.preset(dt=dt)
     raise CliError(
-        f"--model {spec!r} with --axes 3: give a planar model with a preset "
-        f"({', '.join(n for n in PLANAR_MODELS.names() if hasattr(model_class(n), 'preset'))}) "
-        "or a planar .npz file (bushenv fit on 3-axis records writes one)"
+        f"--model {spec!r} with --axes 3: give a three-axis model with a preset "
+        f"({', '.join(presets)}) or a three-axis .npz file (bushenv fit on 3-axis records "
+        "writes one)"
     )
 
 

@@ -13,8 +13,8 @@ from importlib import resources
 from pathlib import Path
 
 from bushenv.models.base import AXES, DT_TOLERANCE, PAPER_DT, BushingModel, ModelError
-from bushenv.models.files import file_hash, load_model, params_sha
-from bushenv.models.registry import MODELS, ModelEntry
+from bushenv.models.files import file_hash, load_model, params_sha, wrong_coordinates
+from bushenv.models.registry import MODELS, Form, ModelEntry, coordinate_words, names_for
 from bushenv.registry import Registry, load_entry_point
 
 # Model files other than bushenv's own .npz, by suffix: a loader living above the models (the
@@ -57,6 +57,8 @@ def get_model(
     dt: float | None = None,
     copy: bool = True,
     preset: dict | None = None,
+    coords: int | None = 1,
+    wanted_by: str = "",
 ) -> BushingModel:
     """Resolve a registered name, a model file or a model object to a ready model.
 
@@ -73,8 +75,15 @@ def get_model(
         A model object is copied (its own state) unless False.
     preset : dict, optional
         Extra keyword arguments of a registered preset (e.g. ``{"measurement": False}``).
+    coords : int or None
+        The number of coordinates wanted (1 by default; 3 for axial, radial and rotation); a
+        name builds its form of that many, a file or an object of another count is refused,
+        naming ``wanted_by`` and what takes it. None: any (a name then means one coordinate).
     """
     if isinstance(spec, BushingModel):
+        if coords is not None and spec.n_coords != coords:
+            label = f"model {spec.name}"
+            raise ModelError(wrong_coordinates(label, spec.n_coords, coords, wanted_by))
         if dt is not None and abs(spec.dt - dt) > DT_TOLERANCE * dt:
             raise ModelError(
                 f"model {spec.name} runs at {1 / spec.dt:.6g} Hz (dt={spec.dt:.6g} s), "
@@ -87,6 +96,14 @@ def get_model(
         raise ModelError(f"empty model name; {MODELS.unknown_message(text)} or a .npz file")
     if text in MODELS:
         entry = MODELS[text]
+        if coords not in (None, 1):
+            return _preset(text, entry.model_class(coords), dt, preset, wanted_by)
+        if entry.entry_point is None:
+            raise ModelError(
+                f"model {text!r} exists for {coordinate_words(entry.coordinate_counts()[0])} "
+                f"only; {wanted_by or 'this'} needs a one-axis model ("
+                f"{', '.join(names_for(1))} or a one-axis .npz file)"
+            )
         if entry.shipped:
             path = default_model_path(text, axis)
             if not path.is_file():
@@ -101,12 +118,32 @@ def get_model(
         loader = MODEL_FILES[suffix]
         return (load_entry_point(loader) if isinstance(loader, str) else loader)(text, dt=dt)
     if text.endswith(".npz") or Path(text).exists():
-        return load_model(text, dt=dt)
+        return load_model(text, dt=dt, coords=coords, wanted_by=wanted_by)
     raise ModelError(f"{MODELS.unknown_message(text)} or a .npz model file")
 
 
+def has_preset(cls: type) -> bool:
+    """Whether a model class builds itself without files (its own ``preset``)."""
+    return getattr(cls.preset, "__func__", None) is not BushingModel.preset.__func__
+
+
+def _preset(name: str, cls: type, dt: float | None, options: dict | None, wanted_by: str):
+    """The preset of a kind over several coordinates; a network without one says what to give."""
+    if not has_preset(cls):
+        raise ModelError(
+            f"model {name!r} over {cls.coordinate_count()} coordinates has no preset (a network "
+            f"must be trained): {wanted_by + ' needs' if wanted_by else 'give'} its .npz file "
+            "(bushenv fit on records of as many coordinates writes one)"
+        )
+    return cls.preset(dt=dt or PAPER_DT, **(options or {}))
+
+
 def get_reference(
-    spec: ModelSpec = "rubber", axis: str = "axial", dt: float | None = None
+    spec: ModelSpec = "rubber",
+    axis: str = "axial",
+    dt: float | None = None,
+    coords: int | None = 1,
+    wanted_by: str = "",
 ) -> BushingModel:
     """The model a verdict is judged against: as ``get_model``, with a registered name built
     with its entry's ``reference_preset`` (``"rubber"``: the specimen without the load cell's
@@ -114,7 +151,7 @@ def get_reference(
     preset = None
     if not isinstance(spec, BushingModel) and os.fspath(spec) in MODELS:
         preset = MODELS[os.fspath(spec)].reference_preset
-    return get_model(spec, axis=axis, dt=dt, preset=preset)
+    return get_model(spec, axis=axis, dt=dt, preset=preset, coords=coords, wanted_by=wanted_by)
 
 
 __all__ = [
@@ -122,6 +159,7 @@ __all__ = [
     "MODELS",
     "PAPER_DT",
     "BushingModel",
+    "Form",
     "ModelEntry",
     "ModelError",
     "ModelSpec",
@@ -130,8 +168,10 @@ __all__ = [
     "file_hash",
     "get_model",
     "get_reference",
+    "has_preset",
     "load_model",
     "model_file",
     "model_names",
+    "names_for",
     "params_sha",
 ]

@@ -1,14 +1,16 @@
 """The one protocol every bushing force model follows, and its file format (written by ``save``).
 
-A model is a small stateful object for ONE axis in SI units (m, m/s, N) at a fixed sample time
-``dt`` (the papers' 204.8 Hz by default). Its memory (past inputs, past outputs, internal
-states) lives in ``self.state``, an array of shape (n_state, B) for B independent histories.
+A model is a small stateful object over C coordinates (``coords``: one deflection, or e.g.
+axial, radial and rotation) in SI units (m or rad; N or N m) at a fixed sample time ``dt``
+(the papers' 204.8 Hz by default). Its memory (past inputs, past outputs, internal states)
+lives in ``self.state``, an array of shape (n_state, B) for B independent histories.
 
-Every model implements ``_advance(x, v, out)`` on arrays of shape (T, B): it runs its compiled
-kernel over T samples, updating ``self.state`` in place. ``step`` (one sample, scalar or (B,))
-and ``simulate`` (a whole (T,) or (T, B) profile, free run from reset) both call it, so looped
-and batched results agree to the last bit. A model registered without shipped files also gives
-``preset(axis, dt)``: the parameters ``get_model(name)`` builds it with.
+Every model implements ``_advance(x, v, out)``: it runs its compiled kernel over T samples,
+updating ``self.state`` in place. The arrays are (T, B) when C = 1 and (T, B, C) otherwise.
+``step`` (one sample: a scalar or (B,) when C = 1, (C,) or (B, C) otherwise) and ``simulate``
+(a whole profile, (T,) / (T, B) or (T, C) / (T, B, C), free run from reset) both call it, so
+looped and batched results agree to the last bit. A model registered without shipped files
+also gives ``preset(axis, dt)``: the parameters ``get_model(name)`` builds it with.
 
 Model files are ``.npz`` archives read with ``allow_pickle=False`` (loading never runs code):
 one array per parameter plus ``__meta__``, a JSON string with the registry name, the format
@@ -31,58 +33,14 @@ FORMAT_VERSION = 1
 PAPER_DT = 1.0 / 204.8  # s; RPC III at 204.8 Hz (seed 000 §4.1, seed 001 §3.2.2)
 DT_TOLERANCE = 1e-9  # relative; two dt values closer than this are the same rate
 AXES = ("axial", "radial")  # the bushing directions of seed 000 Table 1
+ONE_COORD = ("deflection",)  # a one-coordinate bushing: the deflection along its axis
 
 
 class ModelError(BadInput):
     """A model file or a model argument is wrong; the message names the file and the problem."""
 
 
-class SavedParameters:
-    """What every model kind shares: its parameters in one ``.npz`` file (no pickle; the
-    kind's ``FILE_FORMAT`` tag in the ``__meta__`` entry) and a fresh copy from them.
-
-    A subclass sets ``name``, ``param_names``, ``dt`` and a ``params`` dict, and takes its
-    parameters (and ``extra_meta()``) as keyword arguments of its constructor."""
-
-    FILE_FORMAT: ClassVar[str] = "bushenv-model"
-
-    def save(self, path: str | os.PathLike) -> Path:
-        """Write the model to one ``.npz`` file atomically (temp file, then rename)."""
-        path = Path(path)
-        arrays = {k: np.asarray(v, dtype=np.float64) for k, v in self.params.items()}
-        meta = {
-            "format": self.FILE_FORMAT,
-            "version": FORMAT_VERSION,
-            "model": self.name,
-            "dt": self.dt,
-            "shapes": {k: list(a.shape) for k, a in arrays.items()},
-            "extra": self.extra_meta(),
-        }
-        payload = {"__meta__": np.array(json.dumps(meta)), **arrays}
-        atomic_write(path, lambda fh: np.savez(fh, **payload))
-        return path
-
-    def extra_meta(self) -> dict[str, Any]:
-        """Non-array settings a subclass needs to rebuild itself (plain JSON values)."""
-        return {}
-
-    @classmethod
-    def from_params(cls, params: dict[str, np.ndarray], dt: float, extra: dict[str, Any]):
-        return cls(dt=dt, **{k: params[k] for k in cls.param_names if k in params}, **extra)
-
-    def copy(self):
-        """A fresh model with the same parameters (own state, at rest)."""
-        return type(self).from_params(
-            {k: np.array(v, dtype=np.float64) for k, v in self.params.items()},
-            self.dt,
-            self.extra_meta(),
-        )
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}(dt={self.dt:.6g})"
-
-
-class BushingModel(SavedParameters):
+class BushingModel:
     """Base class: state handling, step/simulate over one kernel, parameters, save/load.
 
     Subclasses set ``name``, ``param_names`` (the arrays that define the model; floats are
@@ -93,6 +51,10 @@ class BushingModel(SavedParameters):
 
     name: ClassVar[str] = ""
     param_names: ClassVar[tuple[str, ...]] = ()
+    optional_params: ClassVar[tuple[str, ...]] = ()  # may be absent from older files
+    coords: ClassVar[tuple[str, ...]] = ONE_COORD  # the coordinates, in array order
+    units: ClassVar[tuple[str, ...]] = ("m",)  # of each coordinate
+    force_units: ClassVar[tuple[str, ...]] = ("N",)  # of each force (N m for a rotation)
 
     def __init__(self, dt: float = PAPER_DT) -> None:
         if not (np.isfinite(dt) and dt > 0):
@@ -100,9 +62,19 @@ class BushingModel(SavedParameters):
         self.dt = float(dt)
         self.batch_size = 1
         self.state = np.zeros((self.n_state, 1))
-        self._x1 = np.zeros((1, 1))
-        self._v1 = np.zeros((1, 1))
-        self._f1 = np.zeros((1, 1))
+        lane = (1, 1) if self.n_coords == 1 else (1, 1, self.n_coords)
+        self._x1 = np.zeros(lane)
+        self._v1 = np.zeros(lane)
+        self._f1 = np.zeros(lane)
+
+    @classmethod
+    def coordinate_count(cls) -> int:
+        """C, the number of coordinates the model takes and forces it returns."""
+        return len(cls.coords)
+
+    @property
+    def n_coords(self) -> int:
+        return len(self.coords)
 
     # ----- what subclasses provide -----------------------------------------------------
     @property
@@ -138,12 +110,16 @@ class BushingModel(SavedParameters):
             raise ModelError(f"batch_size must be >= 1, got {batch_size}")
         self.batch_size = int(batch_size)
         self.state = np.ascontiguousarray(self.initial_state(self.batch_size), dtype=np.float64)
-        self._x1 = np.zeros((1, self.batch_size))
-        self._v1 = np.zeros((1, self.batch_size))
-        self._f1 = np.zeros((1, self.batch_size))
+        lane = (1, self.batch_size) if self.n_coords == 1 else (1, self.batch_size, self.n_coords)
+        self._x1 = np.zeros(lane)
+        self._v1 = np.zeros(lane)
+        self._f1 = np.zeros(lane)
 
     def step(self, x: float | np.ndarray, v: float | np.ndarray) -> float | np.ndarray:
-        """Advance one sample. Scalars in -> float out (B == 1); (B,) arrays in -> (B,) out."""
+        """Advance one sample. C = 1: scalars in -> float out (B == 1), (B,) in -> (B,) out.
+        C > 1: (C,) in -> (C,) out (B == 1), (B, C) in -> (B, C) out."""
+        if self.n_coords != 1:
+            return self._step_coords(x, v)
         if np.ndim(x) == 0:
             if self.batch_size != 1:
                 raise ModelError(
@@ -163,6 +139,27 @@ class BushingModel(SavedParameters):
         self._guarded(self._x1, self._v1, self._f1)
         return self._f1[0].copy()
 
+    def _step_coords(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``step`` over C > 1 coordinates."""
+        q = np.asarray(q, dtype=np.float64)
+        c = self.n_coords
+        one = q.shape == (c,)
+        want = (c,) if one and self.batch_size == 1 else (self.batch_size, c)
+        if q.shape != want or np.shape(v) != want:
+            raise ModelError(
+                f"{self.name}: step got q {q.shape} and v {np.shape(v)}, expected {want} "
+                f"(batch of {self.batch_size}; order {', '.join(self.coords)})"
+            )
+        self._x1[0] = q
+        self._v1[0] = v
+        self._guarded(self._x1, self._v1, self._f1)
+        return self._f1[0, 0].copy() if one else self._f1[0].copy()
+
+    def backbone_alone(self) -> BushingModel | None:
+        """A hybrid's backbone as a model of its own (a fresh one, at rest), for judging what
+        its network adds; None for a model without one."""
+        return None
+
     def _guarded(self, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         """``_advance``, with anything the model's own code raises that is not a bushenv error
         (``ModelRefused``: a divergence; ``BadInput``) nor arithmetic turned into
@@ -176,7 +173,8 @@ class BushingModel(SavedParameters):
 
     @property
     def last_force_n(self) -> np.ndarray:
-        """(B,) the force of each history at the last ``step``, N (a copy of the output buffer).
+        """(B,) the force of each history at the last ``step``, N ((B, C) over C > 1
+        coordinates; a copy of the output buffer).
 
         Also after a batched ``step`` that raised part-way: what the kernel had written by then
         (a kernel that refuses a non-finite force leaves it there for its history)."""
@@ -185,14 +183,42 @@ class BushingModel(SavedParameters):
     def simulate(self, x: np.ndarray, v: np.ndarray | None = None) -> np.ndarray:
         """Free run from rest over a whole profile: (T,) -> (T,) or (T, B) -> (T, B).
 
+        Over C > 1 coordinates: (T, C) -> (T, C) or (T, B, C) -> (T, B, C).
         ``v`` defaults to the central-difference velocity of ``x`` (``np.gradient``). The model
         is reset to ``B`` histories first and keeps its final state afterwards.
         """
+        if self.n_coords != 1:
+            return self._simulate_coords(x, v)
         x2, v2, one_d = self._profiles(x, v)
         self.reset(x2.shape[1])
         out = np.empty_like(x2)
         self._guarded(x2, v2, out)
         return out[:, 0] if one_d else out
+
+    def _simulate_coords(self, q: np.ndarray, v: np.ndarray | None) -> np.ndarray:
+        """``simulate`` over C > 1 coordinates."""
+        q = np.asarray(q, dtype=np.float64)
+        c = self.n_coords
+        two_d = q.ndim == 2
+        q3 = q[:, None, :] if two_d else q
+        if q3.ndim != 3 or q3.shape[0] < 1 or q3.shape[2] != c:
+            raise ModelError(
+                f"{self.name}: simulate expects (T, {c}) or (T, B, {c}) "
+                f"({', '.join(self.coords)}), got {q.shape}"
+            )
+        if v is None:
+            v3 = velocity_of(q3, self.dt)
+        else:
+            v3 = np.asarray(v, dtype=np.float64)
+            v3 = v3[:, None, :] if v3.ndim == 2 else v3
+            if v3.shape != q3.shape:
+                raise ModelError(f"{self.name}: v shape {v3.shape} differs from q {q.shape}")
+        q3 = np.ascontiguousarray(q3)
+        v3 = np.ascontiguousarray(v3)
+        self.reset(q3.shape[1])
+        out = np.empty_like(q3)
+        self._guarded(q3, v3, out)
+        return out[:, 0, :] if two_d else out
 
     def _profiles(self, x, v, dtype=np.float64) -> tuple[np.ndarray, np.ndarray, bool]:
         """``simulate``'s inputs as C-contiguous (T, B) arrays of ``dtype``, and whether x was
@@ -219,6 +245,44 @@ class BushingModel(SavedParameters):
         return np.ascontiguousarray(x2, dtype), np.ascontiguousarray(v2, dtype), one_d
 
     # ----- files -------------------------------------------------------------------------
+    FILE_FORMAT: ClassVar[str] = "bushenv-model"
+
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write the model to one ``.npz`` file atomically (temp file, then rename)."""
+        path = Path(path)
+        arrays = {k: np.asarray(v, dtype=np.float64) for k, v in self.params.items()}
+        meta = {
+            "format": self.FILE_FORMAT,
+            "version": FORMAT_VERSION,
+            "model": self.name,
+            "dt": self.dt,
+            "shapes": {k: list(a.shape) for k, a in arrays.items()},
+            "extra": self.extra_meta(),
+        }
+        if self.n_coords != 1:  # one-coordinate files stay as they always were
+            meta["coords"] = list(self.coords)
+        payload = {"__meta__": np.array(json.dumps(meta)), **arrays}
+        atomic_write(path, lambda fh: np.savez(fh, **payload))
+        return path
+
+    def extra_meta(self) -> dict[str, Any]:
+        """Non-array settings a subclass needs to rebuild itself (plain JSON values)."""
+        return {}
+
+    @classmethod
+    def from_params(cls, params: dict[str, np.ndarray], dt: float, extra: dict[str, Any]):
+        return cls(dt=dt, **{k: params[k] for k in cls.param_names if k in params}, **extra)
+
+    def copy(self):
+        """A fresh model with the same parameters (own state, at rest)."""
+        return type(self).from_params(
+            {k: np.array(v, dtype=np.float64) for k, v in self.params.items()},
+            self.dt,
+            self.extra_meta(),
+        )
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(dt={self.dt:.6g})"
 
 
 def velocity_of(x: np.ndarray, dt: float) -> np.ndarray:

@@ -19,6 +19,7 @@ from bushenv.models.base import DT_TOLERANCE, FORMAT_VERSION, BushingModel, Mode
 from bushenv.models.registry import MODELS
 
 ZIP_MAGIC = b"PK\x03\x04"
+LEGACY_THREE_AXIS = "bushenv-planar-model"  # three-axis files' tag before the one format
 _KNOWN_MAGIC = (
     (b"\x93NUMPY", "a single .npy array, not an .npz archive"),
     (b"\x80", "a Python pickle (bushenv never loads pickles: they can run code)"),
@@ -44,32 +45,77 @@ def _not_npz_reason(head: bytes) -> str:
     return f"unknown binary data (starts with {head[:8]!r})"
 
 
-def load_model(path: str | os.PathLike, dt: float | None = None) -> BushingModel:
-    """Read a model file written by ``BushingModel.save``.
+def load_model(
+    path: str | os.PathLike,
+    dt: float | None = None,
+    coords: int | None = None,
+    wanted_by: str = "",
+) -> BushingModel:
+    """Read a model file written by ``BushingModel.save``, of any number of coordinates.
 
     Refuses with ``ModelError``, naming the file and what was expected: a missing file, a
     folder, anything that is not an npz archive (text, an image, a pickle, a lone .npy), a
     truncated or damaged archive, object (pickled) entries -- never unpickled --, another
     format or version, an unknown model name, a corrupt header, missing, non-numeric or
-    wrongly shaped parameters, and (when ``dt`` is given) a sample time other than ``dt``.
+    wrongly shaped parameters, (when ``dt`` is given) a sample time other than ``dt`` and
+    (when ``coords`` is given) a model of another number of coordinates, then naming
+    ``wanted_by`` (what needs it) and what takes the model instead. Files of three-axis models
+    written under their former format tag load as they always did.
     """
     path = Path(path)
     files = _archive(path)
     meta = _header(path, files)
-    name = meta["model"]
-    cls = MODELS[name].model_class()
+    name, count = meta["model"], _coordinate_count(path, meta)
+    if coords is not None and count != coords:
+        raise ModelError(wrong_coordinates(str(path), count, coords, wanted_by))
+    try:
+        cls = MODELS[name].model_class(count)
+    except ModelError as exc:
+        raise ModelError(f"{path}: {exc}") from None
     file_dt = _sample_time(path, meta, dt)
     shapes, extra = meta.get("shapes", {}), meta.get("extra", {})
     if not isinstance(shapes, dict) or not isinstance(extra, dict):
         raise ModelError(f"{path}: corrupt __meta__ entry ('shapes' and 'extra' must be objects)")
     for key in cls.param_names:
-        _check_parameter(path, name, key, files, shapes.get(key))
+        if key in files or key not in cls.optional_params:
+            _check_parameter(path, name, key, files, shapes.get(key))
     try:
         return cls.from_params(files, file_dt, extra)
     except ModelError as exc:
         raise ModelError(f"{path}: {exc}") from None
     except (TypeError, ValueError, KeyError) as exc:
         raise ModelError(f"{path}: parameters do not fit a {name} model: {exc}") from None
+
+
+# What takes a model of C coordinates, for the message that refuses it elsewhere.
+TAKES = {
+    1: "bushenv attack (--env rig or quartercar), certify, export, diagnose, replay, zoo, and "
+    "gym.make('BushRig-v0' or 'QuarterCar-v0', model=FILE)",
+    3: "bushenv attack --env rig3, bushenv card, bushenv measure --axes 3, and "
+    "gym.make('BushRig3-v0', model=FILE)",
+}
+
+
+def wrong_coordinates(label: str, have: int, want: int, wanted_by: str = "") -> str:
+    """The message refusing ``label``, a model of ``have`` coordinates, where ``want`` are
+    needed: what it is, what needed another, and what takes it."""
+    from bushenv.models.registry import coordinate_words
+
+    need = f"{wanted_by} needs" if wanted_by else "this needs"
+    takes = TAKES.get(have)
+    return f"{label} is {coordinate_words(have)}; {need} {coordinate_words(want).split(':')[0]}" + (
+        f". A {have}-coordinate model goes to: {takes}" if takes else ""
+    )
+
+
+def _coordinate_count(path: Path, meta: dict) -> int:
+    """C from the header: its ``coords`` list, 3 for the former three-axis tag, else 1."""
+    if meta.get("format") == LEGACY_THREE_AXIS:
+        return 3
+    names = meta.get("coords", ["deflection"])
+    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+        raise ModelError(f"{path}: corrupt __meta__ entry (coords {names!r}, expected names)")
+    return len(names)
 
 
 def _archive(path: Path) -> dict[str, np.ndarray]:
@@ -118,8 +164,10 @@ def _header(path: Path, files: dict[str, np.ndarray]) -> dict:
         meta = json.loads(str(raw))
     except json.JSONDecodeError as exc:
         raise ModelError(f"{path}: corrupt __meta__ entry: {exc}") from None
-    if not isinstance(meta, dict) or meta.get("format") != "bushenv-model":
-        raise ModelError(f"{path}: not a bushenv model file (format tag missing)")
+    if not isinstance(meta, dict) or meta.get("format") not in ("bushenv-model", LEGACY_THREE_AXIS):
+        got = meta.get("format") if isinstance(meta, dict) else None
+        tag = "format tag missing" if got is None else f"format tag {got!r}"
+        raise ModelError(f"{path}: not a bushenv model file ({tag}, expected 'bushenv-model')")
     if meta.get("version") != FORMAT_VERSION:
         raise ModelError(
             f"{path}: model file format version {meta.get('version')!r}, "

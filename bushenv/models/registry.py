@@ -1,11 +1,14 @@
 """``MODELS``: the one list of bushing models. Adding a model = one module + one line here.
 
-Each entry names the model class and, where the model can be identified from measured records,
-its identification function (``bushenv fit``, ``bushenv reproduce`` and the diagnosis
-baselines read it from here), whether trained defaults ship with the package (one file per
-axis in ``bushenv/data/models``), and the preset options the model takes when it stands as
-the *reference* of a verdict. Entries are ``"module:attribute"`` strings, imported on first
-use, so this module imports no model (and no torch).
+A name is a kind of model (``linear``, ``nn``, ``hybrid``, ...) over any number of coordinates
+C: each entry holds one form per C it exists for (the class, its identification and options),
+e.g. ``linear`` as a scalar Kelvin-Voigt for C = 1 and as 3x3 matrices for the three in-plane
+coordinates. Where the model can be identified from measured records, the entry names its
+identification (``bushenv fit``, ``bushenv reproduce`` and the diagnosis baselines read it
+here); it says whether trained defaults ship with the package (one file per axis in
+``bushenv/data/models``) and the preset options the model takes as the *reference* of a
+verdict. Entries are ``"module:attribute"`` strings, imported on first use, so this module
+imports no model (and no torch).
 """
 
 from __future__ import annotations
@@ -15,6 +18,27 @@ from typing import Any
 
 from bushenv.models.base import ModelError
 from bushenv.registry import Registry, load_entry_point
+
+
+@dataclass(frozen=True)
+class Form:
+    """One kind of model over C > 1 coordinates: its class, identification and options
+    (identification ``fit(histories, dt, options, seed, say) -> (model, info)``, histories a
+    list of (q (T, C), f (T, C)) pairs)."""
+
+    entry_point: str | type
+    fit: Any = None
+    options: Any = None
+
+    def model_class(self) -> type:
+        ep = self.entry_point
+        return load_entry_point(ep) if isinstance(ep, str) else ep
+
+    def fit_function(self) -> Any:
+        return load_entry_point(self.fit) if isinstance(self.fit, str) else self.fit
+
+    def options_class(self) -> Any:
+        return load_entry_point(self.options) if isinstance(self.options, str) else self.options
 
 
 @dataclass(frozen=True)
@@ -46,9 +70,11 @@ class ModelEntry:
         For a preset of another model's class (``nn-paper`` is an ``nn`` network trained
         another way): the registered name of that class, which its files carry. None: the
         entry's own name.
+    wider : dict of int to Form
+        The same kind over C > 1 coordinates, by C (3: axial, radial, rotation).
     """
 
-    entry_point: str | type
+    entry_point: str | type | None
     summary: str
     fit: Any = None
     options: Any = None
@@ -57,19 +83,58 @@ class ModelEntry:
     hybrid: str | None = None
     also: tuple[str, ...] = ()
     kind: str | None = None
+    wider: dict[int, Form] = field(default_factory=dict)
 
-    def model_class(self) -> type:
-        ep = self.entry_point
-        return load_entry_point(ep) if isinstance(ep, str) else ep
+    def coordinate_counts(self) -> tuple[int, ...]:
+        """The numbers of coordinates C this kind exists for."""
+        return ((1,) if self.entry_point is not None else ()) + tuple(sorted(self.wider))
 
-    def fit_function(self) -> Any:
-        return load_entry_point(self.fit) if isinstance(self.fit, str) else self.fit
+    def form(self, coords: int = 1) -> Form:
+        """The kind over ``coords`` coordinates (``ModelError`` saying which C it has)."""
+        if coords == 1 and self.entry_point is not None:
+            return Form(self.entry_point, self.fit, self.options)
+        if coords in self.wider:
+            return self.wider[coords]
+        have = " or ".join(str(c) for c in self.coordinate_counts())
+        raise ModelError(
+            f"{self.summary.split(',')[0]}: exists for {have} coordinate(s), not {coords} "
+            f"({coordinate_words(coords)})"
+        )
 
-    def options_class(self) -> Any:
-        return load_entry_point(self.options) if isinstance(self.options, str) else self.options
+    def model_class(self, coords: int = 1) -> type:
+        return self.form(coords).model_class()
+
+    def fit_function(self, coords: int = 1) -> Any:
+        return self.form(coords).fit_function()
+
+    def options_class(self, coords: int = 1) -> Any:
+        return self.form(coords).options_class()
+
+    def fits(self, coords: int = 1) -> bool:
+        """Whether this kind can be identified from records over ``coords`` coordinates."""
+        return coords in self.coordinate_counts() and self.form(coords).fit is not None
+
+
+def coordinate_words(coords: int) -> str:
+    """How a user names a model of ``coords`` coordinates."""
+    return {1: "a one-axis model", 3: "a three-axis model: axial, radial, rotation"}.get(
+        coords, f"a {coords}-coordinate model"
+    )
+
+
+def names_for(coords: int = 1, fittable: bool = False) -> tuple[str, ...]:
+    """The registered names that exist over ``coords`` coordinates (and can be fitted)."""
+    return tuple(
+        n
+        for n, e in MODELS.items()
+        if coords in e.coordinate_counts() and (not fittable or e.fits(coords))
+    )
 
 
 MODELS: Registry[ModelEntry] = Registry("model", ModelError)
+P = "bushenv.planar."  # the three-coordinate forms
+FITS = "bushenv.planar.fitting:"
+OPTS = "bushenv.identify.options:"
 MODELS.add(
     "linear",
     ModelEntry(
@@ -77,6 +142,7 @@ MODELS.add(
         "Kelvin-Voigt spring and dashpot, F = k x + c v (seed 000 eqs 1-3)",
         fit="bushenv.identify.linear:fit_linear",
         options="bushenv.identify.options:NoOptions",
+        wider={3: Form(P + "linear:PlanarLinear", FITS + "fit_linear", OPTS + "NoOptions")},
     ),
 )
 MODELS.add(
@@ -87,6 +153,25 @@ MODELS.add(
         fit="bushenv.identify.neural:fit_nn",
         options="bushenv.identify.narx_options:NarxOptions",
         shipped=True,
+        wider={
+            3: Form(
+                P + "narx:PlanarNarx", FITS + "fit_nn", P + "train_options:PlanarNetworkOptions"
+            )
+        },  # fmt: skip
+    ),
+)
+MODELS.add(
+    "nn-axis",
+    ModelEntry(
+        None,
+        "three single-axis NARX networks in one model, seed 000 §4.2's kind in three axes",
+        wider={
+            3: Form(
+                P + "narx:PlanarNarxPerAxis",
+                FITS + "fit_nn_axis",
+                P + "train_options:PlanarNetworkOptions",
+            )
+        },  # fmt: skip
     ),
 )
 MODELS.add(
@@ -97,6 +182,13 @@ MODELS.add(
         fit="bushenv.identify.neural:fit_hybrid",
         options="bushenv.identify.narx_options:HybridOptions",
         shipped=True,
+        wider={
+            3: Form(
+                P + "narx:PlanarHybrid",
+                FITS + "fit_hybrid",
+                P + "train_options:PlanarHybridOptions",
+            )
+        },  # fmt: skip
     ),
 )
 MODELS.add(
@@ -129,6 +221,27 @@ MODELS.add(
         fit="bushenv.identify.global_search:fit_boucwen",
         options="bushenv.identify.boucwen_options:BoucWenOptions",
         shipped=True,
+        wider={
+            3: Form(
+                P + "boucwen:PlanarBoucWen",
+                FITS + "fit_boucwen",
+                P + "boucwen_fit:PlanarBoucWenOptions",
+            )
+        },  # fmt: skip
+    ),
+)
+MODELS.add(
+    "hybrid-bw",
+    ModelEntry(
+        None,
+        "vector Bouc-Wen backbone plus a MIMO NARX network on its residual",
+        wider={
+            3: Form(
+                P + "hybrid_bw:PlanarBoucWenHybrid",
+                FITS + "fit_hybrid_bw",
+                FITS + "PlanarHybridBWOptions",
+            )
+        },  # fmt: skip
     ),
 )
 MODELS.add(
@@ -138,5 +251,7 @@ MODELS.add(
         "the reference rubber bushing (bushenv/reference); as a reference without its "
         "measurement chain",
         reference_preset={"measurement": False},
+        wider={3: Form(P + "reference:PlanarRubber")},
     ),
 )
+MODELS.alias("reference", "rubber")  # the three-axis rubber's name in files written before

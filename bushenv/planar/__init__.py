@@ -1,19 +1,9 @@
-"""Planar bushing models: axial, radial and rotation at once (see ``base.py`` for the protocol).
+"""Three-axis bushing physics: the coupled reference, the matrix, network and vector Bouc-Wen
+forms of the registered kinds (``bushenv.models.MODELS``), their identification and checks.
 
-The one-axis protocol (``bushenv.models``) is untouched; this package is its three-coordinate
-sibling with its own registry, ``PLANAR_MODELS``.
+The protocol is ``bushenv.models.base.BushingModel`` over the coordinates ``COORDS``.
 """
 
 from bushenv.planar.base import COORDS, FORCE_UNITS, UNITS, PlanarModel, PlanarModelError
-from bushenv.planar.registry import PLANAR_MODELS, load_planar_model, model_class
 
-__all__ = [
-    "COORDS",
-    "FORCE_UNITS",
-    "PLANAR_MODELS",
-    "UNITS",
-    "PlanarModel",
-    "PlanarModelError",
-    "load_planar_model",
-    "model_class",
-]
+__all__ = ["COORDS", "FORCE_UNITS", "UNITS", "PlanarModel", "PlanarModelError"]

@@ -1,9 +1,9 @@
-"""Identifying planar models from 3-axis records: which models can be fitted, with what options.
+"""Identifying three-axis models from 3-axis records: the identifications ``MODELS`` names.
 
-``PLANAR_FITS`` names the identification of each fittable ``PLANAR_MODELS`` entry (the same
-names) and its options dataclass, whose fields are flags of ``bushenv fit`` as the one-axis
-options are (``bushenv.identify.options``). ``fit_planar(records, name, options, seed)`` runs
-one; records are ``(q (T, 3), f (T, 3))`` pairs at one sample time.
+Each fittable kind's three-coordinate ``Form`` in ``bushenv.models.registry.MODELS`` names one
+of the functions below and its options dataclass, whose fields are flags of ``bushenv fit`` as
+the one-axis options are (``bushenv.identify.options``). ``fit_planar(records, name, options,
+seed)`` runs one; records are ``(q (T, 3), f (T, 3))`` pairs at one sample time.
 
 | name      | identification                                                      |
 |-----------|---------------------------------------------------------------------|
@@ -27,16 +27,15 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.identify.options import NoOptions, option, option_like, options_of
+from bushenv.identify.options import option, option_like, options_of
+from bushenv.models.registry import MODELS, names_for
 from bushenv.planar.base import PlanarModel, PlanarModelError
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
-from bushenv.planar.registry import PLANAR_MODELS
 from bushenv.planar.train_options import (
     PlanarHybridOptions,
     PlanarNetworkOptions,
     record_problem,
 )
-from bushenv.registry import Registry
 
 History = tuple[np.ndarray, np.ndarray]
 
@@ -69,14 +68,6 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
         )
 
 
-@dataclass(frozen=True)
-class PlanarFit:
-    """One identification: its options class and ``fit(histories, dt, opts, seed, say)``."""
-
-    options: type
-    fit: Callable[..., tuple[PlanarModel, dict[str, Any]]]
-
-
 @dataclass
 class PlanarFitResult:
     model: PlanarModel
@@ -87,7 +78,7 @@ class PlanarFitResult:
     info: dict[str, Any] = field(default_factory=dict)
 
 
-def _linear(histories, dt, opts, seed, say):
+def fit_linear(histories, dt, opts, seed, say):
     from bushenv.models.base import velocity_of
     from bushenv.planar.linear import fit_linear
 
@@ -150,19 +141,16 @@ def network_info(model: Any) -> dict[str, str]:
     }
 
 
-def _boucwen(histories, dt, opts, seed, say):
+fit_nn = _network("nn")
+fit_nn_axis = _network("nn-axis")
+fit_hybrid = _network("hybrid")
+
+
+def fit_boucwen(histories, dt, opts, seed, say):
     return fit_planar_boucwen(histories, dt, opts, say=say)
 
 
-PLANAR_FITS: Registry[PlanarFit] = Registry("fittable planar model", PlanarModelError)
-PLANAR_FITS.add("linear", PlanarFit(NoOptions, _linear))
-for _kind in ("nn", "nn-axis"):
-    PLANAR_FITS.add(_kind, PlanarFit(PlanarNetworkOptions, _network(_kind)))
-PLANAR_FITS.add("hybrid", PlanarFit(PlanarHybridOptions, _network("hybrid")))
-PLANAR_FITS.add("boucwen", PlanarFit(PlanarBoucWenOptions, _boucwen))
-
-
-def _hybrid_bw(histories, dt, opts, seed, say):
+def fit_hybrid_bw(histories, dt, opts, seed, say):
     from bushenv.planar.hybrid_bw import compose
     from bushenv.planar.train import fit_planar_network
 
@@ -177,7 +165,9 @@ def _hybrid_bw(histories, dt, opts, seed, say):
     return compose(backbone, net), {**info, **network_info(net)}
 
 
-PLANAR_FITS.add("hybrid-bw", PlanarFit(PlanarHybridBWOptions, _hybrid_bw))
+def options_class(name: str) -> type:
+    """The options dataclass of the three-axis identification of ``name``."""
+    return MODELS[name].options_class(3)
 
 
 BOUCWEN_MIN_SAMPLES = 20  # per record (``boucwen_fit``)
@@ -187,7 +177,7 @@ NETWORK_MIN_WINDOWS = 20  # free-run windows the training history holds at least
 def length_problem(name: str, options: Any, lengths: dict[str, int]) -> str | None:
     """What is too short for identifying ``name`` from records of ``lengths`` (label ->
     samples), with the fix; None when they are long enough."""
-    opts = options_of(PLANAR_FITS[name].options, options, name)
+    opts = options_of(options_class(name), options, name)
     if name in ("boucwen", "hybrid-bw"):
         short = {k: n for k, n in lengths.items() if n < BOUCWEN_MIN_SAMPLES}
         if short:
@@ -222,12 +212,15 @@ def fit_planar(
     say: Callable[[str], None] | None = None,
 ) -> PlanarFitResult:
     """Identify the planar model ``name`` from ``histories`` at sample time ``dt``."""
-    entry = PLANAR_FITS[name]
-    if name not in PLANAR_MODELS:
-        raise PlanarModelError(f"{name!r} has an identification but no PLANAR_MODELS entry")
+    form = MODELS[name].form(3)
+    if form.fit is None:
+        raise PlanarModelError(
+            f"model {name} has no 3-axis identification; for 3-axis records choose one of: "
+            f"{', '.join(names_for(3, fittable=True))}"
+        )
     if dt is None or not dt > 0:
         raise PlanarModelError(f"fit_planar: dt must be a positive number of seconds, got {dt!r}")
-    opts = options_of(entry.options, options, name)
+    opts = options_of(form.options_class(), options, name)
     t0 = time.perf_counter()
-    model, info = entry.fit(list(histories), dt, opts, seed, say)
+    model, info = form.fit_function()(list(histories), dt, opts, seed, say)
     return PlanarFitResult(model, name, opts, seed, time.perf_counter() - t0, info)

@@ -121,7 +121,7 @@ def planar_rubber_kernel(q, v, noise, state, epar, cdamp, relax, kel, slip, vect
 class PlanarRubber(PlanarModel):
     """The planar reference rubber; see the module docstring for the force law."""
 
-    name = "reference"
+    name = "rubber"  # files written as "reference" before load through MODELS' alias
     EFFECTS: ClassVar[tuple[str, ...]] = EFFECTS
     # beyond it the quartic coupling is an extrapolation (docs/planar.md): a judge out of range
     calibrated_rotation_rad: ClassVar[float] = MAX_ROTATION_RAD

@@ -42,7 +42,7 @@ import numpy as np
 from bushenv.identify.options import option_fields
 from bushenv.metrics import esr, max_error, max_error_ratio, rms_ratio
 from bushenv.planar.base import COORDS
-from bushenv.planar.fitting import PLANAR_FITS, fit_planar
+from bushenv.planar.fitting import fit_planar, options_class
 from bushenv.planar.machine import IDENTIFICATIONS, N_VERIFY, coupled_sets
 from bushenv.planar.programme import programme, random_correlated, random_independent
 from bushenv.planar.reference import PlanarRubber
@@ -152,7 +152,7 @@ def planar_table(
 def _untimed(name: str) -> dict[str, float] | None:
     """Default options, but a search stopped by its budget, not by the clock: the table is
     then the same on a loaded machine (a 120 s limit cut the Bouc-Wen search there)."""
-    fields = {f.name for f in option_fields(PLANAR_FITS[name].options)}
+    fields = {f.name for f in option_fields(options_class(name))}
     return {"time_limit_s": 0.0} if "time_limit_s" in fields else None
 
 

@@ -17,8 +17,8 @@ from gymnasium import spaces
 
 from bushenv.divergence import force_termination
 from bushenv.errors import BadInput, ModelRaised
+from bushenv.models import MODELS, BushingModel, ModelError, get_model, names_for
 from bushenv.models.base import DT_TOLERANCE
-from bushenv.planar import PLANAR_MODELS, PlanarModel, load_planar_model, model_class
 from bushenv.rigs.bushrig3_kernels import rig3_motion, rig3_outcome
 from bushenv.rigs.common import RigError, positive, positive_int
 from bushenv.rigs.specs import spec_kwargs
@@ -31,23 +31,23 @@ MODEL_ERRORS = (BadInput, ModelRaised, ArithmeticError)
 
 def resolve_planar(
     value: Any, dt: float, what: str, env_id: str = ENV_ID, rate_setting: str = ""
-) -> PlanarModel:
-    """A planar model from a registered name (its ``preset``), an ``.npz`` file or an object;
-    errors name ``env_id`` and the argument ``what``; a file at another rate names
+) -> BushingModel:
+    """A three-axis model from a registered name (its ``preset``), an ``.npz`` file or an
+    object; errors name ``env_id`` and the argument ``what``; a file at another rate names
     ``rate_setting`` (the caller's argument that sets the step) with the value to give."""
-    if isinstance(value, PlanarModel):
-        return value.copy()
-    if isinstance(value, str) and value in PLANAR_MODELS:
-        cls = model_class(value)
-        if not hasattr(cls, "preset"):
-            raise RigError(
-                f"{env_id}: {what} {value!r} has no preset (a network must be trained): pass "
-                "its .npz file from fit_planar_network(...).save(path)"
-            )
-        kwargs = {"measurement": False} if value == "reference" else {}
-        return cls.preset(dt=dt, **kwargs)
+    wanted = f"{env_id}'s {what}"
+    if isinstance(value, BushingModel) or (isinstance(value, str) and value in MODELS):
+        options = MODELS[value].reference_preset if isinstance(value, str) else None
+        try:
+            model = get_model(value, dt=dt, preset=options, coords=3, wanted_by=wanted)
+        except ModelError as exc:
+            raise RigError(f"{env_id}: {what} {value!r}: {exc}") from None
+        return model
     if isinstance(value, str | Path) and str(value).endswith(".npz"):
-        own = load_planar_model(value)
+        try:
+            own = get_model(str(value), coords=3, wanted_by=wanted)
+        except ModelError as exc:
+            raise RigError(f"{env_id}: {what}: {exc}") from None
         if abs(own.dt - dt) > DT_TOLERANCE * dt:  # a fit at its records' rate: say what to set
             fix = f"pass {rate_setting}={own.dt:.6g}" if rate_setting else "give both one rate"
             raise RigError(
@@ -56,8 +56,8 @@ def resolve_planar(
             )
         return own
     raise RigError(
-        f"{env_id}: {what} {value!r}: {PLANAR_MODELS.unknown_message(value)}, "
-        "or a .npz planar model file"
+        f"{env_id}: {what} {value!r}: {MODELS.unknown_message(value)} (three-axis: "
+        f"{', '.join(names_for(3))}), or a three-axis .npz model file"
     )
 
 

@@ -7,14 +7,14 @@ from pathlib import Path
 
 
 def resolve_planar_spec(spec: str, dt: float | None, what: str):
-    """A planar model by ``PLANAR_MODELS`` name (with a preset) or ``.npz`` file; ``dt`` None:
+    """A three-axis model by ``MODELS`` name (with a preset) or ``.npz`` file; ``dt`` None:
     a file at its own rate (a fit on 500 Hz records runs at 500 Hz), a preset at the papers'."""
+    from bushenv.models import load_model
     from bushenv.models.base import PAPER_DT
-    from bushenv.planar import load_planar_model
     from bushenv.rigs.bushrig3 import resolve_planar
 
     if dt is None and str(spec).endswith(".npz") and Path(spec).is_file():
-        return load_planar_model(spec)
+        return load_model(spec, coords=3, wanted_by=f"the {what}")
     return resolve_planar(spec, PAPER_DT if dt is None else dt, what)
 
 

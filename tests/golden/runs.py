@@ -212,15 +212,15 @@ def planar_attack_run(out: Path) -> dict[str, Any]:
 
 def planar_certificate_run(out: Path) -> dict[str, Any]:
     """A three-axis network's holds over its range and the linear fit's passivity matrix."""
+    from bushenv.models import load_model
     from bushenv.planar.passivity import passivity
     from bushenv.planar.range_holds import range_holds
-    from bushenv.planar.registry import load_planar_model
 
     planar_fit_run(out)
-    nn = load_planar_model(out / "nn3.npz")
+    nn = load_model(out / "nn3.npz")
     holds = range_holds(nn, np.array([0.004, 0.004, 0.05]))
     holds.pop("seconds", None)
-    lin = load_planar_model(out / "linear3.npz")
+    lin = load_model(out / "linear3.npz")
     rep = passivity(lin, np.zeros(3), np.array([1.0, 5.0, 20.0]))
     rows = {k: (v if isinstance(v, str) else np.asarray(v).tolist()) for k, v in vars(rep).items()}
     return strip({"holds": holds, "passivity": rows})

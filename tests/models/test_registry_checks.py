@@ -1,36 +1,41 @@
-"""Every registered model, every axis, through every check of the model contract
-(``bushenv.models.checks``): registering a model is the one step that tests it."""
+"""Every registered model, every form (one coordinate on each axis, three coordinates), through
+every check of the model contract (``bushenv.models.checks``): registering a model is the one
+step that tests it."""
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bushenv.models import AXES, MODELS, get_model, get_reference
-from bushenv.models.checks import CHECKS, drive
+from bushenv.models import MODELS, get_model
+from bushenv.models.checks import CHECKS, drive, example, forms
 
-ENTRIES = [(name, axis) for name in MODELS.names() for axis in AXES]
+FORMS = forms()
 
 
-def checked_model(name, axis="axial"):
-    # a model with a reference preset is checked as it judges (the rubber without its
-    # measurement chain's noise, whose stream is per batch)
-    if MODELS[name].reference_preset:
-        return get_reference(name, axis=axis)
-    return get_model(name, axis=axis)
+def checked_model(name, axis="axial", coords=1):
+    return example(name, coords, axis or "axial")
 
 
 @pytest.mark.parametrize("check", sorted(CHECKS))
-@pytest.mark.parametrize(("name", "axis"), ENTRIES, ids=[f"{n}-{a}" for n, a in ENTRIES])
-def test_every_registered_model_keeps_the_contract(name, axis, check):
-    CHECKS[check](lambda: checked_model(name, axis))
+@pytest.mark.parametrize(
+    ("name", "coords", "axis"), FORMS, ids=[f"{n}-{c}{'-' * bool(a)}{a}" for n, c, a in FORMS]
+)
+def test_every_registered_model_keeps_the_contract(name, coords, axis, check):
+    CHECKS[check](lambda: checked_model(name, axis, coords))
+
+
+def test_every_form_of_three_coordinates_is_checked():
+    three = {n for n, c, _ in FORMS if c == 3}
+    assert {"linear", "nn", "nn-axis", "hybrid", "boucwen", "hybrid-bw", "rubber"} <= three
 
 
 @settings(max_examples=20, deadline=None)
-@given(seed=st.integers(0, 10_000), batch=st.integers(1, 5), name=st.sampled_from(MODELS.names()))
-def test_any_batch_equals_its_columns_run_alone(seed, batch, name):
-    m = checked_model(name)
-    x, v = drive(40, batch, seed, m.dt)
+@given(seed=st.integers(0, 10_000), batch=st.integers(1, 5), form=st.sampled_from(FORMS))
+def test_any_batch_equals_its_columns_run_alone(seed, batch, form):
+    name, coords, axis = form
+    m = checked_model(name, axis, coords)
+    x, v = drive(40, batch, seed, m.dt, m.units)
     batched = m.simulate(x, v)
     for b in range(batch):
         assert np.array_equal(batched[:, b], m.simulate(x[:, b], v[:, b])), name

@@ -133,9 +133,9 @@ def test_axis_yield_surface_keeps_each_coordinate_to_itself(tmp_path):
     one = np.zeros((T, 3))
     one[:, 1] = q[:, 1]
     assert np.array_equal(axis.hysteretic_state(one)[:, 1], z[:, 1])
-    from bushenv.planar import load_planar_model
+    from bushenv.models import load_model
 
-    back = load_planar_model(axis.save(tmp_path / "axis.npz"))
+    back = load_model(axis.save(tmp_path / "axis.npz"))
     assert back.yield_surface == "axis" and np.array_equal(back.hysteretic_state(q), z)
     with pytest.raises(PlanarModelError, match="yield_surface 'box'"):
         PlanarBoucWen(np.zeros((3, 3)), np.zeros((3, 3)), np.ones(3), D, yield_surface="box")

@@ -8,8 +8,8 @@ import pytest
 
 from bushenv.cli import main
 from bushenv.identify.options import flag_of, option_fields
-from bushenv.planar import load_planar_model
-from bushenv.planar.fitting import PLANAR_FITS
+from bushenv.models import load_model, names_for
+from bushenv.planar.fitting import options_class
 from bushenv.planar.records import HEADER_TEXT, load_planar_csv
 
 DOC = (Path(__file__).resolve().parents[2] / "docs" / "fit.md").read_text()
@@ -76,7 +76,7 @@ def test_fit_on_3_axis_records_writes_model_and_per_axis_card(records, tmp_path,
     extra = ["--evaluations", "10"] if model == "boucwen" else []
     args = ["fit", *map(str, train), "--model", model, "--validate", *map(str, held)]
     assert main([*args, "--out", str(out), "--quiet", *extra]) == 0
-    fitted = load_planar_model(out)
+    fitted = load_model(out)
     assert fitted.name == model
     card = json.loads(out.with_name(f"{model}.card.json").read_text())
     assert card["format"] == "bushenv-planar-model-card" and card["model"] == model
@@ -147,14 +147,14 @@ def test_measure_refuses_programmes_without_a_3_axis_form(tmp_path, capsys):
     line = _fails(["measure", "--axes", "3", "--programme", "step", "--out", str(tmp_path)], capsys)
     assert "--programme step has no 3-axis form" in line
     line = _fails(["measure", "--axes", "3", "--model", "nn", "--out", str(tmp_path)], capsys)
-    assert "planar model with a preset" in line
+    assert "three-axis model with a preset" in line
 
 
-@pytest.mark.parametrize("name", PLANAR_FITS.names())
+@pytest.mark.parametrize("name", names_for(3, fittable=True))
 def test_every_planar_fit_flag_is_explained_in_docs_fit(name):
     missing = [
         flag_of(f.name)
-        for f in option_fields(PLANAR_FITS[name].options)
+        for f in option_fields(options_class(name))
         if f"`{flag_of(f.name)}`" not in DOC
     ]
     assert not missing, f"docs/fit.md does not explain {missing} of the 3-axis {name}"
@@ -186,7 +186,7 @@ def test_a_hybrid_card_sets_its_network_against_its_backbone_alone(records, tmp_
     assert card["backbone"]["model"] == "boucwen"
     assert [r["name"] for r in card["backbone"]["records"]] == [p.stem for p in held]
     rec = load_planar_csv(held[0])  # the figures are the backbone's own free run
-    alone = load_planar_model(out).backbone_alone().simulate(rec.q)
+    alone = load_model(out).backbone_alone().simulate(rec.q)
     got = card["backbone"]["records"][0]["metrics"]["radial"]["rms_ratio"]
     assert got == pytest.approx(rms_ratio(rec.f[:, 1], alone[:, 1]), rel=1e-12)
     assert "its backbone alone (boucwen)" in capsys.readouterr().out

@@ -1,17 +1,13 @@
-"""Every PLANAR_MODELS entry passes the planar contract (bushenv/planar/checks.py)."""
+"""The one model contract (``bushenv.models.checks``) catches a broken three-axis model too."""
 
 import pytest
 
-from bushenv.planar import PLANAR_MODELS
-from bushenv.planar.checks import check_planar_model, example
+from bushenv.models import MODELS, ModelEntry
+from bushenv.models.checks import CHECKS
 
 
-@pytest.mark.parametrize("name", PLANAR_MODELS.names())
-def test_registered_planar_model_meets_the_contract(name, tmp_path):
-    check_planar_model(example(name), tmp_path)
-
-
-def test_a_broken_model_fails_the_contract(tmp_path):
+def test_a_broken_three_axis_model_fails_the_contract():
+    from bushenv.models.registry import Form
     from bushenv.planar.linear import PlanarLinear
 
     class Drifting(PlanarLinear):
@@ -24,6 +20,7 @@ def test_a_broken_model_fails_the_contract(tmp_path):
             Drifting.calls += 1
             out += Drifting.calls
 
-    with PLANAR_MODELS.temporarily("drifting", Drifting):
-        with pytest.raises(AssertionError, match="step loop differs"):
-            check_planar_model(Drifting.preset(), tmp_path)
+    with MODELS.temporarily("drifting", ModelEntry(None, "test", wider={3: Form(Drifting)})):
+        assert MODELS["drifting"].coordinate_counts() == (3,)
+        with pytest.raises(AssertionError, match="differs from the first"):
+            CHECKS["reset_reruns_identically"](Drifting.preset)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from bushenv.cli import main
-from bushenv.planar import load_planar_model
+from bushenv.models import load_model
 from bushenv.planar.records import HEADER_TEXT, save_planar_csv
 
 from .test_fit3_records import bushing, user_columns, write
@@ -30,7 +30,7 @@ def test_a_fit_on_the_users_column_order_and_units_gives_the_si_fit(tmp_path):
     user = write(tmp_path / "user.csv", *user_columns(t, q, f))
     assert fit([si], tmp_path / "a.npz", "--model", "linear") == 0
     assert fit([user], tmp_path / "b.npz", "--model", "linear") == 0
-    a, b = load_planar_model(tmp_path / "a.npz"), load_planar_model(tmp_path / "b.npz")
+    a, b = load_model(tmp_path / "a.npz"), load_model(tmp_path / "b.npz")
     np.testing.assert_allclose(b.k_matrix, a.k_matrix, rtol=1e-6)
     assert a.dt == pytest.approx(0.002) and b.dt == pytest.approx(0.002)
 

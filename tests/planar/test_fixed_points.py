@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from bushenv.planar import PlanarModelError, model_class
+from bushenv.models import MODELS
+from bushenv.planar import PlanarModelError
 from bushenv.planar.fixed_points import HeldNetwork, fixed_points, fold_crossings, grid
 from bushenv.planar.narx import N_IN, PlanarNarx, PlanarNarxPerAxis
 
@@ -91,4 +92,4 @@ def test_grid_orders_rotation_fastest():
 
 def test_a_model_that_is_not_a_network_is_refused_by_name():
     with pytest.raises(PlanarModelError, match="linear"):
-        fixed_points(model_class("linear").preset(), np.zeros((1, 3)))
+        fixed_points(MODELS["linear"].model_class(3).preset(), np.zeros((1, 3)))

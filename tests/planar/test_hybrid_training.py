@@ -7,7 +7,7 @@ from bushenv.excitation import random_rpc
 from bushenv.identify.options import options_of
 from bushenv.metrics import rms_ratio
 from bushenv.planar import PlanarModelError
-from bushenv.planar.fitting import PLANAR_FITS
+from bushenv.planar.fitting import options_class
 from bushenv.planar.train import TrainOptions, fit_planar_network
 from bushenv.planar.train_options import NOISY_FEEDBACK_TRAINING, default_options
 
@@ -60,19 +60,19 @@ def test_noisy_feedback_halves_the_free_run_error_on_an_unseen_record():
 def test_every_network_gets_the_plain_training_unless_the_hybrid_asks_for_noisy_feedback():
     for kind in ("nn", "nn-axis", "hybrid"):
         assert default_options(kind) == TrainOptions()
-        assert PLANAR_FITS[kind].options().train_options() == TrainOptions()
-    assert PLANAR_FITS["hybrid-bw"].options().train_options() == TrainOptions()
-    noisy = options_of(PLANAR_FITS["hybrid"].options, {"training": "noisy-feedback"}, "hybrid")
+        assert options_class(kind)().train_options() == TrainOptions()
+    assert options_class("hybrid-bw")().train_options() == TrainOptions()
+    noisy = options_of(options_class("hybrid"), {"training": "noisy-feedback"}, "hybrid")
     assert noisy.train_options() == TrainOptions(**NOISY_FEEDBACK_TRAINING)
     assert NOISY_FEEDBACK_TRAINING["hidden"] == 54 and NOISY_FEEDBACK_TRAINING["feedback_noise"]
 
 
 def test_a_flag_given_beside_the_training_wins():
     given = {"training": "noisy-feedback", "hidden": 81, "certified": "on"}
-    opts = options_of(PLANAR_FITS["hybrid"].options, given, "hybrid")
+    opts = options_of(options_class("hybrid"), given, "hybrid")
     assert opts.hidden == 81 and opts.teacher_batch == 2048 and opts.certified == "on"
     with pytest.raises(Exception, match="training"):
-        options_of(PLANAR_FITS["hybrid"].options, {"training": "fast"}, "hybrid")
+        options_of(options_class("hybrid"), {"training": "fast"}, "hybrid")
 
 
 def test_mini_batch_training_is_deterministic_given_the_seed():
@@ -92,4 +92,4 @@ def test_mini_batch_training_is_deterministic_given_the_seed():
 )
 def test_bad_batch_or_noise_is_refused_naming_it(given):
     with pytest.raises(PlanarModelError, match="teacher_batch .* feedback_noise"):
-        options_of(PLANAR_FITS["hybrid"].options, given, "hybrid")
+        options_of(options_class("hybrid"), given, "hybrid")

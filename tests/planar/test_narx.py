@@ -5,7 +5,8 @@ import pytest
 
 from bushenv.excitation import random_rpc
 from bushenv.metrics import rms_ratio
-from bushenv.planar import PlanarModelError, load_planar_model
+from bushenv.models import load_model
+from bushenv.planar import PlanarModelError
 from bushenv.planar.narx import N_IN, PlanarHybrid, PlanarNarx, PlanarNarxPerAxis, axis_masks
 from bushenv.planar.reference import THETA_N1_RAD, PlanarRubber
 from bushenv.planar.train import TrainOptions, fit_planar_network
@@ -80,7 +81,7 @@ def test_hybrid_stays_within_its_bound_under_wild_input():
 def test_save_load_roundtrip(tmp_path, cls):
     extra = {"k_matrix": np.eye(3), "c_matrix": np.eye(3)} if cls is PlanarHybrid else {}
     m = cls(**_arrays(per_axis=cls is PlanarNarxPerAxis), **extra)
-    back = load_planar_model(m.save(tmp_path / "m.npz"))
+    back = load_model(m.save(tmp_path / "m.npz"))
     assert type(back) is cls
     q = _drive(50)
     np.testing.assert_array_equal(back.simulate(q), m.simulate(q))

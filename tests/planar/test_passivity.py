@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from bushenv.planar import model_class
+from bushenv.models import MODELS
 from bushenv.planar.fixed_points import fixed_points, grid
 from bushenv.planar.linear import PlanarLinear
 from bushenv.planar.narx import PlanarNarx
@@ -64,7 +64,7 @@ def test_linear_with_a_circulatory_stiffness_is_active_below_the_analytic_freque
 
 
 def test_sines_measure_the_linear_stiffness_exactly():
-    model = model_class("linear").preset()
+    model = MODELS["linear"].model_class(3).preset()
     f = np.array([0.5, 3.0, 20.0])
     k = sine_stiffness(model, np.array([[1e-3, -2e-3, 0.05]]), f)
     want = model.k_matrix + (1j * np.sin(2 * np.pi * f * DT) / DT)[:, None, None] * model.c_matrix
@@ -72,7 +72,7 @@ def test_sines_measure_the_linear_stiffness_exactly():
 
 
 def test_coupled_reference_is_passive_at_preloads_and_rotations():
-    ref = model_class("reference").preset(measurement=False)
+    ref = MODELS["reference"].model_class(3).preset(measurement=False)
     holds = grid([0.0], [0.0, 2e-3, 4e-3], [0.0, 0.05, 0.10])
     rep = passivity(ref, holds, np.array([0.5, 2.0, 10.0, 40.0]))
     assert rep.method == "sines" and rep.passive
@@ -121,5 +121,5 @@ def test_script_prints_both_tables_and_refuses_an_unknown_name(tmp_path):
     bad = subprocess.run(
         [sys.executable, str(script), "--models", "nope"], capture_output=True, text=True
     )
-    assert bad.returncode == 2 and "unknown planar model 'nope'" in bad.stderr
+    assert bad.returncode == 2 and "unknown three-axis model" in bad.stderr
     assert "Traceback" not in bad.stderr

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from bushenv.errors import BadInput
-from bushenv.planar import PLANAR_MODELS, PlanarModelError, load_planar_model, model_class
+from bushenv.models import MODELS, load_model
+from bushenv.planar import PlanarModelError
 from bushenv.planar.linear import PlanarLinear, fit_linear
 
 K = np.array([[380e3, 1e3, 0.0], [2e3, 1500e3, 5e3], [0.0, 40.0, 1500.0]])
@@ -48,7 +49,7 @@ def test_step_rejects_wrong_shapes_naming_the_order():
 
 def test_save_load_roundtrip_and_copy(tmp_path):
     m = PlanarLinear(K, C)
-    back = load_planar_model(m.save(tmp_path / "lin.npz"))
+    back = load_model(m.save(tmp_path / "lin.npz"))
     assert isinstance(back, PlanarLinear)
     np.testing.assert_array_equal(back.k_matrix, K)
     q = _q(20)
@@ -56,27 +57,50 @@ def test_save_load_roundtrip_and_copy(tmp_path):
     np.testing.assert_array_equal(m.copy().simulate(q), m.simulate(q))
 
 
-def test_one_axis_file_is_refused_with_a_hint(tmp_path):
+def test_one_file_format_loads_either_and_refuses_the_other_count_naming_what_takes_it(tmp_path):
+    from bushenv.models import ModelError, get_model
     from bushenv.models.linear import LinearBushing
 
-    path = LinearBushing.preset("axial").save(tmp_path / "one.npz")
-    with pytest.raises(PlanarModelError, match="one-axis model file"):
-        load_planar_model(path)
+    one = LinearBushing.preset("axial").save(tmp_path / "one.npz")
+    three = PlanarLinear(K, C).save(tmp_path / "three.npz")
+    assert load_model(one).n_coords == 1 and load_model(three).n_coords == 3
+    with pytest.raises(ModelError, match="one.npz is a one-axis model; the rig3 needs a three"):
+        load_model(one, coords=3, wanted_by="the rig3")
+    with pytest.raises(ModelError, match=r"three.npz is a three-axis model.*attack --env rig3"):
+        get_model(str(three), wanted_by="bushenv export")
+
+
+def test_a_three_axis_file_of_the_former_format_still_loads(tmp_path):
+    import json
+
+    m = PlanarLinear(K, C)
+    path = m.save(tmp_path / "new.npz")
+    with np.load(path) as z:
+        files = {k: z[k] for k in z.files}
+    meta = json.loads(str(files.pop("__meta__")))
+    meta.pop("coords")
+    meta["format"] = "bushenv-planar-model"
+    np.savez(tmp_path / "old.npz", __meta__=np.array(json.dumps(meta)), **files)
+    back = load_model(tmp_path / "old.npz")
+    assert isinstance(back, PlanarLinear)
+    np.testing.assert_array_equal(back.simulate(_q(20)), m.simulate(_q(20)))
 
 
 def test_bad_files_name_the_file(tmp_path):
     txt = tmp_path / "x.npz"
     txt.write_text("hello")
     with pytest.raises(BadInput, match="x.npz"):
-        load_planar_model(txt)
+        load_model(txt)
     with pytest.raises(BadInput, match="no such"):
-        load_planar_model(tmp_path / "missing.npz")
+        load_model(tmp_path / "missing.npz")
 
 
 def test_unknown_name_lists_known_names():
-    with pytest.raises(PlanarModelError, match="known names: .*linear"):
-        model_class("lstm")
-    assert "linear" in PLANAR_MODELS
+    from bushenv.models import ModelError
+
+    with pytest.raises(ModelError, match="known names: .*linear"):
+        MODELS["lstm"].model_class(3)
+    assert "linear" in MODELS
 
 
 def test_fit_linear_recovers_full_matrices():

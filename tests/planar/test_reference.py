@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from bushenv.planar import PlanarModelError, load_planar_model
+from bushenv.models import load_model
+from bushenv.planar import PlanarModelError
 from bushenv.planar.elastic import elastic_force, tangent_stiffness
 from bushenv.planar.reference import PlanarRubber
 from bushenv.reference.rubber import RubberBushing
@@ -116,7 +117,7 @@ def test_step_loop_equals_simulate_with_noise_and_batches():
 
 def test_save_load_keeps_effects_and_force(tmp_path):
     m = PlanarRubber.preset(effects=("coupling", "friction"), friction_yield="axis")
-    back = load_planar_model(m.save(tmp_path / "ref.npz"))
+    back = load_model(m.save(tmp_path / "ref.npz"))
     assert back.effects == m.effects and back.friction_yield == "axis"
     q = _sines(100)
     np.testing.assert_array_equal(back.simulate(q), m.simulate(q))

@@ -4,8 +4,8 @@ its identification inside the vector Bouc-Wen."""
 import numpy as np
 import pytest
 
+from bushenv.models import load_model
 from bushenv.models.base import PAPER_DT
-from bushenv.planar import load_planar_model
 from bushenv.planar.base import PlanarModelError
 from bushenv.planar.boucwen import PlanarBoucWen
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
@@ -56,11 +56,11 @@ def test_a_file_from_before_the_relaxation_loads_without_it(tmp_path):
     with np.load(path) as z:
         arrays = {k: z[k] for k in z.files if not k.startswith("relax_")}
     np.savez(path, **arrays)  # the layout files had before the relaxation
-    back = load_planar_model(path)
+    back = load_model(path)
     q = random_independent(1.0, 1.0, PAPER_DT, 1)
     assert back.relax_tau.shape == (0,) and np.array_equal(back.simulate(q), old.simulate(q))
     new = relaxing([0.05], np.diag([1e5, 2e5, 300.0])[None])
-    again = load_planar_model(new.save(tmp_path / "relaxing.npz"))
+    again = load_model(new.save(tmp_path / "relaxing.npz"))
     assert np.array_equal(again.simulate(q), new.simulate(q))
 
 

@@ -174,7 +174,7 @@ def test_a_certified_mirror_hybrid_keeps_its_network_where_the_free_one_falls_si
 
 def test_bushenv_fit_takes_structure_mirror_for_3_axis_records(tmp_path, capsys):
     from bushenv.cli import main
-    from bushenv.planar.registry import load_planar_model
+    from bushenv.models import load_model
 
     rec = tmp_path / "rec"
     assert main(["measure", "--axes", "3", "--programme", "random", "--duration", "6",
@@ -183,7 +183,7 @@ def test_bushenv_fit_takes_structure_mirror_for_3_axis_records(tmp_path, capsys)
     args = ["fit", *train, "--model", "hybrid", "--hidden", "6", "--teacher-steps", "8",
             "--free-run-steps", "0", "--window", "16", "--quiet"]  # fmt: skip
     assert main([*args, "--structure", "mirror", "--out", str(tmp_path / "m.npz")]) == 0
-    model = load_planar_model(tmp_path / "m.npz")
+    model = load_model(tmp_path / "m.npz")
     assert model.w1.shape[0] == 8 and np.all(model.k_matrix == np.diag(np.diag(model.k_matrix)))
     q = random_independent(1.0, 2.0, PAPER_DT, 3)
     q[:, 1] = 0.0

@@ -5,7 +5,7 @@ import json
 import numpy as np
 
 from bushenv.cli import main
-from bushenv.planar import model_class
+from bushenv.models import MODELS
 from bushenv.planar.linear import PlanarLinear
 from bushenv.planar.vetting import held_vectors, vet_planar_reference
 
@@ -23,7 +23,7 @@ def _linear(k_scale=(1.0, 1.0, 1.0), c_scale=(1.0, 1.0, 1.0), radial_into_axial=
 
 
 def test_the_coupled_reference_and_a_linear_bushing_pass_their_holds():
-    ref = model_class("reference").preset(dt=PlanarLinear.preset().dt, measurement=False)
+    ref = MODELS["reference"].model_class(3).preset(dt=PlanarLinear.preset().dt, measurement=False)
     for model in (ref, _linear()):
         v = vet_planar_reference(model, "m", STROKE, FLOORS)
         assert v.passed and v.checks[0].passed is True and v.checks[2].passed is True, v.lines()

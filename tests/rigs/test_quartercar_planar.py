@@ -106,7 +106,7 @@ def test_a_model_moment_beyond_the_limit_terminates_while_the_twin_stays_within(
 
 
 def test_an_unknown_arm_bushing_name_lists_the_planar_models():
-    with pytest.raises(RigError, match="QuarterCar-v0: arm_bushing 'nope'.*reference"):
+    with pytest.raises(RigError, match="QuarterCar-v0: arm_bushing 'nope'.*three-axis: .*rubber"):
         make(arm_bushing="nope")
 
 
