@@ -72,15 +72,15 @@ class DivergenceReward:
         self.evaluator = evaluator
         self.floor = (evaluator.scales if evaluator is not None else MACHINE).force_floor_n
         self.on_episodes = on_episodes
-        self.reset()
-
-    def reset(self) -> None:
         self.xs: list[list[float]] = [[] for _ in range(self.n)]
         self.peak = np.full(self.n, self.floor)
         # judged already; the env's next-step autoreset calls us once more before resetting
         self.finished = np.zeros(self.n, dtype=bool)
         # x, F_model, F_ref at the last step; W_model, W_ref, normaliser, span, phi
         self.acc = np.zeros((8, self.n))
+
+    def reset(self) -> None:
+        self.reset_columns(np.ones(self.n, dtype=bool))
 
     @property
     def x_now(self) -> np.ndarray:

@@ -29,11 +29,11 @@ class RoadReward:
         self.evaluator, self.on_episodes = evaluator, on_episodes
         self.axis = evaluator.axis
         self.floor = evaluator.scales.force_floor_n
-        self.reset()
-
-    def reset(self) -> None:
         self.roads: list[list[float]] = [[] for _ in range(self.n)]
         self.peak = np.full(self.n, self.floor)
+
+    def reset(self) -> None:
+        self.reset_columns(np.ones(self.n, dtype=bool))
 
     def reset_columns(self, mask) -> None:
         for i in np.flatnonzero(mask):
