@@ -57,10 +57,10 @@ class PlanarBoucWenOptions:
         choices=("vector", "axis"),
     )
     time_limit_s: float = option(
-        120.0,
-        "wall-time limit of the search, s (0: none; a second search after a relaxation "
-        "selection has its own); evaluations decide below it, so a seed reproduces the "
-        "parameters; a stop by the clock is reported on the card",
+        0.0,
+        "wall-time limit of the search, s (0: none, the default: the evaluations decide, so "
+        "the same records give the same parameters on every machine; a second search after a "
+        "relaxation selection has its own); a stop by the clock is reported on the card",
     )
 
     relaxation_times: str = option(

@@ -45,7 +45,9 @@ class PlanarHybridBWOptions(PlanarNetworkOptions):
     """The network's options and the backbone's search (``boucwen_fit``)."""
 
     evaluations: int = option(200, "shape evaluations of the bounded Powell search (after 8)")
-    time_limit_s: float = option(120.0, "wall-time limit of the backbone's search, s (0: none)")
+    time_limit_s: float = option(
+        0.0, "wall-time limit of the backbone's search, s (0: none, the default)"
+    )
     relaxation_times: str = option_like(PlanarBoucWenOptions, "relaxation_times")
     relaxation_selection: str = option_like(PlanarBoucWenOptions, "relaxation_selection")
     network: str = option_like(PlanarHybridOptions, "network")

@@ -184,3 +184,18 @@ def test_a_fit_draws_forces_and_loops_per_coordinate_of_each_held_out_record(tmp
     assert fit([train], tmp_path / "n.npz", "--model", "linear", "--no-plots") == 0
     assert "plots" not in json.loads((tmp_path / "n.card.json").read_text())
     assert not list(tmp_path.glob("n.*.png"))
+
+
+def test_a_bouc_wen_fit_has_no_clock_by_default_and_repeats_to_the_bit(tmp_path):
+    from bushenv.planar.boucwen_fit import PlanarBoucWenOptions
+    from bushenv.planar.fitting import PlanarHybridBWOptions
+
+    assert PlanarBoucWenOptions().time_limit_s == 0 and PlanarHybridBWOptions().time_limit_s == 0
+    rec = save_planar_csv(tmp_path / "r.csv", *bushing())
+    for name in ("a", "b"):
+        assert fit([rec], tmp_path / f"{name}.npz", "--model", "boucwen", "--evaluations", "6") == 0
+    a, b = load_model(tmp_path / "a.npz"), load_model(tmp_path / "b.npz")
+    for key in a.param_names:
+        np.testing.assert_array_equal(getattr(a, key), getattr(b, key), err_msg=key)
+    source = json.loads((tmp_path / "a.card.json").read_text())["source"]
+    assert source["info"]["time_limited"] is False
