@@ -34,8 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
 
+from bushenv.errors import DIVERGENCE_RAISES
 from bushenv.identify.static_estimate import FILTER_ORDER, slow_cutoff_hz
 from bushenv.planar.base import COORDS, PlanarModelError
+from bushenv.scales import STATIC_HOLD_S, STATIC_PROBE_M
 
 FLOOR_FRACTION = 0.01  # of a channel's RMS force: below it a held force has no sign
 COUPLING = 0.08  # c of the band: how much the other coordinates' holds may scale a force
@@ -111,3 +113,27 @@ def planar_static_estimate(
         )
     rms = np.sqrt(np.mean(np.vstack(fs) ** 2, axis=0))
     return PlanarStaticEstimate(k, f0, k_matrix, f_c, np.maximum(rms, 1e-12))
+
+
+# the rotation's probe: the one-axis probe at this lever arm, m
+STIFFNESS_LEVER_M = 0.04
+# holds of the static stiffness per coordinate: the one-axis probe, the rotation at the lever arm
+STIFFNESS_PROBE = np.array([STATIC_PROBE_M, STATIC_PROBE_M, STATIC_PROBE_M / STIFFNESS_LEVER_M])
+
+
+def static_stiffness3(model) -> np.ndarray:
+    """(3,) secant static stiffness per coordinate (N/m, N/m, N m/rad): each alone ramped in
+    0.2 s to +-``STIFFNESS_PROBE`` and held ``STATIC_HOLD_S`` (``scales.static_force``'s hold),
+    the others at rest; NaN where the model is not finite."""
+    dt = model.dt
+    n_ramp, n_hold = max(2, int(round(0.2 / dt))), int(round(STATIC_HOLD_S / dt))
+    shape = np.concatenate([np.linspace(0.0, 1.0, n_ramp), np.ones(n_hold)])
+    q = np.zeros((shape.size, 6, 3))
+    for i in range(3):
+        q[:, 2 * i, i] = shape * STIFFNESS_PROBE[i]
+        q[:, 2 * i + 1, i] = -shape * STIFFNESS_PROBE[i]
+    try:
+        f = model.copy().simulate(q)[-1]
+    except DIVERGENCE_RAISES:
+        return np.full(3, np.nan)
+    return np.array([(f[2 * i, i] - f[2 * i + 1, i]) / (2 * STIFFNESS_PROBE[i]) for i in range(3)])

@@ -26,7 +26,8 @@ import numpy as np
 
 from bushenv.divergence import Verdict, judge
 from bushenv.errors import DIVERGENCE_RAISES, ModelRaised
-from bushenv.scales import FORCE_FLOOR_N, MACHINE, STATIC_HOLD_S, STATIC_PROBE_M, BushingScales
+from bushenv.planar.static_estimate import static_stiffness3
+from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
 from bushenv.search.base import SearchError
 from bushenv.search.families_planar import COORDS, ENV_ID, clip3, rig3_limits
 from bushenv.search.target_base import Responses, Target
@@ -82,26 +83,6 @@ def axis_scales(floors: np.ndarray = MACHINE_FLOORS) -> list[BushingScales]:
 # metres per radian when a rotation counts as motion (any positive lever arm would do: a hold
 # is a run of samples where no coordinate moves)
 ROTATION_LEVER_M = 0.04
-# holds of the static stiffness per coordinate: the one-axis probe, the rotation at the lever arm
-STIFFNESS_PROBE = np.array([STATIC_PROBE_M, STATIC_PROBE_M, STATIC_PROBE_M / ROTATION_LEVER_M])
-
-
-def static_stiffness3(model) -> np.ndarray:
-    """(3,) secant static stiffness per coordinate (N/m, N/m, N m/rad): each alone ramped in
-    0.2 s to +-``STIFFNESS_PROBE`` and held ``STATIC_HOLD_S`` (``scales.static_force``'s hold),
-    the others at rest; NaN where the model is not finite."""
-    dt = model.dt
-    n_ramp, n_hold = max(2, int(round(0.2 / dt))), int(round(STATIC_HOLD_S / dt))
-    shape = np.concatenate([np.linspace(0.0, 1.0, n_ramp), np.ones(n_hold)])
-    q = np.zeros((shape.size, 6, 3))
-    for i in range(3):
-        q[:, 2 * i, i] = shape * STIFFNESS_PROBE[i]
-        q[:, 2 * i + 1, i] = -shape * STIFFNESS_PROBE[i]
-    try:
-        f = model.copy().simulate(q)[-1]
-    except DIVERGENCE_RAISES:
-        return np.full(3, np.nan)
-    return np.array([(f[2 * i, i] - f[2 * i + 1, i]) / (2 * STIFFNESS_PROBE[i]) for i in range(3)])
 
 
 @lru_cache(maxsize=8)
