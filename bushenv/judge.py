@@ -14,9 +14,11 @@ inputs give the same judge everywhere:
 - **criteria**: all of ``divergence.CRITERIA`` against a reference; without one, those that
   need none; ``static`` only where the target has holds and the reference's card shows static
   behaviour (``scales.static_identified``).
-- **vetting** (``bushenv.vetting``): the reference is checked before it judges. A reference
-  that fails is refused (``JudgeError``, exit 2) unless ``trust_reference``; then every verdict
-  is marked as judged by an unvetted reference.
+- **vetting** (``bushenv.vetting``): the reference is checked before it judges; every check
+  passes, fails or is not checked, and the vetting passed only when every check passed. A
+  reference that fails is refused (``JudgeError``, exit 2) unless ``trust_reference``; then
+  every verdict is marked as judged by an unvetted reference, and those whose profile enters
+  a range where it failed (``Judge.in_unvetted_range``) say so.
 """
 
 from __future__ import annotations
@@ -36,6 +38,9 @@ from bushenv.scales import (
     static_identified,
 )
 
+# a profile that spends this long in a range where the reference failed its vetting is
+# judged there (a ring or a departure shows in a hold, not in a sweep through)
+UNVETTED_DWELL_S = 0.5
 NO_REFERENCE = "none"  # the spelling of "judged without a reference" in every command
 BUILTIN_REFERENCE = "rubber"
 
@@ -106,6 +111,28 @@ class Judge:
         return bool(np.max(np.abs(x)) <= x_max * (1 + 1e-9) and rate <= v_max * (1 + 1e-9))
 
     @property
+    def unvetted_ranges_m(self) -> tuple[tuple[float, float], ...]:
+        """Displacement ranges (lo, hi), m, where the reference failed its vetting (it rings,
+        departs or pulls there); empty when it passed or was not vetted."""
+        return () if self.vetting is None else self.vetting.unvetted_ranges_m
+
+    def in_unvetted_range(self, profile, dt: float) -> bool | None:
+        """Whether ``profile`` (deflection, m, at ``dt``) dwells, ``UNVETTED_DWELL_S`` in all,
+        in a range where the reference failed its vetting (it rings, departs or pulls when
+        held there, so a verdict on the profile is unvetted); None without a reference."""
+        if self.reference is None:
+            return None
+        import numpy as np
+
+        x = np.asarray(profile, dtype=np.float64)
+        # one hold grid step about each range: the vetting saw the holds, not between them
+        pad = 2 * self.scales.stroke_m / 200
+        for a, b in self.unvetted_ranges_m:
+            if np.count_nonzero((x >= a - pad) & (x <= b + pad)) * dt >= UNVETTED_DWELL_S:
+                return True
+        return False
+
+    @property
     def unvetted(self) -> bool:
         """A reference judges that did not pass its vetting (or was not vetted)."""
         return self.reference is not None and (self.vetting is None or not self.vetting.passed)
@@ -119,6 +146,8 @@ class Judge:
             "criteria": list(self.criteria),
             "why": self.why,
             "vetting": None if self.vetting is None else self.vetting.describe(),
+            "vetting_verdict": None if self.vetting is None else self.vetting.verdict,
+            "unvetted_ranges_m": [list(r) for r in self.unvetted_ranges_m],
             "trusted_by_flag": self.trusted_by_flag,
             "unvetted": self.unvetted,
             "envelope": None
@@ -256,6 +285,7 @@ def judge_of(
     static = ref is not None and (ref_card is None or static_identified(ref_card))
     criteria, why = criteria_of(ref, static, tgt)
     label = None if reference is None else reference.spec
+    envelope = None if ref is None else envelope_of(ref_card, scales)
     vetting = None
     if ref is not None and vet:
         from bushenv.vetting import vet_reference
@@ -264,6 +294,7 @@ def judge_of(
             ref, label, scales, card=ref_card, card_file=reference.file,
             model=model.model if model is not None and compare else None,
             model_card=model_card, model_file=None if model is None else model.file,
+            envelope=envelope[:2], builtin=builtin,
         )  # fmt: skip
         if scale_problem is not None:
             from bushenv.vetting import Check, Vetting
@@ -286,7 +317,7 @@ def judge_of(
         why=why,
         vetting=vetting,
         trusted_by_flag=bool(trust_reference and vetting is not None and not vetting.passed),
-        envelope=None if ref is None else envelope_of(ref_card, scales),
+        envelope=envelope,
         reference=ref,
     )
 

@@ -1,27 +1,37 @@
 """The reference is checked before it judges (``judge.build_judge`` calls ``vet_reference``).
 
 A verdict says "the model departs from the real bushing"; it is worth only what the reference
-is. Three checks, each with a physical reason and a threshold stated here:
+is. Every check's verdict is *pass*, *fail* or *not checked* (``Check.passed`` True, False or
+None; the detail of a "not checked" names what was missing and how to supply it). The vetting
+*passed* only when every check passed; it *failed* when one failed (the reference is refused
+unless ``--trust-reference``); otherwise it is *not fully checked* and the reference judges,
+saying which checks it did not pass. The checks, each with a physical reason and a threshold:
 
 1. **holds** over the judged stroke: ramp to each of ``HOLDS`` displacements in 0.25 s, hold
    ``HOLD_S``. A passive bushing only relaxes in a hold: its force never oscillates, never grows
-   away from its value after the first second, and pushes back (``f x > 0``). Flagged:
-   *oscillating* (the force, less a straight line, still moves by more than the floor over the
-   last ``TAIL_S``), *departing* (it grows by more than ``DEPART_FRACTION`` of its held value,
-   at least the floor, or changes sign), *wrong sign* (beyond ``SIGN_FRACTION`` of the stroke
-   it pulls by more than the floor), *not finite*.
-2. **records**: the reference's RMS ratio on the records its model card names (when it has a
-   card and they are there) at most ``RECORD_LIMIT``: 30 % is beyond every fitted model of the
-   papers (Tables 2-4) and beyond any model worth judging with.
-3. **compatibility** with the model under test: on the records the model's own card names,
+   away from its value after the first second, and pushes back (``f x > 0``). Flagged
+   (``certify.reached_holds.judge_holds``): *oscillating*, *departing*, *wrong sign* (beyond
+   ``SIGN_FRACTION`` of the stroke), *not finite*, each against one threshold tied to the
+   reference itself (``certify.reached_holds.ring_threshold``: the larger of 3 x its own noise
+   in these holds and 1 % of its largest held force), at most the verdicts' force floor.
+2. **certificate holds** (NARX references: ``nn``, ``hybrid`` or their files): the reference's
+   own certificate (``bushenv certify``, reference-free: wrong sign against the deflection)
+   lists the holds where it oscillates, departs or pulls. Each is reached the way a search
+   reaches it -- a step at the velocity limit, and sines inside the reference's envelope then
+   the hold (``certify.reached_holds.confirm_holds``) -- and judged with the same threshold. A
+   confirmed one fails the check; with ``--trust-reference`` every verdict whose profile enters
+   its range is marked unvetted (``Vetting.unvetted_ranges_m``).
+3. **records**: the reference's RMS ratio on the records its model card names at most
+   ``RECORD_LIMIT``: 30 % is beyond every fitted model of the papers (Tables 2-4) and beyond
+   any model worth judging with. Not checked without a card or without its records. The
+   built-in rubber passes: it is the specimen every record here is measured on.
+4. **compatibility** with the model under test: on the records the model's own card names,
    the reference's RMS ratio at most ``RECORD_LIMIT`` (it is a model of the same bushing: a
    reference 3.2 times as stiff is refused). With no such records, the least-squares stiffness
    of both on one random drive within the stroke is compared: within a factor
-   ``scales.STIFFNESS_MISMATCH`` (2) it passes; beyond, it is a warning, not a refusal -- the
-   model under suspicion is then the only word on which bushing it is, and a broken model
-   looks like another bushing.
-
-Each check is ``passed`` True, False, or None (not run, or undecided: the detail says why).
+   ``scales.STIFFNESS_MISMATCH`` (2) it passes; beyond, it is *not checked* (undecided), not a
+   refusal -- the model under suspicion is then the only word on which bushing it is, and a
+   broken model looks like another bushing; the model's card with its records decides.
 """
 
 from __future__ import annotations
@@ -33,28 +43,52 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.certify.reached_holds import (  # noqa: F401  (the planar vetting's constants)
+    DEPART_FRACTION,
+    HOLD_S,
+    SETTLE_S,
+    TAIL_S,
+    confirm_holds,
+    failing_holds,
+    hold_entries,
+    judge_holds,
+    ranges_of,
+    ring_threshold,
+)
 from bushenv.metrics import rms_ratio
 from bushenv.models import BushingModel
 from bushenv.scales import STIFFNESS_MISMATCH, BushingScales
 
 HOLDS = 41
 RAMP_S = 0.25
-HOLD_S = 4.0
-SETTLE_S = 1.0
-TAIL_S = 2.0
-DEPART_FRACTION = 0.25
 SIGN_FRACTION = 0.1
 RECORD_LIMIT = 0.30
+CERTIFICATE_HOLDS = 201  # the certificate's grid (``bushenv certify``'s default)
+
+
+VERDICTS = {True: "pass", False: "FAILED", None: "not checked"}
 
 
 @dataclass(frozen=True)
 class Check:
+    """One check: ``passed`` True (pass), False (fail) or None (not checked: ``detail`` says
+    what was missing and how to supply it). ``ranges_m``: displacement ranges where a failed
+    check found the reference failing (its verdicts there are unvetted when trusted)."""
+
     name: str
     passed: bool | None
     detail: str
+    ranges_m: tuple[tuple[float, float], ...] = ()
+
+    @property
+    def verdict(self) -> str:
+        return VERDICTS[self.passed]
 
     def describe(self) -> dict[str, Any]:
-        return {"check": self.name, "passed": self.passed, "detail": self.detail}
+        out: dict[str, Any] = {"check": self.name, "passed": self.passed, "detail": self.detail}
+        if self.ranges_m:
+            out["ranges_m"] = [list(r) for r in self.ranges_m]
+        return out
 
 
 @dataclass(frozen=True)
@@ -64,11 +98,54 @@ class Vetting:
 
     @property
     def passed(self) -> bool:
+        """No check failed: the reference may judge (some checks may not have run)."""
         return all(c.passed is not False for c in self.checks)
 
+    @property
+    def complete(self) -> bool:
+        """Every check passed."""
+        return all(c.passed is True for c in self.checks)
+
+    @property
+    def verdict(self) -> str:
+        """The headline: passed (every check passed), FAILED (one failed), not fully checked."""
+        return "passed" if self.complete else "FAILED" if not self.passed else "not fully checked"
+
+    @property
+    def unvetted_ranges_m(self) -> tuple[tuple[float, float], ...]:
+        """Where failed checks found the reference failing, (lo, hi) m."""
+        spans = sorted(r for c in self.checks if c.passed is False for r in c.ranges_m)
+        out: list[tuple[float, float]] = []
+        for a, b in spans:  # their union
+            if out and a <= out[-1][1]:
+                out[-1] = (out[-1][0], max(b, out[-1][1]))
+            else:
+                out.append((a, b))
+        return tuple(out)
+
     def summary(self) -> str:
+        """One line: the failed checks, else the verdict and the checks not passed."""
         bad = [f"{c.name}: {c.detail}" for c in self.checks if c.passed is False]
-        return "; ".join(bad) if bad else "passed"
+        if bad:
+            return "; ".join(bad)
+        if self.complete:
+            return "passed"
+        todo = [f"{c.name} not checked ({c.detail})" for c in self.checks if c.passed is None]
+        n = sum(c.passed is True for c in self.checks)
+        return f"not fully checked: {n} of {len(self.checks)} passed; " + "; ".join(todo)
+
+    def headline(self) -> str:
+        """A few words: passed, FAILED (the failed checks) or not fully checked (which)."""
+        if self.complete:
+            return "passed (every check)"
+        failed = [c.name for c in self.checks if c.passed is False]
+        if failed:
+            return f"FAILED ({', '.join(failed)})"
+        todo = [c.name for c in self.checks if c.passed is None]
+        n = sum(c.passed is True for c in self.checks)
+        return f"not fully checked: {n} of {len(self.checks)} passed, not checked: " + ", ".join(
+            todo
+        )
 
     def describe(self) -> dict[str, Any]:
         return {
@@ -78,8 +155,7 @@ class Vetting:
         }
 
     def lines(self) -> list[str]:
-        mark = {True: "ok", False: "FAILED", None: "undecided"}
-        return [f"{c.name}: {mark[c.passed]} ({c.detail})" for c in self.checks]
+        return [f"{c.name}: {c.verdict} ({c.detail})" for c in self.checks]
 
 
 def vet_reference(
@@ -91,13 +167,30 @@ def vet_reference(
     model: BushingModel | None = None,
     model_card: dict | None = None,
     model_file: Any = None,
+    envelope: tuple[float, float] | None = None,
+    builtin: bool = False,
 ) -> Vetting:
-    """The three checks of the module doc on ``reference`` at ``scales``."""
-    checks = [
-        hold_check(reference, scales),
-        records_check(reference, card, card_file, "its own card's records"),
-        compatibility_check(reference, scales, model, model_card, model_file),
-    ]
+    """The checks of the module doc on ``reference`` at ``scales``; ``envelope``: the largest
+    |x| and |dx/dt| its records cover (default: the judged stroke and velocity); ``builtin``:
+    the built-in rubber (the specimen itself)."""
+    holds, threshold = hold_check(reference, scales)
+    checks = [holds]
+    env = envelope or (scales.stroke_m, scales.velocity_m_per_s)
+    cert = certificate_check(reference, scales, env, threshold)
+    if cert is not None:
+        checks.append(cert)
+    if builtin:
+        checks.append(
+            Check(
+                "records",
+                True,
+                "the built-in rubber is the specimen every record here is "
+                "measured on (bushenv measure): its records are its own",
+            )  # fmt: skip
+        )
+    else:
+        checks.append(records_check(reference, card, card_file, "its own card's records"))
+    checks.append(compatibility_check(reference, scales, model, model_card, model_file))
     return Vetting(label, tuple(checks))
 
 
@@ -110,45 +203,86 @@ def hold_profiles(stroke_m: float, dt: float, holds: int = HOLDS) -> tuple[np.nd
     return np.vstack([ramp, np.repeat(xs[None, :], n_hold, axis=0)]), xs
 
 
-def hold_check(reference: BushingModel, scales: BushingScales) -> Check:
-    """Check 1 of the module doc."""
+def hold_check(reference: BushingModel, scales: BushingScales) -> tuple[Check, float]:
+    """Check 1 of the module doc, and the threshold it judged with (N; the certificate check
+    uses it too)."""
     dt = reference.dt
     x, xs = hold_profiles(scales.stroke_m, dt)
     try:
         f = reference.copy().simulate(x)
     except Exception as exc:  # a reference that cannot even run its holds
-        return Check("holds", False, f"the reference raised {type(exc).__name__}: {exc}")
-    n_ramp = x.shape[0] - int(round(HOLD_S / dt))
-    settle = n_ramp + int(round(SETTLE_S / dt))
-    tail = f[-int(round(TAIL_S / dt)) :]
-    floor = scales.force_floor_n
-    found: dict[str, list[float]] = {"not finite": [], "oscillating": [], "departing": [],
-                                     "wrong sign": []}  # fmt: skip
-    t = np.arange(tail.shape[0])
-    for j, xj in enumerate(xs):
-        col = f[:, j]
-        if not np.all(np.isfinite(col)):
-            found["not finite"].append(xj)
-            continue
-        line = np.polyval(np.polyfit(t, tail[:, j], 1), t)
-        if np.ptp(tail[:, j] - line) > floor:
-            found["oscillating"].append(xj)
-        f0, f1 = col[settle], col[-1]
-        grows = abs(f1) - abs(f0) > max(floor, DEPART_FRACTION * abs(f0))
-        flips = abs(f0) > floor and abs(f1) > floor and np.sign(f0) != np.sign(f1)
-        if grows or flips:
-            found["departing"].append(xj)
-        if abs(xj) >= SIGN_FRACTION * scales.stroke_m and f1 * xj < 0 and abs(f1) > floor:
-            found["wrong sign"].append(xj)
-    bad = {k: v for k, v in found.items() if v}
+        text = f"the reference raised {type(exc).__name__}: {exc}"
+        return Check("holds", False, text), scales.force_floor_n
+    th = ring_threshold(f, dt)
+    limit = min(th.force_n, scales.force_floor_n)
+    how = th.describe() + (
+        f", at most the force floor {scales.force_floor_n:.4g} N"
+        if th.force_n > scales.force_floor_n
+        else ""
+    )
+    flags = judge_holds(f, xs, int(round(HOLD_S / dt)), limit, dt)
+    flags["wrong sign"] &= np.abs(xs) >= SIGN_FRACTION * scales.stroke_m
+    step = xs[1] - xs[0]
     span = f"{len(xs)} holds of {HOLD_S:g} s over +-{scales.stroke_m * 1e3:.3g} mm"
+    bad = {k: xs[flags[k]] for k in KINDS if flags[k].any()}
     if not bad:
-        return Check("holds", True, f"{span}: every hold settles, pushes back, stays finite")
+        text = f"{span}: every hold settles, pushes back, stays finite ({how})"
+        return Check("holds", True, text), limit
     parts = [
-        f"{len(v)} {k} between {min(v) * 1e3:+.3g} and {max(v) * 1e3:+.3g} mm"
+        f"{len(v)} {k} between {v.min() * 1e3:+.3g} and {v.max() * 1e3:+.3g} mm"
         for k, v in bad.items()
     ]
-    return Check("holds", False, f"{span}: " + ", ".join(parts) + f" (floor {floor:.4g} N)")
+    where = ranges_of([float(v) for vs in bad.values() for v in vs], step)
+    return Check("holds", False, f"{span}: " + ", ".join(parts) + f" ({how})", tuple(where)), limit
+
+
+KINDS = ("not finite", "oscillating", "departing", "wrong sign")
+
+
+def certificate_check(
+    reference: BushingModel,
+    scales: BushingScales,
+    envelope: tuple[float, float],
+    threshold: float,
+) -> Check | None:
+    """Check 2 of the module doc; None for a reference that is not a NARX network."""
+    from bushenv.certify.network import CertifyError
+
+    try:
+        entries = hold_entries(reference, None, scales.stroke_m, CERTIFICATE_HOLDS)
+    except CertifyError:
+        return None
+    listed = failing_holds(entries)
+    span = f"its certificate, {CERTIFICATE_HOLDS} holds over +-{scales.stroke_m * 1e3:.3g} mm,"
+    if not listed:
+        return Check("certificate holds", True, f"{span} lists none oscillating, departing or "
+                     "wrong-sign")  # fmt: skip
+    kinds = sorted({k for h in listed for k in h["kinds"]})
+    xl = [h["x_m"] for h in listed]
+    said = (
+        f"{span} lists {len(listed)} ({', '.join(kinds)}) between {min(xl) * 1e3:+.3g} and "
+        f"{max(xl) * 1e3:+.3g} mm"
+    )
+    confirmed, n = confirm_holds(reference, listed, envelope, threshold)
+    reach = (
+        f"{n} profiles reaching them after a step or sines inside its envelope (|x| <= "
+        f"{envelope[0] * 1e3:.3g} mm, |dx/dt| <= {envelope[1]:.3g} m/s); threshold "
+        f"{threshold:.4g} N"
+    )
+    if not confirmed:
+        return Check("certificate holds", True, f"{said}; none confirmed by {reach}")
+    worst = max(confirmed, key=lambda c: c.ripple_n)
+    found = sorted({k for c in confirmed for k in c.kinds})
+    xc = [c.x_m for c in confirmed]
+    text = (
+        f"{said}; {len(confirmed)} confirmed ({', '.join(found)}) between "
+        f"{min(xc) * 1e3:+.3g} and {max(xc) * 1e3:+.3g} mm by {reach}; worst "
+        f"{worst.ripple_n:.4g} N p-p at {worst.x_m * 1e3:+.3g} mm after {worst.after}"
+    )
+    # the listed runs holding a confirmed hold (not every listed hold is simulated)
+    step = 2 * scales.stroke_m / (CERTIFICATE_HOLDS - 1)
+    runs = [(a, b) for a, b in ranges_of(xl, step) if any(a <= x <= b for x in xc)]
+    return Check("certificate holds", False, text, tuple(runs))
 
 
 def card_records(card: dict | None, card_file: Any) -> tuple[list[Path], list[str]]:
@@ -198,10 +332,17 @@ def _record_errors(reference: BushingModel, paths: list[Path]) -> list[tuple[str
 def records_check(reference: BushingModel, card: dict | None, card_file: Any, what: str) -> Check:
     """Check 2: the reference's error on the records its card names."""
     if card is None:
-        return Check("records", None, "no model card: nothing to check it against")
+        return Check(
+            "records", None, "no model card naming the records it was fitted on: give a "
+            "reference file with its card beside it (MODEL.card.json; bushenv fit writes it)",
+        )  # fmt: skip
     paths, missing = card_records(card, card_file)
     if not paths:
-        return Check("records", None, f"{what} are not there ({', '.join(missing) or 'none'})")
+        where = "" if card_file is None else f" beside {Path(os.fspath(card_file)).parent}"
+        return Check(
+            "records", None, f"{what} ({', '.join(missing) or 'none named'}) are not there: "
+            f"put the record files{where} or at the paths the card names",
+        )  # fmt: skip
     errors = _record_errors(reference, paths)
     return judged_errors("records", errors, what, RECORD_LIMIT)
 
@@ -210,7 +351,10 @@ def judged_errors(name: str, errors: list[tuple[str, float]], what: str, limit: 
     text = ", ".join(f"{n} {e:.1%}" if np.isfinite(e) else f"{n} not comparable" for n, e in errors)
     usable = [e for _, e in errors if not np.isnan(e)]
     if not usable:
-        return Check(name, None, f"{what}: another sample rate ({text})")
+        return Check(
+            name, None, f"{what}: at another sample rate than the reference ({text}); give "
+            "records at its rate",
+        )  # fmt: skip
     worst = max(usable)
     ok = bool(worst <= limit)
     verdict = "within" if ok else "beyond"
@@ -230,16 +374,19 @@ def compatibility_check(
         errors = _record_errors(reference, paths)
         return judged_errors("compatibility", errors, "the model's card's records", RECORD_LIMIT)
     if model is None:
-        return Check("compatibility", None, "no model under test to compare with")
+        return Check("compatibility", None, "no model under test to compare with (a rig judges "
+                     "the model's own limits only)")  # fmt: skip
     from bushenv.identify.linear import fitted_linear
 
     try:
         k_ref = fitted_linear(reference, scales).k_n_per_m
         k_mod = fitted_linear(model, scales).k_n_per_m
     except Exception as exc:
-        return Check("compatibility", None, f"no stiffness to compare ({type(exc).__name__})")
+        return Check("compatibility", None, f"no stiffness to compare ({type(exc).__name__}: "
+                     f"{exc}); give the model's card with its records")  # fmt: skip
     if not (np.isfinite(k_ref) and np.isfinite(k_mod) and k_ref > 0 and k_mod > 0):
-        return Check("compatibility", None, "a stiffness is not finite or not positive")
+        return Check("compatibility", None, "a stiffness is not finite or not positive; give "
+                     "the model's card with its records")  # fmt: skip
     ratio = max(k_ref / k_mod, k_mod / k_ref)
     text = (
         f"dynamic stiffness on a random drive: reference {k_ref / 1e3:.4g} N/mm, model "
@@ -252,6 +399,7 @@ def compatibility_check(
     return Check(
         "compatibility",
         None,
-        f"WARNING: {text} (beyond {STIFFNESS_MISMATCH:g}: another bushing, or a broken model; "
-        "a model card with its records decides)",
+        f"undecided: {text}, beyond {STIFFNESS_MISMATCH:g}: another bushing, or a broken "
+        "model; give the model under test with its card and records (bushenv fit writes "
+        "MODEL.card.json beside it) and the reference is compared on those records",
     )

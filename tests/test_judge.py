@@ -123,7 +123,8 @@ def test_the_same_inputs_give_the_same_judge_in_every_command_and_env(tmp_path, 
     env_judge = env.unwrapped.params.judge
     assert env_judge.reference_spec == want.reference_spec
     assert env_judge.scales == want.scales and env_judge.criteria == want.criteria
-    assert [c.name for c in env_judge.vetting.checks] == ["holds", "records", "compatibility"]
+    names = ["holds", "certificate holds", "records", "compatibility"]  # a NARX reference
+    assert [c.name for c in env_judge.vetting.checks] == names
 
 
 def test_a_reference_that_rings_by_itself_is_refused_naming_its_holds(registered, tmp_path, capsys):
@@ -168,12 +169,16 @@ def test_a_reference_of_another_bushing_is_refused_when_the_model_has_records(tm
     assert "beyond 30%" in err
 
 
-def test_a_stiffer_reference_without_records_draws_a_warning_not_a_refusal(registered):
+def test_a_stiffer_reference_without_records_is_not_checked_and_not_passed(registered):
     model = get_model("nn", axis="axial")
     judge = build_judge("nn", "stiff", axis="axial", dt=model.dt, model_object=model)
-    compat = judge.vetting.checks[2]
-    assert compat.passed is None and compat.detail.startswith("WARNING:")
+    compat = {c.name: c for c in judge.vetting.checks}["compatibility"]
+    assert compat.passed is None and compat.verdict == "not checked"
+    assert compat.detail.startswith("undecided:") and "give the model under test" in compat.detail
     assert "a factor 3.1" in compat.detail or "a factor 3.2" in compat.detail
+    # judged, not refused, and never "passed" beside it
+    assert judge.vetting.passed and judge.vetting.verdict == "not fully checked"
+    assert "not checked: records, compatibility" in judge.vetting.headline()
 
 
 def test_a_reference_that_pulls_is_refused_for_its_wrong_sign(registered):
@@ -277,3 +282,50 @@ def test_the_envelope_is_the_reference_cards_records_and_a_failure_says_if_it_le
     assert judge.in_envelope(1.2 / 0.9 * slow, model.dt) is False  # beyond the records' peak
     jump = np.array([0.0, 0.9 * peak])  # within the stroke, faster than the records went
     assert judge.in_envelope(jump, model.dt) is False
+
+
+def test_missing_records_are_not_checked_naming_them_and_the_headline_is_not_passed(tmp_path):
+    from bushenv.machine import random_test
+    from bushenv.records import save_csv
+    from bushenv.reference.rubber import RubberBushing
+    from bushenv.search.campaign_report import format_table
+
+    rec = random_test(RubberBushing.preset("axial", seed=3), 1.0, duration_s=8.0, seed=3)
+    train = save_csv(rec, tmp_path / "train.csv")
+    ref = tmp_path / "ref.npz"
+    assert main(["fit", str(train), "--model", "linear", "--out", str(ref), "--quiet"]) == 0
+    model = get_model("nn", axis="axial")
+    judge = build_judge("nn", str(ref), axis="axial", dt=model.dt, model_object=model)
+    assert {c.name: c.verdict for c in judge.vetting.checks}["records"] == "pass"
+    assert judge.vetting.verdict == "passed" and judge.vetting.complete
+    train.unlink()  # the card's records are gone
+    judge = build_judge("nn", str(ref), axis="axial", dt=model.dt, model_object=model)
+    records = {c.name: c for c in judge.vetting.checks}["records"]
+    assert records.verdict == "not checked" and "train.csv" in records.detail
+    assert f"put the record files beside {tmp_path}" in records.detail
+    assert judge.vetting.passed and judge.vetting.verdict == "not fully checked"
+    # the report's headline says so, never "passed" beside a check that did not pass
+    report = {"reference": {"spec": str(ref)}, "criteria": {"run": []}, "models": {},
+              "judge": json.loads(json.dumps(judge.describe()))}  # fmt: skip
+    text = format_table(report, "nn")
+    assert "vetted, not fully checked: 2 of 3 passed, not checked: records" in text
+    assert "  records: not checked (its own card's records (train.csv) are not there" in text
+    assert "vetted, passed" not in text
+
+
+def test_a_trusted_reference_that_rings_marks_the_verdicts_where_it_rings(tmp_path):
+    from tests.certify.conftest import ringing_hybrid
+
+    ring = ringing_hybrid().save(tmp_path / "ring.npz")
+    t = TABLE1["axial"]
+    pulls = LinearBushing(k_n_per_m=-t["k_n_per_m"], c_ns_per_m=t["c_ns_per_m"])
+    pulls = pulls.save(tmp_path / "pulls.npz")
+    argv = ["attack", "--model", str(pulls), "--reference", str(ring), "--stroke-mm", "2", *FAST]
+    assert main([*argv, "--out", str(tmp_path / "refused")]) == 2
+    assert main([*argv, "--trust-reference", "--out", str(tmp_path / "a")]) == 0
+    report = json.loads((tmp_path / "a" / "report.json").read_text())
+    (lo, hi),  = report["judge"]["unvetted_ranges_m"]  # fmt: skip
+    assert lo < -1.25e-3 < hi and report["judge"]["vetting_verdict"] == "FAILED"
+    row = report["models"]["pulls"]["searchers"]["random"]
+    assert row["diverged"] and 0 < row["failures_in_unvetted_range"] < row["n_failures"]
+    assert row["first_failure"]["reference_unvetted_here"] in (True, False)

@@ -9,6 +9,7 @@
 | ``passivity``     | dynamic stiffness K about a hold, Im K < 0 bands, K from sines       |
 | ``energy``        | where the divergence judge's energy criterion fires on sines         |
 | ``certificate``   | ``certify``: the whole certificate; cheap pieces for searchers       |
+| ``reached_holds`` | the failing holds alone, reached after sines: the reference's vetting |
 | ``plots``, ``command`` | the plots and ``bushenv certify``                               |
 """
 

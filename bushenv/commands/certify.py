@@ -207,7 +207,7 @@ def _summary(doc: dict, paths: list[Path], judge) -> None:
     print(
         f"stroke +-{judge.scales.stroke_m * 1e3:.4g} mm ({judge.scales.source}); reference: "
         f"{judge.reference_spec or 'none'}"
-        + ("" if judge.vetting is None else f", vetting {judge.vetting.summary()}")
+        + ("" if judge.vetting is None else f", vetting {judge.vetting.headline()}")
     )
     if judge.reference is None:
         print(

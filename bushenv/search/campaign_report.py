@@ -130,6 +130,8 @@ def _search_row(key: str, role: str, name: str, s: dict[str, Any]) -> str:
     )
     if s["diverged"] and ff.get("reference_in_envelope") is False:
         fam += " [reference outside its envelope]"
+    if s["diverged"] and ff.get("reference_unvetted_here"):
+        fam += " [UNVETTED: the reference failed its vetting here]"
     wd = s.get("worst_deviation")
     stf = f"{s['seconds_to_failure']:.2f}" if s["diverged"] else "-"
     wds = f"{wd:.3g}" if wd is not None else "-"
@@ -188,7 +190,8 @@ COLUMNS = (
         "<",
         "the excitation family of the first failure and the criterion that fired "
         "(bushenv/divergence.py); [reference outside its envelope]: on that profile the "
-        "reference left the range its card's records cover",
+        "reference left the range its card's records cover; [UNVETTED ...]: the profile dwells "
+        "(0.5 s) where the reference, trusted by --trust-reference, failed its vetting",
     ),
 )
 
@@ -307,11 +310,24 @@ def _judge_lines(judge: dict | None) -> list[str]:
     vet = judge.get("vetting")
     if vet is None:
         return [f"judge: reference {judge['reference']} NOT VETTED"]
-    state = "passed" if vet["passed"] else "FAILED (--trust-reference: verdicts UNVETTED)"
+    from bushenv.vetting import VERDICTS
+
+    checks = vet["checks"]
+    if not vet["passed"]:
+        state = "FAILED (--trust-reference: verdicts UNVETTED)"
+        ranges = judge.get("unvetted_ranges_m") or []
+        if ranges:
+            where = ", ".join(f"{a * 1e3:+.3g}..{b * 1e3:+.3g} mm" for a, b in ranges)
+            state += f"; it failed at {where}"
+    elif all(c["passed"] is True for c in checks):
+        state = "passed (every check)"
+    else:
+        todo = [c["check"] for c in checks if c["passed"] is None]
+        n = sum(c["passed"] is True for c in checks)
+        state = f"not fully checked: {n} of {len(checks)} passed, not checked: {', '.join(todo)}"
     env = judge.get("envelope") or {}
     lines = [f"judge: reference {judge['reference']} vetted, {state}"]
-    mark = {True: "ok", False: "FAILED", None: "undecided"}
-    lines += [f"  {c['check']}: {mark[c['passed']]} ({c['detail']})" for c in vet["checks"]]
+    lines += [f"  {c['check']}: {VERDICTS[c['passed']]} ({c['detail']})" for c in checks]
     if env:
         lines.append(
             f"  envelope: |x| <= {env['max_abs_displacement_m'] * 1e3:.4g} mm, |dx/dt| <= "

@@ -126,6 +126,13 @@ def search_one(
         )
     outside = [judge.in_envelope(c.profile, dt) is False for c in res.failures]
     summary["failures_reference_outside_envelope"] = int(sum(outside))
+    if judge.unvetted_ranges_m:  # trusted despite failing there: those verdicts are unvetted
+        if res.first_failure is not None:
+            summary["first_failure"]["reference_unvetted_here"] = judge.in_unvetted_range(
+                res.first_failure.profile, dt
+            )
+        unvetted = [bool(judge.in_unvetted_range(c.profile, dt)) for c in res.failures]
+        summary["failures_in_unvetted_range"] = int(sum(unvetted))
     if res.worst is not None:
         summary["worst"] = res.worst.to_json()
     kept = res.failures[:MAX_SAVED_FAILURES]

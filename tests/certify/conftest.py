@@ -150,3 +150,32 @@ def pulling_nn(f_scale_n=500.0, beta=0.5) -> NarxBushing:
         n_past_x=1,
         n_past_f=1,
     )
+
+
+def ringing_hybrid(g=1.004, beta=0.25, x_ring_m=-1.25e-3, f_scale_n=3000.0) -> HybridBushing:
+    """A hybrid (Table-1-like k, c) whose residual y_t = tanh(-g y_{t-1} + beta (xs_t +
+    xs_{t-1}) / 2), xs = (x - x_ring) / 1 mm, has a hold fixed point of spectral radius
+    g (1 - y*^2) slightly above 1 (a flip: it rings at the Nyquist rate) within about
+    +-0.3 mm of ``x_ring``. Its input reaches the network through (1 + z^-1) / 2, which has no
+    gain at Nyquist, so a slow ramp to the hold barely excites the ring (it grows as
+    g^n from almost nothing: a few N after 4 s); a sine stopping abruptly, or a step, excites
+    it at once and it rings at its limit cycle, hundreds of N peak to peak. F = 0 at rest."""
+    y = 0.0
+    for _ in range(5000):  # the fixed point at rest, by damped iteration
+        y = 0.5 * y + 0.5 * np.tanh(-g * y + beta * (0.0 - x_ring_m) / X_SCALE_M)
+    return HybridBushing(
+        k_n_per_m=3.8e5,
+        c_ns_per_m=500.0,
+        x_offset_m=x_ring_m,
+        x_scale_m=X_SCALE_M,
+        f_offset_n=-f_scale_n * y,
+        f_scale_n=f_scale_n,
+        w1=np.array([[beta / 2, beta / 2, -g]]),
+        b1=np.zeros(1),
+        w2=np.zeros((0, 1)),
+        b2=np.zeros(0),
+        w_out=np.ones(1),
+        b_out=0.0,
+        n_past_x=1,
+        n_past_f=1,
+    )

@@ -1,0 +1,250 @@
+"""Holds reached the way a search reaches them, and whether a model rings, departs or pulls there.
+
+A certificate's free run steps to each hold from rest; a slow ramp barely excites a hold at all.
+A search reaches a hold after any motion: a network whose hold fixed point is barely unstable
+(spectral radius slightly above 1) stays quiet for seconds after a slow ramp and rings at once
+after a sine. So a listed hold is *confirmed* here from several histories, all inside the
+model's envelope (the largest |x| and |dx/dt| of its card's records, else the judged stroke and
+velocity): the step at the velocity limit (the attack's hold stage), and sines of
+``AMPLITUDE_FRACTIONS`` of the envelope's displacement at ``FREQUENCIES_HZ`` (those within its
+velocity and below a quarter of the sample rate), each from rest, ending at rest position, then
+a move to the hold at the sine's peak speed, then ``HOLD_S`` held (longer for a departure the
+certificate predicts later).
+
+Each hold is judged on its tail (the last ``TAIL_S``), against one threshold
+(:func:`ring_threshold`) tied to the model itself: ``NOISE_FACTOR`` times its own noise (the
+median peak-to-peak of its detrended tails in holds from rest: a few ringing holds do not move
+a median) and ``RING_FRACTION`` of its force scale (its largest settled force over the stroke),
+whichever is larger -- not a fixed floor: a 200 N floor hid a kilonewton ring of a bushing
+whose force scale is 5 kN. A passive bushing only relaxes in a hold, smoothly, so:
+
+- *oscillating*: the tail, less a fitted parabola (a relaxation's curvature), still moves by
+  more than the threshold, peak to peak;
+- *departing*: from one second into the hold to its end the force grows by more than the
+  threshold and by ``DEPART_FRACTION`` of its held value;
+- *wrong sign*: the tail's mean opposes the deflection by more than the threshold;
+- *not finite*.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bushenv.certify.fixed_points import fixed_points
+from bushenv.certify.ghosts import ghosts
+from bushenv.certify.holds import HOLD_S as CERTIFY_HOLD_S
+from bushenv.certify.holds import free_runs, reference_static_force
+from bushenv.certify.network import narx_net
+
+HOLD_S = 4.0
+TAIL_S = 2.0
+SETTLE_S = 1.0
+PRE_S = 0.1
+MAX_HOLD_S = 20.0  # a departure the certificate predicts later than this is not simulated
+SINE_S = 1.0  # at least this long, and at least two cycles
+AMPLITUDE_FRACTIONS = (0.5, 0.25)
+FREQUENCIES_HZ = (2.0, 5.0, 10.0, 20.0, 40.0)
+NOISE_FACTOR = 3.0
+RING_FRACTION = 0.01
+DEPART_FRACTION = 0.25
+MAX_LISTED = 16  # listed holds simulated, spread over the list
+
+
+@dataclass(frozen=True)
+class Threshold:
+    """The force a ring, a departure or a wrong sign must exceed, N, and where it comes from."""
+
+    force_n: float
+    noise_n: float  # the model's own noise: median peak-to-peak of detrended hold tails, N
+    force_scale_n: float  # its largest settled force over the stroke, N
+
+    def describe(self) -> str:
+        return (
+            f"threshold {self.force_n:.4g} N: the larger of {NOISE_FACTOR:g} x its noise "
+            f"{self.noise_n:.3g} N p-p and {RING_FRACTION:.0%} of its force scale "
+            f"{self.force_scale_n:.4g} N"
+        )
+
+
+def tail_ripple(tail: np.ndarray) -> np.ndarray:
+    """(B,) peak-to-peak of each column of (T, B) ``tail`` less its least-squares parabola."""
+    t = np.linspace(-1.0, 1.0, tail.shape[0])
+    basis = np.stack([np.ones_like(t), t, t * t], axis=1)
+    coef, *_ = np.linalg.lstsq(basis, tail, rcond=None)
+    return np.ptp(tail - basis @ coef, axis=0)
+
+
+def ring_threshold(f_rest: np.ndarray, dt: float) -> Threshold:
+    """The threshold of a model from its forces (T, B) in holds reached from rest (the last
+    ``TAIL_S`` of each column is its tail, the last sample its settled force)."""
+    ok = np.all(np.isfinite(f_rest), axis=0)
+    if not ok.any():
+        return Threshold(float("inf"), float("nan"), float("nan"))
+    tail = f_rest[-max(3, int(round(TAIL_S / dt))) :, ok]
+    noise = float(np.median(tail_ripple(tail)))
+    scale = float(np.max(np.abs(f_rest[-1, ok])))
+    return Threshold(max(NOISE_FACTOR * noise, RING_FRACTION * scale), noise, scale)
+
+
+def judge_holds(f: np.ndarray, x_m: np.ndarray, n_hold: int, threshold: float, dt: float) -> dict:
+    """Flags (B,) per kind for forces (T, B) whose last ``n_hold`` samples hold ``x_m`` (B,):
+    {"not finite", "oscillating", "departing", "wrong sign"}, and "ripple_n" (B,)."""
+    finite = np.all(np.isfinite(f), axis=0)
+    g = np.where(finite, f, 0.0)
+    tail = g[-max(3, int(round(TAIL_S / dt))) :]
+    ripple = tail_ripple(tail)
+    f0 = g[-n_hold + int(round(SETTLE_S / dt))]
+    f1 = g[-1]
+    grows = np.abs(f1) - np.abs(f0) > np.maximum(threshold, DEPART_FRACTION * np.abs(f0))
+    flips = (np.abs(f0) > threshold) & (np.abs(f1) > threshold) & (np.sign(f0) != np.sign(f1))
+    mean = tail.mean(axis=0)
+    return {
+        "not finite": ~finite,
+        "oscillating": finite & (ripple > threshold),
+        "departing": finite & (grows | flips),
+        "wrong sign": finite & (mean * np.sign(x_m) < -threshold),
+        "ripple_n": np.where(finite, ripple, np.inf),
+    }
+
+
+def excitations(x_env_m: float, v_env_m_per_s: float, dt: float) -> list[tuple[float, float]]:
+    """(amplitude m, frequency Hz) of the sines inside the envelope (see the module doc)."""
+    out = []
+    for frac in AMPLITUDE_FRACTIONS:
+        a = frac * x_env_m
+        for f in FREQUENCIES_HZ:
+            if 2 * np.pi * f * a <= v_env_m_per_s * (1 + 1e-9) and f <= 0.25 / dt:
+                out.append((a, f))
+    return out
+
+
+def _move(x0: float, x1: float, speed: float, dt: float) -> np.ndarray:
+    n = max(1, int(np.ceil(abs(x1 - x0) / (speed * dt))))
+    return np.linspace(x0, x1, n + 1)[1:]
+
+
+def reach_profiles(
+    x_m: float, x_env_m: float, v_env_m_per_s: float, hold_s: float, dt: float
+) -> tuple[list[np.ndarray], list[str]]:
+    """Profiles that reach the hold ``x_m`` (each ends with ``hold_s`` at ``x_m``), and how."""
+    n_hold = int(round(hold_s / dt))
+    pre = np.zeros(max(1, int(round(PRE_S / dt))))
+    profiles = [np.r_[pre, _move(0.0, x_m, v_env_m_per_s, dt), np.full(n_hold, x_m)]]
+    how = ["a step at the velocity limit"]
+    for a, f in excitations(x_env_m, v_env_m_per_s, dt):
+        cycles = max(2, int(np.ceil(SINE_S * f)))
+        t = np.arange(int(round(cycles / (f * dt))) + 1) * dt
+        sine = a * np.sin(2 * np.pi * f * t)
+        sine[-1] = 0.0
+        move = _move(0.0, x_m, min(2 * np.pi * f * a, v_env_m_per_s), dt)
+        profiles.append(np.r_[pre, sine, move, np.full(n_hold, x_m)])
+        how.append(f"a {a * 1e3:.3g} mm {f:g} Hz sine")
+    return profiles, how
+
+
+@dataclass(frozen=True)
+class Confirmed:
+    """A listed hold the simulation confirms: where, as what, how large, after what."""
+
+    x_m: float
+    kinds: tuple[str, ...]
+    ripple_n: float
+    after: str
+
+
+def confirm_holds(
+    model,
+    listed: list[dict],
+    envelope: tuple[float, float],
+    threshold: float,
+) -> tuple[list[Confirmed], int]:
+    """The ``listed`` holds ([{"x_m", "departure_s"?}]) each simulated after every
+    ``reach_profiles`` history inside ``envelope`` (|x|, |dx/dt| limits); the confirmed ones
+    (any history shows a kind of the module doc) and the number of profiles simulated."""
+    if not listed:
+        return [], 0
+    if len(listed) > MAX_LISTED:
+        keep = np.unique(np.linspace(0, len(listed) - 1, MAX_LISTED).round().astype(int))
+        listed = [listed[i] for i in keep]
+    dt = model.dt
+    later = [h.get("departure_s") or 0.0 for h in listed]
+    hold_s = float(min(MAX_HOLD_S, max(HOLD_S, max(later) + TAIL_S)))
+    n_hold = int(round(hold_s / dt))
+    profiles, owner, how = [], [], []
+    for i, h in enumerate(listed):
+        p, w = reach_profiles(h["x_m"], envelope[0], envelope[1], hold_s, dt)
+        profiles += p
+        owner += [i] * len(p)
+        how += w
+    T = max(p.size for p in profiles)
+    x = np.zeros((T, len(profiles)))
+    for b, p in enumerate(profiles):  # left-padded with rest: every hold ends the profile
+        x[T - p.size :, b] = p
+    try:
+        f = model.copy().simulate(x)
+    except Exception:  # a model that cannot run its holds: every one confirmed, not finite
+        f = np.full(x.shape, np.nan)
+    flags = judge_holds(f, x[-1], n_hold, threshold, dt)
+    kinds = ("not finite", "oscillating", "departing", "wrong sign")
+    owner_a = np.array(owner)
+    out = []
+    for i, h in enumerate(listed):
+        cols = np.flatnonzero(owner_a == i)
+        found = tuple(k for k in kinds if flags[k][cols].any())
+        if not found:
+            continue
+        hit = cols[np.any(np.stack([flags[k][cols] for k in kinds]), axis=0)]
+        worst = int(hit[np.argmax(flags["ripple_n"][hit])])
+        out.append(Confirmed(h["x_m"], found, float(flags["ripple_n"][worst]), how[worst]))
+    return out, len(profiles)
+
+
+def ranges_of(x_m: list[float], step_m: float) -> list[tuple[float, float]]:
+    """Runs of sorted ``x_m`` whose neighbours are at most 1.5 ``step_m`` apart: [(lo, hi)]."""
+    xs = sorted(x_m)
+    out: list[tuple[float, float]] = []
+    for v in xs:
+        if out and v - out[-1][1] <= 1.5 * step_m:
+            out[-1] = (out[-1][0], v)
+        else:
+            out.append((v, v))
+    return out
+
+
+# ----- the certificate's listing of a model's failing holds -----------------------------------
+FAILING_KINDS = ("oscillates", "departs", "wrong_sign")  # what a listed hold is listed as
+
+
+def hold_entries(
+    model,
+    reference=None,
+    stroke_m: float = 12.5e-3,
+    holds: int = 201,
+    hold_s: float = CERTIFY_HOLD_S,
+) -> list[dict]:
+    """The certificate's ``holds`` entries (fixed points, free runs, static force) over a
+    uniform grid of ``holds`` over -stroke..+stroke, without the passivity and the energy scan;
+    ``reference`` None: wrong sign against the deflection (:func:`wrong_sign`). Raises
+    ``CertifyError`` for a model that is not a NARX network."""
+    from bushenv.certify.certificate import _hold_entry
+
+    net = narx_net(model)
+    x = np.linspace(-stroke_m, stroke_m, holds)
+    fp = fixed_points(net, x)
+    gh = ghosts(net, x)
+    runs, _, _ = free_runs(model, net, fp, gh, hold_s)
+    ref = np.full(x.size, np.nan) if reference is None else reference_static_force(reference, x)
+    return [_hold_entry(net, fp, gh, r, i, ref, []) for i, r in enumerate(runs)]
+
+
+def failing_holds(entries: list[dict]) -> list[dict]:
+    """[{"x_m", "kinds", "departure_s"}] of the entries listed as oscillating, departing or
+    wrong-sign (``kinds`` among ``FAILING_KINDS``), by increasing x."""
+    out = []
+    for h in entries:
+        kinds = [k for k in FAILING_KINDS if h.get(k)]
+        if kinds:
+            out.append({"x_m": h["x_m"], "kinds": kinds, "departure_s": h.get("departure_s")})
+    return out
