@@ -67,8 +67,54 @@ def _per_coord(name: str, table: Any) -> np.ndarray:
     return np.array([positive(f"{name}.{c}", table[c]) for c in COORDS])
 
 
+def _registered(spec: Any) -> bool:
+    return isinstance(spec, str) and spec in MODELS
+
+
+def _is_none(spec: Any) -> bool:
+    return spec is None or (isinstance(spec, str) and spec.strip().lower() == "none")
+
+
+def reference_of(model_spec: Any, reference_spec: Any) -> Any:
+    """The reference a rig runs: ``"default"`` is the built-in coupled rubber beside a
+    registered model and none beside a user's model (a file or an object), said as a warning;
+    anything else as given."""
+    if not (isinstance(reference_spec, str) and reference_spec == "default"):
+        return reference_spec
+    if _registered(model_spec):
+        return "rubber"
+    gym.logger.warn(
+        f"{ENV_ID}: model {model_spec if isinstance(model_spec, str | Path) else 'object'} is "
+        "your own bushing's and no reference was given, so the rig runs without one: the "
+        "reward is the model's own force over force_scale and only a force that is not finite "
+        "or beyond force_limit ends an episode; give reference=FILE (your bushing's reference "
+        "model) to judge the model against it, or reference='rubber' for the built-in one"
+    )
+    return "none"
+
+
+def scale_of(kwargs: dict[str, Any], judge: BushingModel, limit: np.ndarray) -> np.ndarray:
+    """force_scale per coordinate: as given, or, where it is the spec's (the built-in rubber's
+    Table-1 stiffness x stroke) and the judge is a user's bushing, that bushing's own static
+    stiffness x the stroke."""
+    given = _per_coord("force_scale", kwargs["force_scale"])
+    builtin = _per_coord("force_scale", spec_kwargs(ENV_ID, {})["force_scale"])
+    if not np.array_equal(given, builtin):
+        return given
+    from bushenv.planar.static_estimate import static_stiffness3
+
+    k = np.abs(static_stiffness3(judge))
+    if not np.all(np.isfinite(k) & (k > 0)):
+        raise RigError(
+            f"{ENV_ID}: the static stiffness of {judge.name} per coordinate is {k.tolist()} "
+            "(not finite or zero), so no force scale can be drawn from it: give force_scale="
+            "{'axial': N, 'radial': N, 'rotation': N m}"
+        )
+    return k * limit
+
+
 class Rig3Core:
-    """The spec's kwargs checked, the two models, and the batched step."""
+    """The spec's kwargs checked, the two models (the reference may be none), the step."""
 
     def __init__(self, kwargs: dict[str, Any], batch: int) -> None:
         self.dt = positive("dt_s", kwargs["dt_s"])
@@ -77,27 +123,36 @@ class Rig3Core:
         self.rate = _per_coord("rate", kwargs["rate"])
         self._rate_dt = self.rate * self.dt
         self.force_limit = _per_coord("force_limit", kwargs["force_limit"])
-        self.force_scale = _per_coord("force_scale", kwargs["force_scale"])
         self.reward_cap = positive("reward_cap", kwargs["reward_cap"])
         self.model = resolve_planar(kwargs["model"], self.dt, "model", rate_setting="dt_s")
-        self.reference = resolve_planar(
-            kwargs["reference"], self.dt, "reference", rate_setting="dt_s"
+        reference = reference_of(kwargs["model"], kwargs["reference"])
+        self.reference: BushingModel | None = (
+            None
+            if _is_none(reference)
+            else resolve_planar(reference, self.dt, "reference", rate_setting="dt_s")
+        )
+        builtin = self.reference is not None and _registered(reference)
+        judge = self.model if self.reference is None else self.reference
+        self.force_scale = (
+            _per_coord("force_scale", kwargs["force_scale"])
+            if builtin or (self.reference is None and _registered(kwargs["model"]))
+            else scale_of(kwargs, judge, self.limit)
         )
         self.batch = batch
-        self.reset(np.ones(batch, dtype=bool))
+        self.q = np.zeros((batch, 3))
+        self.obs = np.zeros((batch, 3, 3, self.history), dtype=np.float32)
+        # (1, B, 3) buffers the models' _advance runs on: the step skips the checks of
+        # BushingModel.step (shapes are right by construction), a third of its cost
+        self._q1, self._v1 = np.zeros((1, batch, 3)), np.zeros((1, batch, 3))
+        self._fm1, self._fr1 = np.zeros((1, batch, 3)), np.zeros((1, batch, 3))
+        self.model.reset(batch)
+        if self.reference is not None:
+            self.reference.reset(batch)
 
     def reset(self, mask: np.ndarray) -> None:
-        if not hasattr(self, "q"):
-            self.q = np.zeros((self.batch, 3))
-            self.obs = np.zeros((self.batch, 3, 3, self.history), dtype=np.float32)
-            self.model.reset(self.batch)
-            self.reference.reset(self.batch)
-            # (1, B, 3) buffers the models' _advance runs on: the step skips the checks of
-            # PlanarModel.step (shapes are right by construction), a third of its cost
-            self._q1, self._v1 = np.zeros((1, self.batch, 3)), np.zeros((1, self.batch, 3))
-            self._fm1, self._fr1 = np.zeros((1, self.batch, 3)), np.zeros((1, self.batch, 3))
         for m in (self.model, self.reference):
-            m.reset_columns(mask)  # a hybrid-bw's backbone too
+            if m is not None:
+                m.reset_columns(mask)  # a hybrid-bw's backbone too
         self.q[mask] = 0.0
         self.obs[mask] = 0.0
 
@@ -110,8 +165,9 @@ class Rig3Core:
             f_model, raised = self._fm1[0], ""
         except MODEL_ERRORS as exc:
             f_model, raised = np.full((self.batch, 3), np.nan), str(exc)
-        self.reference._guarded(self._q1, self._v1, self._fr1)
-        f_ref = self._fr1[0]
+        if self.reference is not None:
+            self.reference._guarded(self._q1, self._v1, self._fr1)
+        f_ref = self._fr1[0]  # stays zero without a reference: the reward is |F_model|
         reward = np.empty(self.batch)
         calm = rig3_outcome(
             self.q, f_model, f_ref, self.limit, self.force_limit, self.force_scale,
@@ -127,7 +183,7 @@ class Rig3Core:
             "q": self.q.copy(),
             "v": self._v1[0].copy(),
             "f_model": f_model.copy(),
-            "f_ref": f_ref.copy(),
+            "f_ref": None if self.reference is None else f_ref.copy(),
             "reward": reward,
             "terminated": terminated,
             "truncated": truncated,
@@ -148,12 +204,14 @@ _INFO_KEYS = tuple(
 
 def _info(s: dict[str, Any], i: int, t: int, dt: float) -> dict[str, Any]:
     # tolist(): one call for three Python floats (float() per element costs 3x the step's
-    # model time at B = 1)
-    values = s["q"][i].tolist() + s["f_model"][i].tolist() + s["f_ref"][i].tolist()
+    # model time at B = 1); without a reference its forces are not in the info at all
+    values = s["q"][i].tolist() + s["f_model"][i].tolist()
+    if s["f_ref"] is not None:
+        values += s["f_ref"][i].tolist()
     return {
         "time_s": t * dt,
         "step": t,
-        **dict(zip(_INFO_KEYS, values, strict=True)),
+        **dict(zip(_INFO_KEYS, values, strict=False)),
         "diverged": bool(s["terminated"][i]),
         "machine_limit": bool(s["truncated"][i]),
         "model_error": s["raised"],
@@ -179,7 +237,9 @@ class BushRig3Env(gym.Env):
     (3 x H), F_reference / force_limit (3 x H), newest first, clipped, NaN as 0.
 
     ## Rewards
-    min(sum_i |F_model,i - F_ref,i| / force_scale_i, reward_cap).
+    min(sum_i |F_model,i - F_ref,i| / force_scale_i, reward_cap); without a reference F_ref is
+    0 (the model's own force: the search then looks for non-finite forces and forces beyond
+    the limit, the verdicts that need no reference).
 
     ## Starting State
     At rest, both models reset; nothing is random.
@@ -191,10 +251,13 @@ class BushRig3Env(gym.Env):
     ``max_episode_steps`` (2048 = 10 s).
 
     ## Arguments
-    Every key of ``envs/BushRig3-v0.toml`` ``[kwargs]``: ``model`` and ``reference`` (a name in
-    ``bushenv.planar.PLANAR_MODELS`` with a preset, a ``.npz`` planar model file, or a model),
-    ``dt_s``, ``history``, ``stroke``, ``rate``, ``force_limit``, ``force_scale``,
-    ``reward_cap``.
+    Every key of ``envs/BushRig3-v0.toml`` ``[kwargs]``: ``model`` (a name in
+    ``bushenv.models.MODELS`` whose three-axis form has a preset, a three-axis ``.npz`` model
+    file, or a model) and ``reference`` (the same, ``"none"``, or ``"default"``: the built-in
+    coupled rubber beside a registered model, none beside a user's model, with a warning
+    saying so), ``dt_s``, ``history``, ``stroke``, ``rate``, ``force_limit``, ``force_scale``
+    (left at the spec's values with a user's reference: that bushing's static stiffness x the
+    stroke per coordinate), ``reward_cap``.
 
     ## Example
     >>> import gymnasium as gym
@@ -209,7 +272,9 @@ class BushRig3Env(gym.Env):
     (6.136, -0.0736)
 
     ## Version History
-    - v0: first version.
+    - v0: first version. The reference ``"default"`` (none beside a user's model file, said)
+      and ``"none"``, and the force scale of a user's reference, came later without a new id:
+      with the built-in models nothing changed.
     """
 
     metadata = {"render_modes": [], "render_fps": 204.8}
@@ -255,7 +320,9 @@ class BushRig3VectorEnv(ArrayVectorEnv):
         render_mode: str | None = None,
         **spec_overrides: Any,
     ) -> None:
-        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode)
+        super().__init__(
+            ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode
+        )
         self.core = Rig3Core(spec_kwargs(ENV_ID, spec_overrides), self.num_envs)
         self.reward_fn = self.divergence_monitor = None
         self.render_mode = render_mode

@@ -40,10 +40,10 @@ def autoreset_mode_of(value: Any) -> AutoresetMode:
 
 
 class ArrayVectorEnv(VectorEnv):
-    """Base of the array vector envs. Subclasses call ``_setup`` in ``__init__``, write their
-    step's arrays, call ``_end_step`` last, and implement ``_reset_columns(mask)`` (physics and
-    models of the columns ``mask`` back to rest) and ``_rest_info()`` (one column's info at
-    rest, plain values)."""
+    """Base of the array vector envs. Subclasses call ``super().__init__`` first in their
+    ``__init__``, write their step's arrays, call ``_end_step`` last, and implement
+    ``_reset_columns(mask)`` (physics and models of the columns ``mask`` back to rest) and
+    ``_rest_info()`` (one column's info at rest, plain values)."""
 
     metadata = {
         "render_modes": ["rgb_array"],
@@ -51,7 +51,7 @@ class ArrayVectorEnv(VectorEnv):
         "autoreset_mode": AutoresetMode.NEXT_STEP,
     }
 
-    def _setup(
+    def __init__(
         self, env_id, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode=None
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -67,6 +67,11 @@ class ArrayVectorEnv(VectorEnv):
         self._t = np.zeros(n, dtype=np.int64)
         self._end = np.full(n, self.max_episode_steps, dtype=np.int64)
         self._prev_done = np.zeros(n, dtype=bool)
+
+    def _setup(self, *args: Any, **kwargs: Any) -> None:
+        """The former name of ``ArrayVectorEnv.__init__``, kept until every subclass calls
+        ``super().__init__``."""
+        ArrayVectorEnv.__init__(self, *args, **kwargs)
 
     def _reset_columns(self, mask: np.ndarray) -> None:
         raise NotImplementedError

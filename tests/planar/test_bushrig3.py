@@ -31,11 +31,50 @@ def _nn_file(tmp_path):
     return str(m.save(tmp_path / "nn.npz"))
 
 
-@pytest.mark.parametrize("model", ["linear", "reference", "file"])
+@pytest.mark.parametrize("model", ["linear", "reference", "file", "file judged"])
 def test_gymnasium_and_sb3_checkers_pass(model, tmp_path):
-    env = gym.make("BushRig3-v0", model=_nn_file(tmp_path) if model == "file" else model)
+    kwargs = {"model": model}
+    if model.startswith("file"):
+        kwargs["model"] = _nn_file(tmp_path)
+    if model == "file judged":
+        kwargs["reference"] = "rubber"
+    env = gym.make("BushRig3-v0", **kwargs)
     check_env(env.unwrapped, skip_render_check=True)
     sb3_check_env(env.unwrapped, warn=False)
+
+
+def test_a_users_model_without_a_reference_runs_without_one_and_says_so(tmp_path):
+    with pytest.warns(UserWarning, match="no reference was given, so the rig runs without one"):
+        env = gym.make("BushRig3-v0", model=_nn_file(tmp_path)).unwrapped
+    assert env.core.reference is None
+    env.reset(seed=0)
+    _, reward, _, _, info = env.step(np.array([0.5, -0.5, 0.2], np.float32))
+    assert "force_reference_axial" not in info
+    f = np.array([info[f"force_model_{c}"] for c in ("axial", "radial", "rotation")])
+    assert reward == pytest.approx(min(np.sum(np.abs(f) / env.core.force_scale), 10.0))
+
+
+def test_reference_none_is_accepted_and_a_registered_reference_keeps_the_spec_scale():
+    env = gym.make("BushRig3-v0", model="linear", reference="none").unwrapped
+    assert env.core.reference is None
+    builtin = gym.make("BushRig3-v0", model="linear").unwrapped
+    assert builtin.core.reference.name == "rubber"
+    np.testing.assert_array_equal(env.core.force_scale, builtin.core.force_scale)
+    np.testing.assert_array_equal(builtin.core.force_scale, [4746.0, 18984.125, 450.0])
+
+
+def test_a_users_reference_sets_the_force_scale_unless_one_is_given(tmp_path):
+    from bushenv.planar.static_estimate import static_stiffness3
+
+    soft = PlanarLinear(np.diag([1e5, 2e5, 300.0]), np.diag([100.0, 200.0, 1.0]))
+    ref = str(soft.save(tmp_path / "soft.npz"))
+    env = gym.make("BushRig3-v0", model="linear", reference=ref).unwrapped
+    want = np.abs(static_stiffness3(soft)) * env.core.limit
+    np.testing.assert_allclose(env.core.force_scale, want)
+    np.testing.assert_allclose(env.core.force_scale, [1250.0, 2500.0, 45.0], rtol=1e-9)
+    given = {"axial": 1.0, "radial": 2.0, "rotation": 3.0}
+    env = gym.make("BushRig3-v0", model="linear", reference=ref, force_scale=given).unwrapped
+    np.testing.assert_array_equal(env.core.force_scale, [1.0, 2.0, 3.0])
 
 
 def test_vector_env_equals_single_envs_bit_for_bit():
@@ -77,7 +116,7 @@ def test_stroke_and_rate_limits_hold():
 
 def test_a_model_beyond_the_force_limit_terminates():
     stiff = PlanarLinear(np.diag([1e9, 1e9, 1e9]), np.zeros((3, 3)))
-    env = gym.make("BushRig3-v0", model=stiff)
+    env = gym.make("BushRig3-v0", model=stiff, reference="rubber")
     env.reset(seed=0)
     _, _, terminated, truncated, info = env.step(np.array([0.01, 0, 0], np.float32))
     assert terminated and not truncated and info["diverged"]
