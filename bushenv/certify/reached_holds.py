@@ -71,9 +71,8 @@ class Threshold:
 def tail_ripple(tail: np.ndarray) -> np.ndarray:
     """(B,) peak-to-peak of each column of (T, B) ``tail`` less its least-squares parabola."""
     t = np.linspace(-1.0, 1.0, tail.shape[0])
-    basis = np.stack([np.ones_like(t), t, t * t], axis=1)
-    coef, *_ = np.linalg.lstsq(basis, tail, rcond=None)
-    return np.ptp(tail - basis @ coef, axis=0)
+    q, _ = np.linalg.qr(np.stack([np.ones_like(t), t, t * t], axis=1))  # (T, 3) orthonormal
+    return np.ptp(tail - q @ (q.T @ tail), axis=0)
 
 
 def ring_threshold(f_rest: np.ndarray, dt: float) -> Threshold:
