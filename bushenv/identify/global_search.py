@@ -28,8 +28,8 @@ Procedure: ``scipy.optimize.differential_evolution`` (seeded, ``vectorized=True`
 ``generations`` generations) on the first ``fit_seconds`` of the records (record after record,
 each run from rest), then a bounded Powell polish on all of every record, from the final
 population's member with the lowest error on all of the records. Why 400 generations:
-docs/fit-seed-spread.md. Generations and evaluations, not the clock, end the search, so a seed
-reproduces the parameters; ``time_limit_s`` (off by default) stops the search after the
+studies/2026-11-fit-seed-spread. Generations and evaluations, not the clock, end the search, so
+a seed reproduces the parameters; ``time_limit_s`` (off by default) stops the search after the
 generation that passes it, and the log says so (``stopped``, ``time_limited``,
 ``budget_used``). Members that cannot be integrated (more than ``max_substeps`` trial
 steps in a sample, or a solution that blows up) score ``inf``.

@@ -14,7 +14,7 @@ A row whose best h is negative (a hysteresis that would give energy) is refitted
 With a relaxation, its branches act on each coordinate alone (R_m diagonal) with R_m[i, i] >= 0
 and h_i >= 0, by non-negative least squares: every branch stores and dissipates energy only,
 so the element stays passive (a free 3x3 R_m, fitted and then made semidefinite, was measured
-worse: docs/planar_fit_unseen.md). ``relaxation_selection="extrapolation"`` then drops the
+worse: studies/2026-11-planar-fit-unseen). ``relaxation_selection="extrapolation"`` then drops the
 shortest branches when that predicts the training records' largest deflections better
 (``_select``; an option: measured to help on one bushing and hurt on another). The summary warns
 of branches the records cannot tell from the static stiffness (``relaxation.inseparable``).
@@ -73,7 +73,8 @@ class PlanarBoucWenOptions:
         "all",
         "all: keep every relaxation branch; extrapolation: drop the shortest ones when that "
         "predicts the training records' largest tenth of deflections clearly better from the "
-        "rest (measured to help on one bushing and hurt on another: docs/planar_fit_unseen.md)",
+        "rest (measured to help on one bushing and hurt on another: "
+        "studies/2026-11-planar-fit-unseen)",
         choices=("all", "extrapolation"),
     )
 
@@ -295,7 +296,7 @@ def _select(prob: _Problem, p: np.ndarray, every: np.ndarray) -> tuple[np.ndarra
     (``_Problem.beyond``) at the shape ``p``; the fullest grid within ``SELECTION_TIE`` of the
     best score. Short branches can
     imitate an amplitude-dependent friction loop at the training amplitude and not beyond it
-    (docs/planar_fit_unseen.md); this asks the training records, not held-out ones."""
+    (studies/2026-11-planar-fit-unseen); this asks the training records, not held-out ones."""
     beyond = prob.beyond()
     if beyond is None:
         return every, "every branch (too few samples to test extrapolation)"

@@ -10,7 +10,7 @@ items)`` runs each from rest. ``kind``:
   under a 3 mm radial sweep; 20 s each) and at n = 1 (2 mm, 0.05 rad): n = 1 identifies,
   n = 1.5 verifies. The n = 1 sets hold a preload, which random motion with nothing below 1 Hz
   never does: without them a fit cannot tell its slow relaxation from its static stiffness
-  (docs/planar_fit_unseen.md). The axial sets came last, after the others;
+  (studies/2026-11-planar-fit-unseen). The axial sets came last, after the others;
 - ``"random"``: random on all axes at ``n_index``, independent and correlated.
 
 The planar reference (``reference`` with its load cell) measures each record with its own

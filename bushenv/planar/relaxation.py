@@ -7,7 +7,7 @@ tau_m: p_m is the branch spring's deflection, which follows a fast motion and re
 under a held one. This is the linear viscoelastic solid of rubber (the Prony series of finite
 element codes), here with matrix moduli so a branch can couple the coordinates. A backbone
 needs it because a NARX network's 5 lags (10 ms at 500 Hz) cannot carry a 200 ms relaxation
-except through its own fed-back outputs (docs/planar_fit_unseen.md).
+except through its own fed-back outputs (studies/2026-11-planar-fit-unseen).
 
 Discrete law (exact when q moves on a straight line within a sample, as the Bouc-Wen kernel
 assumes): p_m,t = a_m p_m,t-1 + b_m (q_t - q_t-1), a_m = exp(-dt / tau_m),

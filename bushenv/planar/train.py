@@ -7,7 +7,7 @@ measured start), keeping the weights with the lowest free-run error on a held-ou
 only trains; the arrays go to ``narx.PlanarNarx`` whose numpy loop does every run in use.
 
 The hybrid's accurate recipe (``train_options.NOISY_FEEDBACK_TRAINING``, ``--training
-noisy-feedback``, docs/planar_fit_unseen.md) trains differently one step ahead: mini-batches
+noisy-feedback``, studies/2026-11-planar-fit-unseen) trains differently one step ahead: mini-batches
 instead of the full batch (many more, cheaper Adam steps), Gaussian noise on the fed-back past
 outputs, so the network leans on the displacement inputs rather than on its own last output,
 and 54 units, 6000 steps at a lower rate. It is 3x as accurate on unseen records and has more

@@ -52,7 +52,7 @@ class PlanarNetworkOptions:
         "on: a loss term holding every fixed point of the held network, over the rig3 box "
         "(single coordinates, pairs, all three), within a band of the records' static force per "
         "coordinate and below a spectral radius, and every held run after a step settled "
-        "(planar/certified.py; docs/planar_certified.md)",
+        "(planar/certified.py; studies/2026-11-planar-certified)",
         choices=SWITCH,
     )
     # the same as the one-axis network's term (``identify.narx_options``)
@@ -69,7 +69,7 @@ class PlanarNetworkOptions:
         "free",
         "weights tied by construction (nn, hybrid): mirror (odd in each coordinate, diagonal "
         "backbone), rate (displacement as increments: one held fixed point), mirror-rate "
-        "(planar/structure.py; docs/planar_certified.md)",
+        "(planar/structure.py; studies/2026-11-planar-certified)",
         choices=STRUCTURES,
     )
 
@@ -127,7 +127,8 @@ class PlanarNetworkOptions:
         )
 
 
-# the hybrid's accurate recipe (docs/planar_fit_unseen.md, "The matrix-backbone hybrid"): twice
+# the hybrid's accurate recipe (studies/2026-11-planar-fit-unseen, "The matrix-backbone
+# hybrid"): twice
 # the units, 6000 mini-batch steps one step ahead with noise on the fed-back outputs, about 1.4x
 # the plain fit's time; 3x as accurate on unseen records, but at some holds inside its training
 # range more than one fixed point (docs/planar.md, "Passivity"), so not the default

@@ -29,7 +29,8 @@ NARX_MODELS = ("nn", "hybrid")  # the models with a recipe and a certificate
 CELL_KEYS = ("recipe", "model", "axis", "seed", "budget", "searchers", "train_options")
 RESULT_KEYS = ("accuracy", "attacks", "step", "certificate")
 # Training time relative to teacher forcing, for the time left only (median of the 10-seed
-# run in docs/recipes.md: teacher forcing 11 s, free run 52-72 s per model on a loaded machine).
+# run in studies/2026-11-training-recipes: teacher forcing 11 s, free run 52-72 s per model
+# on a loaded machine).
 RECIPE_EFFORT = {"teacher-forcing": 1.0, "free-run": 6.0}
 
 

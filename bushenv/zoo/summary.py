@@ -128,7 +128,7 @@ def pct(r: dict) -> str:
 
 
 def markdown(summary: dict[str, Any]) -> str:
-    """The tables of docs/recipes.md."""
+    """The tables of studies/2026-11-training-recipes."""
     lines = ["| recipe / model | cells | any searcher | " + "by searcher |", "|---|---|---|---|"]
     for key, g in summary.items():
         per = "; ".join(
