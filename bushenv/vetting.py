@@ -93,6 +93,9 @@ class Check:
 
 @dataclass(frozen=True)
 class Vetting:
+    """The checks of one reference. ``passed``: none failed (it may judge; ``describe()``'s
+    "passed" means this too); ``complete``: every check passed; ``verdict``: the headline."""
+
     reference: str
     checks: tuple[Check, ...]
 
@@ -215,11 +218,9 @@ def hold_check(reference: BushingModel, scales: BushingScales) -> tuple[Check, f
         return Check("holds", False, text), scales.force_floor_n
     th = ring_threshold(f, dt)
     limit = min(th.force_n, scales.force_floor_n)
-    how = th.describe() + (
-        f", at most the force floor {scales.force_floor_n:.4g} N"
-        if th.force_n > scales.force_floor_n
-        else ""
-    )
+    how = th.describe()  # capped: never coarser than the verdicts' resolution
+    if th.force_n > limit:
+        how = f"threshold {limit:.4g} N, the force floor, below the {how}"
     flags = judge_holds(f, xs, int(round(HOLD_S / dt)), limit, dt)
     flags["wrong sign"] &= np.abs(xs) >= SIGN_FRACTION * scales.stroke_m
     step = xs[1] - xs[0]
