@@ -375,14 +375,19 @@ def _coverage_lines(report: dict[str, Any], target_key: str) -> list[str]:
     return lines
 
 
+def _md_cell(text: str) -> str:
+    """``text`` inside a markdown table cell (|F| would end the cell)."""
+    return text.replace("|", "\\|")
+
+
 def report_markdown(report: dict[str, Any], target_key: str, plots: list[str]) -> str:
     """``report.md``: the table, what each column means with its unit, the scales, the plots."""
     table = format_table(report, target_key, legend=False)
     lines = ["# Adversarial campaign", "", "```", table, "```", ""]
     lines += ["## The columns", "", "| column | meaning |", "|---|---|"]
-    lines += [f"| {c.name} | {c.meaning} |" for c in COLUMNS]
+    lines += [f"| {c.name} | {_md_cell(c.meaning)} |" for c in COLUMNS]
     lines += ["", "| lines starting | meaning |", "|---|---|"]
-    lines += [f"| {k} | {t} |" for k, t in SECTIONS if _has_section(table, k)]
+    lines += [f"| {k} | {_md_cell(t)} |" for k, t in SECTIONS if _has_section(table, k)]
     lines += ["", "## Criteria", "", report["criteria"]["why"], ""]
     sc = report["scales"]
     lines += [

@@ -113,7 +113,9 @@ def test_the_legend_is_one_list_shared_with_report_md():
     md = report_markdown(_report(), "nn", [])
     assert "what the columns say" not in md  # the markdown has its own table of them
     for c in COLUMNS:
-        assert f"| {c.name} | {c.meaning} |" in md
+        assert f"| {c.name} | {c.meaning.replace('|', chr(92) + '|')} |" in md
+    rows = [ln for ln in md.splitlines() if ln.startswith("| ")]
+    assert all(ln.replace("\\|", "").count("|") == 3 for ln in rows)  # two cells each
     assert len(legend_lines()) > len(COLUMNS)
 
 
