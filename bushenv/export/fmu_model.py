@@ -102,6 +102,7 @@ class FmuBushing(BushingModel):
         except Exception as exc:
             raise ModelError(f"{self.path}: damaged FMU: cannot extract it ({exc})") from None
         self._slaves: list = []
+        self._n = 0  # samples done: time = n dt, never accumulated
         super().__init__(file_dt if file_dt is not None else dt)
 
     @property
@@ -136,7 +137,7 @@ class FmuBushing(BushingModel):
     def reset(self, batch_size: int = 1) -> None:
         super().reset(batch_size)
         self._free()
-        self._n = 0  # samples done: time = n dt, never accumulated
+        self._n = 0
         self._slaves = [self._instance(i) for i in range(self.batch_size)]
 
     def _free(self) -> None:

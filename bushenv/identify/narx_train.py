@@ -105,6 +105,11 @@ class Trainer:
             )
         self.net = TorchNarx(1 + nx + nf, opt.hidden, basis)
         self.val_runs = problem.validation_runs()
+        self.adam, self.sched = self._free_run_optimiser()
+        self.stale = 0  # free-run evaluations since the validation error last improved
+        # the weights kept (renewed after teacher forcing) and the free-run validation history
+        self.keep = Keeper(self)
+        self.history: list[tuple[int, float]] = []
         self.log: dict[str, Any] = {
             "options": as_dict(opt),
             "recipe": opt.recipe,
@@ -206,14 +211,19 @@ class Trainer:
             self.log["best_teacher_validation_mse"] = float(keep.val)
 
     # ----- stage 2: free-run fine-tuning -------------------------------------------------------
-    def free_run(self) -> None:
+    def _free_run_optimiser(self):
+        """Adam and its cosine schedule over every free-run iteration (nothing is stepped
+        before ``free_run``, so building them with the net changes no number)."""
         opt = self.opt
-        self.adam = torch.optim.Adam(self.net.parameters(), lr=opt.free_run_lr)
-        self.sched = torch.optim.lr_scheduler.CosineAnnealingLR(
-            self.adam,
+        adam = torch.optim.Adam(self.net.parameters(), lr=opt.free_run_lr)
+        sched = torch.optim.lr_scheduler.CosineAnnealingLR(
+            adam,
             max(1, sum(n for _, n in self.stages)),
             eta_min=opt.free_run_lr * opt.free_run_lr_final,
         )
+        return adam, sched
+
+    def free_run(self) -> None:
         self.it, self.stale, self.log["stopped"] = 0, 0, "iterations done"
         if self.log["skipped_windows"]:
             longest = self.problem.longest_train

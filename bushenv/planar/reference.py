@@ -187,7 +187,8 @@ class PlanarRubber(PlanarModel):
         self.seed = int(seed)
         self.effects = self._switched_on(effects)
         self.dt = float(dt)
-        self._build_args()
+        self._n_rel, self._n_fric, self._args = self._kernel_args()
+        self._rng = np.random.default_rng(self.seed)  # the noise's draws; reset restarts them
         super().__init__(dt)
 
     def _configured(self) -> tuple[str, ...]:
@@ -239,7 +240,8 @@ class PlanarRubber(PlanarModel):
             p[E_LA], p[E_LR], p[E_LT] = self.hardening_m
         return p
 
-    def _build_args(self) -> None:
+    def _kernel_args(self) -> tuple[int, int, tuple]:
+        """(relaxation branches, friction elements, the kernel's parameter arguments)."""
         on = set(self.effects)
         if "relaxation" in on:
             tau = self.relax_tau_s
@@ -252,8 +254,7 @@ class PlanarRubber(PlanarModel):
         k0 = self.friction_fmax / np.where(self.friction_x2 > 0, self.friction_x2, 1.0)
         kel = k0 / max(n, 1)
         slip = kel * 2.0 * self.friction_x2 * ((np.arange(n) + 0.5) / max(n, 1))[:, None]
-        self._n_rel, self._n_fric = relax.shape[0], n
-        self._args = (
+        args = (
             self.elastic_params(),
             self.damping.copy(),
             np.ascontiguousarray(relax),
@@ -261,6 +262,7 @@ class PlanarRubber(PlanarModel):
             np.ascontiguousarray(slip.reshape(n, 3)),
             self.friction_yield == "vector",
         )
+        return relax.shape[0], n, args
 
     @property
     def n_state(self) -> int:

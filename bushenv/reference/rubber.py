@@ -323,7 +323,10 @@ class RubberBushing(BushingModel):
         self.seed = int(seed)
         self.effects = self._switched_on(effects)
         super().__init__(dt)
-        self._build_kernel_args()
+        self._n_branches, self._n_fric, self._n_delay, self._args = self._kernel_args()
+        self._noise_on = "noise" in self.effects
+        self._no_noise = np.zeros((1, 1))
+        self._rng = np.random.default_rng(self.seed)  # the noise's draws; reset restarts them
         self.reset(1)
 
     # ----- effects -----------------------------------------------------------------------
@@ -395,7 +398,9 @@ class RubberBushing(BushingModel):
         return float(bound)
 
     # ----- kernel arguments --------------------------------------------------------------
-    def _build_kernel_args(self) -> None:
+    def _kernel_args(self) -> tuple[int, int, int, tuple]:
+        """(relaxation branches, friction rows, delay samples held, the kernel's parameter
+        arguments (fpar, ipar, relax, iwan))."""
         dt = self.dt
         on = set(self.effects)
         if "relaxation" in on:
@@ -439,10 +444,6 @@ class RubberBushing(BushingModel):
         else:
             d_int, d_frac, n_delay = 0, 0.0, 0
         m_fix = self.fixture_mass_kg if "inertia" in on else 0.0
-        self._noise_on = "noise" in on
-        self._n_fric = friction_rows(law, self.friction_elements)
-        self._n_branches = rk.size
-        self._n_delay = n_delay
         fpar = np.zeros(kernel.N_FPAR)
         fpar[kernel.F_K] = self.k_n_per_m
         fpar[kernel.F_C] = self.c_ns_per_m
@@ -461,11 +462,11 @@ class RubberBushing(BushingModel):
         ipar[kernel.I_HARD_LAW] = hard
         ipar[kernel.I_DELAY_INT] = d_int
         ipar[kernel.I_N_DELAY] = n_delay
-        ipar[kernel.I_NOISE_ON] = int(self._noise_on)
+        ipar[kernel.I_NOISE_ON] = int("noise" in on)
         relax = np.ascontiguousarray(np.stack([rk, decay, gain, eta]).reshape(4, rk.size))
         iwan = np.ascontiguousarray(np.stack([iwan_k, iwan_f]).reshape(2, iwan_k.size))
-        self._args = (fpar, ipar, relax, iwan)
-        self._no_noise = np.zeros((1, 1))
+        n_fric = friction_rows(law, self.friction_elements)
+        return rk.size, n_fric, n_delay, (fpar, ipar, relax, iwan)
 
     @property
     def n_state(self) -> int:

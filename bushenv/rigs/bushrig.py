@@ -47,6 +47,24 @@ MAX_HISTORY = 10_000  # samples per channel in the observation (3 x 10 000 float
 PHYSICS_ATTRS = ("space", "ground", "actuator", "groove", "_space_step", "_set_actuator_velocity")
 
 
+def build_physics() -> tuple:
+    """The rig's pymunk objects, in ``PHYSICS_ATTRS`` order: the space, its static body, the
+    actuator, the groove, and the chipmunk calls that step the space and set the actuator's
+    velocity."""
+    space = pymunk.Space()
+    ground = space.static_body
+    # The actuator piston: a dynamic body in displacement control. Its velocity is set every
+    # step so it arrives at the commanded x at the end of the step; the servo supplies the
+    # force that takes, so the bushing's reaction never feeds back into the motion.
+    actuator = pymunk.Body(ACTUATOR_MASS_KG, math.inf)
+    actuator.position = (0.0, 0.0)
+    space.add(actuator)
+    # the groove: the translational joint of Fig. 11, the actuator slides along x
+    groove = pymunk.GrooveJoint(ground, actuator, (-0.05, 0.0), (0.05, 0.0), (0.0, 0.0))
+    space.add(groove)
+    return space, ground, actuator, groove, space_stepper(space), velocity_setter(actuator)
+
+
 def check_excitation(profile: Any, max_displacement_m: float, max_step_m: float) -> np.ndarray:
     """A replayable displacement profile: finite (T,) or (T, N), within the stroke, and each
     sample (the rig starting at rest at 0) at most ``max_step_m`` from the previous one."""
@@ -257,28 +275,17 @@ class BushRigEnv(gym.Env):
         self._t = 0
         self._replay: np.ndarray | None = None
         self._end: int | None = None  # the replay's length; no limit of its own otherwise
-        self._build_space()
+        (
+            self.space,
+            self.ground,
+            self.actuator,
+            self.groove,
+            self._space_step,
+            self._set_actuator_velocity,
+        ) = build_physics()
         self._canvas: Canvas | None = None
         self._trace = Trace(3) if render_mode else None
         self._last = (0.0, 0.0, 0.0)
-
-    # ----- pymunk ------------------------------------------------------------------------
-    def _build_space(self) -> None:
-        self.space = pymunk.Space()
-        self.ground = self.space.static_body
-        # The actuator piston: a dynamic body in displacement control. Its velocity is set every
-        # step so it arrives at the commanded x at the end of the step; the servo supplies the
-        # force that takes, so the bushing's reaction never feeds back into the motion.
-        self.actuator = pymunk.Body(ACTUATOR_MASS_KG, math.inf)
-        self.actuator.position = (0.0, 0.0)
-        self.space.add(self.actuator)
-        # the groove: the translational joint of Fig. 11, the actuator slides along x
-        self.groove = pymunk.GrooveJoint(
-            self.ground, self.actuator, (-0.05, 0.0), (0.05, 0.0), (0.0, 0.0)
-        )
-        self.space.add(self.groove)
-        self._space_step = space_stepper(self.space)
-        self._set_actuator_velocity = velocity_setter(self.actuator)
 
     def __getstate__(self) -> dict[str, Any]:
         """Everything but the pymunk space and the chipmunk call handles (which cannot be
@@ -292,7 +299,14 @@ class BushRigEnv(gym.Env):
     def __setstate__(self, state: dict[str, Any]) -> None:
         position, velocity = state.pop("_actuator_state")
         self.__dict__.update(state)
-        self._build_space()
+        (
+            self.space,
+            self.ground,
+            self.actuator,
+            self.groove,
+            self._space_step,
+            self._set_actuator_velocity,
+        ) = build_physics()
         self.actuator.position = position
         self.actuator.velocity = velocity
 

@@ -215,6 +215,7 @@ class Car:
         if p.planar:  # the bushing also carries the arm's rotation (a moment)
             k_in, c_in = p.rotation_in[role]
             self.rotation = SplitRotation(space, self.chassis, self.unsprung, k_in, c_in, p.h)
+        self._damping_angle = 0.0  # the arm's angle the dampers were last computed for
         self.reset()
 
     def reset(self) -> None:
@@ -332,17 +333,18 @@ class CarPair:
         self.p = p
         self.car = Car(p, pymunk.Space())
         self.twin = Car(p, pymunk.Space(), "reference")
-        self._connect()
+        self._space_steps = self._steppers()
 
-    def _connect(self) -> None:
-        self._space_steps = (space_stepper(self.car.space), space_stepper(self.twin.space))
+    def _steppers(self) -> tuple:
+        """The two spaces' step calls (chipmunk handles: rebuilt, never pickled)."""
+        return space_stepper(self.car.space), space_stepper(self.twin.space)
 
     def __getstate__(self) -> dict[str, Any]:
         return {"p": self.p, "car": self.car, "twin": self.twin}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
-        self._connect()
+        self._space_steps = self._steppers()
 
     def sample(self, car: Car, models: dict[str, BushingModel]):
         """(motion, forces, why) of ``car`` at t_k: the bushing's (x, v) per axis, both axis

@@ -89,19 +89,28 @@ class QuarterCarBatch:
         self._rows = 5 if self.arm is not None else 4  # F_RADIAL .. X_AXIAL (, F_MOMENT)
         self._shared: dict[tuple[str, str], np.ndarray] = {}
         self.raised = {"model": "", "reference": ""}
-        self.reset()
-
-    def reset(self) -> None:
+        # the cars' arrays (columns: the model cars, then their twins); reset fills them
         n = self.num_cars
-        cars = 2 if self.references is not None else 1
         self.state = np.zeros((8, cars * n))
-        self.state[X_U] = self.params.x_cm
         self.road = np.zeros(cars * n)
         self.held = np.zeros((3, cars * n))
         self.active = np.ones(cars * n, dtype=bool)
         self.diverged = np.zeros(n, dtype=bool)
         self.reference_out = np.zeros(n, dtype=bool)
         self._motion = np.zeros((4, cars * n))
+        self._t = 0
+        self.reset()
+
+    def reset(self) -> None:
+        n = self.num_cars
+        self.state[:] = 0.0
+        self.state[X_U] = self.params.x_cm
+        self.road[:] = 0.0
+        self.held[:] = 0.0
+        self.active[:] = True
+        self.diverged[:] = False
+        self.reference_out[:] = False
+        self._motion[:] = 0.0
         self._t = 0
         for m in self.models.values():
             m.reset(n)
@@ -149,10 +158,10 @@ class QuarterCarBatch:
         )  # fmt: skip
         self.road[:] = road_all  # exact, as the env sets the kinematic road body
         self._t += 1
-        out = self._summary(forces, xr, xa)
+        out, wheel_y = self._summary(forces, xr, xa)
         # bounds: a car out of bounds stops; the model car's verdict counts only while its
         # twin is within bounds
-        bad = self._out_of_bounds(forces, out)
+        bad = self._out_of_bounds(forces, wheel_y)
         self.active &= ~bad
         if self.references is not None:
             self.reference_out |= bad[n:]
@@ -190,7 +199,8 @@ class QuarterCarBatch:
                     ok = np.isfinite(held) & (np.abs(f) <= p.force_limit)
                 self.held[row, cols] = np.where(ok, held, 0.0)
 
-    def _summary(self, forces, xr, xa) -> dict[str, np.ndarray]:
+    def _summary(self, forces, xr, xa) -> tuple[dict[str, np.ndarray], np.ndarray]:
+        """The step's outputs (the env's info keys) and every car's wheel height (B or 2B,)."""
         n, s, p = self.num_cars, self.state, self.params
         c = np.cos(s[TH])
         wheel_y = s[Y_U] + (p.L - p.x_cm) * np.sin(s[TH])
@@ -225,12 +235,11 @@ class QuarterCarBatch:
             )
         if self.arm is not None:
             out.update(self.arm.summary(s, forces, n, self.references is not None))
-        self._wheel_y = wheel_y
-        return out
+        return out, wheel_y
 
-    def _out_of_bounds(self, forces, out) -> np.ndarray:
+    def _out_of_bounds(self, forces, wheel_y) -> np.ndarray:
         p, s = self.params, self.state
-        yc, yw = s[Y_C], self._wheel_y
+        yc, yw = s[Y_C], wheel_y
         with np.errstate(invalid="ignore"):
             bad = ~np.isfinite(forces).all(axis=0) | ~np.isfinite(s).all(axis=0)
             bad |= (np.abs(forces[0]) > p.force_limit) | (np.abs(forces[1]) > p.force_limit)

@@ -90,7 +90,9 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
         divergence_monitor=None,
         **spec_overrides: Any,
     ) -> None:
-        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode)
+        super().__init__(
+            ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode
+        )
         n = self.num_envs
         self.batch = QuarterCarBatch(n, with_reference=True, **spec_overrides)
         self.params = p = self.batch.params

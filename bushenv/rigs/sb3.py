@@ -60,7 +60,8 @@ class SB3VecEnv(VecEnv):
     def reset(self) -> np.ndarray:
         obs, info = self.venv.reset(seed=self._seeds[0], options=self._one_options())
         self._rest_obs = obs.copy()
-        self.reset_infos = self._per_env(info, np.zeros(self.num_envs, dtype=bool))
+        # the list SB3's VecEnv.__init__ made, refilled
+        self.reset_infos[:] = self._per_env(info, np.zeros(self.num_envs, dtype=bool))
         self._reset_seeds()
         self._reset_options()
         return obs

@@ -84,7 +84,9 @@ class BushRigVectorEnv(ArrayVectorEnv):
         divergence_monitor=None,
         **spec_overrides: Any,
     ) -> None:
-        self._setup(ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode)
+        super().__init__(
+            ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode
+        )
         n = self.num_envs
         p = RigParameters(spec_kwargs(ENV_ID, spec_overrides))
         self.params = p

@@ -68,11 +68,6 @@ class ArrayVectorEnv(VectorEnv):
         self._end = np.full(n, self.max_episode_steps, dtype=np.int64)
         self._prev_done = np.zeros(n, dtype=bool)
 
-    def _setup(self, *args: Any, **kwargs: Any) -> None:
-        """The former name of ``ArrayVectorEnv.__init__``, kept until every subclass calls
-        ``super().__init__``."""
-        ArrayVectorEnv.__init__(self, *args, **kwargs)
-
     def _reset_columns(self, mask: np.ndarray) -> None:
         raise NotImplementedError
 
