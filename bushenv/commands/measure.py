@@ -50,10 +50,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--programme",
         default="papers",
-        choices=PROGRAMMES,
+        choices=(*PROGRAMMES, "combined"),
         help="harmonic: 25 sines; random: one RPC-like record (--n, --duration, --seed); "
         "step: one held step (--step-mm, --hold); papers: harmonic + random n=1 40 s + "
-        "random n=1.5 20 s (seed+1) + 4 mm step (default)",
+        "random n=1.5 20 s (seed+1) + 4 mm step (default); with --axes 3: papers, random, or "
+        "combined (each coordinate held at +- n x its n = 1 peak while each other one is "
+        "swept, 10 s each or --duration)",
     )
     parser.add_argument("--n", type=float, default=IDENTIFICATION_N, help="random index n")
     parser.add_argument(
@@ -104,6 +106,11 @@ def cli_run(args: argparse.Namespace) -> int:
         from bushenv.commands.measure_planar import run_planar
 
         return run_planar(args)
+    if args.programme == "combined":
+        raise MachineError(
+            "--programme combined holds one coordinate while another moves: it is a programme "
+            "of several coordinates (add --axes 3)"
+        )
     model = get_model(args.model, axis=args.axis, dt=1.0 / args.rate)
     items = programme_items(args, model.dt)
     paths = [out / f"{item.name}.csv" for item in items]

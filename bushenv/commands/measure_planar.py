@@ -47,11 +47,12 @@ def run_planar(args: argparse.Namespace) -> int:
     from bushenv.progress import Progress
     from bushenv.records import RecordError
 
-    if args.programme not in ("papers", "random"):
+    if args.programme not in ("papers", "random", "combined"):
         raise CliError(
             f"--programme {args.programme} has no 3-axis form; with --axes 3 choose papers "
-            "(random n = 1 and 1.5, independent and correlated, and the coupled sine sets) "
-            "or random"
+            "(random n = 1 and 1.5, independent and correlated, and the coupled sine sets), "
+            "random, or combined (each coordinate held at +- n x its n = 1 peak while each "
+            "other one is swept: 12 records)"
         )
     if args.axis != "axial":
         raise CliError("--axis names one axis; --axes 3 measures all three (drop --axis)")

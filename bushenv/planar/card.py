@@ -22,6 +22,10 @@
 - ``training_range``: the training records' largest |deflection| per coordinate, m / rad;
   each record's ``peak_deflection`` beside it; held-out records beyond it by more than
   ``BEYOND`` are named (``coverage_lines``): their figures judge extrapolation;
+- ``coverage``: which combinations of coordinates the training records showed the model
+  (``bushenv.identify.coverage``: one coordinate held while another moves, by sign) and which
+  they never did; each held-out record's ``not_shown`` combinations beside it, named by
+  ``coverage_lines``: their figures judge a use the model was not shown;
 - ``plots``: the figures beside the model file (``plots.fit_figures3``; none with
   ``--no-plots``).
 """
@@ -123,10 +127,14 @@ def save_planar_fit(
         + [record_entry(r, "held-out", model, here) for r in held_out],
         "notes": list(notes or []),
     }
+    from bushenv.identify.coverage import coverage, not_shown
     from bushenv.planar.range_holds import range_holds
 
     span = np.max([np.abs(r.q).max(axis=0) for r in train], axis=0)
     card["training_range"] = {c: float(span[i]) for i, c in enumerate(COORDS)}
+    card["coverage"] = coverage([r.q for r in train], model.dt, COORDS)
+    for entry, r in zip(card["records"][len(train) :], held_out, strict=True):
+        entry["not_shown"] = not_shown(card["coverage"], r.q, r.dt)
     holds = range_holds(model, span)
     if holds is not None:
         card["holds"] = holds
@@ -181,12 +189,23 @@ def backbone_lines(card: dict[str, Any]) -> list[str]:
 
 
 def coverage_lines(card: dict[str, Any]) -> list[str]:
-    """The held-out records that go beyond the training records' largest deflection in some
-    coordinate by more than ``BEYOND``: their figures judge extrapolation, not the fit's range."""
+    """What the training records showed (held combinations), and the held-out records that go
+    beyond it: beyond the largest deflection in some coordinate by more than ``BEYOND``, or
+    holding a combination training never held: their figures judge extrapolation, not the
+    fit's range."""
+    from bushenv.identify.coverage import coverage_summary
+
     span = card.get("training_range")
     if not span:
         return []
-    out = []
+    out = coverage_summary(card["coverage"]) if "coverage" in card else []
+    for r in card["records"]:
+        if r.get("not_shown"):
+            out.append(
+                f"not shown: {r['file'] or r['name']} holds {'; '.join(sorted(r['not_shown']))}, "
+                "which the training records never held: its figures judge a use the model was "
+                "not shown"
+            )
     for r in card["records"]:
         if r["role"] != "held-out" or "peak_deflection" not in r:
             continue

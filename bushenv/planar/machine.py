@@ -11,7 +11,10 @@ items)`` runs each from rest. ``kind``:
   n = 1.5 verifies. The n = 1 sets hold a preload, which random motion with nothing below 1 Hz
   never does: without them a fit cannot tell its slow relaxation from its static stiffness
   (studies/2026-11-planar-fit-unseen). The axial sets came last, after the others;
-- ``"random"``: random on all axes at ``n_index``, independent and correlated.
+- ``"random"``: random on all axes at ``n_index``, independent and correlated;
+- ``"combined"``: every held combination (``programme.held_sweeps``): each coordinate held at
+  +- n x its n = 1 peak while each other one is swept, 10 s each (12 records), the uses a
+  vehicle makes of a bushing that random motion never holds still.
 
 The planar reference (``reference`` with its load cell) measures each record with its own
 noise seed, so no two records share their noise.
@@ -26,13 +29,14 @@ import numpy as np
 from bushenv.planar.base import PlanarModel, PlanarModelError
 from bushenv.planar.programme import (
     PEAK_AT_N1,
+    held_sweeps,
     preload_sweep,
     random_correlated,
     random_independent,
 )
 from bushenv.planar.reference import PlanarRubber
 
-KINDS = ("papers", "random")
+KINDS = ("papers", "random", "combined")
 # what a 3-axis identification uses of the papers' programme at n = 1 (``bushenv reproduce
 # --planar-identification``): the random records and the coupled sets, or the random only
 IDENTIFICATIONS = {
@@ -65,6 +69,8 @@ def items(
                 f"{duration_s} s"
             )
         return _random(n_index, duration_s, dt, seed)
+    if kind == "combined":
+        return held_sweeps(n_index, dt, 10.0 if duration_s is None else duration_s)
     verify, identify = coupled_sets(N_VERIFY, dt), coupled_sets(1.0, dt)
     # each addition last, so the records before keep their noise seeds (and their files)
     return [

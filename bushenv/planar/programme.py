@@ -72,6 +72,24 @@ def preload_sweep(
     return q
 
 
+def held_sweeps(n_index: float, dt: float, duration_s: float = 10.0) -> list:
+    """Every held combination a vehicle loads a bushing in: each coordinate held at +- n x its
+    n = 1 peak (``PEAK_AT_N1``) while each other one is swept (0.5-5 Hz, n x its peak), the
+    third at rest: 12 named (T, 3) motions (``coverage.every_combination``'s list)."""
+    from bushenv.planar.base import COORDS
+
+    out = []
+    for held in range(3):
+        for sign in (1.0, -1.0):
+            for swept in range(3):
+                if swept == held:
+                    continue
+                level, amp = sign * n_index * PEAK_AT_N1[held], n_index * PEAK_AT_N1[swept]
+                name = f"{COORDS[held]}_held_{'+' if sign > 0 else '-'}_{COORDS[swept]}_sweep"
+                out.append((name, preload_sweep(held, level, amp, duration_s, dt, swept=swept)))
+    return out
+
+
 def programme(
     dt: float, seed: int, n_verify: float = 1.5, duration_s: float = 20.0
 ) -> dict[str, np.ndarray]:
