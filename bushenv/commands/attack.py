@@ -147,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
         print(format_planar_table(planar.report))
         print(f"\nreport: {planar.report_path}  ({planar.report['seconds']:.1f} s in total)")
         if planar.control_flagged:
-            progress.say("WARNING: the planar control (linear) was flagged on a failing profile")
+            progress.say(f"WARNING: the control ({planar.report['control']['label']}) was flagged")
         return 0
     attacked = run_attack(config_from(args), progress)
     report = attacked.report

@@ -1,13 +1,24 @@
 """``bushenv attack --env rig3``: the attack on a planar (three-coordinate) model.
 
-The one-axis pipeline (``campaign.py``) resolves one-axis models and judges (vetting, static
-curve, fitted control); none of that exists for planar models yet, so a planar attack has its
-own short pipeline through the same search contracts: the planar model and the coupled planar
-reference resolved as BushRig3-v0 resolves them, each searcher run on a ``BatchEvaluator`` of
-the ``rig3`` target, the failures rechecked on the control (the planar Table-1 linear model,
-which must stay clean) and on ``--hybrid`` when given, the first ``max_shrink`` shrunk per axis
-and written as cases (``case_file.py``; ``--save`` adds them to the corpus). ``report.json``
-and ``report.md`` in ``--out`` tally the failures by family and by the axis that failed.
+A short pipeline through the one-axis search contracts, as the one-axis attack does it:
+
+1. **resolve**: the planar model and the reference (the coupled planar reference unless
+   ``--reference``), each with the card beside its file; the **limits** the search drives
+   (``Rig3Limits``: for a user's reference, from its card's training records -- else the
+   model's card -- 1.5 x their peak |q| and |dq/dt| per coordinate, the one-axis rule;
+   ``--stroke-mm`` and ``--max-velocity`` then set the axial and radial ones, the rotation
+   keeps its own; for the built-in reference, BushRig3-v0's); the reference vetted within
+   them; the **control** (``--control``; for a user's reference a linear model fitted to it
+   on its card's records, saved in ``models/control-linear.npz``; else the planar Table-1
+   linear preset) and ``--hybrid`` when given;
+2. **search**: each searcher on a ``BatchEvaluator`` of the ``rig3`` target, its failing
+   profiles (and its worst) saved in ``failures/<model>-<searcher>.npz`` (``load_profiles``
+   reads them: (T, 3) each), its coverage per coordinate in its unit;
+3. **recheck**: the control (which must stay clean) and the hybrid on every saved failure;
+4. **shrink**: the first ``max_shrink`` failures shrunk per axis and written as cases
+   (``case_file.py``; ``--save`` adds them to the corpus);
+5. **report**: ``report.json`` (rewritten after every step, so ``--resume`` continues an
+   interrupted attack where it stopped: every step is seeded) and ``report.md`` in ``--out``.
 """
 
 from __future__ import annotations
@@ -21,18 +32,23 @@ from pathlib import Path
 
 import numpy as np
 
-from bushenv.persist import write_json
+from bushenv.persist import atomic_write, json_default, load_profiles, write_json
 from bushenv.progress import Progress
-from bushenv.search.base import Searcher, SearchError, SearchResult
+from bushenv.search.base import Searcher, SearchError
 from bushenv.search.campaign_config import CampaignConfig
+from bushenv.search.campaign_search import MAX_SAVED_FAILURES
 from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.planar_models import resolve_planar_spec, resolved_planar
+from bushenv.search.families_planar import UNITS, Rig3Limits, limits_text, machine_limits
+from bushenv.search.planar_models import (  # noqa: F401 (DEFAULT_REFERENCE, vetted_judge: the zoo's)
+    DEFAULT_REFERENCE,
+    Planar,
+    resolve_planar_attack,
+    vetted_judge,
+)
 from bushenv.search.searchers import SEARCHERS
 from bushenv.search.shrink import shrink
+from bushenv.search.target_rig3 import covered_search
 from bushenv.search.targets import TARGETS
-
-DEFAULT_REFERENCE = "reference"
-DEFAULT_CONTROL = "linear"
 
 
 @dataclass
@@ -75,6 +91,14 @@ def held_to(searcher: str, family: str) -> dict:
     return HELD_TO[searcher](family)
 
 
+def _searcher(searcher: str | Searcher, family: str | None) -> Searcher:
+    if isinstance(searcher, str):
+        return SEARCHERS[searcher].make(**({} if family is None else held_to(searcher, family)))
+    if family is None:
+        return searcher
+    raise SearchError("planar_search: family= holds a searcher given by name only")
+
+
 def planar_search(
     model,
     reference,
@@ -85,28 +109,44 @@ def planar_search(
     progress: Callable[[str, int], None] | None = None,
     target: str = "rig3",
     family: str | None = None,
-) -> SearchResult:
-    """One search of the planar attack on the ``rig3`` target; ``progress`` gets each line of
-    the searcher's with the evaluations made so far (the population study runs it as it is).
-    ``family``: the searcher held to that one family (``one_axis``: the single-axis check)."""
-    if isinstance(searcher, str):
-        s = SEARCHERS[searcher].make(**({} if family is None else held_to(searcher, family)))
-    elif family is None:
-        s = searcher
-    else:
-        raise SearchError("planar_search: family= holds a searcher given by name only")
-    with BatchEvaluator(model, reference, TARGETS[target], threads=threads) as ev:
+    limits: Rig3Limits | None = None,
+    coverage: bool = False,
+):
+    """One search of the planar attack on the ``rig3`` target within ``limits`` (None:
+    BushRig3-v0's); ``progress`` gets each line of the searcher's with the evaluations made
+    so far (the population study runs it as it is). ``family``: the searcher held to that
+    one family (``one_axis``: the single-axis check). Returns the ``SearchResult``; with
+    ``coverage``, (result, coverage per family and coordinate)."""
+    s = _searcher(searcher, family)
+    with BatchEvaluator(
+        model, reference, TARGETS[target], threads=threads, scales=limits or machine_limits()
+    ) as ev:
         said = None if progress is None else (lambda msg: progress(msg, ev.n_evaluations))
-        return s.run(ev, budget, seed=seed, progress=said)
+        result, covered = covered_search(s, ev, budget, seed, said)
+    return (result, covered) if coverage else result
 
 
-def _recheck(model, reference, profiles, target, threads) -> dict:
-    if not profiles:
-        return {"profiles": 0, "diverged": 0}
-    with BatchEvaluator(model, reference, target, threads=threads) as ev:
-        v = ev.evaluate(profiles).verdict
-    axes = Counter(str(a) for a, d in zip(v.first_axis, v.diverged, strict=True) if d)
-    return {"profiles": len(profiles), "diverged": int(v.diverged.sum()), "by_axis": dict(axes)}
+def save_profiles3(path: Path, profiles: list[np.ndarray], meta: list[dict]) -> Path:
+    """(T_i, 3) profiles in ``persist.save_profiles``'s format (``profiles`` padded to
+    (T, B, 3), ``lengths``, ``count``, JSON ``meta``), so ``load_profiles`` reads them back
+    (T_i, 3) each; atomic."""
+    n = len(profiles)
+    arr = np.zeros((max((p.shape[0] for p in profiles), default=1), max(n, 1), 3))
+    lengths = np.zeros(max(n, 1), dtype=np.int64)
+    for i, p in enumerate(profiles):
+        arr[: p.shape[0], i] = p
+        lengths[i] = p.shape[0]
+
+    def write(fh) -> None:
+        np.savez_compressed(
+            fh,
+            profiles=arr,
+            lengths=lengths,
+            count=np.array(n),
+            meta=np.array(json.dumps(meta, default=json_default)),
+        )
+
+    return atomic_write(path, write)
 
 
 def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttack:
@@ -115,157 +155,229 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     target = TARGETS[c.target]
     out = Path(c.out)
     report_path = out / "report.json"
-    if c.resume:
-        raise SearchError("--resume: a planar attack is not resumable yet; run it with --force")
-    if report_path.exists() and not c.force:
-        raise SearchError(f"{report_path} exists: pass --force to overwrite it")
+    if report_path.exists() and not (c.resume or c.force):
+        raise SearchError(
+            f"{report_path} exists; pass --resume to continue it or --force to start again"
+        )
     for s in c.searchers:
         if s not in target.default_searchers:
             known = ", ".join(target.default_searchers)
             raise SearchError(f"--searchers {s}: the {c.target} target takes {known}")
-    model = resolve_planar_spec(c.model, None, "--model")
-    reference = resolve_planar_spec(c.reference or DEFAULT_REFERENCE, model.dt, "--reference")
-    others = {"control": resolve_planar_spec(c.control or DEFAULT_CONTROL, model.dt, "--control")}
-    if c.hybrid and c.hybrid != "none":
-        others["hybrid"] = resolve_planar_spec(c.hybrid, model.dt, "--hybrid")
-    judge = vetted_judge(
-        reference,
-        str(c.reference or DEFAULT_REFERENCE),
-        target,
-        progress,
-        model=model,
-        model_file=c.model if str(c.model).endswith(".npz") else None,
-        trust=c.trust_reference,
-    )
+    p = resolve_planar_attack(c, progress)
+    report = fresh_report(c, p)
+    if c.resume and report_path.exists():
+        report = resumed(report_path, report)
+        progress.say(f"resuming {report_path}")
+    t0, before = time.perf_counter(), float(report["seconds"])
+
+    def save() -> None:
+        report["seconds"] = round(before + time.perf_counter() - t0, 2)
+        out.mkdir(parents=True, exist_ok=True)
+        write_json(report_path, report)
+
     threads = max(1, int(c.threads or 1))
-    t0 = time.perf_counter()
-    searches, failing = [], []
-    total = c.budget * len(c.searchers)
-    progress.total = total
-    done = 0
-    for name in c.searchers:
-        progress.say(f"[{c.model}] {name}: budget {c.budget} evaluations on {c.target} ...")
-
-        def said(msg: str, evaluations: int, start=done) -> None:
-            progress.update(start + evaluations, f"  {msg}")
-
-        result = planar_search(model, reference, name, c.budget, c.seed, threads, said, c.target)
-        done += c.budget
-        progress.update(done, f"[{c.model}] {name}: {result.n_failures} failures", force=True)
-        summary = result.summary()
-        summary["failures"] = tally(result.failures)
-        if result.first_failure is not None:
-            summary["first_failure"] = {
-                "family": result.first_failure.family,
-                **result.first_failure.verdict,
-            }
-        searches.append(summary)
-        failing += [(name, f) for f in result.failures]
-    profiles = [f.profile for _, f in failing]
-    rechecks = {
-        role: _recheck(m, reference, profiles, target, threads) for role, m in others.items()
-    }
-    shrunk, shown = _shrink_some(model, reference, target, failing, c, progress, out)
+    progress.total = c.budget * len(c.searchers)
+    done = {s["searcher"]: s for s in report["searchers"]}
+    report["searchers"] = []
+    for i, name in enumerate(c.searchers):
+        if name in done:
+            progress.say(f"[{c.model}] {name}: done earlier (resumed)")
+            report["searchers"].append(done[name])
+            continue
+        report["searchers"].append(_search_one(c, p, name, i * c.budget, threads, progress))
+        save()
+    failing = _failing(out, report["searchers"])
+    profiles = [q for _, q, _ in failing]
+    if not report["recheck"]:
+        report["recheck"] = {
+            role: _recheck(p.models[role].model, p.reference, profiles, target, threads, p.limits)
+            for role in ("control", "hybrid")
+            if role in p.models
+        }
+        for role, r in report["recheck"].items():
+            r["model"] = p.control["label"] if role == "control" else p.models[role].spec
+        save()
+    reach = failure_reach(profiles, p.limits)
+    if reach is not None:
+        report["failure_reach"] = reach
+    if report["shrunk"] is None:
+        report["shrunk"], shown = _shrink_some(p, target, failing, c, progress, out)
+    else:
+        progress.say("shrink: done earlier (resumed)")
+        shown = []
     plots = []
     if c.plots and shown:
         from bushenv.search.campaign_planar_plots import plot_shrunk
 
-        plots = [str(p) for p in plot_shrunk(model, reference, shown, out / "plots")]
-    report = {
-        "env": c.target,
-        "model": c.model,
-        "reference": c.reference or DEFAULT_REFERENCE,
-        "judge": judge,
-        "budget": c.budget,
-        "seed": c.seed,
-        "searchers": searches,
-        "recheck": rechecks,
-        "shrunk": shrunk,
-        "plots": plots,
-        "seconds": round(time.perf_counter() - t0, 2),
-    }
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(report_path, report)
+        plots = [str(q) for q in plot_shrunk(p.model, p.reference, shown, out / "plots")]
+    report["plots"] = plots or report["plots"]
+    report["complete"] = True
+    save()
     (out / "report.md").write_text(format_planar_table(report) + "\n")
-    flagged = rechecks.get("control", {}).get("diverged", 0) > 0
+    flagged = report["recheck"].get("control", {}).get("diverged", 0) > 0
     return PlanarAttack(report, report_path, flagged)
 
 
-def vetted_judge(
-    reference,
-    ref_spec: str,
-    target,
-    progress: Progress,
-    model=None,
-    model_file=None,
-    trust: bool = False,
-    error: type[Exception] = SearchError,
-) -> dict:
-    """The reference checked before it judges (``planar.vetting``): ``error`` when it fails,
-    unless ``trust``; what judged (the vetting, floors, stroke) for a report."""
-    from bushenv.planar.vetting import vet_planar_reference
-    from bushenv.search.target_rig3 import reference_floors
+def arguments(c: CampaignConfig) -> dict:
+    """The settings a resumed planar attack must share with the one it continues."""
+    keep = ("stroke_mm", "max_velocity_m_per_s")
+    return {**c.arguments(), "searchers": list(c.searchers), **{k: getattr(c, k) for k in keep}}
 
-    stroke, _ = target.profile_bounds()
-    floors, floors_source = reference_floors(reference)
-    vetting = vet_planar_reference(
-        reference,
-        ref_spec,
-        stroke,
-        floors,
-        reference_file=ref_spec if ref_spec.endswith(".npz") else None,
-        model=model,
-        model_file=model_file,
-    )
-    for line in vetting.lines():
-        progress.say(f"reference {ref_spec}: {line}")
-    if not vetting.passed and not trust:
-        raise error(
-            f"the reference {ref_spec} failed its vetting ({vetting.summary()}): it cannot judge; "
-            "give another --reference, or pass --trust-reference to judge with it anyway "
-            "(every verdict is then marked)"
-        )
+
+def fresh_report(c: CampaignConfig, p: Planar) -> dict:
+    """The report before any search."""
     return {
-        "vetting": vetting.describe(),
-        "trusted_despite_failed_vetting": bool(not vetting.passed),
-        "force_floors": dict(zip(target.coords, floors.tolist(), strict=True)),
-        "force_floors_source": floors_source,
-        "stroke": dict(zip(target.coords, np.asarray(stroke).tolist(), strict=True)),
+        "env": c.target,
+        "model": c.model,
+        "reference": c.reference or DEFAULT_REFERENCE,
+        "judge": p.judge,
+        "limits": p.limits.to_json(),
+        "control": p.control,
+        "budget": c.budget,
+        "seed": c.seed,
+        "arguments": arguments(c),
+        "searchers": [],
+        "recheck": {},
+        "shrunk": None,
+        "plots": [],
+        "seconds": 0.0,
+        "complete": False,
     }
 
 
-def _shrink_some(model, reference, target, failing, c, progress, out: Path):
+def resumed(path: Path, fresh: dict) -> dict:
+    """The report at ``path`` when it was made with ``fresh``'s arguments; ``SearchError``
+    naming the first argument that differs."""
+    try:
+        old = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise SearchError(f"{path}: cannot resume from it ({exc}); pass --force") from None
+    for k, v in fresh["arguments"].items():
+        if old.get("arguments", {}).get(k) != v:
+            raise SearchError(
+                f"--resume: {path} was made with {k}={old.get('arguments', {}).get(k)!r}"
+                f", not {v!r}; pass --force to start again"
+            )
+    return {
+        **fresh,
+        **{k: old[k] for k in ("searchers", "recheck", "shrunk", "plots", "seconds") if k in old},
+    }
+
+
+def _search_one(c, p: Planar, name: str, start: int, threads: int, progress: Progress) -> dict:
+    """One search, its failures and worst saved under ``failures/``: its report entry."""
+    progress.say(f"[{c.model}] {name}: budget {c.budget} evaluations on {c.target} ...")
+
+    def said(msg: str, evaluations: int) -> None:
+        progress.update(start + evaluations, f"  {msg}")
+
+    result, covered = planar_search(
+        p.model,
+        p.reference,
+        name,
+        c.budget,
+        c.seed,
+        threads,
+        said,
+        c.target,
+        limits=p.limits,
+        coverage=True,
+    )
+    progress.update(
+        start + c.budget, f"[{c.model}] {name}: {result.n_failures} failures", force=True
+    )
+    summary = result.summary()
+    summary["coverage"] = covered
+    summary["failures"] = tally(result.failures)
+    if result.first_failure is not None:
+        summary["first_failure"] = {
+            "family": result.first_failure.family,
+            **result.first_failure.verdict,
+        }
+    kept = result.failures[:MAX_SAVED_FAILURES]
+    profiles, meta = [k.profile for k in kept], [k.to_json() for k in kept]
+    if result.worst is not None:
+        profiles.append(result.worst.profile)
+        meta.append({**result.worst.to_json(), "worst": True})
+    path = Path(c.out) / "failures" / f"{p.models['target'].key}-{name}.npz"
+    save_profiles3(path, profiles, meta)
+    summary["profiles_file"] = str(path.relative_to(c.out))
+    return summary
+
+
+def _failing(out: Path, searches: list[dict]) -> list[tuple[str, np.ndarray, dict]]:
+    """(searcher, (T, 3) profile, metadata) of every failure the searches saved, in order
+    (the worst is saved beside them; when it failed, it is one of them)."""
+    rows = []
+    for s in searches:
+        profiles, meta = load_profiles(out / s["profiles_file"])
+        rows += [
+            (s["searcher"], q, m)
+            for q, m in zip(profiles, meta, strict=True)
+            if m.get("diverged") and not m.get("worst")
+        ]
+    return rows
+
+
+def failure_reach(profiles: list[np.ndarray], limits: Rig3Limits) -> dict | None:
+    """How far beyond the records the failures sit: per profile the largest over the
+    coordinates of its peak |q| over the records' (``limits.records_peak``); its median,
+    smallest and largest. None when the limits come from no records."""
+    seen = None if limits.records_peak is None else np.array(limits.records_peak)
+    if seen is None or not profiles or not np.any(seen > 0):
+        return None
+    moved = seen > 0
+    ratio = [float(np.max(np.max(np.abs(q), axis=0)[moved] / seen[moved])) for q in profiles]
+    return {
+        "failures": len(ratio),
+        "median": round(float(np.median(ratio)), 3),
+        "min": round(min(ratio), 3),
+        "max": round(max(ratio), 3),
+        "of": "each failure's largest peak |q| over the records' peak, per coordinate",
+    }
+
+
+def _recheck(model, reference, profiles, target, threads, limits) -> dict:
+    if not profiles:
+        return {"profiles": 0, "diverged": 0}
+    with BatchEvaluator(model, reference, target, threads=threads, scales=limits) as ev:
+        v = ev.evaluate(profiles).verdict
+    axes = Counter(str(a) for a, d in zip(v.first_axis, v.diverged, strict=True) if d)
+    return {"profiles": len(profiles), "diverged": int(v.diverged.sum()), "by_axis": dict(axes)}
+
+
+def _shrink_some(p: Planar, target, failing, c, progress, out: Path):
     """The first ``max_shrink`` failures shrunk per axis and written as cases: their report
     rows and ``(title, shrunk profile)`` for the plots."""
     from bushenv.models import params_sha
     from bushenv.search.corpus import make_case, save_case
 
-    control = resolved_planar(c.control or DEFAULT_CONTROL, model.dt, "--control")
-    subject = resolved_planar(c.model, model.dt, "--model")
+    subject, control, reference = p.models["target"], p.models["control"], p.reference
     ref_spec = c.reference or DEFAULT_REFERENCE
     ref_record = {"spec": ref_spec, "file_sha256": None, "params_sha256": params_sha(reference)}
     kept, shown = [], []
-    for name, cand in failing[: c.max_shrink]:
-        with BatchEvaluator(model, reference, target) as ev:
-            res = shrink(cand.profile, ev, budget=c.shrink_budget)
+    for name, profile, meta in failing[: c.max_shrink]:
+        family = meta["family"]
+        with BatchEvaluator(p.model, reference, target, scales=p.limits) as ev:
+            res = shrink(profile, ev, budget=c.shrink_budget)
         moving = [a for i, a in enumerate(target.coords) if np.any(res.profile[:, i] != 0.0)]
         progress.say(
-            f"  shrunk a {cand.family} failure ({cand.verdict.get('axis')}): "
+            f"  shrunk a {family} failure ({meta['verdict'].get('axis')}): "
             f"{res.original} -> {res.final}, moving {', '.join(moving)}"
         )
         case = make_case(
             res.profile,
             env=c.target,
             axis="planar",
-            family=cand.family,
-            params=cand.params,
+            family=family,
+            params=meta.get("params"),
             found_by={
                 "searcher": name,
                 "seed": c.seed,
                 "model": c.model,
                 "model_sha256": subject.sha256,
             },
-            models={c.model: model, control.spec: control.model},
+            models={c.model: p.model, control.spec: control.model},
             reference=reference,
             reference_spec=ref_spec,
             shas={c.model: subject.sha256, control.spec: control.sha256},
@@ -279,15 +391,15 @@ def _shrink_some(model, reference, target, failing, c, progress, out: Path):
         kept.append(
             {
                 "searcher": name,
-                "family": cand.family,
+                "family": family,
                 "axis": res.verdict.get("axis"),
                 "criterion": res.verdict.get("first_criterion"),
                 "moving": moving,
                 **res.summary(),
-                "cases": [str(p) for p in paths if p is not None],
+                "cases": [str(q) for q in paths if q is not None],
             }
         )
-        shown.append((f"{cand.family}, failed in {res.verdict.get('axis')}", res.profile))
+        shown.append((f"{family}, failed in {res.verdict.get('axis')}", res.profile))
     return kept, shown
 
 
@@ -300,10 +412,36 @@ def _judge_lines(judge: dict | None) -> list[str]:
     checks = "; ".join(f"{c['check']} {mark[c['passed']]}" for c in v["checks"])
     floors = ", ".join(f"{k} {x:.4g}" for k, x in judge["force_floors"].items())
     source = judge.get("force_floors_source")
-    head = "JUDGED BY A REFERENCE THAT FAILED ITS VETTING (--trust-reference): " if (
-        judge["trusted_despite_failed_vetting"]) else ""  # fmt: skip
-    return [f"{head}judge: reference {v['reference']} vetted ({checks}); force floors {floors} "
-            f"(N, N, N m){': ' + source if source else ''}", ""]  # fmt: skip
+    head = (
+        "JUDGED BY A REFERENCE THAT FAILED ITS VETTING (--trust-reference): "
+        if (judge["trusted_despite_failed_vetting"])
+        else ""
+    )
+    return [
+        f"{head}judge: reference {v['reference']} vetted ({checks}); force floors {floors} "
+        f"(N, N, N m){': ' + source if source else ''}",
+        "",
+    ]
+
+
+def _limits_lines(report: dict) -> list[str]:
+    lim, ctl = report.get("limits"), report.get("control")
+    lines = [f"searched within {limits_text(lim)}"] if lim else []
+    if ctl:
+        lines.append(f"control: {ctl['label']} ({ctl['how']})")
+    return [*lines, ""] if lines else []
+
+
+def _coverage_line(s: dict) -> str | None:
+    cov = s.get("coverage") or {}
+    coords = TARGETS["rig3"].coords
+    if not cov or not all(c in row for row in cov.values() for c in coords):
+        return None
+    parts = []
+    for c, u in zip(coords, UNITS, strict=True):
+        top = max(row[c][f"peak_{u}_max"] for row in cov.values())
+        parts.append(f"{c} {top:.4g} {u}")
+    return f"{s['searcher']}: largest peak tried {', '.join(parts)}"
 
 
 def format_planar_table(report: dict) -> str:
@@ -313,6 +451,7 @@ def format_planar_table(report: dict) -> str:
         f"budget {report['budget']}, seed {report['seed']}",
         "",
         *_judge_lines(report.get("judge")),
+        *_limits_lines(report),
         "| searcher | failures / evaluations | first failure at | first: family (axis) | "
         "worst robustness |",
         "|---|---|---|---|---|",
@@ -328,13 +467,28 @@ def format_planar_table(report: dict) -> str:
         )
     for s in report["searchers"]:
         f = s["failures"]
-        if f["by_family"]:
+        covered = _coverage_line(s)
+        if f["by_family"] or covered:
             lines.append("")
+        if covered:
+            lines.append(covered)
+        if f["by_family"]:
             lines.append(f"{s['searcher']}: failures by family {json.dumps(f['by_family'])}")
             lines.append(f"{s['searcher']}: failures by axis {json.dumps(f['by_axis'])}")
+        if s.get("profiles_file"):
+            lines.append(f"{s['searcher']}: failing profiles in {s['profiles_file']}")
+    reach = report.get("failure_reach")
+    if reach:
+        lines.append(
+            f"failures reach {reach['median']:.3g}x the records' peak (median; "
+            f"{reach['min']:.3g}x to {reach['max']:.3g}x)"
+        )
     for role, r in report["recheck"].items():
-        lines.append(f"recheck {role}: {r['diverged']} of {r['profiles']} failing profiles diverge")
-    for k in report["shrunk"]:
+        who = f" ({r['model']})" if r.get("model") else ""
+        lines.append(
+            f"recheck {role}{who}: {r['diverged']} of {r['profiles']} failing profiles diverge"
+        )
+    for k in report["shrunk"] or []:
         lines.append(
             f"shrunk {k['family']} ({k['axis']}, {k['criterion']}): moving {k['moving']}, "
             f"{k['original']['segments']} -> {k['final']['segments']} segments"

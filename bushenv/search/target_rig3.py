@@ -1,8 +1,10 @@
 """The ``rig3`` target: BushRig3-v0's prescribed motion in three coordinates, a planar model
-against the coupled planar reference, judged axis by axis.
+against the coupled planar reference, judged axis by axis; what a search on it tried, per
+coordinate in its unit (``CoordinateRecorder``, ``covered_search``).
 
-A profile is a (T, 3) array (axial m, radial m, rotation rad) within the rig's stroke and rate
-(``families_planar.rig3_limits``); a batch is (T, B, 3). Each coordinate's force (or moment) is
+A profile is a (T, 3) array (axial m, radial m, rotation rad) within a stroke and rate per
+coordinate (``families_planar.Rig3Limits``: the rig's, ``rig3_limits``, or a user's bushing's,
+passed as the evaluator's ``scales``); a batch is (T, B, 3). Each coordinate's force (or moment) is
 judged by ``divergence.judge`` on its own scale (``axis_scales``): stroke, rate and force limit
 of that coordinate from the env's spec, and a force floor per coordinate. A profile fails when
 any coordinate fails; the verdict names the coordinate (``PlanarVerdict.first_axis``: the one
@@ -19,8 +21,10 @@ built-in reference gets exactly the papers' floors. The static criterion does no
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -28,8 +32,16 @@ from bushenv.divergence import Verdict, judge
 from bushenv.errors import DIVERGENCE_RAISES, ModelRaised
 from bushenv.planar.static_estimate import static_stiffness3
 from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
-from bushenv.search.base import SearchError
-from bushenv.search.families_planar import COORDS, ENV_ID, clip3, rig3_limits
+from bushenv.search.base import (
+    Recorder,
+    SearchContext,
+    Searcher,
+    SearchError,
+    SearchResult,
+    _check_budget,
+    _stable_id,
+)
+from bushenv.search.families_planar import COORDS, ENV_ID, UNITS, clip3, limits3
 from bushenv.search.target_base import Responses, Target
 
 ROTATION_FLOOR_NM = FORCE_FLOOR_N * 2500.0 / 25000.0
@@ -193,6 +205,64 @@ def simulate_planar_or_nan(model, q: np.ndarray) -> np.ndarray:
     return out
 
 
+class CoordinateRecorder(Recorder):
+    """The search's book-keeping, and what it tried per family and coordinate: profiles,
+    smallest and largest peak |q|, largest |dq/dt| (the base's coverage takes the largest
+    over the coordinates, which mixes m and rad)."""
+
+    def __init__(self, result: SearchResult, evaluator) -> None:
+        super().__init__(result, evaluator)
+        self.per_coordinate: dict[str, list] = {}
+
+    def _cover(self, batch, families: list[str], n: int) -> None:
+        super()._cover(batch, families, n)
+        x = batch.x[:, :n]  # (T, n, 3)
+        peak = np.max(np.abs(x), axis=0)
+        rate = (
+            np.max(np.abs(np.diff(x, axis=0)), axis=0) / self.evaluator.dt
+            if x.shape[0] > 1
+            else 0 * peak
+        )
+        for b in range(n):
+            c = self.per_coordinate.setdefault(
+                families[b], [0, np.full(3, np.inf), np.zeros(3), np.zeros(3)]
+            )
+            c[0] += 1
+            c[1] = np.minimum(c[1], peak[b])
+            c[2] = np.maximum(c[2], peak[b])
+            c[3] = np.maximum(c[3], rate[b])
+
+    def coverage_json(self) -> dict[str, dict]:
+        """Per family: profiles, then per coordinate its peak range and fastest rate, each
+        key naming its unit (``peak_mm_*`` for axial and radial, ``peak_mrad_*`` for the
+        rotation)."""
+        out = {}
+        for fam, (n, lo, hi, rate) in sorted(self.per_coordinate.items()):
+            row: dict[str, Any] = {"profiles": int(n)}
+            for i, (c, u) in enumerate(zip(COORDS, UNITS, strict=True)):
+                per_s = "rad_per_s" if u == "mrad" else "m_per_s"
+                row[c] = {
+                    f"peak_{u}_min": round(1e3 * float(lo[i]), 4),
+                    f"peak_{u}_max": round(1e3 * float(hi[i]), 4),
+                    f"max_rate_{per_s}": round(float(rate[i]), 4),
+                }
+            out[fam] = row
+        return out
+
+
+def covered_search(searcher: Searcher, evaluator, budget: int, seed: int, progress=None):
+    """``searcher.run(evaluator, budget, seed, progress)`` -- the same seeding, the same
+    result -- with a ``CoordinateRecorder``: (result, its per-coordinate coverage)."""
+    budget = _check_budget(budget)
+    result = SearchResult(searcher.name, int(seed), budget, evaluator.target.name)
+    recorder = CoordinateRecorder(result, evaluator)
+    rng = np.random.default_rng([int(seed), _stable_id(searcher.name)])
+    said = progress or (lambda line: None)
+    searcher.search(SearchContext(evaluator, budget, rng, recorder, int(seed), said))
+    result.seconds = time.perf_counter() - recorder.t0
+    return result, recorder.coverage_json()
+
+
 class Rig3Target(Target):
     """BushRig3-v0: prescribed motion in axial, radial and rotation; model and reference see
     the same motion, each coordinate judged on its own scale."""
@@ -205,16 +275,16 @@ class Rig3Target(Target):
     coords = COORDS
 
     def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
-        return clip3(x, dt)
+        return clip3(x, dt, limits)
 
     def judging_facts(self, reference) -> dict[str, dict[str, float]]:
         floors = reference_floors(reference)[0]
         return {"force_floors": dict(zip(COORDS, floors.tolist(), strict=True))}
 
     def profile_bounds(self, limits=MACHINE) -> tuple[np.ndarray, np.ndarray]:
-        """Per coordinate (3,) arrays: BushRig3-v0's stroke and rate (``limits``, a one-axis
-        bushing's, do not apply)."""
-        return rig3_limits()
+        """Per coordinate (3,) arrays: the stroke and rate of ``limits`` when they are
+        ``Rig3Limits``, else BushRig3-v0's (a one-axis bushing's ``BushingScales`` do not apply)."""
+        return limits3(limits)
 
     def responses(
         self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE

@@ -1,0 +1,197 @@
+"""``bushenv attack --env rig3`` on a user's bushing: limits from the reference's card, the
+control fitted to the reference, failing profiles saved, coverage per coordinate in its unit,
+resume."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bushenv.cli import main
+from bushenv.persist import load_profiles
+from bushenv.planar.linear import PlanarLinear, fit_linear
+from bushenv.planar.records import load_planar_csv
+from bushenv.search.families import FAMILIES
+from bushenv.search.families_planar import COORDS, Rig3Limits, machine_limits
+from bushenv.search.targets import TARGETS
+
+TRAIN = "random_independent_n1_8s_seed0.csv"
+
+
+@pytest.fixture(scope="module")
+def bushing(tmp_path_factory) -> Path:
+    """Three-axis records of the coupled reference, a linear fit with its card (the user's
+    reference) and a model of negative damping (no card) that fails on it."""
+    d = tmp_path_factory.mktemp("rig3-user")
+    assert main(["measure", "--axes", "3", "--programme", "random", "--duration", "8",
+                 "--out", str(d / "rec3"), "--quiet"]) == 0  # fmt: skip
+    train, held = d / "rec3" / TRAIN, d / "rec3" / "random_correlated_n1_8s_seed0.csv"
+    assert main(["fit", str(train), "--validate", str(held), "--model", "linear", "--out",
+                 str(d / "ref3.npz"), "--no-plots", "--quiet"]) == 0  # fmt: skip
+    ref = PlanarLinear.preset()
+    PlanarLinear(0.5 * ref.k_matrix, -ref.c_matrix, ref.dt).save(d / "active3.npz")
+    return d
+
+
+def _attack(d: Path, out: str, *extra: str, quiet: bool = True) -> dict:
+    args = ["attack", "--env", "rig3", "--model", str(d / "active3.npz"), "--reference",
+            str(d / "ref3.npz"), "--budget", "12", "--max-shrink", "1", "--shrink-budget", "10",
+            "--threads", "1", "--no-plots", "--out", str(d / out), *extra]  # fmt: skip
+    if quiet:
+        args.append("--quiet")
+    assert main(args) == 0
+    return json.loads((d / out / "report.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def attacked(bushing) -> dict:
+    return _attack(bushing, "att")
+
+
+def test_a_users_reference_sets_stroke_and_rate_per_coordinate_from_its_cards_records(
+    bushing, attacked
+):
+    rec = load_planar_csv(bushing / "rec3" / TRAIN)
+    peak = np.max(np.abs(rec.q), axis=0)
+    speed = np.max(np.abs(np.diff(rec.q, axis=0)), axis=0) / rec.dt
+    lim = attacked["limits"]
+    for i, (c, u, r) in enumerate(
+        zip(COORDS, ("mm", "mm", "mrad"), ("m", "m", "rad"), strict=True)
+    ):
+        assert lim[c][f"stroke_{u}"] == pytest.approx(1.5e3 * peak[i], rel=1e-5)
+        assert lim[c][f"rate_{r}_per_s"] == pytest.approx(1.5 * speed[i], rel=1e-5)
+        assert lim[c][f"records_peak_{u}"] == pytest.approx(1e3 * peak[i], rel=1e-5)
+    assert "ref3.card.json" in lim["source"]
+    stroke = 1.5 * peak
+    for s in attacked["searchers"]:
+        profiles, _ = load_profiles(bushing / "att" / s["profiles_file"])
+        for q in profiles:
+            assert np.all(np.max(np.abs(q), axis=0) <= stroke * (1 + 1e-9))
+    assert attacked["failure_reach"]["max"] <= 1.5 + 1e-9
+
+
+def test_stroke_mm_sets_axial_and_radial_and_the_rotation_keeps_the_cards(bushing, attacked):
+    report = _attack(bushing, "att-stroke", "--stroke-mm", "1.5", "--searchers", "random")
+    lim = report["limits"]
+    assert lim["axial"]["stroke_mm"] == lim["radial"]["stroke_mm"] == 1.5
+    assert lim["rotation"] == attacked["limits"]["rotation"]
+    assert "--stroke-mm 1.5" in lim["source"]
+
+
+def test_the_control_is_a_linear_fit_to_the_users_reference_and_named_as_such(bushing, attacked):
+    from bushenv.models import load_model
+
+    control = attacked["control"]
+    fitted = load_model(control["file"], coords=3)
+    ref = load_model(bushing / "ref3.npz", coords=3)
+    q = load_planar_csv(bushing / "rec3" / TRAIN).q
+    v = np.gradient(q, ref.dt, axis=0)
+    expected = fit_linear(q, v, ref.copy().simulate(q, v), dt=ref.dt)
+    assert np.allclose(fitted.k_matrix, expected.k_matrix, rtol=1e-9)
+    assert np.allclose(fitted.c_matrix, expected.c_matrix, rtol=1e-9)
+    assert "ref3.npz" in control["label"] and control["file"] in control["label"]
+    assert attacked["recheck"]["control"]["model"] == control["label"]
+    md = (bushing / "att" / "report.md").read_text()
+    assert f"recheck control ({control['label']})" in md
+
+
+def test_the_warning_names_a_flagged_control_given_by_the_user(bushing, capsys):
+    _attack(bushing, "att-ctl", "--control", str(bushing / "active3.npz"), "--searchers",
+            "random", quiet=False)  # fmt: skip
+    err = capsys.readouterr().err
+    assert f"WARNING: the control ({bushing / 'active3.npz'}) was flagged" in err
+    assert "(linear)" not in err
+
+
+def test_every_failing_profile_is_saved_with_three_coordinates(bushing, attacked):
+    for s in attacked["searchers"]:
+        profiles, meta = load_profiles(bushing / "att" / s["profiles_file"])
+        failing = [m for m in meta if m["diverged"] and not m.get("worst")]
+        assert len(failing) == min(s["n_failures"], 256) > 0
+        assert all(q.ndim == 2 and q.shape[1] == 3 for q in profiles)
+        assert [m.get("worst") for m in meta].count(True) == 1
+
+
+def test_coverage_is_per_coordinate_with_its_unit_in_the_key(attacked):
+    stroke = attacked["limits"]
+    for s in attacked["searchers"]:
+        for row in s["coverage"].values():
+            assert set(row) == {"profiles", *COORDS}
+            assert set(row["axial"]) == {"peak_mm_min", "peak_mm_max", "max_rate_m_per_s"}
+            assert set(row["rotation"]) == {"peak_mrad_min", "peak_mrad_max",
+                                            "max_rate_rad_per_s"}  # fmt: skip
+            assert row["rotation"]["peak_mrad_max"] <= stroke["rotation"]["stroke_mrad"] + 1e-6
+            assert row["axial"]["peak_mm_max"] <= stroke["axial"]["stroke_mm"] + 1e-6
+
+
+def _untimed(obj):
+    """``obj`` without its wall times."""
+    if isinstance(obj, dict):
+        return {k: _untimed(v) for k, v in obj.items() if not k.startswith("seconds")}
+    if isinstance(obj, list):
+        return [_untimed(v) for v in obj]
+    return obj
+
+
+def test_resume_finishes_an_interrupted_attack_as_the_uninterrupted_one(bushing, attacked, capsys):
+    import shutil
+
+    out = bushing / "att-resume"
+    shutil.copytree(bushing / "att", out)
+    report = json.loads((out / "report.json").read_text())
+    report["searchers"] = report["searchers"][:1]  # stopped after the first search
+    report["recheck"], report["shrunk"], report["complete"] = {}, None, False
+    (out / "report.json").write_text(json.dumps(report))
+    resumed = _attack(bushing, "att-resume", "--resume")
+    for key in ("searchers", "recheck", "shrunk", "limits", "control", "failure_reach"):
+        a, b = json.dumps(_untimed(resumed[key])), json.dumps(_untimed(attacked[key]))
+        assert a.replace("att-resume", "att") == b, key
+    capsys.readouterr()
+    with pytest.raises(AssertionError):
+        _attack(bushing, "att-resume", "--resume", "--budget", "13")
+    assert "was made with budget=12, not 13" in capsys.readouterr().err
+
+
+def test_the_builtin_reference_keeps_the_machine_and_the_linear_preset(tmp_path):
+    ref = PlanarLinear.preset()
+    PlanarLinear(ref.k_matrix, -0.3 * ref.c_matrix, ref.dt).save(tmp_path / "a.npz")
+    assert main(["attack", "--env", "rig3", "--model", str(tmp_path / "a.npz"), "--budget", "4",
+                 "--searchers", "random", "--max-shrink", "0", "--threads", "1", "--no-plots",
+                 "--quiet", "--out", str(tmp_path / "o")]) == 0  # fmt: skip
+    report = json.loads((tmp_path / "o" / "report.json").read_text())
+    assert report["limits"] == machine_limits().to_json()
+    assert report["control"]["label"] == "linear"
+    assert "failure_reach" not in report
+
+
+@pytest.mark.parametrize("name", TARGETS["rig3"].family_names())
+def test_every_family_stays_within_small_limits_of_a_users_bushing(name):
+    lim = Rig3Limits((2e-3, 1e-3, 0.02), (0.05, 0.2, 0.5))
+    fam = FAMILIES[name]
+    rng = np.random.default_rng(4)
+    dt = PlanarLinear.preset().dt
+    for _ in range(10):
+        q = fam.profile(rng.random(fam.dim), dt, limits=lim)
+        assert np.all(np.max(np.abs(q), axis=0) <= np.array(lim.stroke) * (1 + 1e-12))
+        rate = np.max(np.abs(np.diff(q, axis=0)), axis=0) / dt
+        assert np.all(rate <= np.array(lim.rate) * (1 + 1e-9))
+
+
+def test_the_covered_search_is_the_searchers_own_run():
+    from bushenv.search.evaluate import BatchEvaluator
+    from bushenv.search.searchers import SEARCHERS
+    from bushenv.search.target_rig3 import covered_search
+
+    ref = PlanarLinear.preset()
+    model = PlanarLinear(ref.k_matrix, -0.3 * ref.c_matrix, ref.dt)
+    for name in ("random", "cma"):
+        with BatchEvaluator(model, ref, "rig3") as ev:
+            plain = SEARCHERS[name].make().run(ev, 8, seed=3).summary()
+        with BatchEvaluator(model, ref, "rig3") as ev:
+            covered, per_coordinate = covered_search(SEARCHERS[name].make(), ev, 8, 3)
+        covered = covered.summary()
+        for s in (plain, covered):
+            s.pop("seconds"), s.pop("seconds_to_failure")
+        assert covered == plain
+        assert set(per_coordinate) == set(plain["coverage"])
