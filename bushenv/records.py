@@ -72,7 +72,8 @@ UNITS = {
     "displacement": {"m": 1.0, "mm": 1e-3, "um": 1e-6},
     "force": {"N": 1.0, "kN": 1e3},
 }
-_NAME_UNIT = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]*?)\s*[\])]\s*$")
+# a column name with its unit in brackets or parentheses, e.g. "displacement [mm]"
+NAME_UNIT = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]*?)\s*[\])]\s*$")
 _SNIFF_BYTES = 8192
 # What numpy's parser reads exactly as the line-by-line parser does (digits, signs, points,
 # exponents, commas, blanks, LF and CRLF); a file holding anything else takes the slow path.
@@ -253,13 +254,13 @@ def _check_columns(
             )
 
 
-def _check_rate(t: np.ndarray, label: str, where) -> None:
+def check_rate(t: np.ndarray, label: str, where) -> None:
     """Refuse a plain ``time`` column whose sample rate no dynamic test has (``where(1)``
     names the second sample); the message says which unit the column looks like."""
     step = float(np.median(np.diff(t)))
     rate = 1.0 / step
     low, high = PLAUSIBLE_RATE_HZ
-    if _is_plausible_rate(t):
+    if is_plausible_rate(t):
         return
     looks = [
         (name, unit)
@@ -283,7 +284,7 @@ def _check_rate(t: np.ndarray, label: str, where) -> None:
     )
 
 
-def _is_plausible_rate(t: np.ndarray) -> bool:
+def is_plausible_rate(t: np.ndarray) -> bool:
     """Within ``PLAUSIBLE_RATE_HZ``, give or take the time step's own 1 % tolerance."""
     rate = 1.0 / float(np.median(np.diff(t)))
     low, high = PLAUSIBLE_RATE_HZ
@@ -318,7 +319,7 @@ def header_units(fields: list[str]) -> tuple[list[str], dict[str, float], str | 
     """(names without units, {column: factor to SI} for stated units, problem or None)."""
     names, factors = [], {}
     for text in fields:
-        m = _NAME_UNIT.match(text)
+        m = NAME_UNIT.match(text)
         if m is None:
             names.append(text.strip())
             continue
@@ -507,7 +508,7 @@ def _load_plain(
         max_displacement_m=max_displacement_m,
         max_force_n=max_force_n,
     )
-    _check_rate(record.time, str(path), where)
+    check_rate(record.time, str(path), where)
     return record
 
 
@@ -553,7 +554,7 @@ def _load_line_by_line(
         max_force_n=np.inf if "force" in factors else max_force_n,
     )
     if "time" not in factors:  # a stated unit is taken as stated
-        _check_rate(record.time, str(path), lambda i: f"{path} line {int(line_of[i])}")
+        check_rate(record.time, str(path), lambda i: f"{path} line {int(line_of[i])}")
     return record
 
 
@@ -634,7 +635,7 @@ def save_csv(record: Record, path: str | os.PathLike, overwrite: bool = False) -
     record.validate()
     if path.exists() and not overwrite:
         raise RecordError(f"{path} already exists; refusing to overwrite it (pass overwrite=True)")
-    plain = _is_plausible_rate(record.time)
+    plain = is_plausible_rate(record.time)
     head = (HEADER_TEXT if plain else "time [s],displacement,force") + "\n"
     # tolist() gives Python floats, whose repr is the shortest exact round-trip text.
     rows = zip(

@@ -31,12 +31,12 @@ import numpy as np
 
 from bushenv.persist import atomic_write
 from bushenv.records import (
-    _NAME_UNIT,
+    NAME_UNIT,
     STEP_ATOL_S,
     STEP_RTOL,
     RecordError,
-    _check_rate,
-    _is_plausible_rate,
+    check_rate,
+    is_plausible_rate,
 )
 from bushenv.records import HEADER as ONE_AXIS_HEADER
 from bushenv.records import UNITS as ONE_AXIS_UNITS
@@ -97,7 +97,7 @@ def header_names(fields: list[str]) -> list[str]:
     """The column names of a header row, units in brackets dropped."""
     names = []
     for text in fields:
-        m = _NAME_UNIT.match(text)
+        m = NAME_UNIT.match(text)
         names.append((m.group(1) if m else text).strip())
     return names
 
@@ -161,7 +161,7 @@ def _header(path: Path, fields: list[str]) -> tuple[np.ndarray, np.ndarray]:
     order = np.array([names.index(n) for n in HEADER])
     factors = np.ones(len(HEADER))
     for k, name in enumerate(HEADER):
-        m = _NAME_UNIT.match(fields[order[k]])
+        m = NAME_UNIT.match(fields[order[k]])
         if m:
             unit, table = m.group(2), UNITS[_KIND[name]]
             if unit not in table:
@@ -190,12 +190,12 @@ def load_planar_csv(path: str | os.PathLike) -> PlanarRecord:
     order, factors = _header(path, fields)
     a = _plain_rows(body)
     a = _parse_rows(path, text, order) if a is None else a[:, order]
-    stated = np.array([bool(_NAME_UNIT.match(fields[j])) for j in order])
+    stated = np.array([bool(NAME_UNIT.match(fields[j])) for j in order])
     _check_plausible(path, a, stated)
     a = a * factors
     _check_time(path, a[:, 0])
     if not stated[0]:
-        _check_rate(a[:, 0], str(path), lambda i: f"{path} line {i + 2}")
+        check_rate(a[:, 0], str(path), lambda i: f"{path} line {i + 2}")
     return PlanarRecord(
         a[:, 0], np.ascontiguousarray(a[:, 1:4]), np.ascontiguousarray(a[:, 4:7]), str(path)
     )
@@ -380,7 +380,7 @@ def save_planar_csv(
         raise RecordError(f"{path}: NaN or inf in the data; refusing to write it")
     _check_time(path, t)
     # a plain time column must read as a dynamic test's rate; state seconds when it does not
-    head = HEADER_TEXT if _is_plausible_rate(t) else HEADER_TEXT.replace("time", "time [s]", 1)
+    head = HEADER_TEXT if is_plausible_rate(t) else HEADER_TEXT.replace("time", "time [s]", 1)
     lines = [head] + [",".join(repr(float(x)) for x in row) for row in a]
     atomic_write(path, lambda fh: fh.write(("\n".join(lines) + "\n").encode()))
     return path
