@@ -23,7 +23,8 @@ def private_imports(root: Path) -> list[str]:
             for alias in node.names:
                 name = alias.name
                 if name.startswith("_") and not name.startswith("__") and source != package:
-                    found.append(f"{path.relative_to(root.parent)}:{node.lineno} {node.module}.{name}")
+                    where = f"{path.relative_to(root.parent)}:{node.lineno}"
+                    found.append(f"{where} {node.module}.{name}")
     return found
 
 

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from bushenv.persist import atomic_write
+from bushenv.records import HEADER as ONE_AXIS_HEADER
 from bushenv.records import (
     NAME_UNIT,
     STEP_ATOL_S,
@@ -38,7 +39,6 @@ from bushenv.records import (
     check_rate,
     is_plausible_rate,
 )
-from bushenv.records import HEADER as ONE_AXIS_HEADER
 from bushenv.records import UNITS as ONE_AXIS_UNITS
 
 HEADER = (
