@@ -13,6 +13,11 @@ the TESTs. Writes
 - ``DIR/predictions/<file-stem>.csv`` per judged record:
   time,force_measured,force_baseline,force_augmented (the named model's prediction)
 
+Three-axis records (header ``time,displacement_axial,displacement_radial,rotation,
+force_axial,force_radial,moment``) are diagnosed per coordinate against the linear three-axis
+baseline: which coordinate carries the gap, which effect, how far it shrinks; ``DIR/<coordinate>/``
+holds each coordinate's report. One-axis and three-axis records are not mixed.
+
 An existing DIR is refused unless ``--force``; with ``--force`` only the files named above are
 replaced, nothing else in DIR is touched. Arguments become a ``DiagnoseConfig``
 (``bushenv/diagnose/report.py``); the core is ``bushenv.diagnose.fit.diagnose``.
@@ -36,7 +41,11 @@ EXAMPLE = (
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("train", metavar="TRAIN_CSV", help="record that identifies the models")
+    parser.add_argument(
+        "train",
+        metavar="TRAIN_CSV",
+        help="record that identifies the models (one-axis or three-axis, all records one kind)",
+    )
     parser.add_argument("tests", metavar="TEST_CSV", nargs="+", help="held-out records that judge")
     parser.add_argument(
         "--out", required=True, metavar="DIR", help="output folder (must not exist)"
@@ -128,9 +137,11 @@ def run(args: argparse.Namespace) -> int:
     config = config_from(args)
     progress = Progress(quiet=args.quiet)
     result = run_diagnosis(config, progress)
+    where = f"coordinate {result['coordinate']}, " if result.get("coordinate") else ""
     progress(
-        f"done ({result['mode']}): effect {result['effect']}, gap {100 * result['gap_before']:.2f}"
-        f" % -> {100 * result['gap_after']:.2f} % (shrink {100 * result['shrink']:.0f} %)"
+        f"done ({result['mode']}): {where}effect {result['effect']}, gap "
+        f"{100 * result['gap_before']:.2f} % -> {100 * result['gap_after']:.2f} % (shrink "
+        f"{100 * result['shrink']:.0f} %)"
     )
     print(config.out / "report.md")
     return 0

@@ -27,6 +27,7 @@ import numpy as np
 
 from bushenv.diagnose import evidence, regimes, rule
 from bushenv.diagnose.candidates import candidate_sets, get_effect
+from bushenv.diagnose.coordinates import coordinate_count, diagnose_coordinates
 from bushenv.diagnose.design import ColumnStore, Prepared
 from bushenv.diagnose.effects.base import NULL, Scales
 from bushenv.diagnose.errors import DiagnoseError
@@ -178,9 +179,25 @@ def diagnose(
     (docs/diagnose.md) plus ``"predictions"``: one dict per judged record with ``name``,
     ``role`` and (T,) arrays ``time``, ``displacement``, ``force_measured``,
     ``force_baseline``, ``force_augmented`` (the answer's held-out prediction).
+
+    Records of C > 1 coordinates (``.q``, ``.f`` (T, C)) go to
+    ``bushenv.diagnose.coordinates.diagnose_coordinates``: which coordinate carries the gap,
+    then this diagnosis on that coordinate.
     """
-    say = progress or (lambda msg: None)
     trains = list(train) if isinstance(train, list | tuple) else [train]
+    if any(coordinate_count(r) > 1 for r in trains + list(tests)):  # records of C coordinates
+        return diagnose_coordinates(
+            trains,
+            tests,
+            baseline,
+            progress,
+            seed,
+            test_names,
+            cross=cross,
+            effects=effects,
+            train_names=train_names,
+        )
+    say = progress or (lambda msg: None)
     if not trains:
         raise DiagnoseError("no TRAIN record given")
     t_names = (

@@ -35,7 +35,11 @@ def _parameter_lines(params: dict[str, Any], indent: str = "") -> list[str]:
 
 def _header(data: dict[str, Any]) -> list[str]:
     recs = data["records"]
-    lines = ["# Sim-to-real gap diagnosis", "", f"- mode: {data['mode_text']}"]
+    title = "# Sim-to-real gap diagnosis"
+    if data.get("coordinate"):  # one coordinate of a diagnosis over several
+        u = data["units"]
+        title += f": coordinate {data['coordinate']} ({u['displacement']}, {u['force']})"
+    lines = [title, "", f"- mode: {data['mode_text']}"]
     for t in recs["train"]:
         lines.append(f"- TRAIN: `{t['name']}` ({t['samples']} samples at {t['rate_hz']:.6g} Hz)")
     for t in recs["tests"]:

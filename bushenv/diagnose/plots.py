@@ -12,6 +12,15 @@ from bushenv.diagnose.regimes import residual_spectrum
 from bushenv.persist import write_figure
 
 MAX_POINTS = 3000  # points per curve drawn (records are decimated for the figure only)
+SHOWN = {"m": ("mm", 1e3), "rad": ("mrad", 1e3)}  # a deflection unit as drawn, its factor
+
+
+def units_of(result: dict[str, Any]) -> tuple[str, float, str]:
+    """(deflection unit drawn, its factor from SI, force unit): a coordinate of a diagnosis
+    over several names its own (``result["units"]``), one axis is m and N."""
+    u = result.get("units") or {"displacement": "m", "force": "N"}
+    shown, factor = SHOWN.get(u["displacement"], (u["displacement"], 1.0))
+    return shown, factor, u["force"]
 
 
 def _plt():
@@ -77,7 +86,9 @@ def spectrum_plot(result: dict[str, Any], out: Path, names: list[str]) -> None:
         a1.loglog(f[1:], p[1:], label=f"{pred['name']} baseline")
         a1.loglog(f[1:], pa[1:], ls="--", label=f"{pred['name']} augmented")
         a2.semilogx(f[1:], coh[1:], label=pred["name"])
-    a1.set_ylabel("residual PSD, N²/Hz")
+    force_unit = units_of(result)[2]
+    a1.set_ylabel(f"residual PSD, {force_unit}²/Hz" if " " not in force_unit else
+                  f"residual PSD, ({force_unit})²/Hz")  # fmt: skip
     a1.legend(fontsize=7)
     a2.set_ylabel("coherence with input")
     a2.set_xlabel("frequency, Hz")
@@ -99,7 +110,7 @@ def time_plot(result: dict[str, Any], out: Path, names: list[str]) -> None:
             step = max(t.size // MAX_POINTS, 1)
             ax.plot(t[::step], run[::step], ls=ls, label=f"{pred['name']} {key[6:]}")
     ax.set_xlabel("time, s")
-    ax.set_ylabel("1 s running RMS of the gap, N")
+    ax.set_ylabel(f"1 s running RMS of the gap, {units_of(result)[2]}")
     ax.legend(fontsize=7)
     ax.set_title("where: the gap over time")
     _save(fig, out, "where_time.png", names)
@@ -115,7 +126,7 @@ def _window(t: np.ndarray, r: np.ndarray, dt: float) -> tuple[slice, str]:
     return slice(i0, i0 + w), f"the {w * dt:.3g} s with the largest baseline gap"
 
 
-def force_plot(pred: dict[str, Any], out: Path, names: list[str]) -> None:
+def force_plot(pred: dict[str, Any], out: Path, names: list[str], force_unit: str = "N") -> None:
     """Force over time (measured, baseline, augmented) and, under it, both residuals."""
     plt = _plt()
     t = np.asarray(pred["time"])
@@ -130,22 +141,27 @@ def force_plot(pred: dict[str, Any], out: Path, names: list[str]) -> None:
     a1.plot(t[::step], fm[::step], "k", lw=1, label="measured")
     a1.plot(t[::step], fb[::step], lw=1, label="baseline")
     a1.plot(t[::step], fa[::step], "--", lw=1, label="augmented")
-    a1.set_ylabel("force, N")
+    a1.set_ylabel(f"force, {force_unit}")
     a1.legend(fontsize=8)
     a1.set_title(f"{pred['name']}: {what}")
     a2.plot(t[::step], (fm - fb)[::step], lw=0.8, label="measured - baseline")
     a2.plot(t[::step], (fm - fa)[::step], lw=0.8, label="measured - augmented")
     a2.axhline(0.0, color="k", lw=0.5)
     a2.set_xlabel("time, s")
-    a2.set_ylabel("residual, N")
+    a2.set_ylabel(f"residual, {force_unit}")
     a2.legend(fontsize=7)
     _save(fig, out, f"forces_{pred['name']}.png", names)
 
 
-def loops_plot(pred: dict[str, Any], out: Path, names: list[str]) -> None:
-    """Force-deflection loops: measured, baseline, augmented."""
+def loops_plot(
+    pred: dict[str, Any],
+    out: Path,
+    names: list[str],
+    units: tuple[str, float, str] = ("mm", 1e3, "N"),
+) -> None:
+    """Force-deflection loops: measured, baseline, augmented (``units``: ``units_of``)."""
     plt = _plt()
-    x = 1e3 * np.asarray(pred["displacement"])
+    x = units[1] * np.asarray(pred["displacement"])
     step = max(x.size // (3 * MAX_POINTS), 1)
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for key, style, label in (
@@ -154,8 +170,8 @@ def loops_plot(pred: dict[str, Any], out: Path, names: list[str]) -> None:
         ("force_augmented", dict(lw=0.8, ls="--", alpha=0.9), "augmented"),
     ):
         ax.plot(x[::step], np.asarray(pred[key])[::step], label=label, **style)
-    ax.set_xlabel("deflection, mm")
-    ax.set_ylabel("force, N")
+    ax.set_xlabel(f"deflection, {units[0]}")
+    ax.set_ylabel(f"force, {units[2]}")
     ax.legend(fontsize=8)
     ax.set_title(f"{pred['name']}: force-deflection loops")
     _save(fig, out, f"loops_{pred['name']}.png", names)
@@ -168,7 +184,8 @@ def make_plots(result: dict[str, Any], out: Path) -> list[str]:
     regimes_plot(result, out, names)
     spectrum_plot(result, out, names)
     time_plot(result, out, names)
+    units = units_of(result)
     for pred in result["predictions"]:
-        force_plot(pred, out, names)
-        loops_plot(pred, out, names)
+        force_plot(pred, out, names, units[2])
+        loops_plot(pred, out, names, units)
     return names

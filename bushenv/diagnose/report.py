@@ -4,7 +4,8 @@
 ``bushenv diagnose`` (``bushenv/commands/diagnose.py``) translates its arguments into a
 ``DiagnoseConfig``; the core is ``bushenv.diagnose.fit.diagnose``. An existing DIR is refused
 unless ``force``; with it only the files named above are replaced, nothing else in DIR is
-touched.
+touched. Three-axis records (every file; a mix is refused) go the same way, written by
+``coordinates_report.py``.
 """
 
 from __future__ import annotations
@@ -79,9 +80,12 @@ def run_diagnosis(config: DiagnoseConfig, say: Say | None = None) -> dict[str, A
             f"judged files need distinct file names (stems {judged}): each one's predictions "
             "go to predictions/<stem>.csv"
         )
-    trains = _load(config.train, config, say)
-    tests = _load(config.tests, config, say)
-    trains, tests = one_rate([trains, tests], config.resample, "diagnose")
+    if three_axis_files(config.train + config.tests):
+        trains, tests = _load_three_axis(config, say)
+    else:
+        trains = _load(config.train, config, say)
+        tests = _load(config.tests, config, say)
+        trains, tests = one_rate([trains, tests], config.resample, "diagnose")
     result = diagnose(
         trains,
         tests,
@@ -95,8 +99,69 @@ def run_diagnosis(config: DiagnoseConfig, say: Say | None = None) -> dict[str, A
     )
     result["files"] = {"train": [str(p) for p in config.train], "tests": list(config.tests)}
     say(f"writing {out}")
-    write_report(result, out)
+    if "diagnoses" in result:  # records of several coordinates
+        from bushenv.diagnose.coordinates_report import write_coordinates_report
+
+        write_coordinates_report(result, out)
+    else:
+        write_report(result, out)
     return result
+
+
+def _is_three_axis(path: str) -> bool:
+    """Whether the file's header is meant as a three-axis record's (``looks_planar``: seven
+    columns or a three-axis column name); an unreadable file is not (its loader says why)."""
+    import csv
+
+    from bushenv.planar.records import looks_planar
+
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as fh:
+            first = next(csv.reader(fh), [])
+    except (OSError, UnicodeDecodeError, csv.Error):
+        return False
+    return looks_planar(first)
+
+
+def three_axis_files(paths: tuple[str, ...]) -> bool:
+    """True when every record file is three-axis, False when none is; a mix is refused
+    naming a file of each kind."""
+    kinds = {p: _is_three_axis(p) for p in paths}
+    three = [p for p, k in kinds.items() if k]
+    one = [p for p, k in kinds.items() if not k]
+    if three and one:
+        from bushenv.planar.records import HEADER_TEXT
+
+        raise DiagnoseError(
+            f"{three[0]} is a three-axis record but {one[0]} is a one-axis record ({len(three)} "
+            f"three-axis, {len(one)} one-axis): one diagnosis takes records of one kind; "
+            f"three-axis records have the header '{HEADER_TEXT}'"
+        )
+    return bool(three)
+
+
+def _load_three_axis(config: DiagnoseConfig, say: Say) -> tuple[list, list]:
+    from bushenv.planar.records import load_planar_csv
+
+    if config.max_displacement_m is not None or config.max_force_n is not None:
+        raise DiagnoseError(
+            "--max-displacement and --max-force are the one-axis loader's limits; a three-axis "
+            "record states a column's unit in its header instead (e.g. 'displacement_radial "
+            "[m]', 'moment [N m]'), which lifts the limit for that column"
+        )
+    if config.resample is not None:
+        raise DiagnoseError(
+            f"--resample {config.resample}: three-axis records are diagnosed at one shared "
+            "rate (the baseline's matrices are identified at it); resample them first"
+        )
+    out = []
+    for paths in (config.train, config.tests):
+        recs = []
+        for p in paths:
+            say(f"loading {p} (three-axis)")
+            recs.append(load_planar_csv(p))
+        out.append(recs)
+    return out[0], out[1]
 
 
 def check_out_dir(out: Path, force: bool) -> None:
