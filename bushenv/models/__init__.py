@@ -97,7 +97,11 @@ def get_model(
     if text in MODELS:
         entry = MODELS[text]
         if coords not in (None, 1):
-            return _preset(text, entry.model_class(coords), dt, preset, wanted_by)
+            try:
+                cls = entry.model_class(coords)
+            except ModelError as exc:
+                raise ModelError(f"model {text!r}: {exc}") from None
+            return _preset(text, cls, dt, preset, wanted_by)
         if entry.entry_point is None:
             raise ModelError(
                 f"model {text!r} exists for {coordinate_words(entry.coordinate_counts()[0])} "

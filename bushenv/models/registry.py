@@ -97,8 +97,9 @@ class ModelEntry:
             return self.wider[coords]
         have = " or ".join(str(c) for c in self.coordinate_counts())
         raise ModelError(
-            f"{self.summary.split(',')[0]}: exists for {have} coordinate(s), not {coords} "
-            f"({coordinate_words(coords)})"
+            f"this kind exists for {have} coordinate(s), not {coords}: for "
+            f"{coordinate_words(coords).split(':')[0]} choose one of "
+            f"{', '.join(names_for(coords))}"
         )
 
     def model_class(self, coords: int = 1) -> type:

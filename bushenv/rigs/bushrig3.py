@@ -41,7 +41,7 @@ def resolve_planar(
         try:
             model = get_model(value, dt=dt, preset=options, coords=3, wanted_by=wanted)
         except ModelError as exc:
-            raise RigError(f"{env_id}: {what} {value!r}: {exc}") from None
+            raise RigError(f"{env_id}: {what}: {exc}") from None
         return model
     if isinstance(value, str | Path) and str(value).endswith(".npz"):
         try:

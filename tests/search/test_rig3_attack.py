@@ -94,7 +94,7 @@ def test_a_one_axis_model_name_on_rig3_is_refused_in_one_line(tmp_path, capsys):
             "--out", str(tmp_path / "run")]  # fmt: skip
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "nn-paper" in err[0] and "planar model" in err[0]
+    assert len(err) == 1 and "nn-paper" in err[0] and "not 3: for a three-axis model" in err[0]
 
 
 def test_the_matrix_refuses_a_planar_target_pointing_at_the_attack(tmp_path):
