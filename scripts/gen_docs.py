@@ -9,6 +9,8 @@
 | docs/diagnose.md, between the effects-table   | ``bushenv.diagnose.candidates.effects_table`` |
 | markers                                       |                                               |
 | docs/studies.md (the whole page)              | the tops of ``studies/*/README.md``           |
+| docs/search.md, between the attack-legend     | ``bushenv.search.campaign_report.             |
+| markers                                       | legend_markdown``                             |
 
 A doc generated in part keeps everything outside its ``<!-- NAME -->`` ... ``<!-- /NAME -->``
 markers. ``tests/test_gen_docs.py`` runs ``--check``, so a registry entry added without
@@ -80,10 +82,17 @@ def _studies() -> str:
     return STUDIES_HEAD + "\n".join(rows) + "\n"
 
 
+def _attack_legend() -> str:
+    from bushenv.search.campaign_report import legend_markdown
+
+    return legend_markdown()
+
+
 GENERATED = (
     Generated("docs/registries.md", None, _registries),
     Generated("docs/diagnose.md", "effects-table", _effects_table),
     Generated("docs/studies.md", None, _studies),
+    Generated("docs/search.md", "attack-legend", _attack_legend),
 )
 
 

@@ -380,14 +380,22 @@ def _md_cell(text: str) -> str:
     return text.replace("|", "\\|")
 
 
+def legend_markdown(printed: str | None = None) -> str:
+    """The legend as two markdown tables (report.md; the docs' page, ``scripts/gen_docs.py``):
+    every column, then the lines around the table ``printed`` holds (all when None)."""
+    lines = ["| column | meaning |", "|---|---|"]
+    lines += [f"| {c.name} | {_md_cell(c.meaning)} |" for c in COLUMNS]
+    lines += ["", "| lines starting | meaning |", "|---|---|"]
+    shown = [(k, t) for k, t in SECTIONS if printed is None or _has_section(printed, k)]
+    lines += [f"| {k} | {_md_cell(t)} |" for k, t in shown]
+    return "\n".join(lines)
+
+
 def report_markdown(report: dict[str, Any], target_key: str, plots: list[str]) -> str:
     """``report.md``: the table, what each column means with its unit, the scales, the plots."""
     table = format_table(report, target_key, legend=False)
     lines = ["# Adversarial campaign", "", "```", table, "```", ""]
-    lines += ["## The columns", "", "| column | meaning |", "|---|---|"]
-    lines += [f"| {c.name} | {_md_cell(c.meaning)} |" for c in COLUMNS]
-    lines += ["", "| lines starting | meaning |", "|---|---|"]
-    lines += [f"| {k} | {_md_cell(t)} |" for k, t in SECTIONS if _has_section(table, k)]
+    lines += ["## The columns", "", legend_markdown(table)]
     lines += ["", "## Criteria", "", report["criteria"]["why"], ""]
     sc = report["scales"]
     lines += [
