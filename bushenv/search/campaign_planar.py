@@ -14,11 +14,14 @@ A short pipeline through the one-axis search contracts, as the one-axis attack d
 2. **search**: each searcher on a ``BatchEvaluator`` of the ``rig3`` target, its failing
    profiles (and its worst) saved in ``failures/<model>-<searcher>.npz`` (``load_profiles``
    reads them: (T, 3) each), its coverage per coordinate in its unit;
+   then the **hold stage** (``campaign_planar_holds``): the holds a planar network's fixed
+   points mark as suspect, each stepped to and held, judged, filed as a search;
 3. **recheck**: the control (which must stay clean) and the hybrid on every saved failure;
 4. **shrink**: the first ``max_shrink`` failures shrunk per axis and written as cases
    (``case_file.py``; ``--save`` adds them to the corpus);
-5. **report**: ``report.json`` (rewritten after every step, so ``--resume`` continues an
-   interrupted attack where it stopped: every step is seeded) and ``report.md`` in ``--out``.
+5. **report** (``campaign_planar_report``): ``report.json`` (rewritten after every step, so
+   ``--resume`` continues an interrupted attack where it stopped: every step is seeded) and
+   ``report.md`` in ``--out``.
 """
 
 from __future__ import annotations
@@ -36,9 +39,12 @@ from bushenv.persist import atomic_write, json_default, load_profiles, write_jso
 from bushenv.progress import Progress
 from bushenv.search.base import Searcher, SearchError
 from bushenv.search.campaign_config import CampaignConfig
+from bushenv.search.campaign_planar_holds import NAME as HOLDS
+from bushenv.search.campaign_planar_holds import PlanarHolds, listed_holds3
+from bushenv.search.campaign_planar_report import format_planar_table, fresh_report, resumed
 from bushenv.search.campaign_search import MAX_SAVED_FAILURES
 from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.families_planar import UNITS, Rig3Limits, limits_text, machine_limits
+from bushenv.search.families_planar import Rig3Limits, machine_limits
 from bushenv.search.planar_models import (  # noqa: F401 (DEFAULT_REFERENCE, vetted_judge: the zoo's)
     DEFAULT_REFERENCE,
     Planar,
@@ -186,6 +192,14 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
             continue
         report["searchers"].append(_search_one(c, p, name, i * c.budget, threads, progress))
         save()
+    if report["hold_stage"] is None:
+        report["hold_stage"], summary = _hold_stage(c, p, threads, progress)
+        if summary is not None:
+            report["searchers"].append(summary)
+        save()
+    elif HOLDS in done:
+        progress.say(f"[{c.model}] {HOLDS}: done earlier (resumed)")
+        report["searchers"].append(done[HOLDS])
     failing = _failing(out, report["searchers"])
     profiles = [q for _, q, _ in failing]
     if not report["recheck"]:
@@ -218,74 +232,38 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     return PlanarAttack(report, report_path, flagged)
 
 
-def arguments(c: CampaignConfig) -> dict:
-    """The settings a resumed planar attack must share with the one it continues."""
-    keep = ("stroke_mm", "max_velocity_m_per_s")
-    return {**c.arguments(), "searchers": list(c.searchers), **{k: getattr(c, k) for k in keep}}
+def _hold_stage(c, p: Planar, threads: int, progress: Progress) -> tuple[dict, dict | None]:
+    """The hold stage (``campaign_planar_holds``): its report entry and its search's."""
+    floors = np.array(list(p.judge["force_floors"].values()))
+    holds = listed_holds3(p.model, p.limits, floors)
+    if holds is None:
+        return {"run": False, "why": "not a planar network (no fixed points)"}, None
+    if not holds:
+        progress.say(f"[{c.model}] {HOLDS}: the fixed points mark no hold")
+        stage = PlanarHolds([], p.limits)
+        return stage.entry(), None
+    stage = PlanarHolds(holds, p.limits)
+    progress.total += len(holds)
+    summary = _search_one(c, p, HOLDS, progress.total - len(holds), threads, progress, stage,
+                          len(holds))  # fmt: skip
+    return stage.entry(), summary
 
 
-def fresh_report(c: CampaignConfig, p: Planar) -> dict:
-    """The report before any search."""
-    return {
-        "env": c.target,
-        "model": c.model,
-        "reference": c.reference or DEFAULT_REFERENCE,
-        "judge": p.judge,
-        "limits": p.limits.to_json(),
-        "control": p.control,
-        "budget": c.budget,
-        "seed": c.seed,
-        "arguments": arguments(c),
-        "searchers": [],
-        "recheck": {},
-        "shrunk": None,
-        "plots": [],
-        "seconds": 0.0,
-        "complete": False,
-    }
-
-
-def resumed(path: Path, fresh: dict) -> dict:
-    """The report at ``path`` when it was made with ``fresh``'s arguments; ``SearchError``
-    naming the first argument that differs."""
-    try:
-        old = json.loads(path.read_text())
-    except (OSError, ValueError) as exc:
-        raise SearchError(f"{path}: cannot resume from it ({exc}); pass --force") from None
-    for k, v in fresh["arguments"].items():
-        if old.get("arguments", {}).get(k) != v:
-            raise SearchError(
-                f"--resume: {path} was made with {k}={old.get('arguments', {}).get(k)!r}"
-                f", not {v!r}; pass --force to start again"
-            )
-    return {
-        **fresh,
-        **{k: old[k] for k in ("searchers", "recheck", "shrunk", "plots", "seconds") if k in old},
-    }
-
-
-def _search_one(c, p: Planar, name: str, start: int, threads: int, progress: Progress) -> dict:
-    """One search, its failures and worst saved under ``failures/``: its report entry."""
-    progress.say(f"[{c.model}] {name}: budget {c.budget} evaluations on {c.target} ...")
+def _search_one(c, p: Planar, name: str, start: int, threads: int, progress: Progress,
+                searcher: Searcher | None = None, budget: int | None = None) -> dict:  # fmt: skip
+    """One search (``searcher``, else ``name``'s), its failures and worst saved under
+    ``failures/``: its report entry."""
+    budget = c.budget if budget is None else budget
+    progress.say(f"[{c.model}] {name}: budget {budget} evaluations on {c.target} ...")
 
     def said(msg: str, evaluations: int) -> None:
         progress.update(start + evaluations, f"  {msg}")
 
     result, covered = planar_search(
-        p.model,
-        p.reference,
-        name,
-        c.budget,
-        c.seed,
-        threads,
-        said,
-        c.target,
-        limits=p.limits,
-        coverage=True,
-    )
-    progress.update(
-        start + c.budget, f"[{c.model}] {name}: {result.n_failures} failures", force=True
-    )
+        p.model, p.reference, searcher or name, budget, c.seed, threads, said, c.target,
+        limits=p.limits, coverage=True,
+    )  # fmt: skip
+    progress.update(start + budget, f"[{c.model}] {name}: {result.n_failures} failures", force=True)
     summary = result.summary()
     summary["coverage"] = covered
     summary["failures"] = tally(result.failures)
@@ -401,96 +379,3 @@ def _shrink_some(p: Planar, target, failing, c, progress, out: Path):
         )
         shown.append((f"{family}, failed in {res.verdict.get('axis')}", res.profile))
     return kept, shown
-
-
-def _judge_lines(judge: dict | None) -> list[str]:
-    """What judged: the reference's vetting, the floors; marked when trusted despite failing."""
-    if not judge:
-        return []
-    v = judge["vetting"]
-    mark = {True: "ok", False: "FAILED", None: "undecided"}
-    checks = "; ".join(f"{c['check']} {mark[c['passed']]}" for c in v["checks"])
-    floors = ", ".join(f"{k} {x:.4g}" for k, x in judge["force_floors"].items())
-    source = judge.get("force_floors_source")
-    head = (
-        "JUDGED BY A REFERENCE THAT FAILED ITS VETTING (--trust-reference): "
-        if (judge["trusted_despite_failed_vetting"])
-        else ""
-    )
-    return [
-        f"{head}judge: reference {v['reference']} vetted ({checks}); force floors {floors} "
-        f"(N, N, N m){': ' + source if source else ''}",
-        "",
-    ]
-
-
-def _limits_lines(report: dict) -> list[str]:
-    lim, ctl = report.get("limits"), report.get("control")
-    lines = [f"searched within {limits_text(lim)}"] if lim else []
-    if ctl:
-        lines.append(f"control: {ctl['label']} ({ctl['how']})")
-    return [*lines, ""] if lines else []
-
-
-def _coverage_line(s: dict) -> str | None:
-    cov = s.get("coverage") or {}
-    coords = TARGETS["rig3"].coords
-    if not cov or not all(c in row for row in cov.values() for c in coords):
-        return None
-    parts = []
-    for c, u in zip(coords, UNITS, strict=True):
-        top = max(row[c][f"peak_{u}_max"] for row in cov.values())
-        parts.append(f"{c} {top:.4g} {u}")
-    return f"{s['searcher']}: largest peak tried {', '.join(parts)}"
-
-
-def format_planar_table(report: dict) -> str:
-    """The attack's table: one line per searcher, then what broke it and the rechecks."""
-    lines = [
-        f"planar attack on {report['model']} ({report['env']}, vs {report['reference']}), "
-        f"budget {report['budget']}, seed {report['seed']}",
-        "",
-        *_judge_lines(report.get("judge")),
-        *_limits_lines(report),
-        "| searcher | failures / evaluations | first failure at | first: family (axis) | "
-        "worst robustness |",
-        "|---|---|---|---|---|",
-    ]
-    for s in report["searchers"]:
-        ff = s.get("first_failure")
-        first = f"{ff['family']} ({ff.get('axis')})" if ff else "-"
-        worst = s.get("worst_robustness")
-        lines.append(
-            f"| {s['searcher']} | {s['n_failures']} / {s['evaluations']} | "
-            f"{s['evaluations_to_failure'] or '-'} | {first} | "
-            f"{'-' if worst is None else f'{worst:.3g}'} |"
-        )
-    for s in report["searchers"]:
-        f = s["failures"]
-        covered = _coverage_line(s)
-        if f["by_family"] or covered:
-            lines.append("")
-        if covered:
-            lines.append(covered)
-        if f["by_family"]:
-            lines.append(f"{s['searcher']}: failures by family {json.dumps(f['by_family'])}")
-            lines.append(f"{s['searcher']}: failures by axis {json.dumps(f['by_axis'])}")
-        if s.get("profiles_file"):
-            lines.append(f"{s['searcher']}: failing profiles in {s['profiles_file']}")
-    reach = report.get("failure_reach")
-    if reach:
-        lines.append(
-            f"failures reach {reach['median']:.3g}x the records' peak (median; "
-            f"{reach['min']:.3g}x to {reach['max']:.3g}x)"
-        )
-    for role, r in report["recheck"].items():
-        who = f" ({r['model']})" if r.get("model") else ""
-        lines.append(
-            f"recheck {role}{who}: {r['diverged']} of {r['profiles']} failing profiles diverge"
-        )
-    for k in report["shrunk"] or []:
-        lines.append(
-            f"shrunk {k['family']} ({k['axis']}, {k['criterion']}): moving {k['moving']}, "
-            f"{k['original']['segments']} -> {k['final']['segments']} segments"
-        )
-    return "\n".join(lines)

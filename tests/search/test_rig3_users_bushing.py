@@ -195,3 +195,49 @@ def test_the_covered_search_is_the_searchers_own_run():
             s.pop("seconds"), s.pop("seconds_to_failure")
         assert covered == plain
         assert set(per_coordinate) == set(plain["coverage"])
+
+
+def test_a_model_that_is_no_network_skips_the_hold_stage_and_says_why(attacked):
+    assert attacked["hold_stage"] == {"run": False, "why": "not a planar network (no fixed points)"}
+    assert "cert-holds" not in [s["searcher"] for s in attacked["searchers"]]
+
+
+@pytest.fixture(scope="module")
+def network(bushing) -> Path:
+    path = bushing / "nn3.npz"
+    short = ["--teacher-steps", "40", "--free-run-steps", "20"]
+    assert main(["fit", str(bushing / "rec3" / TRAIN), "--model", "nn", "--out", str(path),
+                 "--no-plots", "--quiet", *short]) == 0  # fmt: skip
+    return path
+
+
+def test_the_hold_stage_steps_to_each_suspect_hold_within_the_limits_and_judges_it(network):
+    from bushenv.models import load_model
+    from bushenv.search.campaign_planar_holds import KINDS, PlanarHolds, listed_holds3
+    from bushenv.search.evaluate import BatchEvaluator
+    from bushenv.search.target_rig3 import covered_search
+
+    model = load_model(network, coords=3)
+    lim = Rig3Limits((3e-3, 3e-3, 0.075), (0.2, 0.2, 5.0))
+    holds = listed_holds3(model, lim, floors=np.zeros(3))  # no floor: every inward push counts
+    assert holds, "a network with no floor to its pushes lists some hold"
+    for h in holds:
+        assert set(h["kinds"]) <= set(KINDS) and h["kinds"]
+        assert np.all(np.abs(h["q"]) <= np.array(lim.stroke) * (1 + 1e-12))
+    assert listed_holds3(PlanarLinear.preset(), lim, np.zeros(3)) is None
+    stage = PlanarHolds(holds, lim)
+    with BatchEvaluator(model, PlanarLinear.preset(), "rig3", scales=lim) as ev:
+        result, covered = covered_search(stage, ev, len(holds), 0)
+    assert result.evaluations == len(holds) and set(covered) == {"step_hold3"}
+    assert covered["step_hold3"]["rotation"]["max_rate_rad_per_s"] <= 5.0 + 1e-9
+    entry = stage.entry()
+    assert entry["listed"] == len(entry["holds"]) == len(holds)
+    assert entry["confirmed"] == sum(h["confirmed"] for h in entry["holds"])
+
+
+def test_an_attack_on_a_network_runs_the_hold_stage(bushing, network):
+    report = _attack(bushing, "att-nn", "--model", str(network), "--searchers", "random")
+    stage = report["hold_stage"]
+    assert stage["run"] and stage["grid_points"] == 5
+    names = [s["searcher"] for s in report["searchers"]]
+    assert names == (["random", "cert-holds"] if stage["listed"] else ["random"])
