@@ -95,14 +95,16 @@ class Rig3Limits:
 
     def __post_init__(self) -> None:
         top_stroke, top_rate = rig3_limits()
-        for name, vals, top in (("stroke", self.stroke, top_stroke), ("rate", self.rate, top_rate)):
+        rates = [r.replace("_per_s", "/s") for r in RATE_UNITS]
+        for name, vals, top, units, k in (("stroke", self.stroke, top_stroke, UNITS, 1e3),
+                                          ("rate", self.rate, top_rate, rates, 1.0)):  # fmt: skip
             if len(vals) != 3:
                 raise SearchError(f"rig3 {name} needs 3 values (axial, radial, rotation): {vals}")
-            for c, v, t in zip(COORDS, vals, top, strict=True):
+            for c, v, t, u in zip(COORDS, vals, top, units, strict=True):
                 if not (np.isfinite(v) and 0 < v <= t * (1 + 1e-9)):
                     raise SearchError(
-                        f"rig3 {name} of the {c} coordinate must be in (0, {t:.6g}] "
-                        f"(BushRig3-v0's), got {v!r}"
+                        f"the {c} {name} must be in (0, {k * t:.6g}] {u} (BushRig3-v0's), "
+                        f"got {k * v:.6g} {u}"
                     )
 
     def to_json(self) -> dict:

@@ -241,3 +241,10 @@ def test_an_attack_on_a_network_runs_the_hold_stage(bushing, network):
     assert stage["run"] and stage["grid_points"] == 5
     names = [s["searcher"] for s in report["searchers"]]
     assert names == (["random", "cert-holds"] if stage["listed"] else ["random"])
+
+
+def test_a_stroke_beyond_the_machine_is_refused_in_mm(bushing, capsys):
+    with pytest.raises(AssertionError):
+        _attack(bushing, "att-far", "--stroke-mm", "20", "--searchers", "random")
+    err = capsys.readouterr().err
+    assert "the axial stroke must be in (0, 12.5] mm (BushRig3-v0's), got 20 mm" in err
