@@ -1,4 +1,5 @@
-"""``bushenv export``: a bushing model as an FMU (FMI 2.0 / 3.0 co-simulation, compiled C)."""
+"""``bushenv export``: a bushing model as an FMU (FMI 2.0 / 3.0, co-simulation and model exchange,
+compiled C)."""
 
 from __future__ import annotations
 
@@ -72,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
     print(done.path)
     if not args.quiet:
         print(
-            f"FMI {done.fmi_version} co-simulation FMU of the {done.model!r} model, compiled with "
+            f"FMI {done.fmi_version} FMU (co-simulation and model exchange; deflection in, force "
+            f"out) of the {done.model!r} model, compiled with "
             f"{done.compiler}; envelope |x| <= {env.stroke_m * 1e3:.4g} mm, |v| <= "
             f"{env.velocity_m_per_s:.4g} m/s ({env.source})",
             file=sys.stderr,

@@ -30,7 +30,7 @@ from bushenv.export.description import (
     model_description,
 )
 from bushenv.export.facts import Facts, facts_of, find_card
-from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE, model_source, uses_velocity
+from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE, model_source
 from bushenv.models import ModelError, ModelSpec, file_hash, get_model, model_file
 from bushenv.persist import atomic_write
 
@@ -179,7 +179,6 @@ def export_fmu(
         stroke_m,
         velocity_m_per_s,
     )
-    has_v = uses_velocity(model)
     body = model_source(model, substeps)
     token = (
         "{"
@@ -188,7 +187,7 @@ def export_fmu(
         )
         + "}"
     )
-    model_h = body + fmu_header(token, has_v, facts)
+    model_h = body + fmu_header(token, facts)
     main = "fmi2.c" if fmi_version == "2.0" else "fmi3.c"
     sources = {"model.h": model_h.encode(), main: _c_file(main)}
     for name in HEADERS + FMI_HEADERS[fmi_version]:
@@ -196,9 +195,7 @@ def export_fmu(
     with tempfile.TemporaryDirectory(prefix="bushenv-fmu-") as tmp:
         binary = compile_library(sources, main, compiler, Path(tmp))
     tool = f"bushenv {__version__}"
-    description = model_description(
-        fmi_version, model.name, token, has_v, facts, model.dt, tool, ode=model.name == "boucwen"
-    )
+    description = model_description(fmi_version, model.name, token, facts, model.dt, tool)
     files = {"modelDescription.xml": description.encode()}
     files[f"binaries/{folders[fmi_version]}/{MODEL_IDENTIFIER}.so"] = binary
     for name, data in sources.items():

@@ -1,9 +1,11 @@
 """modelDescription.xml (FMI 2.0 and 3.0), buildDescription.xml (3.0) and the generated
-``fmu.h`` that ties the C to them (token, velocity input or not, envelope, facts).
+``fmu.h`` that ties the C to them (token, envelope, facts).
 
+Every FMU has one interface, whatever the model kind, in co-simulation and model exchange.
 Value references are fixed (``c/variables.h``): 0 time (FMI 3), 1 deflection [m], 2 velocity
-[m/s] (models that use it), 3 force [N], 4 outside_envelope, 5 time_outside_envelope_s [s],
-6-8 the envelope's stroke and velocity and the sample time (constants), 100.. the facts.
+[m/s] (optional: used once the master sets it), 3 force [N], 4 outside_envelope,
+5 time_outside_envelope_s [s], 6-8 the envelope's stroke and velocity and the sample time
+(constants), 100.. the facts.
 """
 
 from __future__ import annotations
@@ -16,6 +18,11 @@ from bushenv.export.facts import Facts
 from bushenv.export.model_c import lit
 
 MODEL_IDENTIFIER = "bushing"
+# The FMU's interface version (modelDescription's ``version``), raised when what a master sees
+# changes. 1: the velocity input required by linear, hybrid and boucwen, none on nn, Bouc-Wen
+# alone in model exchange (states y, w, z1, z2). 2: one interface for every kind, the velocity
+# optional (the FMU's own backward difference otherwise), every kind in model exchange.
+INTERFACE_VERSION = "2"
 FMI_VERSIONS = ("2.0", "3.0")
 UNITS = {"m": {"m": 1}, "m/s": {"m": 1, "s": -1}, "N": {"kg": 1, "m": 1, "s": -2}, "s": {"s": 1}}
 
@@ -30,20 +37,12 @@ class Variable:
     description: str
     unit: str | None = None
     start: str | None = None
-    derivative_of: int | None = None  # vr of the state this is the derivative of
 
 
-STATES = ("y", "w", "z1", "z2")  # seed 002 eqs. 1-4, model exchange (value references 10-13)
-# where eqs. 1-2 switch (sgn d sgn z): relative velocities d1, d2 and z1, z2 (references 18-21)
-INDICATORS = ("d1", "d2", "z1", "z2")
-UNIT_OF = {"d1": "m/s", "d2": "m/s", "z1": "m", "z2": "m"}
-
-
-def variables(has_velocity: bool, facts: Facts, dt: float, ode: bool = False) -> list[Variable]:
-    """The FMU's variables; ``ode``: the model is an ODE (model exchange too): the force is
-    continuous and the states and their derivatives are listed."""
+def variables(facts: Facts, dt: float) -> list[Variable]:
+    """The FMU's variables. The force is continuous (in model exchange it follows the current
+    deflection between samples); the envelope's outputs change at samples only."""
     env = facts.envelope
-    changes = "continuous" if ode else "discrete"
     out = [
         Variable(
             "deflection",
@@ -56,18 +55,26 @@ def variables(has_velocity: bool, facts: Facts, dt: float, ode: bool = False) ->
             "0.0",
         ),
     ]
-    if has_velocity:
-        out.append(
-            Variable("velocity", 2, "Real", "input", "continuous", "deflection rate", "m/s", "0.0")
-        )
     out += [
+        Variable(
+            "velocity",
+            2,
+            "Real",
+            "input",
+            "continuous",
+            "deflection rate; optional: once set after initialisation it replaces the FMU's "
+            "own backward difference of the deflection",
+            "m/s",
+            "0.0",
+        ),
         Variable(
             "force",
             3,
             "Real",
             "output",
-            changes,
-            "bushing force of the latest model sample",
+            "continuous",
+            "bushing force: co-simulation, of the latest model sample; model exchange, the "
+            "latest sample recomputed with the current input",
             "N",
         ),
         Variable(
@@ -83,7 +90,7 @@ def variables(has_velocity: bool, facts: Facts, dt: float, ode: bool = False) ->
             5,
             "Real",
             "output",
-            changes,
+            "discrete",
             "time the input has spent outside the validity envelope",
             "s",
         ),
@@ -118,47 +125,6 @@ def variables(has_velocity: bool, facts: Facts, dt: float, ode: bool = False) ->
             lit(dt),
         ),
     ]
-    if ode:
-        for i, name in enumerate(STATES):
-            unit = "m"
-            out.append(
-                Variable(
-                    f"state.{name}",
-                    10 + i,
-                    "Real",
-                    "local",
-                    "continuous",
-                    f"seed 002 eqs. 1-4: {name}",
-                    unit,
-                    "0.0",
-                )
-            )
-        for i, name in enumerate(STATES):
-            out.append(
-                Variable(
-                    f"der(state.{name})",
-                    14 + i,
-                    "Real",
-                    "local",
-                    "continuous",
-                    f"d{name}/dt",
-                    "m/s",
-                    None,
-                    10 + i,
-                )
-            )
-        for i, name in enumerate(INDICATORS):
-            out.append(
-                Variable(
-                    f"event.{name}",
-                    18 + i,
-                    "Real",
-                    "local",
-                    "continuous",
-                    f"event indicator: {name} changes sign",
-                    UNIT_OF[name],
-                )
-            )
     for i, (name, value) in enumerate(facts.lines):
         out.append(
             Variable(
@@ -204,43 +170,34 @@ def model_description(
     version: str,
     kind: str,
     token: str,
-    has_velocity: bool,
     facts: Facts,
     dt: float,
     tool: str,
-    ode: bool = False,
 ) -> str:
-    """modelDescription.xml for FMI ``version``: co-simulation, and model exchange if ``ode``."""
-    vs = variables(has_velocity, facts, dt, ode)
+    """modelDescription.xml for FMI ``version``: co-simulation and model exchange."""
+    vs = variables(facts, dt)
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
     head = _attr(
         fmiVersion=version,
         modelName=f"bushenv_{kind}",
         description=f"bushenv {kind!r} bushing model, compiled C at {1 / dt:.6g} Hz",
+        version=INTERFACE_VERSION,
         generationTool=tool,
         generationDateAndTime=now,
         variableNamingConvention="structured",
     )
     make = _fmi2 if version == "2.0" else _fmi3
-    return (
-        "\n".join(['<?xml version="1.0" encoding="UTF-8"?>', *make(vs, head, token, dt, ode)])
-        + "\n"
-    )
+    return "\n".join(['<?xml version="1.0" encoding="UTF-8"?>', *make(vs, head, token, dt)]) + "\n"
 
 
-def _fmi2(vs: list[Variable], head: str, token: str, dt: float, ode: bool) -> list[str]:
+def _fmi2(vs: list[Variable], head: str, token: str, dt: float) -> list[str]:
     idx = {v.vr: i + 1 for i, v in enumerate(vs)}
-    # outputs of an ODE model depend on the states too: no list (= on every known)
-    deps = (
-        ""
-        if ode
-        else _attr(dependencies=" ".join(str(idx[v.vr]) for v in vs if v.causality == "input"))
-    )
+    deps = _attr(dependencies=" ".join(str(idx[v.vr]) for v in vs if v.causality == "input"))
     src = '<SourceFiles><File name="fmi2.c"/></SourceFiles>'
-    n_ind = len(INDICATORS) if ode else 0
-    lines = [f'<fmiModelDescription{head} guid="{token}" numberOfEventIndicators="{n_ind}">']
-    if ode:
-        lines.append(f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}">{src}</ModelExchange>')
+    lines = [
+        f'<fmiModelDescription{head} guid="{token}" numberOfEventIndicators="0">',
+        f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}">{src}</ModelExchange>',
+    ]
     lines += [
         f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}"'
         ' canHandleVariableCommunicationStepSize="true" canInterpolateInputs="true"'
@@ -262,39 +219,27 @@ def _fmi2(vs: list[Variable], head: str, token: str, dt: float, ode: bool) -> li
             variability=v.variability,
             initial="exact" if exact else None,
         )
-        der = idx[v.derivative_of] if v.derivative_of is not None else None
         lines.append(
             f"    <ScalarVariable{attrs}>"
-            f"<{v.kind}{_attr(unit=v.unit, start=v.start, derivative=der)}/>"
+            f"<{v.kind}{_attr(unit=v.unit, start=v.start)}/>"
             "</ScalarVariable>"
         )
     outs = [idx[v.vr] for v in vs if v.causality == "output"]
-    ders = [idx[v.vr] for v in vs if v.derivative_of is not None]
     lines += ["  </ModelVariables>", "  <ModelStructure>", "    <Outputs>"]
     lines += [f'      <Unknown index="{i}"{deps}/>' for i in outs]
-    lines += ["    </Outputs>"]
-    if ders:
-        lines += [
-            "    <Derivatives>",
-            *[f'      <Unknown index="{i}"/>' for i in ders],
-            "    </Derivatives>",
-        ]
-    lines += ["    <InitialUnknowns>"]
-    lines += [f'      <Unknown index="{i}"{deps}/>' for i in sorted(outs + ders)]
+    lines += ["    </Outputs>", "    <InitialUnknowns>"]
+    lines += [f'      <Unknown index="{i}"{deps}/>' for i in outs]
     lines += ["    </InitialUnknowns>", "  </ModelStructure>", "</fmiModelDescription>"]
     return lines
 
 
-def _fmi3(vs: list[Variable], head: str, token: str, dt: float, ode: bool) -> list[str]:
-    deps = (
-        "" if ode else _attr(dependencies=" ".join(str(v.vr) for v in vs if v.causality == "input"))
-    )
-    lines = [f'<fmiModelDescription{head} instantiationToken="{token}">']
-    if ode:
-        lines.append(
-            f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}"'
-            ' needsCompletedIntegratorStep="true"/>'
-        )
+def _fmi3(vs: list[Variable], head: str, token: str, dt: float) -> list[str]:
+    deps = _attr(dependencies=" ".join(str(v.vr) for v in vs if v.causality == "input"))
+    lines = [
+        f'<fmiModelDescription{head} instantiationToken="{token}">',
+        f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}"'
+        ' needsCompletedIntegratorStep="false"/>',
+    ]
     lines += [
         f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}"'
         ' canHandleVariableCommunicationStepSize="true" hasEventMode="false"'
@@ -317,19 +262,15 @@ def _fmi3(vs: list[Variable], head: str, token: str, dt: float, ode: bool) -> li
             variability=v.variability,
             initial="exact" if exact else None,
             unit=v.unit,
-            derivative=v.derivative_of,
         )
         if v.kind == "String" and v.start is not None:
             lines.append(f"    <{tag}{attrs}><Start value={quoteattr(v.start)}/></{tag}>")
         else:
             lines.append(f"    <{tag}{attrs}{_attr(start=v.start)}/>")
     outs = [v.vr for v in vs if v.causality == "output"]
-    ders = [v.vr for v in vs if v.derivative_of is not None]
     lines += ["  </ModelVariables>", "  <ModelStructure>"]
     lines += [f'    <Output valueReference="{vr}"{deps}/>' for vr in outs]
-    lines += [f'    <ContinuousStateDerivative valueReference="{vr}"/>' for vr in ders]
-    lines += [f'    <InitialUnknown valueReference="{vr}"{deps}/>' for vr in outs + ders]
-    lines += [f'    <EventIndicator valueReference="{v.vr}"/>' for v in vs if v.vr in range(18, 22)]
+    lines += [f'    <InitialUnknown valueReference="{vr}"{deps}/>' for vr in outs]
     lines += [
         "  </ModelStructure>",
         '  <Annotations><Annotation type="org.bushenv.card">'
@@ -368,7 +309,7 @@ def _c_string(text: str) -> str:
     return '"' + "".join(out) + '"'
 
 
-def fmu_header(token: str, has_velocity: bool, facts: Facts) -> str:
+def fmu_header(token: str, facts: Facts) -> str:
     """The generated constants ``core.h`` and ``variables.h`` read (appended to model.h)."""
     env = facts.envelope
     flagged = [lit(v) for pair in env.flagged_m for v in pair] or ["0.0"]
@@ -377,7 +318,7 @@ def fmu_header(token: str, has_velocity: bool, facts: Facts) -> str:
         "\n".join(
             [
                 f'#define FMU_TOKEN "{token}"',
-                f"#define HAS_VELOCITY {int(has_velocity)}",
+                "#define HAS_VELOCITY 1 /* every FMU has the (optional) velocity input */",
                 f"#define ENV_STROKE_M {lit(env.stroke_m)}",
                 f"#define ENV_VELOCITY_M_PER_S {lit(env.velocity_m_per_s)}",
                 f"#define ENV_N_FLAGGED {len(env.flagged_m)}",

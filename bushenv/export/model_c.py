@@ -2,8 +2,9 @@
 
 ``model_source(model)`` returns ``model.h``: ``MODEL_N_STATE``, ``MODEL_DT_S``,
 ``model_reset(double *s)`` (the state at rest) and ``model_step(double *s, x, v)`` (advance one
-sample, return the force, N), for the FMU core (``c/core.h``) to call. Each reproduces the
-model's own discrete definition:
+sample with deflection x and velocity v, return the force, N), for the FMU core (``c/core.h``),
+which supplies v (the backward difference, or the velocity input). Each reproduces the model's
+own discrete definition:
 
 * linear: F = k x + c v (``kernels.linear_kernel``);
 * nn, hybrid: the NARX recurrence of ``kernels.narx_kernel`` with the same operations in the
@@ -31,11 +32,6 @@ def lit(value: float) -> str:
     return text if any(c in text for c in ".eE") else text + ".0"
 
 
-def uses_velocity(model: BushingModel) -> bool:
-    """Whether the model's force depends on its velocity input (the pure NN ignores it)."""
-    return model.name != "nn"
-
-
 def model_source(model: BushingModel, substeps: int = BOUCWEN_SUBSTEPS) -> str:
     """``model.h`` for ``model`` (see the module docstring); ModelError for another kind."""
     kind = model.name
@@ -56,14 +52,6 @@ def model_source(model: BushingModel, substeps: int = BOUCWEN_SUBSTEPS) -> str:
         body = _boucwen(model, substeps)
     else:
         body = _narx(model)
-    if kind != "boucwen":  # a recurrence, not an ODE: co-simulation only
-        body += [
-            "#define MODEL_HAS_RHS 0",
-            "static void model_rhs(double x, double u, const double *q, double *dq)"
-            " { (void)x; (void)u; (void)q; (void)dq; }",
-            "static double model_force(const double *q, double x, double u)"
-            " { (void)q; (void)x; (void)u; return 0.0; }",
-        ]
     return "\n".join(head + body) + "\n"
 
 
@@ -164,7 +152,6 @@ def _boucwen(m, substeps: int) -> list[str]:
     p = {k: lit(getattr(m, k)) for k in m.param_names}
     return [
         "#define MODEL_N_STATE 6",
-        "#define MODEL_HAS_RHS 1 /* an ODE: model exchange too (y, w, z1, z2) */",
         f"#define MODEL_SUBSTEPS {int(substeps)}",
         "static double sgn_prod(double d, double z) {",
         "    if (d == 0.0 || z == 0.0) return 0.0;",

@@ -1,14 +1,17 @@
 """What the export tests share: bushenv excitations and FMPy-driven masters of an FMU.
 
-The masters drive an exported FMU from outside, through FMPy's FMU classes, as an importer
-would: ``set_then_read`` sets the inputs, then reads the outputs (many vehicle simulators do;
-FMPy's own ``simulate_fmu`` reads after ``doStep``, before the next input);
-``derivatives_then_step`` gives FMI 2 input derivatives; ``model_exchange_rk4`` integrates a
-model-exchange FMU with a fixed-step RK4 of its own. ``converged`` is the converged Bouc-Wen
-run the FMUs are judged against (tests/models/boucwen_converged.py).
+The masters drive an exported FMU from outside, as an importer would: ``set_then_read`` (FMPy's
+FMU classes) sets the inputs, then reads the outputs (many vehicle simulators do);
+``derivatives_then_step`` gives FMI 2 input derivatives; ``fmpy_simulate`` is FMPy's own
+``simulate_fmu`` (co-simulation: it reads after ``doStep``, before the next input; model
+exchange: its solver, the samples as time events); ``libcosim`` is libcosim's execution (FMI
+Library; ``pip install libcosimpy``), which sets the inputs, calls ``doStep``, then reads.
+``backward_velocity`` is the velocity rule of the FMU and the rigs; ``held`` is bushenv's force
+held over each sample, what the forces read at communication points are judged against.
+``converged`` is the converged Bouc-Wen run (tests/models/boucwen_converged.py).
 
-studies/2026-11-fmu-accuracy/fmu_accuracy.py and scripts/bench_fmu.py use these masters too
-(``sys.path`` gets this folder).
+studies/2026-11-fmu-accuracy/fmu_accuracy.py, studies/2026-11-fmu-masters/fmu_masters_study.py
+and scripts/bench_fmu.py use these masters too (``sys.path`` gets this folder).
 """
 
 import importlib.util
@@ -79,16 +82,27 @@ def opened(path, log=None, start_s: float = 0.0):
             s.freeInstance()
 
 
-def set_then_read(path, t_comm, x_comm, v_comm, log=None) -> np.ndarray:
-    """At each communication point set the inputs, read the force, ``doStep`` to the next
-    point. Returns the forces read, (len(t_comm),); ``log``: FMI 3 log-message callback."""
+def backward_velocity(x: np.ndarray, dt: float) -> np.ndarray:
+    """(x_k - x_(k-1)) / dt with x_(-1) = 0: the FMU's own velocity rule (and the rigs')."""
+    return np.diff(x, prepend=0.0) / dt
+
+
+def held(force: np.ndarray, t_comm: np.ndarray, dt: float) -> np.ndarray:
+    """bushenv's ``force`` (one per sample) held over each sample, at the times ``t_comm``."""
+    return force[np.floor(np.asarray(t_comm) / dt + 1e-6).astype(int)]
+
+
+def set_then_read(path, t_comm, x_comm, v_comm=None, log=None) -> np.ndarray:
+    """At each communication point set the inputs (``v_comm`` None: the deflection only, the
+    FMU's own velocity), read the force, ``doStep`` to the next point. Returns the forces
+    read, (len(t_comm),); ``log``: FMI 3 log-message callback."""
     with opened(path, log, float(t_comm[0])) as (s, vr, three):
         setf = s.setFloat64 if three else s.setReal
         getf = s.getFloat64 if three else s.getReal
         out = np.empty(len(t_comm))
         for j, t in enumerate(t_comm):
             setf([vr["deflection"]], [float(x_comm[j])])
-            if "velocity" in vr:
+            if v_comm is not None:
                 setf([vr["velocity"]], [float(v_comm[j])])
             out[j] = getf([vr["force"]])[0]
             if j + 1 < len(t_comm):
@@ -98,17 +112,17 @@ def set_then_read(path, t_comm, x_comm, v_comm, log=None) -> np.ndarray:
         return out
 
 
-def derivatives_then_step(path, t_comm, x_comm, v_comm) -> np.ndarray:
+def derivatives_then_step(path, t_comm, x_comm, v_comm=None) -> np.ndarray:
     """FMI 2: at each point set the inputs and their slope to the next point
-    (``fmi2SetRealInputDerivatives``), ``doStep``, read the force at the next point before
-    setting its input. Returns the forces at t_comm[1:]."""
+    (``fmi2SetRealInputDerivatives``; ``v_comm`` None: the deflection only), ``doStep``, read
+    the force at the next point before setting its input. Returns the forces at t_comm[1:]."""
     with opened(path, None, float(t_comm[0])) as (s, vr, three):
         if three:
             raise ValueError("input derivatives are an FMI 2 co-simulation feature")
         out = np.empty(len(t_comm) - 1)
         for j in range(len(t_comm) - 1):
             h = t_comm[j + 1] - t_comm[j]
-            names = ["deflection"] + (["velocity"] if "velocity" in vr else [])
+            names = ["deflection"] + (["velocity"] if v_comm is not None else [])
             vals = {"deflection": x_comm, "velocity": v_comm}
             for n in names:
                 s.setReal([vr[n]], [float(vals[n][j])])
@@ -118,70 +132,51 @@ def derivatives_then_step(path, t_comm, x_comm, v_comm) -> np.ndarray:
         return out
 
 
-def model_exchange_rk4(path, t, x, v, substeps: int = 64) -> np.ndarray:
-    """Model exchange through FMPy's FMU classes with a fixed-step RK4 of our own: per sample,
-    ``substeps`` steps with the inputs linear within the sample (as ``boucwen_reference``),
-    the FMU giving the derivatives. Returns the force at each sample (inputs set, then read)."""
-    from ctypes import c_double
+def fmpy_simulate(path, t, x, h: float, fmi_type: str = "CoSimulation"):
+    """FMPy's ``simulate_fmu`` on the record ``x`` at samples ``t`` (the deflection only; FMPy
+    interpolates it linearly), output every ``h``. Returns (times, forces)."""
+    from fmpy import simulate_fmu
 
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Model
-    from fmpy.fmi3 import FMU3Model
+    signal = np.array(list(zip(t, x, strict=True)), dtype=[("time", float), ("deflection", float)])
+    res = simulate_fmu(
+        str(path),
+        stop_time=float(t[-1]),
+        output_interval=h,
+        input=signal,
+        output=["force"],
+        fmi_type=fmi_type,
+        record_events=False,
+    )
+    return res["time"], res["force"]
 
-    md = read_model_description(str(path))
-    vr = {var.name: var.valueReference for var in md.modelVariables}
-    three = md.fmiVersion.startswith("3")
-    with tempfile.TemporaryDirectory(prefix="bushenv-fmu-") as folder:
-        m = (FMU3Model if three else FMU2Model)(
-            guid=md.guid,
-            unzipDirectory=extract(str(path), folder),
-            modelIdentifier=md.modelExchange.modelIdentifier,
-            instanceName="bushenv",
-        )
-        m.instantiate()
-        if three:
-            m.enterInitializationMode(startTime=float(t[0]))
-        else:
-            m.setupExperiment(startTime=float(t[0]))
-            m.enterInitializationMode()
-        m.exitInitializationMode()
-        if not three:
-            m.newDiscreteStates()
-        m.enterContinuousTimeMode()
-        setf = m.setFloat64 if three else m.setReal
-        getf = m.getFloat64 if three else m.getReal
-        deriv = m.getContinuousStateDerivatives if three else m.getDerivatives
-        q, dq = (c_double * 4)(), (c_double * 4)()
-        m.getContinuousStates(q, 4)
 
-        def rhs(tt, xx, uu, state):
-            m.setTime(tt)
-            setf([vr["deflection"], vr["velocity"]], [xx, uu])
-            m.setContinuousStates((c_double * 4)(*state), 4)
-            deriv(dq, 4)
-            return np.array(dq[:])
+def libcosim(path, t, x, h: float):
+    """libcosim's execution (FMI 2 FMUs: libcosimpy 0.0.6 crashes loading an FMI 3 one) with
+    the deflection only (an override manipulator sets it before
+    each step; a last-value observer reads the force after it). libcosim counts time in whole
+    nanoseconds: the step is ``h`` rounded up to one. Returns (times, forces): the force read
+    after the step that ends at each time."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
 
-        out = np.empty(len(t))
-        y = np.array(q[:])
-        x0 = u0 = 0.0
-        dt = t[1] - t[0]
-        h = dt / substeps
-        for k in range(len(t)):
-            for i in range(substeps):  # from rest before t[0], as the reference
-                a, mid, e = i / substeps, (i + 0.5) / substeps, (i + 1.0) / substeps
-                ta = t[k] - dt + a * dt
-                k1 = rhs(ta, x0 + a * (x[k] - x0), u0 + a * (v[k] - u0), y)
-                xm, um = x0 + mid * (x[k] - x0), u0 + mid * (v[k] - u0)
-                k2 = rhs(ta + h / 2, xm, um, y + h / 2 * k1)
-                k3 = rhs(ta + h / 2, xm, um, y + h / 2 * k2)
-                k4 = rhs(ta + h, x0 + e * (x[k] - x0), u0 + e * (v[k] - u0), y + h * k3)
-                y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-            m.setTime(float(t[k]))
-            setf([vr["deflection"], vr["velocity"]], [float(x[k]), float(v[k])])
-            m.setContinuousStates((c_double * 4)(*y), 4)
-            out[k] = getf([vr["force"]])[0]
-            m.completedIntegratorStep()
-            x0, u0 = float(x[k]), float(v[k])
-        m.terminate()
-        m.freeInstance()
-        return out
+    log_output_level(CosimLogLevel.ERROR)
+    step_ns = int(np.ceil(h * 1e9))
+    execution = CosimExecution.from_step_size(step_ns)
+    index = execution.add_local_slave(CosimLocalSlave(fmu_path=str(path), instance_name="bushing"))
+    vr = {v.name.decode(): v.reference for v in execution.slave_variables(index)}
+    manipulator = CosimManipulator.create_override()
+    execution.add_manipulator(manipulator)
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    n = int(np.floor(t[-1] / (step_ns * 1e-9)))
+    times = np.arange(1, n + 1) * step_ns * 1e-9
+    out = np.empty(n)
+    for k in range(n):
+        x_k = float(np.interp(k * step_ns * 1e-9, t, x))
+        manipulator.slave_real_values(index, [vr["deflection"]], [x_k])
+        execution.step()
+        out[k] = observer.last_real_values(index, [vr["force"]])[0]
+    return times, out

@@ -1,5 +1,5 @@
 /* FMI 2.0 interface of a bushenv bushing FMU (model.h generated, core.h shared): co-simulation,
-   and model exchange for ODE models (fmi2_me.h). */
+   and model exchange (fmi2_me.h). */
 #include <stdlib.h>
 #include "fmi2Functions.h"
 #include "model.h"
@@ -52,11 +52,6 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
                               fmi2Boolean visible, fmi2Boolean logging_on) {
     (void)resources; (void)visible;
     if (!cb || !cb->logger) return NULL;
-    if (type != fmi2CoSimulation && !(type == fmi2ModelExchange && MODEL_HAS_RHS)) {
-        cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError",
-                   "this FMU supports co-simulation only");
-        return NULL;
-    }
     if (!guid || strcmp(guid, FMU_TOKEN) != 0) {
         cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError",
                    "GUID %s does not match this binary's %s", guid ? guid : "(null)", FMU_TOKEN);
@@ -91,7 +86,9 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, fmi2Rea
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    ((Instance *)c)->initialised = 1;
+    Instance *m = (Instance *)c;
+    m->initialised = 1;
+    m->core.started = 1;
     return fmi2OK;
 }
 fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }
@@ -206,7 +203,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     for (size_t i = 0; i < n; i++) {
         if (order[i] != 1) continue; /* the input is linear between points: higher orders unused */
         if (vr[i] == VR_DEFLECTION) core_set_derivative(&m->core, 0, v[i]);
-        else if (HAS_VELOCITY && vr[i] == VR_VELOCITY) core_set_derivative(&m->core, 1, v[i]);
+        else if (vr[i] == VR_VELOCITY) core_set_derivative(&m->core, 1, v[i]);
         else return fail2(m, "fmi2SetRealInputDerivatives: not an input");
     }
     return fmi2OK;

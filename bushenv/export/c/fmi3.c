@@ -1,5 +1,5 @@
 /* FMI 3.0 interface of a bushenv bushing FMU (model.h generated, core.h shared): co-simulation,
-   and model exchange for ODE models (fmi3_me.h). Functions of scheduled execution and of types
+   and model exchange (fmi3_me.h). Functions of scheduled execution and of types
    this FMU has none of are in fmi3_stubs.h: they report an error. */
 #include <stdlib.h>
 #include "fmi3Functions.h"
@@ -81,7 +81,10 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean tol_defined, 
     return fmi3OK;
 }
 
-fmi3Status fmi3ExitInitializationMode(fmi3Instance c) { (void)c; return fmi3OK; }
+fmi3Status fmi3ExitInitializationMode(fmi3Instance c) {
+    ((Instance *)c)->core.started = 1;
+    return fmi3OK;
+}
 fmi3Status fmi3EnterEventMode(fmi3Instance c) { (void)c; return fmi3OK; }
 fmi3Status fmi3EnterStepMode(fmi3Instance c) { (void)c; return fmi3OK; }
 fmi3Status fmi3Terminate(fmi3Instance c) { (void)c; return fmi3OK; }
@@ -96,9 +99,13 @@ fmi3Status fmi3Reset(fmi3Instance c) {
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *update, fmi3Boolean *terminate,
                                     fmi3Boolean *nominals, fmi3Boolean *values,
                                     fmi3Boolean *next_defined, fmi3Float64 *next) {
-    (void)c;
+    Instance *m = (Instance *)c;
     *update = *terminate = *nominals = *values = *next_defined = fmi3False;
     *next = 0.0;
+    if (!m->core.me) return fmi3OK;
+    if (core_me_event(&m->core)) return fail3(m, m->core.message);
+    *next_defined = fmi3True; /* model exchange: the next sample is the next time event */
+    *next = core_me_next_event(&m->core);
     return fmi3OK;
 }
 
