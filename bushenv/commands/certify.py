@@ -1,4 +1,5 @@
-"""``bushenv certify``: hold-stability and passivity certificates of a NARX model.
+"""``bushenv certify``: hold-stability and passivity certificates of a NARX model, of one
+coordinate or of several (``bushenv.certify.vector``: holds on a grid of deflection vectors).
 
 Writes DIR/certificate.json and three plots (static force, spectral radius, Im K); prints a
 summary on stdout and progress on stderr. Exits as a test runner does: 0 when the certificate
@@ -25,11 +26,6 @@ EXAMPLE = "bushenv certify hybrid --axis radial --reference rubber --out runs/ce
 DEFAULTS = CertifyOptions()
 
 
-def resolve_model(spec: str, axis: str, dt: float | None = None):
-    """A registered name or a model file -> the model to certify."""
-    return get_model(spec, axis=axis, dt=dt)
-
-
 def _mm_list(text: str) -> tuple[float, ...]:
     try:
         vals = tuple(float(v) * 1e-3 for v in text.split(",") if v.strip())
@@ -49,7 +45,11 @@ def _fmt_mm(vals: tuple[float, ...]) -> str:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from bushenv.models import AXES
 
-    parser.add_argument("model", metavar="MODEL", help="nn, hybrid or a NARX model file (.npz)")
+    parser.add_argument(
+        "model",
+        metavar="MODEL",
+        help="nn, hybrid or a NARX model file (.npz) of one or three coordinates",
+    )
     parser.add_argument(
         "--reference",
         default=None,
@@ -75,6 +75,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="holds span -S..+S mm (default: the model card's stroke, 1.5 x its records'; "
         f"{DEFAULTS.stroke_m * 1e3:g}, the machine's, for the shipped models)",
+    )
+    parser.add_argument(
+        "--rotation-mrad",
+        type=float,
+        default=None,
+        help="three-axis models: holds span -R..+R mrad in rotation (default: 1.5 x the "
+        "card's training range)",
     )
     parser.add_argument(
         "--at-mm",
@@ -140,7 +147,9 @@ def run(args: argparse.Namespace) -> int:
     target = out / "certificate.json"
     if target.exists() and not args.force:
         raise CertifyError(f"{target} exists; pass --force to replace it")
-    model = resolve_model(args.model, args.axis)
+    model = get_model(args.model, axis=args.axis, coords=None)
+    if model.n_coords > 1:
+        return _run_vector(args, model, out, target)
     try:
         narx_net(model)
     except CertifyError as exc:
@@ -191,6 +200,75 @@ def run(args: argparse.Namespace) -> int:
     write_json(target, doc)
     _summary(doc, [target, *paths], judge)
     s = doc["summary"]
+    return 0 if s["passes_holds"] and s["passes_passivity"] else 1
+
+
+def _vector_span(args: argparse.Namespace, model) -> tuple[tuple[float, ...], str]:
+    """The holds' half-width per coordinate: 1.5 x the card's training range (the one-axis
+    stroke rule), else --stroke-mm for translations and --rotation-mrad for rotations."""
+    from bushenv.identify.card import card_paths
+
+    given = {"m": args.stroke_mm, "rad": args.rotation_mrad}
+    if all(given[u] is not None for u in model.units):
+        return tuple(given[u] * 1e-3 for u in model.units), "--stroke-mm/--rotation-mrad"
+    card = card_paths(args.model)[0]
+    if Path(args.model).suffix == ".npz" and card.is_file():
+        import json
+
+        span = json.loads(card.read_text()).get("training_range")
+        if span:
+            out = [
+                1.5 * span[c] if given[u] is None else given[u] * 1e-3
+                for c, u in zip(model.coords, model.units, strict=True)
+            ]
+            return tuple(out), f"1.5 x the training range of {card.name}"
+    missing = " and ".join(
+        f for f, u in (("--stroke-mm", "m"), ("--rotation-mrad", "rad")) if given[u] is None
+    )
+    raise CertifyError(
+        f"{args.model}: no model card with a training range beside it to take the holds' span "
+        f"from; give {missing} (the deflections the bushing is used at)"
+    )
+
+
+def _run_vector(args: argparse.Namespace, model, out: Path, target: Path) -> int:
+    """The certificate over C > 1 coordinates (``bushenv.certify.vector``): holds on a grid of
+    deflection vectors, wrong sign without a reference, passivity as a matrix test."""
+    from bushenv.certify.vector import VectorOptions, certify_vector, per_coordinate, radius_plot
+
+    if args.reference not in (None, "none"):
+        raise CertifyError(
+            f"--reference {args.reference}: a three-axis certificate compares with no reference "
+            "yet (wrong sign is judged against the deflection, q . f >= 0); drop --reference"
+        )
+    span, source = _vector_span(args, model)
+    opts = VectorOptions(span, per_coordinate(args.holds, model.n_coords))
+    doc, grid = certify_vector(model, opts, progress=_progress(args.quiet))
+    doc["model"] = {"source": str(args.model), "name": model.name, "dt_s": model.dt}
+    doc["settings"]["span_source"] = source
+    out.mkdir(parents=True, exist_ok=True)
+    plot = radius_plot(doc, grid, out / "spectral_radius.png", f"{Path(args.model).name}: holds")
+    write_json(target, doc)
+    s = doc["summary"]
+    units = ["mrad" if u == "rad" else "mm" for u in model.units]
+    shown = ", ".join(
+        f"{c} +-{v * 1e3:.4g} {u}" for c, v, u in zip(model.coords, span, units, strict=True)
+    )
+    print(f"holds over {shown} ({source}); no reference: wrong sign is q . f < 0")
+    print(
+        f"holds: {s['holds']} ({opts.per_coordinate} per coordinate), settling stably "
+        f"{s['holds_settling_stably']}, more than one fixed point {s['holds_with_more_than_one']}, "
+        f"no stable one {s['holds_without_a_stable_one']}, fold crossings {s['fold_crossings']}, "
+        f"wrong sign {s['wrong_sign_holds']}"
+    )
+    print(
+        f"passivity: {s['non_passive_holds']} of {s['passivity_holds']} holds non-passive "
+        f"(least loss eigenvalue {s['least_loss_eigenvalue_j']:.3g} J); hold certificate "
+        f"{'passes' if s['passes_holds'] else 'FAILS'}, passivity "
+        f"{'passes' if s['passes_passivity'] else 'FAILS'}"
+    )
+    print(target)
+    print(plot)
     return 0 if s["passes_holds"] and s["passes_passivity"] else 1
 
 
