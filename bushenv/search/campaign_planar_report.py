@@ -3,14 +3,15 @@ with the same arguments) and its table (``format_planar_table``), as ``campaign_
 the one-axis attack's.
 
 ``report.json`` holds ``env``, ``model``, ``reference``; ``judge`` (the vetting, the force
-floors, the stroke it was vetted within); ``limits`` (per coordinate its stroke and rate, keys
-naming the unit -- ``stroke_mm`` / ``stroke_mrad``, ``rate_m_per_s`` / ``rate_rad_per_s`` --,
-the records' peak when they come from records, and ``source``); ``control`` (``label``,
-``how``, ``spec``, ``file``); ``budget``, ``seed``, ``arguments`` (what a resume must share);
-``searchers`` (each search's summary: ``coverage`` per family and coordinate, ``failures``
-tallied, ``profiles_file`` with every failing profile and the worst); ``hold_stage``;
-``recheck`` (per role: profiles, diverged, by axis, ``model``); ``failure_reach`` (how far
-beyond the records' peak the failures sit); ``shrunk``; ``plots``; ``seconds``; ``complete``.
+floors, the stroke it was vetted within); ``scales`` (the limits searched: per coordinate its
+stroke and rate, keys naming the unit -- ``stroke_mm`` / ``stroke_mrad``, ``rate_m_per_s`` /
+``rate_rad_per_s`` --, the records' peak when they come from records, and ``source``);
+``control`` (``label``, ``how``, ``spec``, ``file``); ``budget``, ``seed``, ``arguments`` (what
+a resume must share); ``searchers`` (each search's summary: ``coverage`` per family and
+coordinate, ``failures`` tallied, ``profiles_file`` with every failing profile and the worst);
+``hold_stage``; ``recheck`` (per role: profiles, diverged, by axis, ``model``);
+``failure_reach`` (how far beyond the records' peak the failures sit); ``shrunk``; ``plots``;
+``seconds``; ``complete``.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ def fresh_report(c: CampaignConfig, p: Planar) -> dict:
         "model": c.model,
         "reference": c.reference or DEFAULT_REFERENCE,
         "judge": p.judge,
-        "limits": p.limits.to_json(),
+        "scales": p.limits.to_json(),
         "control": p.control,
         "budget": c.budget,
         "seed": c.seed,
@@ -96,7 +97,7 @@ def _judge_lines(judge: dict | None) -> list[str]:
 
 
 def _limits_lines(report: dict) -> list[str]:
-    lim, ctl = report.get("limits"), report.get("control")
+    lim, ctl = report.get("scales"), report.get("control")
     lines = [f"searched within {limits_text(lim)}"] if lim else []
     if ctl:
         lines.append(f"control: {ctl['label']} ({ctl['how']})")

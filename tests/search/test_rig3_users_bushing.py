@@ -55,7 +55,7 @@ def test_a_users_reference_sets_stroke_and_rate_per_coordinate_from_its_cards_re
     rec = load_planar_csv(bushing / "rec3" / TRAIN)
     peak = np.max(np.abs(rec.q), axis=0)
     speed = np.max(np.abs(np.diff(rec.q, axis=0)), axis=0) / rec.dt
-    lim = attacked["limits"]
+    lim = attacked["scales"]
     for i, (c, u, r) in enumerate(
         zip(COORDS, ("mm", "mm", "mrad"), ("m", "m", "rad"), strict=True)
     ):
@@ -73,9 +73,9 @@ def test_a_users_reference_sets_stroke_and_rate_per_coordinate_from_its_cards_re
 
 def test_stroke_mm_sets_axial_and_radial_and_the_rotation_keeps_the_cards(bushing, attacked):
     report = _attack(bushing, "att-stroke", "--stroke-mm", "1.5", "--searchers", "random")
-    lim = report["limits"]
+    lim = report["scales"]
     assert lim["axial"]["stroke_mm"] == lim["radial"]["stroke_mm"] == 1.5
-    assert lim["rotation"] == attacked["limits"]["rotation"]
+    assert lim["rotation"] == attacked["scales"]["rotation"]
     assert "--stroke-mm 1.5" in lim["source"]
 
 
@@ -114,7 +114,7 @@ def test_every_failing_profile_is_saved_with_three_coordinates(bushing, attacked
 
 
 def test_coverage_is_per_coordinate_with_its_unit_in_the_key(attacked):
-    stroke = attacked["limits"]
+    stroke = attacked["scales"]
     for s in attacked["searchers"]:
         for row in s["coverage"].values():
             assert set(row) == {"profiles", *COORDS}
@@ -144,7 +144,7 @@ def test_resume_finishes_an_interrupted_attack_as_the_uninterrupted_one(bushing,
     report["recheck"], report["shrunk"], report["complete"] = {}, None, False
     (out / "report.json").write_text(json.dumps(report))
     resumed = _attack(bushing, "att-resume", "--resume")
-    for key in ("searchers", "recheck", "shrunk", "limits", "control", "failure_reach"):
+    for key in ("searchers", "recheck", "shrunk", "scales", "control", "failure_reach"):
         a, b = json.dumps(_untimed(resumed[key])), json.dumps(_untimed(attacked[key]))
         assert a.replace("att-resume", "att") == b, key
     capsys.readouterr()
@@ -160,7 +160,7 @@ def test_the_builtin_reference_keeps_the_machine_and_the_linear_preset(tmp_path)
                  "--searchers", "random", "--max-shrink", "0", "--threads", "1", "--no-plots",
                  "--quiet", "--out", str(tmp_path / "o")]) == 0  # fmt: skip
     report = json.loads((tmp_path / "o" / "report.json").read_text())
-    assert report["limits"] == machine_limits().to_json()
+    assert report["scales"] == machine_limits().to_json()
     assert report["control"]["label"] == "linear"
     assert "failure_reach" not in report
 
