@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.diagnose.coupling import COUPLING_MIN, coupling_test
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.inputs import LINEAR, MIN_SAMPLES, Progress, names_of
 from bushenv.metrics import rms_ratio
@@ -202,6 +203,7 @@ def diagnose_coordinates(
     recs += [(n, "test", r) for n, r in zip(names, tests, strict=True)]
     cross_of = {n: cross_terms(np.asarray(r.q, float), dt, k, cm) for n, _, r in recs}
     diagnoses: dict[str, dict] = {}
+    couplings: dict[str, dict] = {}
     for i, name in enumerate(coords):
         views = {
             n: CoordinateView(
@@ -214,7 +216,7 @@ def diagnose_coordinates(
             for n, _, r in recs
         }
         say(f"coordinate {name} ({i + 1}/{c})")
-        diagnoses[name] = diagnose(
+        diagnoses[name] = d = diagnose(
             [views[n] for n in t_names],
             [views[n] for n in names],
             progress=lambda msg, name=name: say(f"{name}: {msg}"),
@@ -224,30 +226,63 @@ def diagnose_coordinates(
             cross=cross,
             effects=effects,
         )
+        d["coordinate"] = name
+        couplings[name] = _coupling(recs, cross_of, i, list(coords), diagnoses[name])
+        say(f"{name}: coupling terms close {100 * couplings[name]['closes']:.0f} % beyond its own")
     by_name = {n: r for n, _, r in recs}
     rows = [
-        _coordinate_row(name, units[i], force_units[i], i, diagnoses[name], by_name, cross_of)
-        for i, name in enumerate(coords)
+        _coordinate_row(units[i], force_units[i], i, diagnoses[c], by_name, cross_of, couplings[c])
+        for i, c in enumerate(coords)
     ]
     return _result(rows, diagnoses, coords, units, force_units, k, cm, recs, cross_of, t_names)
 
 
-def _coordinate_row(name, unit, force_unit, i, d, by_name, cross_of) -> dict[str, Any]:
+def _coupling(recs: list, cross_of: dict, i: int, coords: list[str], d: dict) -> dict[str, Any]:
+    """The coupling test on coordinate ``i`` (``coupling.py``), on the engine's folds; named
+    where the one-axis diagnosis found a gap clear of the noise that no candidate closes."""
+    records = {
+        n: {"q": np.asarray(r.q, float), "force": np.asarray(r.f, float)[:, i] - cross_of[n][:, i],
+            "dt": float(r.dt)}
+        for n, _, r in recs
+    }  # fmt: skip
+    test = coupling_test(records, d["records"]["folds"], i, coords, d["gap_noise"])
+    test["named"] = bool(
+        d["effect"] == "outside_candidates"
+        and test["closes"] >= COUPLING_MIN
+        and test["gap_coupled"] < test["gap_null"]
+    )
+    return test
+
+
+def augmented(pred: dict[str, Any], coupling: dict[str, Any]) -> np.ndarray:
+    """The judged prediction of the answer's model on one record: the coupled fit where
+    ``coupling`` is named, else the engine's (both less the cross-coordinate terms)."""
+    if coupling["named"]:
+        return coupling["predictions"][pred["name"]]
+    return pred["force_augmented"]
+
+
+def _coordinate_row(unit, force_unit, i, d, by_name, cross_of, coupling) -> dict[str, Any]:
     """One coordinate's numbers on its measured force (the cross-coordinate terms added back)."""
     preds = d["predictions"]
+    name = d.get("coordinate") or ""
     cross = np.concatenate([cross_of[p["name"]][:, i] for p in preds])
     f = np.concatenate([np.asarray(by_name[p["name"]].f, float)[:, i] for p in preds])
     base = cross + np.concatenate([p["force_baseline"] for p in preds])
-    aug = cross + np.concatenate([p["force_augmented"] for p in preds])
+    aug = cross + np.concatenate([augmented(p, coupling) for p in preds])
     rms_f = float(np.sqrt(np.mean(f**2)))
     rms_adj = float(np.sqrt(np.mean(np.concatenate([p["force_measured"] for p in preds]) ** 2)))
     gap_before, gap_after = rms_ratio(f, base), rms_ratio(f, aug)
     noise = d["gap_noise"] * rms_adj / rms_f if rms_f > 0 else 0.0
+    shown = {k: v for k, v in coupling.items() if k != "predictions"}
     return {
         "coordinate": name,
         "unit": unit,
         "force_unit": force_unit,
-        "effect": d["effect"],
+        "effect": "coupling" if coupling["named"] else d["effect"],
+        "effect_one_axis": d["effect"],
+        "coupled_to": coupling["partners"] if coupling["named"] else [],
+        "coupling": shown,
         "carries_gap": d["effect"] != "none",
         "top_two": d["top_two"],
         "ambiguous_between": d["ambiguous_between"],
@@ -259,6 +294,7 @@ def _coordinate_row(name, unit, force_unit, i, d, by_name, cross_of) -> dict[str
         "rms_force": rms_f,
         "cross_share": float(np.sqrt(np.mean(cross**2))) / rms_f if rms_f > 0 else 0.0,
         "report": f"{name}/report.md",
+        "_coupling": coupling,
     }
 
 
@@ -272,7 +308,6 @@ def _result(rows, diagnoses, coords, units, force_units, k, cm, recs, cross_of, 
     first = diagnoses[coords[0]]
     for name, unit, fu in zip(coords, units, force_units, strict=True):
         d = diagnoses[name]
-        d["coordinate"] = name
         d["units"] = {"displacement": unit, "force": fu}
         d["parameters"] = unit_keys(d["parameters"], unit, fu)
         for w in d["shift_warnings"]:
@@ -287,15 +322,19 @@ def _result(rows, diagnoses, coords, units, force_units, k, cm, recs, cross_of, 
             f"RMS); deflection in {unit}, parameters in {unit} and {fu}. K row: "
             f"{np.array2string(k[i], precision=6)}, C row: {np.array2string(cm[i], precision=6)}",
         )
+        c_test = _row(rows, name)["coupling"]
+        if c_test["named"] or c_test["closes"] >= COUPLING_MIN:
+            d["notes"].insert(1, _coupling_note(name, c_test))
     judged = first["records"]["judged"]
     by_name = {n: r for n, _, r in recs}
     predictions = []
     for j, n in enumerate(judged):
-        cols = {  # the engine's predictions with the cross-coordinate terms added back
-            key: np.stack([diagnoses[c]["predictions"][j][key] for c in coords], axis=1)
-            + cross_of[n]
-            for key in ("force_baseline", "force_augmented")
-        }
+        rows_by = {r["coordinate"]: r for r in rows}
+        base = np.stack([diagnoses[c]["predictions"][j]["force_baseline"] for c in coords], 1)
+        aug = np.stack(
+            [augmented(diagnoses[c]["predictions"][j], rows_by[c]["_coupling"]) for c in coords], 1
+        )
+        cols = {"force_baseline": base + cross_of[n], "force_augmented": aug + cross_of[n]}
         predictions.append(
             {
                 "name": n,
@@ -307,11 +346,15 @@ def _result(rows, diagnoses, coords, units, force_units, k, cm, recs, cross_of, 
                 **cols,
             }
         )
+    for r in rows:
+        del r["_coupling"]
     if top is None:
         answer = "none: the baseline explains every coordinate down to the force's noise"
     else:
         answer = f"{top['coordinate']}: {top['effect']}"
-        if top["ambiguous_between"]:
+        if top["coupled_to"]:
+            answer += f" (to {', '.join(top['coupled_to'])})"
+        elif top["ambiguous_between"]:
             answer += f" ({' or '.join(top['ambiguous_between'])})"
     return {
         "coordinate": top["coordinate"] if top else None,
@@ -349,9 +392,27 @@ def _row(rows: list[dict], name: str) -> dict:
     return next(r for r in rows if r["coordinate"] == name)
 
 
+def _coupling_note(name: str, test: dict[str, Any]) -> str:
+    said = (
+        "named coupling: no one-axis candidate closes the gap, and"
+        if test["named"]
+        else "besides the answer,"
+    )
+    return (
+        f"three-axis coupling test on {name}: {said} the terms {name} x (other coordinate)^2 "
+        f"close {100 * test['closes']:.0f} % of the gap above the noise beyond {name}'s own "
+        f"cubic (gap {100 * test['gap_null']:.2f} % -> {100 * test['gap_coupled']:.2f} %), most "
+        f"with {', '.join(test['partners']) or '-'}: a stiffness that follows another "
+        "coordinate's deflection (bushenv/diagnose/coupling.py)"
+    )
+
+
 COORDINATE_RULE = (
     "each coordinate's gap is rms(f_i - baseline_i) / rms(f_i) over the judged records; a "
     "coordinate carries a gap when the one-axis diagnosis of it answers other than none (a gap "
     "clear of the force's noise); the answer is the carrying coordinate with the largest gap "
-    "above the noise, sqrt(gap^2 - gap_noise^2), and the effect named there"
+    "above the noise, sqrt(gap^2 - gap_noise^2), and the effect named there; where the one-axis "
+    f"diagnosis answers outside_candidates and terms q_i q_j^2 close at least "
+    f"{100 * COUPLING_MIN:.0f} % of the gap above the noise beyond the coordinate's own cubic, "
+    "the effect is coupling (to the coordinates j whose term closes most)"
 )

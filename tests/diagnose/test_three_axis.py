@@ -40,6 +40,27 @@ def test_withheld_effect_is_named_on_its_coordinate(name):
         assert result["coordinate"] is None and result["shrink"] == 0.0
 
 
+def test_elastic_coupling_is_named_with_its_partner_coordinate():
+    _, _, result = case("coupling")
+    assert score(result, "coupling")["hit"]
+    row = next(r for r in result["coordinates"] if r["coordinate"] == "axial")
+    # no one-axis candidate holds it; the terms axial x radial^2 close it
+    assert row["effect_one_axis"] == "outside_candidates"
+    assert row["effect"] == "coupling" and row["coupled_to"] == ["radial"]
+    assert row["coupling"]["closes"] > 0.8 and row["shrink"] > 0.5
+    assert result["answer"] == "axial: coupling (to radial)"
+    i = result["coords"].index("axial")  # the augmented predictions are the coupled fit's
+    f = np.concatenate([p["force_measured"][:, i] for p in result["predictions"]])
+    aug = np.concatenate([p["force_augmented"][:, i] for p in result["predictions"]])
+    assert np.sqrt(np.mean((f - aug) ** 2) / np.mean(f**2)) == pytest.approx(row["gap_after"])
+
+
+def test_coupling_is_not_named_where_a_candidate_explains_the_gap():
+    _, _, result = case("friction@radial")
+    row = next(r for r in result["coordinates"] if r["coordinate"] == "radial")
+    assert row["coupled_to"] == [] and row["coupling"]["closes"] < 0.2
+
+
 def test_coordinates_are_ranked_by_their_gap_with_units():
     _, _, result = case("friction@radial")
     rows = result["coordinates"]

@@ -14,8 +14,8 @@ seed. ``score(result, spec)`` says whether ``diagnose`` named the right coordina
 | friction@c         | Iwan friction on c only (yield per coordinate), 0.3..1 x F_max    |
 | hardening@c        | cubic stiffening on c only, 5..25 % extra force at TEST's peak    |
 | friction_vector    | Iwan friction on all three, the vector yield surface (coupled)    |
-| relaxation_coupled | relaxation of the coupled elastic force (QLV), coupling on        |
-| coupling           | the elastic coupling only (no candidate: ``outside_candidates``)  |
+| coupling           | the elastic coupling only (no one-axis candidate holds it)        |
+| relaxation+coupling| relaxation on all three (of the coupled elastic force) + coupling |
 
 The magnitudes are the preset's (``PlanarRubber.preset``) scaled, so each effect stands clear
 of the preset noise on its coordinate.
@@ -46,19 +46,19 @@ class Spec:
     name: str
     effect: str  # the reference's effect switched on ("none": none)
     coords: tuple[str, ...]  # where it acts
-    expected: str  # the effect a right answer names on those coordinates
+    expected: tuple[str, ...]  # the effects a right answer names on those coordinates
 
 
 SPECS = (
-    Spec("none", "none", (), "none"),
+    Spec("none", "none", (), ("none",)),
     *(
-        Spec(f"{e}@{c}", e, (c,), e)
+        Spec(f"{e}@{c}", e, (c,), (e,))
         for e in ("relaxation", "friction", "hardening")
         for c in COORDS
     ),
-    Spec("friction_vector", "friction", COORDS, "friction"),
-    Spec("relaxation_coupled", "relaxation", COORDS, "relaxation"),
-    Spec("coupling", "coupling", ("axial", "radial"), "outside_candidates"),
+    Spec("friction_vector", "friction", COORDS, ("friction",)),
+    Spec("coupling", "coupling", ("axial", "radial"), ("coupling",)),
+    Spec("relaxation+coupling", "relaxation", COORDS, ("relaxation", "coupling")),
 )
 FAST = ("none", "friction@radial", "relaxation@rotation", "hardening@axial")  # the tests' subset
 
@@ -80,8 +80,8 @@ def reference(spec: Spec, seed: int, dt: float = PAPER_DT) -> tuple[dict[str, An
     if spec.effect == "relaxation":
         w = np.array(base.relax_weight) * rng.uniform(0.3, 1.0)
         w[:, ~mask] = 0.0
-        extra = {"coupling": ("coupling",)} if spec.name == "relaxation_coupled" else {}
-        return {"relax_weight": w}, ("relaxation", *extra.get("coupling", ()))
+        coupled = ("coupling",) if "coupling" in spec.name else ()
+        return {"relax_weight": w}, ("relaxation", *coupled)
     if spec.effect == "friction":
         fmax = np.where(mask, base.friction_fmax * rng.uniform(0.3, 1.0), OFF)
         x2 = np.where(mask, base.friction_x2, 1.0)
@@ -115,21 +115,25 @@ def make_case(
 
 
 def score(result: dict[str, Any], spec: Spec | str) -> dict[str, Any]:
-    """Whether the answer is right: ``hit`` (coordinate and effect), and per coordinate
-    whether an effect was named where none acts (``false_coordinates``)."""
+    """Whether the answer is right. ``hit``: the answer's coordinate is one the effect acts on
+    and its effect an expected one (``none``: nothing named); ``every_coordinate``: each
+    coordinate it acts on answers an expected effect; ``false_coordinates``: coordinates
+    where an effect is named although none acts there; ``wrong_effects``: coordinates it acts
+    on that name an effect it is not."""
     spec = get_spec(spec) if isinstance(spec, str) else spec
     named = result["effects"]
     false = [c for c, e in named.items() if c not in spec.coords and e != "none"]
-    if spec.expected == "none":
-        hit = result["effect"] == "none"
-    elif len(spec.coords) == 1:
-        hit = result["coordinate"] == spec.coords[0] and result["effect"] == spec.expected
-    else:  # coupled: every coordinate it acts on answers it
-        hit = all(named[c] == spec.expected for c in spec.coords)
+    wrong = [c for c in spec.coords if named[c] not in (*spec.expected, "none")]
     top = result["coordinate"]
+    if not spec.coords:
+        hit = result["effect"] == "none"
+    else:
+        hit = top in spec.coords and result["effect"] in spec.expected
     return {
         "case": spec.name,
         "hit": bool(hit),
+        "every_coordinate": all(named[c] in spec.expected for c in spec.coords),
+        "wrong_effects": wrong,
         "coordinate_right": (top is None) if not spec.coords else top in spec.coords,
         "answer": result["answer"],
         "effects": named,
