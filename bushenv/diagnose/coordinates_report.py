@@ -42,7 +42,7 @@ def coordinates_plot(result: dict[str, Any], out: Path) -> str:
         (0.0, "gap_after", "with the effect named"),
         (0.27, "gap_noise", "force noise"),
     ):
-        ax.bar(x + off, [100 * r[key] for r in rows], 0.27, label=label)
+        ax.bar(x + off, [100 * (r[key] or 0.0) for r in rows], 0.27, label=label)
     ax.set_xticks(x, [f"{r['coordinate']}\n{r['effect']}" for r in rows], fontsize=8)
     ax.set_ylabel("gap, % of the coordinate's RMS force")
     ax.legend(fontsize=8)
@@ -52,8 +52,8 @@ def coordinates_plot(result: dict[str, Any], out: Path) -> str:
     return "coordinates.png"
 
 
-def _pct(v: float) -> str:
-    return f"{100 * v:.2f} %"
+def _pct(v: float | None) -> str:
+    return "-" if v is None else f"{100 * v:.2f} %"
 
 
 def coordinates_markdown(data: dict[str, Any]) -> str:
@@ -93,7 +93,7 @@ def coordinates_markdown(data: dict[str, Any]) -> str:
             f"| {r['coordinate']} | {r['unit']}, {r['force_unit']} | {_pct(r['gap_before'])} | "
             f"{_pct(r['gap_after'])} | {100 * r['shrink']:.1f} % | {_pct(r['gap_noise'])} | "
             f"{_pct(r['share_above_noise'])} | {r['effect']} | {', '.join(r['top_two'])} | "
-            f"[{r['report']}]({r['report']}) |"
+            + (f"[{r['report']}]({r['report']}) |" if r["report"] else "- |")
         )
     lines += ["", "![coordinates](coordinates.png)", "", "## Baseline matrices (SI)", ""]
     units = ", ".join(f"{c} {u}" for c, u in zip(data["coords"], data["units"], strict=True))
@@ -115,13 +115,13 @@ def write_coordinates_report(result: dict[str, Any], out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     (out / "predictions").mkdir(exist_ok=True)
     coords = result["coords"]
-    for name in coords:
-        write_report(result["diagnoses"][name], out / name)
+    for name, diagnosis in result["diagnoses"].items():
+        write_report(diagnosis, out / name)
     for pred in result["predictions"]:
         write_coordinate_predictions(pred, coords, out / "predictions" / f"{pred['name']}.csv")
     data = {k: v for k, v in result.items() if k not in ("predictions", "diagnoses")}
     data["predictions"] = [f"predictions/{p['name']}.csv" for p in result["predictions"]]
-    data["diagnoses"] = {name: f"{name}/report.json" for name in coords}
+    data["diagnoses"] = {name: f"{name}/report.json" for name in result["diagnoses"]}
     data["plots"] = [coordinates_plot(result, out)]
     write_text(out / "report.json", json.dumps(json_safe(data), indent=2) + "\n")
     write_text(out / "report.md", coordinates_markdown(data))

@@ -11,11 +11,17 @@ import numpy as np
 import pytest
 
 from bushenv.cli import main
-from bushenv.diagnose.coordinates import unit_keys
+from bushenv.diagnose.coordinate_answer import unit_keys
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import diagnose
-from bushenv.diagnose.validation.three_axis_cases import FAST, get_spec, make_case, score
-from bushenv.planar.records import save_planar_csv
+from bushenv.diagnose.validation.three_axis_cases import (
+    FAST,
+    get_spec,
+    make_case,
+    reference,
+    score,
+)
+from bushenv.planar.records import PlanarRecord, save_planar_csv
 from bushenv.records import Record, save_csv
 
 
@@ -94,6 +100,25 @@ def test_rotation_parameters_carry_rotation_units():
         "slip_length_rad": 2,
         "inertia_kg_m2": 3,
     }
+
+
+def test_a_coordinate_held_still_in_a_record_is_left_out_of_its_diagnosis_only():
+    from bushenv.planar.programme import preload_sweep
+    from bushenv.planar.reference import PlanarRubber
+
+    train, test, _ = case("friction@radial")
+    overrides, effects = reference(get_spec("friction@radial"), 0)
+    q = preload_sweep(2, 0.075, 3e-3, 10.0, train.dt)  # rotation held, radial swept, axial at 0
+    f = PlanarRubber.preset(effects=effects, seed=7, dt=train.dt, **overrides).simulate(q)
+    sweep = PlanarRecord(np.arange(len(q)) * train.dt, q, f.reshape(q.shape), "sweep")
+    result = diagnose(train, [test, sweep])
+    assert (result["coordinate"], result["effect"]) == ("radial", "friction")
+    rows = {r["coordinate"]: r for r in result["coordinates"]}
+    assert rows["axial"]["left_out"] == ["sweep"] and rows["radial"]["left_out"] == []
+    assert result["records"]["per_coordinate"]["axial"] == ["train", "test"]
+    alone = diagnose(train, [sweep])  # no TEST moves axially: axial is not diagnosed
+    assert alone["effects"]["axial"] == "not_diagnosed" and "axial" not in alone["diagnoses"]
+    assert alone["coordinate"] == "radial"
 
 
 def test_other_baselines_and_mixed_records_are_refused_by_the_library():
