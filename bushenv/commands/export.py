@@ -8,7 +8,7 @@ import sys
 
 from bushenv.export.build import export_fmu
 from bushenv.export.description import FMI_VERSIONS
-from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE
+from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE_BY_COORDS
 
 EXAMPLE = "bushenv export nn --fmi 3.0 --out bushing.fmu"
 
@@ -17,11 +17,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from bushenv.models import AXES
 
     parser.add_argument(
-        "model", metavar="MODEL", help=f"{', '.join(EXPORTABLE)} or a model file (.npz)"
+        "model",
+        metavar="MODEL",
+        help=f"{', '.join(EXPORTABLE_BY_COORDS[1])} or a model file (.npz) of one or three axes",
     )
     parser.add_argument("--fmi", default="2.0", choices=FMI_VERSIONS, help="FMI version")
     parser.add_argument("--out", required=True, help="the FMU to write (.fmu)")
     parser.add_argument("--axis", default="axial", choices=AXES, help="shipped model's axis")
+    parser.add_argument(
+        "--axes",
+        type=int,
+        default=None,
+        choices=sorted(EXPORTABLE_BY_COORDS),
+        help="coordinates of a registered MODEL: 3 for its three-axis form "
+        f"({', '.join(EXPORTABLE_BY_COORDS[3])}; axial, radial, rotation in, force_axial, "
+        "force_radial, moment out); a file's own count otherwise (default: 1 for a name)",
+    )
     parser.add_argument(
         "--card",
         default=None,
@@ -68,15 +79,21 @@ def run(args: argparse.Namespace) -> int:
         stroke_m=args.stroke_mm * 1e-3 if args.stroke_mm is not None else None,
         velocity_m_per_s=args.velocity_m_per_s,
         substeps=args.substeps,
+        coords=args.axes,
     )
     env = done.facts.envelope
     print(done.path)
     if not args.quiet:
+        if done.coords == 1:
+            io = "deflection in, force out"
+            bounds = f"|x| <= {env.stroke_m * 1e3:.4g} mm, |v| <= {env.velocity_m_per_s:.4g} m/s"
+        else:
+            io = "axial, radial, rotation in; force_axial, force_radial, moment out"
+            bounds = dict(done.facts.lines)["envelope"].split(" (")[0]
         print(
-            f"FMI {done.fmi_version} FMU (co-simulation and model exchange; deflection in, force "
-            f"out) of the {done.model!r} model, compiled with "
-            f"{done.compiler}; envelope |x| <= {env.stroke_m * 1e3:.4g} mm, |v| <= "
-            f"{env.velocity_m_per_s:.4g} m/s ({env.source})",
+            f"FMI {done.fmi_version} FMU (co-simulation and model exchange; {io}) of the "
+            f"{done.model!r} model, compiled with {done.compiler}; envelope {bounds} "
+            f"({env.source})",
             file=sys.stderr,
         )
     return 0

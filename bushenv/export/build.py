@@ -30,7 +30,7 @@ from bushenv.export.description import (
     model_description,
 )
 from bushenv.export.facts import Facts, facts_of, find_card
-from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE, model_source
+from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE_BY_COORDS, model_source
 from bushenv.models import ModelError, ModelSpec, file_hash, get_model, model_file
 from bushenv.persist import atomic_write
 
@@ -76,6 +76,7 @@ class Exported:
     model: str
     facts: Facts
     compiler: str
+    coords: int = 1
 
 
 def c_compiler() -> str:
@@ -145,13 +146,16 @@ def export_fmu(
     stroke_m: float | None = None,
     velocity_m_per_s: float | None = None,
     substeps: int = BOUCWEN_SUBSTEPS,
+    coords: int | None = None,
 ) -> Exported:
     """Write ``out`` (.fmu): ``spec`` (a registered name, a model file or a model) as compiled C.
 
     ``card``: the model card (default: ``MODEL.card.json`` beside a model file, if any);
     ``certificate``: a ``certificate.json`` of ``bushenv certify``; ``stroke_m``,
     ``velocity_m_per_s``: the envelope instead of the card's; ``substeps``: Bouc-Wen RK4
-    sub-steps per sample. Raises ExportError / ModelError naming the problem.
+    sub-steps per sample; ``coords``: the number of coordinates a registered name is built
+    over (None: a file's or a model's own, a name's one). The FMU has one input and one output
+    per coordinate. Raises ExportError / ModelError naming the problem.
     """
     from bushenv import __version__
 
@@ -159,16 +163,20 @@ def export_fmu(
         raise ExportError(f"unknown FMI version {fmi_version!r}; known: {', '.join(FMI_VERSIONS)}")
     out = Path(out)
     _check_out(out)
-    model = get_model(spec, axis=axis)
-    if model.name not in EXPORTABLE:
+    model = get_model(spec, axis=axis, coords=coords, wanted_by="bushenv export")
+    kinds = EXPORTABLE_BY_COORDS.get(model.n_coords, ())
+    if model.name not in kinds:
+        over = "" if model.n_coords == 1 else f" over {model.n_coords} coordinates"
         raise ExportError(
-            f"cannot export a {type(model).__name__} ({model.name!r} model); exportable kinds: "
-            f"{', '.join(EXPORTABLE)}"
+            f"cannot export a {type(model).__name__} ({model.name!r} model{over}); exportable "
+            f"kinds{over}: {', '.join(kinds) or 'none'}"
         )
     folders = platform_folders()
     compiler = c_compiler()
     path = model_file(spec, axis)
-    card_path = Path(card) if card is not None else find_card(spec, axis)
+    card_path = Path(card) if card is not None else None
+    if card_path is None and model.n_coords == 1:
+        card_path = find_card(spec, axis)
     if card_path is not None and not card_path.is_file():
         raise ExportError(f"{card_path}: no such model card")
     facts = facts_of(
@@ -187,7 +195,7 @@ def export_fmu(
         )
         + "}"
     )
-    model_h = body + fmu_header(token, facts)
+    model_h = body + fmu_header(token, facts, model.n_coords)
     main = "fmi2.c" if fmi_version == "2.0" else "fmi3.c"
     sources = {"model.h": model_h.encode(), main: _c_file(main)}
     for name in HEADERS + FMI_HEADERS[fmi_version]:
@@ -195,7 +203,9 @@ def export_fmu(
     with tempfile.TemporaryDirectory(prefix="bushenv-fmu-") as tmp:
         binary = compile_library(sources, main, compiler, Path(tmp))
     tool = f"bushenv {__version__}"
-    description = model_description(fmi_version, model.name, token, facts, model.dt, tool)
+    description = model_description(
+        fmi_version, model.name, token, facts, model.dt, tool, model.n_coords
+    )
     files = {"modelDescription.xml": description.encode()}
     files[f"binaries/{folders[fmi_version]}/{MODEL_IDENTIFIER}.so"] = binary
     for name, data in sources.items():
@@ -219,7 +229,7 @@ def export_fmu(
             f"{out}: cannot write into {out.parent} ({exc.strerror}; a read-only folder?); "
             "choose another --out"
         ) from None
-    return Exported(out, fmi_version, model.name, facts, compiler)
+    return Exported(out, fmi_version, model.name, facts, compiler, model.n_coords)
 
 
 __all__ = ["ExportError", "Exported", "ModelError", "c_compiler", "export_fmu"]

@@ -24,7 +24,58 @@ MODEL_IDENTIFIER = "bushing"
 # optional (the FMU's own backward difference otherwise), every kind in model exchange.
 INTERFACE_VERSION = "2"
 FMI_VERSIONS = ("2.0", "3.0")
-UNITS = {"m": {"m": 1}, "m/s": {"m": 1, "s": -1}, "N": {"kg": 1, "m": 1, "s": -2}, "s": {"s": 1}}
+UNITS = {
+    "m": {"m": 1},
+    "m/s": {"m": 1, "s": -1},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "s": {"s": 1},
+    "rad": {"rad": 1},
+    "rad/s": {"rad": 1, "s": -1},
+    "N.m": {"kg": 1, "m": 2, "s": -2},
+}
+
+
+@dataclass(frozen=True)
+class Port:
+    """One coordinate's variables: its input, velocity input, force output and envelope
+    constants, with their value references."""
+
+    x: str
+    x_unit: str
+    x_text: str
+    v: str
+    v_unit: str
+    f: str
+    f_unit: str
+    stroke: str
+    rate: str
+    symbol: str  # in messages
+    vr_x: int
+    vr_v: int
+    vr_f: int
+    vr_stroke: int
+    vr_rate: int
+
+
+# One coordinate: the references of interface version 1 kept. Three (axial, radial, rotation,
+# as bushenv's three-axis models order them): references 30-45.
+PORTS = {
+    1: (
+        Port("deflection", "m", "bushing deflection along its axis", "velocity", "m/s", "force",
+             "N", "envelope_stroke_m", "envelope_velocity_m_per_s", "x", 1, 2, 3, 6, 7),
+    ),
+    3: (
+        Port("deflection_axial", "m", "axial deflection", "velocity_axial", "m/s",
+             "force_axial", "N", "envelope_stroke_axial_m", "envelope_velocity_axial_m_per_s",
+             "x_axial", 30, 33, 36, 40, 43),
+        Port("deflection_radial", "m", "radial deflection", "velocity_radial", "m/s",
+             "force_radial", "N", "envelope_stroke_radial_m", "envelope_velocity_radial_m_per_s",
+             "x_radial", 31, 34, 37, 41, 44),
+        Port("rotation", "rad", "rotation, the third coordinate of bushenv's three-axis models",
+             "rotation_rate", "rad/s", "moment", "N.m", "envelope_rotation_rad",
+             "envelope_rotation_rate_rad_per_s", "theta", 32, 35, 38, 42, 45),
+    ),
+}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -39,44 +90,44 @@ class Variable:
     start: str | None = None
 
 
-def variables(facts: Facts, dt: float) -> list[Variable]:
-    """The FMU's variables. The force is continuous (in model exchange it follows the current
-    deflection between samples); the envelope's outputs change at samples only."""
-    env = facts.envelope
+def variables(facts: Facts, dt: float, coords: int = 1) -> list[Variable]:
+    """The FMU's variables over ``coords`` coordinates. The forces are continuous (in model
+    exchange they follow the current input between samples); the envelope's outputs change at
+    samples only."""
+    ports = PORTS[coords]
+    strokes, rates = facts.envelope.limits(coords)
     out = [
-        Variable(
-            "deflection",
-            1,
-            "Real",
-            "input",
-            "continuous",
-            "bushing deflection along its axis",
-            "m",
-            "0.0",
-        ),
+        Variable(p.x, p.vr_x, "Real", "input", "continuous", p.x_text, p.x_unit, "0.0")
+        for p in ports
     ]
     out += [
         Variable(
-            "velocity",
-            2,
+            p.v,
+            p.vr_v,
             "Real",
             "input",
             "continuous",
-            "deflection rate; optional: once set after initialisation it replaces the FMU's "
-            "own backward difference of the deflection",
-            "m/s",
+            f"rate of {p.x}; optional: once set after initialisation it replaces the FMU's own "
+            "backward difference",
+            p.v_unit,
             "0.0",
-        ),
+        )
+        for p in ports
+    ]
+    out += [
         Variable(
-            "force",
-            3,
+            p.f,
+            p.vr_f,
             "Real",
             "output",
             "continuous",
-            "bushing force: co-simulation, of the latest model sample; model exchange, the "
-            "latest sample recomputed with the current input",
-            "N",
-        ),
+            f"bushing {p.f.split('_')[0]}: co-simulation, of the latest model sample; model "
+            "exchange, of the current input (between samples)",
+            p.f_unit,
+        )
+        for p in ports
+    ]
+    out += [
         Variable(
             "outside_envelope",
             4,
@@ -94,26 +145,17 @@ def variables(facts: Facts, dt: float) -> list[Variable]:
             "time the input has spent outside the validity envelope",
             "s",
         ),
-        Variable(
-            "envelope_stroke_m",
-            6,
-            "Real",
-            "local",
-            "constant",
-            "largest |deflection| of the envelope",
-            "m",
-            lit(env.stroke_m),
-        ),
-        Variable(
-            "envelope_velocity_m_per_s",
-            7,
-            "Real",
-            "local",
-            "constant",
-            "largest |velocity| of the envelope",
-            "m/s",
-            lit(env.velocity_m_per_s),
-        ),
+    ]
+    for p, stroke, rate in zip(ports, strokes, rates, strict=True):
+        out.append(
+            Variable(p.stroke, p.vr_stroke, "Real", "local", "constant",
+                     f"largest |{p.x}| of the envelope", p.x_unit, lit(stroke))
+        )  # fmt: skip
+        out.append(
+            Variable(p.rate, p.vr_rate, "Real", "local", "constant",
+                     f"largest |{p.v}| of the envelope", p.v_unit, lit(rate))
+        )  # fmt: skip
+    out.append(
         Variable(
             "sample_time_s",
             8,
@@ -123,8 +165,8 @@ def variables(facts: Facts, dt: float) -> list[Variable]:
             "the model's own sample time",
             "s",
             lit(dt),
-        ),
-    ]
+        )
+    )
     for i, (name, value) in enumerate(facts.lines):
         out.append(
             Variable(
@@ -173,9 +215,10 @@ def model_description(
     facts: Facts,
     dt: float,
     tool: str,
+    coords: int = 1,
 ) -> str:
     """modelDescription.xml for FMI ``version``: co-simulation and model exchange."""
-    vs = variables(facts, dt)
+    vs = variables(facts, dt, coords)
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
     head = _attr(
         fmiVersion=version,
@@ -309,24 +352,43 @@ def _c_string(text: str) -> str:
     return '"' + "".join(out) + '"'
 
 
-def fmu_header(token: str, facts: Facts) -> str:
+def _c_array(kind: str, name: str, values) -> str:
+    return f"static const {kind} {name}[] = {{{', '.join(values)}}};"
+
+
+def fmu_header(token: str, facts: Facts, coords: int = 1) -> str:
     """The generated constants ``core.h`` and ``variables.h`` read (appended to model.h)."""
     env = facts.envelope
+    ports = PORTS[coords]
+    strokes, rates = env.limits(coords)
     flagged = [lit(v) for pair in env.flagged_m for v in pair] or ["0.0"]
     facts_c = ", ".join(_c_string(v) for _, v in facts.lines) or '""'
-    return (
-        "\n".join(
-            [
-                f'#define FMU_TOKEN "{token}"',
-                "#define HAS_VELOCITY 1 /* every FMU has the (optional) velocity input */",
-                f"#define ENV_STROKE_M {lit(env.stroke_m)}",
-                f"#define ENV_VELOCITY_M_PER_S {lit(env.velocity_m_per_s)}",
-                f"#define ENV_N_FLAGGED {len(env.flagged_m)}",
-                f"static const double ENV_FLAGGED[] = {{{', '.join(flagged)}}};",
-                f"#define ENV_SOURCE {_c_string(env.source)}",
-                f"#define N_FACTS {len(facts.lines)}",
-                f"static const char *const FACTS[] = {{{facts_c}}};",
-            ]
-        )
-        + "\n"
-    )
+    lines = [
+        f'#define FMU_TOKEN "{token}"',
+        "#define HAS_VELOCITY 1 /* every FMU has the (optional) velocity inputs */",
+        _c_array("double", "ENV_STROKE", [lit(v) for v in strokes]),
+        _c_array("double", "ENV_VELOCITY", [lit(v) for v in rates]),
+        f"#define ENV_N_FLAGGED {len(env.flagged_m)}",
+        _c_array("double", "ENV_FLAGGED", flagged),
+        f"#define ENV_SOURCE {_c_string(env.source)}",
+        f"#define N_FACTS {len(facts.lines)}",
+        f"static const char *const FACTS[] = {{{facts_c}}};",
+    ]
+    for name, values in (
+        ("COORD_NAMES", [p.x for p in ports]),
+        ("COORD_SYMBOLS", [p.symbol for p in ports]),
+        ("COORD_UNITS", [p.x_unit for p in ports]),
+        ("FORCE_NAMES", [p.f for p in ports]),
+    ):
+        lines.append(_c_array("char *const", name, [_c_string(v) for v in values]))
+    for name, attr in (
+        ("VR_X", "vr_x"),
+        ("VR_V", "vr_v"),
+        ("VR_F", "vr_f"),
+        ("VR_STROKE_OF", "vr_stroke"),
+        ("VR_RATE_OF", "vr_rate"),
+    ):
+        lines.append(_c_array("unsigned", name, [str(getattr(p, attr)) for p in ports]))
+    if coords == 1:  # the names of interface version 1 (scripts/bench_fmu.py's harness)
+        lines += ["#define VR_DEFLECTION 1", "#define VR_VELOCITY 2", "#define VR_FORCE 3"]
+    return "\n".join(lines) + "\n"

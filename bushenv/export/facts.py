@@ -19,15 +19,36 @@ from bushenv import excitation as ex
 from bushenv.identify.card import CardError, card_paths, load_card
 from bushenv.models import BushingModel, ModelError, model_file
 
+# The three-axis test machine (envs/BushRig3-v0.toml): seed 002 Table 1's stroke and rate on
+# the two translations, the assumed +-0.15 rad rotation at the same rate rule.
+MAX_ROTATION_RAD = 0.15
+THREE_AXIS_STROKES = (ex.MAX_DISPLACEMENT_M, ex.MAX_DISPLACEMENT_M, MAX_ROTATION_RAD)
+THREE_AXIS_RATES = (
+    ex.MAX_VELOCITY_M_PER_S,
+    ex.MAX_VELOCITY_M_PER_S,
+    ex.MAX_VELOCITY_M_PER_S / ex.MAX_DISPLACEMENT_M * MAX_ROTATION_RAD,
+)
+
 
 @dataclass(frozen=True)
 class Envelope:
-    """Where the exported model may be driven; ``flagged_m``: [lo, hi] ranges of x, m."""
+    """Where the exported model may be driven; ``flagged_m``: [lo, hi] ranges of x, m.
+
+    One coordinate: ``stroke_m`` and ``velocity_m_per_s``. Several: ``strokes`` and ``rates``,
+    one per coordinate (m or rad; m/s or rad/s)."""
 
     stroke_m: float = ex.MAX_DISPLACEMENT_M
     velocity_m_per_s: float = ex.MAX_VELOCITY_M_PER_S
     flagged_m: tuple[tuple[float, float], ...] = ()
     source: str = "the papers' test machine (no model card)"
+    strokes: tuple[float, ...] = ()
+    rates: tuple[float, ...] = ()
+
+    def limits(self, coords: int = 1) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """(strokes, rates), one each per coordinate."""
+        if coords == 1:
+            return (self.stroke_m,), (self.velocity_m_per_s,)
+        return self.strokes, self.rates
 
 
 @dataclass(frozen=True)
@@ -73,6 +94,8 @@ def facts_of(
     ``stroke_m`` and ``velocity_m_per_s`` override the card's."""
     lines = [("model", model.name), ("sample_rate_hz", f"{1 / model.dt:.10g}")]
     lines.append(("model_sha256", model_sha256 or "none (a preset, not a file)"))
+    if model.n_coords != 1:
+        return _three_axis(model, lines, card_path, certificate_path, stroke_m, velocity_m_per_s)
     env = Envelope()
     if card_path is not None:
         env, card_lines = _from_card(card_path, model_sha256)
@@ -144,3 +167,34 @@ def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, lis
     stroke = max(r["max_abs_displacement_m"] for r in train)
     speed = max(r["max_abs_velocity_m_per_s"] for r in train)
     return Envelope(stroke, speed, (), f"the training records of {card_path.name}"), lines
+
+
+def _three_axis(model, lines, card_path, certificate_path, stroke_m, velocity_m_per_s) -> Facts:
+    """A model over several coordinates carries the three-axis test machine's envelope; its
+    card's and certificate's ranges are one-axis quantities, not read into the FMU yet."""
+    given = [
+        name
+        for name, value in (
+            ("--card", card_path),
+            ("--certificate", certificate_path),
+            ("--stroke-mm", stroke_m),
+            ("--velocity-m-per-s", velocity_m_per_s),
+        )
+        if value is not None
+    ]
+    if given:
+        raise ModelError(
+            f"{' and '.join(given)}: a three-axis FMU carries the three-axis test machine's "
+            "envelope; cards, certificates and envelope overrides go into one-axis FMUs only"
+        )
+    source = "the three-axis test machine (BushRig3-v0's stroke and rate; no model card)"
+    env = Envelope(source=source, strokes=THREE_AXIS_STROKES, rates=THREE_AXIS_RATES)
+    lines.append(("coordinates", ", ".join(model.coords)))
+    lines.append(("card", "none: three-axis cards are not read into FMUs"))
+    lines.append(("certificate", "none"))
+    bounds = ", ".join(
+        f"|{c}| <= {s:.6g} {u}, rate <= {r:.6g} {u}/s"
+        for c, u, s, r in zip(model.coords, model.units, env.strokes, env.rates, strict=True)
+    )
+    lines.append(("envelope", f"{bounds} ({source})"))
+    return Facts(env, tuple(lines))

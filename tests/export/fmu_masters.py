@@ -83,8 +83,10 @@ def opened(path, log=None, start_s: float = 0.0):
 
 
 def backward_velocity(x: np.ndarray, dt: float) -> np.ndarray:
-    """(x_k - x_(k-1)) / dt with x_(-1) = 0: the FMU's own velocity rule (and the rigs')."""
-    return np.diff(x, prepend=0.0) / dt
+    """(x_k - x_(k-1)) / dt along axis 0, x_(-1) = 0: the FMU's own velocity rule (and the
+    rigs')."""
+    x = np.asarray(x, dtype=float)
+    return np.diff(x, axis=0, prepend=np.zeros((1, *x.shape[1:]))) / dt
 
 
 def held(force: np.ndarray, t_comm: np.ndarray, dt: float) -> np.ndarray:
@@ -92,24 +94,36 @@ def held(force: np.ndarray, t_comm: np.ndarray, dt: float) -> np.ndarray:
     return force[np.floor(np.asarray(t_comm) / dt + 1e-6).astype(int)]
 
 
+def ports(vr: dict):
+    """The FMU's coordinates (``description.PORTS``): one, or axial, radial and rotation."""
+    from bushenv.export.description import PORTS
+
+    return PORTS[1] if "deflection" in vr else PORTS[3]
+
+
 def set_then_read(path, t_comm, x_comm, v_comm=None, log=None) -> np.ndarray:
     """At each communication point set the inputs (``v_comm`` None: the deflection only, the
-    FMU's own velocity), read the force, ``doStep`` to the next point. Returns the forces
-    read, (len(t_comm),); ``log``: FMI 3 log-message callback."""
+    FMU's own velocity), read the force, ``doStep`` to the next point. ``x_comm``, ``v_comm``
+    (T,) or, for a three-axis FMU, (T, 3). Returns the forces read, (T,) or (T, 3); ``log``:
+    FMI 3 log-message callback."""
     with opened(path, log, float(t_comm[0])) as (s, vr, three):
         setf = s.setFloat64 if three else s.setReal
         getf = s.getFloat64 if three else s.getReal
-        out = np.empty(len(t_comm))
+        ps = ports(vr)
+        xs = np.asarray(x_comm, dtype=float).reshape(len(t_comm), -1)
+        vs = None if v_comm is None else np.asarray(v_comm, dtype=float).reshape(len(t_comm), -1)
+        vr_x, vr_v, vr_f = ([vr[getattr(p, a)] for p in ps] for a in ("x", "v", "f"))
+        out = np.empty((len(t_comm), len(ps)))
         for j, t in enumerate(t_comm):
-            setf([vr["deflection"]], [float(x_comm[j])])
-            if v_comm is not None:
-                setf([vr["velocity"]], [float(v_comm[j])])
-            out[j] = getf([vr["force"]])[0]
+            setf(vr_x, [float(a) for a in xs[j]])
+            if vs is not None:
+                setf(vr_v, [float(a) for a in vs[j]])
+            out[j] = getf(vr_f)
             if j + 1 < len(t_comm):
                 s.doStep(
                     currentCommunicationPoint=float(t), communicationStepSize=t_comm[j + 1] - t
                 )
-        return out
+        return out[:, 0] if np.ndim(x_comm) == 1 else out
 
 
 def derivatives_then_step(path, t_comm, x_comm, v_comm=None) -> np.ndarray:
@@ -133,21 +147,29 @@ def derivatives_then_step(path, t_comm, x_comm, v_comm=None) -> np.ndarray:
 
 
 def fmpy_simulate(path, t, x, h: float, fmi_type: str = "CoSimulation"):
-    """FMPy's ``simulate_fmu`` on the record ``x`` at samples ``t`` (the deflection only; FMPy
-    interpolates it linearly), output every ``h``. Returns (times, forces)."""
-    from fmpy import simulate_fmu
+    """FMPy's ``simulate_fmu`` on the record ``x`` at samples ``t`` ((T,), or (T, 3) for a
+    three-axis FMU; the coordinates only: FMPy interpolates them linearly), output every ``h``.
+    Returns (times, forces): forces (N,) or (N, 3)."""
+    from fmpy import read_model_description, simulate_fmu
 
-    signal = np.array(list(zip(t, x, strict=True)), dtype=[("time", float), ("deflection", float)])
+    md = read_model_description(str(path))
+    ps = ports({v.name: v.valueReference for v in md.modelVariables})
+    cols = np.asarray(x, dtype=float).reshape(len(t), -1)
+    signal = np.array(
+        list(zip(t, *cols.T, strict=True)),
+        dtype=[("time", float)] + [(p.x, float) for p in ps],
+    )
     res = simulate_fmu(
         str(path),
         stop_time=float(t[-1]),
         output_interval=h,
         input=signal,
-        output=["force"],
+        output=[p.f for p in ps],
         fmi_type=fmi_type,
         record_events=False,
     )
-    return res["time"], res["force"]
+    forces = np.stack([res[p.f] for p in ps], axis=1)
+    return res["time"], forces[:, 0] if np.ndim(x) == 1 else forces
 
 
 def libcosim(path, t, x, h: float):

@@ -1,10 +1,11 @@
 /* bushenv FMU core: runs the model (model.h) at its own sample time whatever the master's step.
 
-   Inputs: the deflection, and an optional velocity. The model's velocity at sample n is the
-   backward difference (x_n - x_(n-1)) / dt of the deflections it was given (x_(-1) = 0: the
-   bushing starts at rest), as bushenv's rigs feed their models; once the master connects the
-   `velocity` input (sets it after initialisation, or to other than its start value 0 during
-   it), that input is used instead.
+   Inputs: the MODEL_N_COORDS coordinates x (one deflection; or axial, radial, rotation), and
+   an optional velocity of each. The model's velocity at sample n is the backward difference
+   (x_n - x_(n-1)) / dt of the coordinates it was given (x_(-1) = 0: the bushing starts at
+   rest), as bushenv's rigs feed their models; once the master connects a coordinate's velocity
+   input (sets it after initialisation, or to other than its start value 0 during it), that
+   input is used for that coordinate instead. Outputs: one force (N, or N m) per coordinate.
 
    Co-simulation: sample n lies at t0 + n * MODEL_DT_S. The core keeps the model state after
    every sample whose input is known ("committed"): at doStep(t, h) every sample at or before t
@@ -26,19 +27,22 @@
    interpolation of the model's forces when the model is linear in x and v. docs/export.md
    states the error of each case.
 
-   Envelope (model.h, generated): a sample is outside when |x| > ENV_STROKE_M, |x_n -
-   x_(n-1)| / dt > ENV_VELOCITY_M_PER_S, or x lies in a range the model's certificate flags. */
+   Envelope (model.h, generated): a sample is outside when for a coordinate i |x_i| >
+   ENV_STROKE[i], |x_i,n - x_i,(n-1)| / dt > ENV_VELOCITY[i], or (one coordinate) x lies in a
+   range the model's certificate flags. */
 #include <stdio.h>
 #include <string.h>
 
 #define CORE_EPS (1e-6 * MODEL_DT_S) /* a time this close to a sample is on it */
+#define NC MODEL_N_COORDS
 
 typedef void (*core_log_fn)(void *env, int warning, const char *message);
 
 typedef struct {
     double s[MODEL_N_STATE]; /* model state after the last counted sample */
     long n;                  /* samples counted */
-    double x_last, force;    /* input and force of the last counted sample */
+    double x_last[NC];       /* input of the last counted sample */
+    double force[NC];        /* its forces */
     int outside;             /* the last counted sample is outside the envelope */
     long n_outside;          /* counted samples outside */
 } CoreRun;
@@ -46,15 +50,17 @@ typedef struct {
 typedef struct {
     CoreRun done, pending, before; /* before: model exchange, the run before the latest sample */
     int pending_valid;
-    double t0, t_known, x_known, v_known; /* last committed communication point */
+    double t0, t_known; /* last committed communication point */
+    double x_known[NC], v_known[NC];
     int have_known;
-    double t_now, x_now, v_now; /* current time and inputs (set or extrapolated) */
-    double dx_now, dv_now;      /* input derivatives set by the master (FMI 2) */
-    int fresh;                  /* the input at t_now is known: set, or along a derivative */
-    int has_derivative;         /* the master sets input derivatives (FMI 2) */
-    int started;                /* initialisation is over */
-    int velocity_connected;     /* the master connected `velocity` (see the top) */
-    int me;                     /* model exchange */
+    double t_now;                 /* current time */
+    double x_now[NC], v_now[NC];  /* current inputs (set or extrapolated) */
+    double dx_now[NC], dv_now[NC]; /* input derivatives set by the master (FMI 2) */
+    int fresh;                    /* the input at t_now is known: set, or along a derivative */
+    int has_derivative;           /* the master sets input derivatives (FMI 2) */
+    int started;                  /* initialisation is over */
+    int velocity_connected[NC];   /* the master connected that velocity (see the top) */
+    int me;                       /* model exchange */
     core_log_fn log;
     void *log_env;
     char message[512];
@@ -67,11 +73,32 @@ static void core_reset(Core *c, double t0) {
     c->pending_valid = 0;
     c->t0 = c->t_now = c->t_known = t0;
     c->have_known = 0;
-    c->x_now = c->v_now = c->x_known = c->v_known = c->dx_now = c->dv_now = 0.0;
+    for (int i = 0; i < NC; i++) {
+        c->x_now[i] = c->v_now[i] = c->x_known[i] = c->v_known[i] = 0.0;
+        c->dx_now[i] = c->dv_now[i] = 0.0;
+        c->velocity_connected[i] = 0;
+    }
     c->fresh = 1;
     c->has_derivative = 0;
     c->started = 0;
-    c->velocity_connected = 0;
+}
+
+/* A new start time, keeping the inputs set so far and the form (co-simulation or not). */
+static void core_restart(Core *c, double t0) {
+    double x[NC], v[NC];
+    int me = c->me, connected[NC];
+    for (int i = 0; i < NC; i++) {
+        x[i] = c->x_now[i];
+        v[i] = c->v_now[i];
+        connected[i] = c->velocity_connected[i];
+    }
+    core_reset(c, t0);
+    for (int i = 0; i < NC; i++) {
+        c->x_now[i] = x[i];
+        c->v_now[i] = v[i];
+        c->velocity_connected[i] = connected[i];
+    }
+    c->me = me;
 }
 
 static int core_in_flagged(double x) {
@@ -80,30 +107,40 @@ static int core_in_flagged(double x) {
     return 0;
 }
 
-/* Why a sample is outside the envelope (NULL: inside). */
-static const char *core_outside_why(double x, double speed) {
-    if (fabs(x) > ENV_STROKE_M) return "deflection beyond the fitted stroke";
-    if (speed > ENV_VELOCITY_M_PER_S) return "velocity beyond the fitted range";
-    if (core_in_flagged(x)) return "deflection in a range the certificate flags";
+/* Why a sample is outside the envelope (NULL: inside); *which: the coordinate. */
+static const char *core_outside_why(const double *x, const double *x_prev, int first,
+                                    int *which) {
+    for (int i = 0; i < NC; i++) {
+        *which = i;
+        if (fabs(x[i]) > ENV_STROKE[i]) return "beyond the fitted stroke";
+        if (!first && fabs(x[i] - x_prev[i]) / MODEL_DT_S > ENV_VELOCITY[i])
+            return "rate beyond the fitted range";
+    }
+    *which = 0;
+    if (NC == 1 && core_in_flagged(x[0])) return "in a range the certificate flags";
     return NULL;
 }
 
-/* Count one sample at ts with input x (and velocity input v) into r. Returns 0, or -1 when
-   the force is not finite. */
-static int core_sample(Core *c, CoreRun *r, double ts, double x, double v) {
-    double rate = (x - r->x_last) / MODEL_DT_S; /* backward difference; x_(-1) = 0 */
-    double speed = r->n > 0 ? fabs(x - r->x_last) / MODEL_DT_S : 0.0;
-    if (!c->velocity_connected) v = rate;
-    r->force = model_step(r->s, x, v);
-    if (!(r->force == r->force) || fabs(r->force) > 1e300) {
-        snprintf(c->message, sizeof c->message,
-                 "the model's force is not finite at t = %.6g s (x = %.6g m, v = %.6g m/s)",
-                 ts, x, v);
-        return -1;
+/* Count one sample at ts with inputs x (and velocity inputs v) into r. Returns 0, or -1 when
+   a force is not finite. */
+static int core_sample(Core *c, CoreRun *r, double ts, const double *x, const double *v) {
+    double vv[NC];
+    int which;
+    for (int i = 0; i < NC; i++) /* backward difference; x_(-1) = 0 */
+        vv[i] = c->velocity_connected[i] ? v[i] : (x[i] - r->x_last[i]) / MODEL_DT_S;
+    model_step_n(r->s, x, vv, r->force);
+    for (int i = 0; i < NC; i++) {
+        if (!(r->force[i] == r->force[i]) || fabs(r->force[i]) > 1e300) {
+            snprintf(c->message, sizeof c->message,
+                     "the model's %s is not finite at t = %.6g s (%s = %.6g %s, rate %.6g %s/s)",
+                     FORCE_NAMES[i], ts, COORD_NAMES[i], x[i], COORD_UNITS[i], vv[i],
+                     COORD_UNITS[i]);
+            return -1;
+        }
     }
-    r->outside = core_outside_why(x, speed) != NULL;
+    r->outside = core_outside_why(x, r->x_last, r->n == 0, &which) != NULL;
     r->n_outside += r->outside;
-    r->x_last = x;
+    for (int i = 0; i < NC; i++) r->x_last[i] = x[i];
     r->n += 1;
     return 0;
 }
@@ -112,13 +149,17 @@ static int core_sample(Core *c, CoreRun *r, double ts, double x, double v) {
 static void core_input(const Core *c, double ts, double *x, double *v) {
     double span = c->t_now - c->t_known;
     if (!c->have_known || span <= CORE_EPS || ts >= c->t_now - CORE_EPS) {
-        *x = c->x_now;
-        *v = c->v_now;
+        for (int i = 0; i < NC; i++) {
+            x[i] = c->x_now[i];
+            v[i] = c->v_now[i];
+        }
         return;
     }
     double a = (ts - c->t_known) / span;
-    *x = c->x_known + a * (c->x_now - c->x_known);
-    *v = c->v_known + a * (c->v_now - c->v_known);
+    for (int i = 0; i < NC; i++) {
+        x[i] = c->x_known[i] + a * (c->x_now[i] - c->x_known[i]);
+        v[i] = c->v_known[i] + a * (c->v_now[i] - c->v_known[i]);
+    }
 }
 
 /* Count every sample at or before t_now into c->pending (from the committed run). Returns 0,
@@ -129,8 +170,8 @@ static int core_pending(Core *c) {
     for (;;) {
         double ts = c->t0 + (double)r.n * MODEL_DT_S;
         if (ts > c->t_now + CORE_EPS) break;
-        double x, v;
-        core_input(c, ts, &x, &v);
+        double x[NC], v[NC];
+        core_input(c, ts, x, v);
         if (core_sample(c, &r, ts, x, v)) return -1;
     }
     c->pending = r;
@@ -138,13 +179,14 @@ static int core_pending(Core *c) {
     return 0;
 }
 
-/* Log an entry into the outside of the envelope at sample time ts. */
-static void core_log_entry(Core *c, double ts, const char *why, double x) {
+/* Log an entry into the outside of the envelope at sample time ts (coordinate i). */
+static void core_log_entry(Core *c, double ts, const char *why, int i, const double *x) {
     if (!c->log) return;
     snprintf(c->message, sizeof c->message,
-             "t = %.6g s: input leaves the bushing's validity envelope: %s "
-             "(x = %.6g m, stroke %.6g m, velocity limit %.6g m/s; %s)",
-             ts, why, x, ENV_STROKE_M, ENV_VELOCITY_M_PER_S, ENV_SOURCE);
+             "t = %.6g s: input leaves the bushing's validity envelope: %s %s "
+             "(%s = %.6g %s, stroke %.6g %s, rate limit %.6g %s/s; %s)",
+             ts, COORD_NAMES[i], why, COORD_SYMBOLS[i], x[i], COORD_UNITS[i], ENV_STROKE[i],
+             COORD_UNITS[i], ENV_VELOCITY[i], COORD_UNITS[i], ENV_SOURCE);
     c->log(c->log_env, 1, c->message);
 }
 
@@ -153,15 +195,16 @@ static int core_commit(Core *c) {
     CoreRun before = c->done;
     if (core_pending(c)) return -1;
     /* re-walk only to find entries (cheap: the envelope test, not the model) */
-    int was_outside = before.outside;
-    double x_prev = before.x_last;
+    int was_outside = before.outside, which;
+    double x_prev[NC];
+    for (int i = 0; i < NC; i++) x_prev[i] = before.x_last[i];
     for (long n = before.n; n < c->pending.n; n++) {
-        double ts = c->t0 + (double)n * MODEL_DT_S, x, v;
-        core_input(c, ts, &x, &v);
-        const char *why = core_outside_why(x, n > 0 ? fabs(x - x_prev) / MODEL_DT_S : 0.0);
-        if (why && !was_outside) core_log_entry(c, ts, why, x);
+        double ts = c->t0 + (double)n * MODEL_DT_S, x[NC], v[NC];
+        core_input(c, ts, x, v);
+        const char *why = core_outside_why(x, x_prev, n == 0, &which);
+        if (why && !was_outside) core_log_entry(c, ts, why, which, x);
         was_outside = why != NULL;
-        x_prev = x;
+        for (int i = 0; i < NC; i++) x_prev[i] = x[i];
     }
     c->done = c->pending;
     return 0;
@@ -172,12 +215,14 @@ static int core_do_step(Core *c, double t, double h) {
     c->t_now = t;
     if (core_commit(c)) return -1;
     c->t_known = t;
-    c->x_known = c->x_now;
-    c->v_known = c->v_now;
+    for (int i = 0; i < NC; i++) {
+        c->x_known[i] = c->x_now[i];
+        c->v_known[i] = c->v_now[i];
+        c->x_now[i] = c->x_known[i] + h * c->dx_now[i];
+        c->v_now[i] = c->v_known[i] + h * c->dv_now[i];
+    }
     c->have_known = 1;
     c->t_now = t + h;
-    c->x_now = c->x_known + h * c->dx_now;
-    c->v_now = c->v_known + h * c->dv_now;
     c->pending_valid = 0;
     c->fresh = c->has_derivative;
     return 0;
@@ -186,14 +231,15 @@ static int core_do_step(Core *c, double t, double h) {
 /* Model exchange, at an event: commit every sample due by t_now with the current input.
    Returns 0, or -1 when the force is not finite. */
 static int core_me_event(Core *c) {
+    int which;
     for (;;) {
         double ts = c->t0 + (double)c->done.n * MODEL_DT_S;
         if (ts > c->t_now + CORE_EPS) break;
         c->before = c->done;
         if (core_sample(c, &c->done, ts, c->x_now, c->v_now)) return -1;
         const char *why =
-            core_outside_why(c->x_now, fabs(c->x_now - c->before.x_last) / MODEL_DT_S);
-        if (why && !c->before.outside) core_log_entry(c, ts, why, c->x_now);
+            core_outside_why(c->x_now, c->before.x_last, c->before.n == 0, &which);
+        if (why && !c->before.outside) core_log_entry(c, ts, why, which, c->x_now);
     }
     c->pending_valid = 0;
     return 0;
@@ -204,7 +250,7 @@ static double core_me_next_event(const Core *c) {
     return c->t0 + (double)c->done.n * MODEL_DT_S;
 }
 
-/* Model exchange: the force at t_now between samples n and n+1 (see the top). */
+/* Model exchange: the forces at t_now between samples n and n+1 (see the top). */
 static int core_me_pending(Core *c) {
     if (c->pending_valid) return 0;
     c->pending = c->done;
@@ -219,9 +265,10 @@ static int core_me_pending(Core *c) {
     if (a > CORE_EPS / MODEL_DT_S) {
         if (a > 1.0) a = 1.0;
         if (core_sample(c, &next, c->t_now, c->x_now, c->v_now)) return -1;
-        c->pending.force = (1.0 - a) * latest.force + a * next.force;
-    } else {
-        c->pending.force = latest.force; /* on the sample: the model's force there */
+        for (int i = 0; i < NC; i++)
+            c->pending.force[i] = (1.0 - a) * latest.force[i] + a * next.force[i];
+    } else { /* on the sample: the model's forces there */
+        for (int i = 0; i < NC; i++) c->pending.force[i] = latest.force[i];
     }
     c->pending_valid = 1;
     return 0;
@@ -229,7 +276,7 @@ static int core_me_pending(Core *c) {
 
 /* What the outputs show: the samples up to t_now when their input is known (set at t_now, or
    extrapolated along a derivative), else the committed ones (the input at t_now is unknown);
-   in model exchange, the latest sample recomputed with the current input. */
+   in model exchange, the forces of the current input (core_me_pending). */
 static const CoreRun *core_outputs(Core *c) {
     if (c->me) return core_me_pending(c) ? NULL : &c->pending;
     if (!c->fresh) return &c->done;
@@ -237,20 +284,21 @@ static const CoreRun *core_outputs(Core *c) {
     return &c->pending;
 }
 
-static void core_set_inputs(Core *c, int which, double value) {
-    if (which == 0) c->x_now = value;
+/* Set coordinate i's deflection (velocity 0) or velocity (1). */
+static void core_set_input(Core *c, int velocity, int i, double value) {
+    if (!velocity) c->x_now[i] = value;
     else {
-        c->v_now = value;
+        c->v_now[i] = value;
         /* connected: set after initialisation, or to other than its start value (0) during
            it; a master that only applies the start value has not connected it */
-        if (c->started || value != 0.0) c->velocity_connected = 1;
+        if (c->started || value != 0.0) c->velocity_connected[i] = 1;
     }
     c->pending_valid = 0;
     c->fresh = 1;
 }
 
-static void core_set_derivative(Core *c, int which, double value) {
-    if (which == 0) c->dx_now = value;
-    else c->dv_now = value;
+static void core_set_derivative(Core *c, int velocity, int i, double value) {
+    if (!velocity) c->dx_now[i] = value;
+    else c->dv_now[i] = value;
     c->has_derivative = 1;
 }

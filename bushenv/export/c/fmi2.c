@@ -75,12 +75,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, fmi2Rea
                                fmi2Real start, fmi2Boolean stop_defined, fmi2Real stop) {
     (void)tol_defined; (void)tol; (void)stop_defined; (void)stop;
     Instance *m = (Instance *)c;
-    double x = m->core.x_now, v = m->core.v_now;
-    int me = m->core.me;
-    core_reset(&m->core, start);
-    m->core.x_now = x;
-    m->core.v_now = v;
-    m->core.me = me;
+    core_restart(&m->core, start);
     return fmi2OK;
 }
 
@@ -202,9 +197,10 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     Instance *m = (Instance *)c;
     for (size_t i = 0; i < n; i++) {
         if (order[i] != 1) continue; /* the input is linear between points: higher orders unused */
-        if (vr[i] == VR_DEFLECTION) core_set_derivative(&m->core, 0, v[i]);
-        else if (vr[i] == VR_VELOCITY) core_set_derivative(&m->core, 1, v[i]);
-        else return fail2(m, "fmi2SetRealInputDerivatives: not an input");
+        int velocity, k;
+        if (var_input(vr[i], &velocity, &k))
+            return fail2(m, "fmi2SetRealInputDerivatives: not an input");
+        core_set_derivative(&m->core, velocity, k, v[i]);
     }
     return fmi2OK;
 }

@@ -72,12 +72,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean tol_defined, 
                                        fmi3Float64 stop) {
     (void)tol_defined; (void)tol; (void)stop_defined; (void)stop;
     Instance *m = (Instance *)c;
-    double x = m->core.x_now, v = m->core.v_now;
-    int me = m->core.me;
-    core_reset(&m->core, start);
-    m->core.x_now = x;
-    m->core.v_now = v;
-    m->core.me = me;
+    core_restart(&m->core, start);
     return fmi3OK;
 }
 
