@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose.coupling import COUPLING_MIN
+from bushenv.diagnose.coupling import COUPLING_BEATS, COUPLING_MIN
 from bushenv.metrics import rms_ratio
 
 SI_TOKENS = {"m": "m", "rad": "rad", "N": "n", "N m": "nm"}  # unit -> its token in a key
@@ -19,10 +19,11 @@ COORDINATE_RULE = (
     "each coordinate's gap is rms(f_i - baseline_i) / rms(f_i) over the judged records; a "
     "coordinate carries a gap when the one-axis diagnosis of it answers other than none (a gap "
     "clear of the force's noise); the answer is the carrying coordinate with the largest gap "
-    "above the noise, sqrt(gap^2 - gap_noise^2), and the effect named there; where the one-axis "
-    f"diagnosis answers outside_candidates and terms q_i q_j^2 close at least "
-    f"{100 * COUPLING_MIN:.0f} % of the gap above the noise beyond the coordinate's own cubic, "
-    "the effect is coupling (to the coordinates j whose term closes most)"
+    "above the noise, sqrt(gap^2 - gap_noise^2), and the effect named there; where terms "
+    f"q_i q_j^2 close at least {100 * COUPLING_MIN:.0f} % of the gap above the noise beyond the "
+    "coordinate's own cubic and the one-axis diagnosis answers outside_candidates (or names an "
+    f"effect leaving over {1 / COUPLING_BEATS:.2g} x the coupled fit's gap), the effect is "
+    "coupling (to the coordinates j whose term closes most)"
 )
 
 
@@ -132,7 +133,7 @@ def _in_units(setup, i: int, d: dict[str, Any], row: dict[str, Any]) -> None:
     test = row["coupling"]
     if test["named"] or test["closes"] >= COUPLING_MIN:
         said = (
-            "named coupling: no one-axis candidate closes the gap, and"
+            f"named coupling ({row['effect_one_axis']} one axis), as"
             if test["named"]
             else "besides the answer,"
         )

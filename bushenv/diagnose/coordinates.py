@@ -14,8 +14,9 @@ coordinates' SI units (three-axis: m, m, rad and N, N, N m) and ``.dt`` s, such 
    record used or held out), so the candidates take the coordinate's own deflection. A record
    in which the coordinate does not move (held at exactly one value) is left out of that
    coordinate's diagnosis; a coordinate no TRAIN or no TEST record moves is not diagnosed.
-3. **Coupling** (``coupling.py``): where the engine finds a gap clear of the noise that no
-   candidate closes, terms ``q_i q_j^2`` of the other coordinates are tried.
+3. **Coupling** (``coupling.py``): terms ``q_i q_j^2`` of the other coordinates; named where
+   the engine finds a gap clear of the noise that no candidate closes, or where they leave
+   less than ``COUPLING_BEATS`` of the gap the named candidate leaves.
 4. **Which coordinate** (``coordinate_answer.py``): each coordinate's gap on its measured
    force ranks the coordinates; the answer is the coordinate carrying a gap (the engine's
    answer there is not ``none``) with the largest gap above the noise, and its effect.
@@ -36,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.diagnose.coordinate_answer import coordinate_result
-from bushenv.diagnose.coupling import COUPLING_MIN, coupling_test
+from bushenv.diagnose.coupling import COUPLING_BEATS, COUPLING_MIN, coupling_test
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.inputs import LINEAR, MIN_SAMPLES, Progress, names_of
 
@@ -282,9 +283,10 @@ def _coupling(setup: Setup, i: int, d: dict[str, Any]) -> dict[str, Any]:
         for n in dict.fromkeys(used)
     }
     test = coupling_test(records, d["records"]["folds"], i, list(setup.coords), d["gap_noise"])
+    leaves = d["effect"] == "outside_candidates" or (
+        d["effect"] != "none" and test["gap_coupled"] < COUPLING_BEATS * d["gap_after"]
+    )  # no candidate closes the gap, or the one named leaves far more than the coupling
     test["named"] = bool(
-        d["effect"] == "outside_candidates"
-        and test["closes"] >= COUPLING_MIN
-        and test["gap_coupled"] < test["gap_null"]
+        leaves and test["closes"] >= COUPLING_MIN and test["gap_coupled"] < test["gap_null"]
     )
     return test

@@ -13,8 +13,9 @@ i's force (less the baseline's fixed cross-coordinate terms) by least squares on
 on the engine's folds (each judged record by a fit on the others) and measures what the
 coupling terms close beyond ``own``, above the force's noise, as a share of the null's gap
 above the noise (``closes``). ``COUPLING_MIN`` of it names ``coupling`` where the one-axis
-diagnosis answered ``outside_candidates``; the partner coordinates are those whose term alone
-closes at least half as much.
+diagnosis answered ``outside_candidates``, or named an effect whose judged gap is more than
+1 / ``COUPLING_BEATS`` times the coupled fit's; the partner coordinates are those whose term
+alone closes at least half as much.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ import numpy as np
 from bushenv.models.base import velocity_of
 
 COUPLING_MIN = 0.5  # share of the null's gap above the noise the coupling terms must close
+COUPLING_BEATS = 0.7  # ... and leave less than this share of the named candidate's gap
 
 
 def _columns(q: np.ndarray, i: int, dt: float, partners: list[int]) -> np.ndarray:

@@ -57,7 +57,7 @@ SPECS = (
         for c in COORDS
     ),
     Spec("friction_vector", "friction", COORDS, ("friction",)),
-    Spec("coupling", "coupling", ("axial", "radial"), ("coupling",)),
+    Spec("coupling", "coupling", COORDS, ("coupling",)),
     Spec("relaxation+coupling", "relaxation", COORDS, ("relaxation", "coupling")),
 )
 FAST = ("none", "friction@radial", "relaxation@rotation", "hardening@axial")  # the tests' subset
