@@ -2,10 +2,10 @@
 ``fmu.h`` that ties the C to them (token, envelope, facts).
 
 Every FMU has one interface, whatever the model kind, in co-simulation and model exchange.
-Value references are fixed (``c/variables.h``): 0 time (FMI 3), 1 deflection [m], 2 velocity
-[m/s] (optional: used once the master sets it), 3 force [N], 4 outside_envelope,
-5 time_outside_envelope_s [s], 6-8 the envelope's stroke and velocity and the sample time
-(constants), 100.. the facts.
+Value references: 0 time (FMI 3), 4 outside_envelope, 5 time_outside_envelope_s [s], 8 the
+sample time, 100.. the facts; per coordinate (``PORTS``) its input, optional velocity input
+(used once the master connects it), force output and envelope constants: one axis 1
+deflection [m], 2 velocity [m/s], 3 force [N], 6-7 the envelope; three axes 30-45.
 """
 
 from __future__ import annotations

@@ -1,10 +1,11 @@
 """C source of one bushing model's sample step, its parameters written in as constants.
 
 ``model_source(model)`` returns ``model.h``: ``MODEL_N_STATE``, ``MODEL_DT_S``,
-``model_reset(double *s)`` (the state at rest) and ``model_step(double *s, x, v)`` (advance one
-sample with deflection x and velocity v, return the force, N), for the FMU core (``c/core.h``),
-which supplies v (the backward difference, or the velocity input). Each reproduces the model's
-own discrete definition:
+``MODEL_N_COORDS``, ``model_reset(double *s)`` (the state at rest) and
+``model_step_n(double *s, x[], v[], f[])`` (advance one sample with the coordinates x and their
+velocities v, write the forces f; one axis also has the scalar ``model_step(s, x, v)``), for
+the FMU core (``c/core.h``), which supplies v (the backward difference, or the velocity
+inputs). Each reproduces the model's own discrete definition:
 
 * linear: F = k x + c v (``kernels.linear_kernel``);
 * nn, hybrid: the NARX recurrence of ``kernels.narx_kernel`` with the same operations in the
@@ -12,7 +13,10 @@ own discrete definition:
   multiply-adds (``-ffp-contract=off``) it gives the model's bits;
 * boucwen: seed 002 eqs. 1-5 as printed, integrated with classical RK4 over ``substeps`` equal
   sub-steps per sample, x and v linear within the sample -- ``boucwen_reference``'s scheme, not
-  bushenv's exponential collocation (its error against both is measured in docs/export.md).
+  bushenv's exponential collocation (its error against both is measured in docs/export.md);
+* three axes: linear f = K q + C v (``planar.kernels.planar_linear_kernel``, bit for bit); nn,
+  nn-axis, hybrid as ``planar_narx_kernel``, which numba may contract into fused multiply-adds:
+  the C is the model to rounding.
 """
 
 from __future__ import annotations
