@@ -102,7 +102,10 @@ class RecordError(BadInput):
 
 @dataclass(eq=False)
 class Record:
-    """One uniformly sampled record: ``time`` (s), ``displacement`` (m), ``force`` (N), all (T,).
+    """One uniformly sampled record of a bushing of C coordinates: ``time`` (T,) s, and
+    ``displacement`` and ``force``, (T,) for one coordinate (m, N), (T, C) for several (the
+    three in-plane ones: m, m, rad and N, N, N m; ``coords`` names them, read from the shape
+    when not given).
 
     ``name`` labels it in messages (defaults to the file stem on load); ``path`` is the file it
     came from, if any; ``info`` carries notes that are not written to the CSV (e.g. the machine's
@@ -115,18 +118,44 @@ class Record:
     name: str = ""
     path: Path | None = None
     info: dict[str, Any] = field(default_factory=dict)
+    coords: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
-        arrays = {}
-        for key in HEADER:
-            a = np.ascontiguousarray(getattr(self, key), dtype=np.float64)
-            if a.ndim != 1:
-                raise RecordError(f"{self.label}: {key} has shape {a.shape}, expected (T,)")
-            arrays[key] = a
-        lengths = {k: a.size for k, a in arrays.items()}
+        arrays = {k: np.ascontiguousarray(getattr(self, k), dtype=np.float64) for k in HEADER}
+        if arrays["time"].ndim != 1:
+            raise RecordError(f"{self.label}: time has shape {arrays['time'].shape}, expected (T,)")
+        if self.coords is None:
+            self.coords = _coords_of(arrays["displacement"])
+        c = len(self.coords)
+        want = "(T,)" if c == 1 else f"(T, {c}) ({', '.join(self.coords)})"
+        for key in HEADER[1:]:
+            a = arrays[key]
+            if (c == 1 and a.ndim != 1) or (c > 1 and (a.ndim != 2 or a.shape[1] != c)):
+                raise RecordError(f"{self.label}: {key} has shape {a.shape}, expected {want}")
+        lengths = {k: a.shape[0] for k, a in arrays.items()}
         if len(set(lengths.values())) != 1:
             raise RecordError(f"{self.label}: columns differ in length: {lengths}")
         self.time, self.displacement, self.force = (arrays[k] for k in HEADER)
+        self.coords = tuple(self.coords)
+
+    @property
+    def n_coords(self) -> int:
+        return len(self.coords)
+
+    @property
+    def q(self) -> np.ndarray:
+        """The displacement as (T, C), whatever C."""
+        return self.displacement.reshape(len(self.time), -1)
+
+    @property
+    def f(self) -> np.ndarray:
+        """The force as (T, C), whatever C."""
+        return self.force.reshape(len(self.time), -1)
+
+    @property
+    def source(self) -> str:
+        """The file it came from, else its name ("" for neither)."""
+        return str(self.path) if self.path is not None else self.name
 
     @classmethod
     def from_arrays(
@@ -185,6 +214,28 @@ class Record:
             where=lambda i: f"{self.label} sample {i}",
         )
         return self
+
+
+def _coords_of(displacement: np.ndarray) -> tuple[str, ...]:
+    """The coordinates a displacement array's shape says: one, or the three in-plane ones."""
+    if displacement.ndim < 2:
+        return ("deflection",)
+    if displacement.shape[1] == 3:
+        return ("axial", "radial", "rotation")
+    return tuple(f"q{i}" for i in range(displacement.shape[1]))
+
+
+def load_record(path: str | os.PathLike) -> Record:
+    """A record of any number of coordinates: the header says which (``time,displacement,force``
+    or the three-axis header, ``bushenv.planar.records.HEADER``); each loader's checks apply."""
+    from bushenv.planar.records import load_planar_csv, looks_planar
+
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as fh:
+            first = next(csv.reader(fh), [])
+    except (OSError, UnicodeDecodeError, csv.Error):
+        first = []  # the one-axis loader names the problem
+    return load_planar_csv(path) if looks_planar(first) else load_csv(path)
 
 
 # ----- checks shared by load and save ----------------------------------------------------------
@@ -632,6 +683,10 @@ def save_csv(record: Record, path: str | os.PathLike, overwrite: bool = False) -
     record under the final name.
     """
     path = Path(path)
+    if record.n_coords > 1:
+        from bushenv.planar.records import save_planar_csv
+
+        return save_planar_csv(path, record.time, record.q, record.f, overwrite=overwrite)
     record.validate()
     if path.exists() and not overwrite:
         raise RecordError(f"{path} already exists; refusing to overwrite it (pass overwrite=True)")

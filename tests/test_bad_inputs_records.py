@@ -209,9 +209,13 @@ def test_record_from_arrays_refuses_a_non_positive_or_non_finite_dt(dt):
         Record.from_arrays(np.zeros(3), np.zeros(3), dt, name="r")
 
 
-def test_record_refuses_two_dimensional_columns():
+def test_record_refuses_columns_that_disagree_on_the_coordinates():
     with pytest.raises(RecordError, match=r"r: displacement has shape \(3, 2\), expected \(T,\)"):
+        Record(np.arange(3.0), np.zeros((3, 2)), np.zeros((3, 2)), name="r", coords=("x",))
+    with pytest.raises(RecordError, match=r"r: force has shape \(3,\), expected \(T, 2\)"):
         Record(time=np.arange(3.0), displacement=np.zeros((3, 2)), force=np.zeros(3), name="r")
+    with pytest.raises(RecordError, match=r"r: time has shape \(3, 1\), expected \(T,\)"):
+        Record(np.zeros((3, 1)), np.zeros(3), np.zeros(3), name="r")
 
 
 def test_validate_names_the_sample_of_a_repeat_in_an_in_memory_record():

@@ -24,7 +24,6 @@ import io
 import os
 import re
 import warnings
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +34,7 @@ from bushenv.records import (
     NAME_UNIT,
     STEP_ATOL_S,
     STEP_RTOL,
+    Record,
     RecordError,
     check_rate,
     is_plausible_rate,
@@ -79,18 +79,9 @@ _HINT = {
 }
 
 
-@dataclass(frozen=True)
-class PlanarRecord:
-    """time (T,) s; q (T, 3) m, m, rad; f (T, 3) N, N, N m; ``source`` names the file."""
-
-    time: np.ndarray
-    q: np.ndarray
-    f: np.ndarray
-    source: str = ""
-
-    @property
-    def dt(self) -> float:
-        return float(np.median(np.diff(self.time)))
+# the one record type (``bushenv.records.Record``) over these three coordinates: time (T,) s;
+# q (T, 3) m, m, rad; f (T, 3) N, N, N m; ``source`` the file
+PlanarRecord = Record
 
 
 def header_names(fields: list[str]) -> list[str]:
@@ -196,8 +187,13 @@ def load_planar_csv(path: str | os.PathLike) -> PlanarRecord:
     _check_time(path, a[:, 0])
     if not stated[0]:
         check_rate(a[:, 0], str(path), lambda i: f"{path} line {i + 2}")
-    return PlanarRecord(
-        a[:, 0], np.ascontiguousarray(a[:, 1:4]), np.ascontiguousarray(a[:, 4:7]), str(path)
+    return Record(
+        a[:, 0],
+        np.ascontiguousarray(a[:, 1:4]),
+        np.ascontiguousarray(a[:, 4:7]),
+        name=path.stem,
+        path=path,
+        coords=("axial", "radial", "rotation"),
     )
 
 
