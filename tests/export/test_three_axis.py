@@ -130,3 +130,41 @@ def test_a_three_axis_file_with_a_certificate_is_refused_naming_why(tmp_path, ca
     assert "cards, certificates and envelope overrides go into one-axis FMUs only" in (
         capsys.readouterr().err
     )
+
+
+def test_a_rotation_beyond_the_machines_range_is_flagged_and_logged_naming_it(fmu3):
+    """Only the rotation leaves the envelope (a ramp to 0.2 rad, the machine's range 0.15)."""
+    from fmpy import simulate_fmu
+
+    n = 300
+    t = np.arange(n) * PAPER_DT
+    theta = np.concatenate([np.linspace(0, 0.2, n // 2), np.linspace(0.2, 0, n - n // 2)])
+    q = np.stack([np.zeros(n), np.zeros(n), theta], axis=1)
+    messages = []
+    set_then_read(fmu3("linear", "3.0"), t, q, log=lambda *a: messages.append(a[3]))
+    entries = [m for m in messages if b"leaves the bushing's validity envelope" in m]
+    assert len(entries) == 1 and b"rotation beyond the fitted stroke" in entries[0]
+    sig = np.array(
+        list(zip(t, *q.T, strict=True)),
+        dtype=[("time", float), ("deflection_axial", float), ("deflection_radial", float),
+               ("rotation", float)],
+    )  # fmt: skip
+    res = simulate_fmu(
+        str(fmu3("linear", "3.0")),
+        stop_time=t[-1],
+        output_interval=PAPER_DT,
+        input=sig,
+        output=["outside_envelope", "time_outside_envelope_s"],
+    )
+    outside = np.abs(theta) > 0.15
+    assert np.array_equal(res["outside_envelope"][1:], outside[:-1])
+    assert res["time_outside_envelope_s"][-1] == pytest.approx(outside[:-1].sum() * PAPER_DT)
+
+
+def test_connected_velocities_replace_the_fmus_own_per_coordinate(fmu3):
+    q = _motion(200)
+    t = np.arange(len(q)) * PAPER_DT
+    v = np.gradient(q, PAPER_DT, axis=0)  # simulate's default, the central difference
+    want = _model("linear").simulate(q, v)
+    got = set_then_read(fmu3("linear", "2.0"), t, q, v)
+    assert np.all(np.max(np.abs(got - want), axis=0) <= ROUNDING * np.max(np.abs(want), axis=0))
