@@ -72,7 +72,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="name or file that must stay clean (default: the Table-1 linear model with the "
         "built-in rubber; for your bushing a linear model fitted to the reference)",
     )
-    p.add_argument("--stroke-mm", type=float, default=None, help="the bushing's stroke, +-mm")
+    p.add_argument(
+        "--stroke-mm",
+        type=float,
+        default=None,
+        help="the bushing's stroke, +-mm (with --env rig3: axial and radial)",
+    )
+    p.add_argument(
+        "--rotation-mrad",
+        type=float,
+        default=None,
+        help="with --env rig3: the rotation's range, +-mrad (default: 1.5 x the card's "
+        "records', else the machine's)",
+    )
     p.add_argument(
         "--max-velocity", type=float, default=None, help="the bushing's velocity limit, m/s"
     )
@@ -120,6 +132,7 @@ def config_from(args: argparse.Namespace) -> CampaignConfig:
         control=args.control,
         stroke_mm=args.stroke_mm,
         max_velocity_m_per_s=args.max_velocity,
+        rotation_mrad=args.rotation_mrad,
         force_floor_n=args.force_floor_n,
         force_scale_n=args.force_scale_n,
         max_shrink=args.max_shrink,
@@ -140,6 +153,13 @@ def run(args: argparse.Namespace) -> int:
 
     torch.set_num_threads(1)
     progress = Progress(quiet=args.quiet)
+    if args.rotation_mrad is not None and not TARGETS[args.env].coords:
+        from bushenv.cli import CliError
+
+        raise CliError(
+            f"--rotation-mrad is the rotation's range of a three-axis bushing; --env {args.env} "
+            "has no rotation (add --env rig3, or drop it)"
+        )
     if TARGETS[args.env].coords:  # planar profiles: the planar attack
         from bushenv.search.campaign_planar import format_planar_table, run_planar_attack
 

@@ -35,6 +35,7 @@ class CampaignConfig:
     control: str | None = None  # must stay clean; None: see ``campaign_models.roles``
     stroke_mm: float | None = None  # the bushing's limits, beyond what the reference gives
     max_velocity_m_per_s: float | None = None
+    rotation_mrad: float | None = None  # three-axis targets: the rotation's range, +-mrad
     force_floor_n: float | None = None
     force_scale_n: float | None = None  # typical peak force, for judging without a reference
     max_shrink: int = 3

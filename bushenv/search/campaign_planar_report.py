@@ -30,7 +30,7 @@ RESUMED = ("searchers", "hold_stage", "recheck", "shrunk", "plots", "seconds")  
 
 def arguments(c: CampaignConfig) -> dict:
     """The settings a resumed planar attack must share with the one it continues."""
-    keep = ("stroke_mm", "max_velocity_m_per_s")
+    keep = ("stroke_mm", "max_velocity_m_per_s", "rotation_mrad")
     return {**c.arguments(), "searchers": list(c.searchers), **{k: getattr(c, k) for k in keep}}
 
 

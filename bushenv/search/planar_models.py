@@ -193,9 +193,14 @@ def search_limits(config: CampaignConfig, subject, reference) -> Rig3Limits:
     if c.max_velocity_m_per_s is not None:
         rate[:2] = [c.max_velocity_m_per_s] * 2
         given.append(f"--max-velocity {c.max_velocity_m_per_s:g}")
-    if not given:
+    if not given and c.rotation_mrad is None:
         return limits
-    source = f"{' and '.join(given)} on axial and radial (the rotation: {limits.source})"
+    source = f"{' and '.join(given)} on axial and radial" if given else ""
+    if c.rotation_mrad is not None:
+        stroke[2] = c.rotation_mrad * 1e-3
+        source += f"{'; ' if source else ''}--rotation-mrad {c.rotation_mrad:g} on the rotation"
+    else:
+        source += f" (the rotation: {limits.source})"
     return replace(limits, stroke=tuple(stroke), rate=tuple(rate), source=source)
 
 

@@ -248,3 +248,19 @@ def test_a_stroke_beyond_the_machine_is_refused_in_mm(bushing, capsys):
         _attack(bushing, "att-far", "--stroke-mm", "20", "--searchers", "random")
     err = capsys.readouterr().err
     assert "the axial stroke must be in (0, 12.5] mm (BushRig3-v0's), got 20 mm" in err
+
+
+def test_rotation_mrad_sets_the_rotations_range_and_is_refused_without_one(tmp_path, capsys):
+    from bushenv.cli import main
+
+    argv = ["attack", "--env", "rig3", "--model", "linear", "--budget", "4", "--max-shrink", "0",
+            "--searchers", "random", "--rotation-mrad", "40", "--no-plots", "--quiet",
+            "--out", str(tmp_path / "a")]  # fmt: skip
+    assert main(argv) in (0, 1)
+    report = json.loads((tmp_path / "a" / "report.json").read_text())
+    assert report["scales"]["rotation"]["stroke_mrad"] == 40.0
+    assert "--rotation-mrad 40 on the rotation" in report["scales"]["source"]
+    assert report["scales"]["axial"]["stroke_mm"] == 12.5
+    capsys.readouterr()
+    assert main(["attack", "--rotation-mrad", "40", "--out", str(tmp_path / "b")]) == 2
+    assert "--env rig has no rotation" in capsys.readouterr().err
