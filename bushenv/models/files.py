@@ -91,7 +91,7 @@ def load_model(
 TAKES = {
     1: "bushenv attack (--env rig or quartercar), certify, export, diagnose, replay, zoo, and "
     "gym.make('BushRig-v0' or 'QuarterCar-v0', model=FILE)",
-    3: "bushenv attack --env rig3, bushenv card, bushenv measure --axes 3, and "
+    3: "bushenv attack --env rig3, certify, export, card, measure --axes 3, and "
     "gym.make('BushRig3-v0', model=FILE)",
 }
 
