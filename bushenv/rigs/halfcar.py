@@ -1,0 +1,461 @@
+"""HalfCar-v0: a roll-plane front axle whose four inner arm pivots are bushings (Gymnasium env).
+
+The car (pymunk bodies, springs, the split bushing coupling) is ``halfcar_car.py``, its
+parameters and geometry ``halfcar_params.py``; this module steps a model car beside its
+reference twin and turns them into observations, rewards, ``info`` and the episode's end.
+``halfcar_vector.py`` steps N of these as a vector env.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from bushenv.rigs.actions import _array, check_options, check_profile, describe
+from bushenv.rigs.car_verdict import MODEL_ERROR_PREFIX
+from bushenv.rigs.common import (
+    MODEL_ERRORS,
+    ForceDeviationReward,
+    RigError,
+    ask_monitor,
+    call_reset,
+    check_hook,
+    model_error_text,
+)
+from bushenv.rigs.halfcar_car import SIGN, HalfCar, HalfCarPair, step_models
+from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, SIDES, HalfCarParameters
+from bushenv.rigs.specs import spec_kwargs
+
+OBS_SIZE = 16
+COORD_KEYS = (("axial", "n"), ("radial", "n"), ("moment", "nm"))
+REPLAY_KEYS = ("road_left", "road_right", "lateral_accel")
+
+
+class HalfCarEnv(gym.Env):
+    """
+    ## Description
+
+    A roll-plane front axle seen from the front (issue 39; seeds 000 §5.3 and 001 §5 drove
+    full cars with bushing models over bumps, potholes and pulse steer). A sprung body (lateral,
+    vertical, roll) sits on two double wishbones; each has a lower and an upper arm whose inner
+    pivots hang on the body *through bushings* (no joint: each pivot is one three-coordinate
+    bushing model -- axial: lateral in the body frame, outboard positive; radial: vertical in
+    the body frame; rotation: the arm relative to the body, wheel-up positive; the right side
+    mirrored), an upright with its wheel on two ball joints, a coil-over on the lower arm and a
+    tyre (vertical spring and damper, lift-off; lateral spring and damper). A twin car with the
+    reference bushings drives the same roads under the same lateral load. One step is one
+    bushing-model sample (204.8 Hz); pymunk takes ``physics_substeps`` steps in between, the
+    bushing forces split as QuarterCar-v0's (``coupling.SplitBushing``: the planar linear
+    preset inside every sub-step, the model's remainder held). Geometry and data: Project
+    Chrono's Sedan, cited in ``envs/HalfCar-v0.toml``; docs/envs.md gives the checks.
+
+    ## Action Space
+
+    ``Box(-1, 1, (3,), float32)``: the left and right road heights' change and the lateral
+    acceleration's change this step::
+
+        h_k = clip(h_{k-1} + a_side * max_road_step_m, +-max_road_height_m)       (each side)
+        a_y,k = clip(a_y,k-1 + a_2 * max_lateral_accel_step_m_per_s2, +-max_lateral_accel)
+
+    (50 mm, 0.25 m/s^2 per step; +-150 mm, +-8 m/s^2 by default). a_y > 0 accelerates the car
+    to its left (a left turn): every body feels -m a_y. NaN counts as 0, beyond +-1 as +-1.
+
+    ## Observation Space
+
+    ``Box(-1, 1, (16,), float32)``, each entry clipped, NaN shown as 0 (model car unless
+    stated):
+
+    | index | observation                                   | unit  | scale                      |
+    |-------|-----------------------------------------------|-------|----------------------------|
+    | 0, 1  | road height left, right                       | m     | max_road_height_m          |
+    | 2     | lateral acceleration input                    | m/s^2 | max_lateral_accel_m_per_s2 |
+    | 3     | body vertical displacement                    | m     | max_body_displacement_m    |
+    | 4     | body vertical velocity                        | m/s   | v_s = max_road_step / dt   |
+    | 5     | body lateral displacement                     | m     | max_body_displacement_m    |
+    | 6     | body roll                                     | rad   | max_roll_rad               |
+    | 7     | body roll rate                                | rad/s | 2 v_s / track              |
+    | 8, 9  | dynamic wheel load left, right                | N     | tyre static load           |
+    | 10-13 | |bushing force| (axial, radial) per pivot     | N     | force_limit_n              |
+    | 14    | largest bushing force difference to the twin  | N     | force_limit_n              |
+    | 15    | body roll, model car minus reference car      | rad   | max_roll_rad               |
+
+    Pivots in the order ``lower_left, upper_left, lower_right, upper_right``.
+
+    ## Rewards
+
+    ``ForceDeviationReward`` on ``info["error_n"]``, the largest over the four pivots of
+    hypot(axial, radial) difference of the two cars' bushing forces: min(error /
+    force_scale_n, reward_cap). Replace with ``reward_fn(info)``.
+
+    ## Starting State
+
+    Both cars at rest at design position on flat roads, no lateral load (an exact
+    equilibrium), models reset. Deterministic: every seed gives the same episode.
+
+    ## Episode End
+
+    Termination (``info["diverged"]``): the model car leaves its bounds while its twin does
+    not -- a state or force not finite, |bushing force| > ``force_limit_n`` or |moment| >
+    ``moment_limit_nm`` (judged before it is applied, and never applied), a bushing
+    deflection > ``max_bushing_deflection_m``, suspension travel >
+    ``max_suspension_travel_m``, body or wheel beyond ``max_body_displacement_m``, roll beyond
+    ``max_roll_rad`` -- or the model raised (``ValueError``, ``ArithmeticError``), or
+    ``divergence_monitor(info)``. Truncation: the twin leaving its bounds
+    (``info["physical_limit"]``), the end of a replay, and through ``gym.make`` the spec's
+    ``max_episode_steps`` (2048 = 10 s).
+
+    ## Info
+
+    Plain values. Inputs: ``time_s, step, road_left_m, road_right_m,
+    lateral_accel_m_per_s2``. Per car (the twin's with the prefix ``reference_``):
+    ``body_y_m, body_x_m, body_vy_m_per_s, body_vertical_accel_m_per_s2,
+    body_lateral_accel_m_per_s2`` (inertial: a_y + the body's own), ``roll_rad,
+    roll_rate_rad_per_s, track_change_m``, per side ``wheel_load_{side}_n`` (total, >= 0),
+    ``wheel_lift_{side}`` (bool), ``camber_{side}_rad`` (top outward positive),
+    ``travel_{side}_m``; per pivot ``force_{pivot}_{axial|radial}_{model|reference}_n``,
+    ``moment_{pivot}_{model|reference}_nm`` and ``deflection_{pivot}_{axial|radial}_m``,
+    ``rotation_{pivot}_rad`` (model car). Verdict: ``error_n, roll_error_rad,
+    model_out_of_bounds, reference_out_of_bounds, monitor_verdict, diverged, physical_limit,
+    divergence_reason, model_error``.
+
+    ## Arguments
+
+    Every key of ``envs/HalfCar-v0.toml`` ``[kwargs]``, plus ``reward_fn``,
+    ``divergence_monitor``, ``render_mode``. ``model``/``reference``: a three-axis name
+    (``bushenv.models.names_for(3)``), ``.npz`` or model object for all four pivots, or a
+    table ``{"lower_left": ..., "upper_left": ..., "lower_right": ..., "upper_right": ...}``.
+    ``reset(options={"road_left": (T,), "road_right": (T,), "lateral_accel": (T,)})`` replays
+    those inputs exactly (any subset; the others stay 0; equal lengths), ignoring actions, and
+    truncates after T steps.
+
+    ## Vectorized environment
+
+    ``gym.make_vec("HalfCar-v0", num_envs=N, vectorization_mode="vector_entry_point")`` gives
+    ``HalfCarVectorEnv``: N of these envs stepped in turn, bit-equal to them (no array
+    integrator yet: the cost per car-step is the scalar env's).
+
+    ## Example
+
+    >>> import gymnasium as gym
+    >>> import numpy as np
+    >>> import bushenv
+    >>> env = gym.make("bushenv/HalfCar-v0")
+    >>> obs, info = env.reset(seed=0)
+    >>> obs.shape, float(abs(obs).max()), round(info["wheel_load_left_n"])
+    ((16,), 0.0, 4096)
+    >>> obs, reward, terminated, truncated, info = env.step(np.array([1, 0, 0], np.float32))
+    >>> info["road_left_m"], info["road_right_m"], terminated, truncated
+    (0.05, 0.0, False, False)
+
+    ## Version History
+
+    - v0: the car of ``envs/HalfCar-v0.toml``.
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 204.8}
+
+    def __init__(
+        self, *, render_mode=None, reward_fn=None, divergence_monitor=None, **overrides: Any
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise RigError(f"render_mode must be one of {self.metadata['render_modes']}")
+        p = HalfCarParameters(spec_kwargs(ENV_ID, overrides))
+        self.params = p
+        self.metadata = {**type(self).metadata, "render_fps": 1.0 / p.dt}
+        self.render_mode = render_mode
+        self.models, self.references = p.models, p.references
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(3,), dtype=np.float32)
+        self.observation_space = spaces.Box(-1.0, 1.0, shape=(OBS_SIZE,), dtype=np.float32)
+        self.reward_fn = check_hook("reward_fn", reward_fn) or ForceDeviationReward(
+            p.force_scale, p.reward_cap
+        )
+        self.divergence_monitor = check_hook("divergence_monitor", divergence_monitor)
+        self.cars = HalfCarPair(p)
+        self._inputs = np.zeros(3)  # road left, road right, a_y: the last step's
+        self._t = 0
+        self._replay: np.ndarray | None = None
+        self._prev_v = np.zeros((2, 2))  # (car, [vx, vy]) at the last step
+        self._obs = np.zeros(OBS_SIZE, dtype=np.float32)
+        self._canvas = None
+        self._info_last: dict[str, Any] = {}
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {**self.__dict__, "_canvas": None}
+
+    @property
+    def car(self) -> HalfCar:
+        return self.cars.car
+
+    @property
+    def twin(self) -> HalfCar:
+        return self.cars.twin
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        self._replay = replay_inputs(self.params, check_options(ENV_ID, options))
+        for models in (self.models, self.references):
+            for m, b in _model_batches(models):
+                m.reset(b)
+        call_reset(self.reward_fn)
+        call_reset(self.divergence_monitor)
+        self.cars = HalfCarPair(self.params)  # fresh bodies: nothing from the last episode
+        self._inputs = np.zeros(3)
+        self._t = 0
+        self._prev_v[:] = 0.0
+        self._obs[:] = 0.0
+        zero = np.zeros((4, 3))
+        info = self._info((zero, zero, zero, ""), (zero, zero, zero, ""), "")
+        self._info_last = info
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.copy(), info
+
+    def _next_inputs(self, action) -> np.ndarray:
+        if self._replay is not None:
+            return self._replay[min(self._t, len(self._replay) - 1)]
+        p = self.params
+        a = unit_actions3(action)
+        step = np.array([p.max_road_step, p.max_road_step, p.max_ay_step])
+        limit = np.array([p.max_road, p.max_road, p.max_ay])
+        return np.clip(self._inputs + a * step, -limit, limit)
+
+    def step(self, action):
+        p = self.params
+        before = self._inputs
+        now = self._next_inputs(action)
+        self._inputs = now
+        self._t += 1
+        sample_m = sample(self.car, self.models, p)
+        sample_r = sample(self.twin, self.references, p)
+        self.cars.integrate(before[:2], now[:2], before[2], now[2])
+        why_m = sample_m[3] or out_of_bounds(p, self.car, sample_m[0])
+        why_r = sample_r[3] or out_of_bounds(p, self.twin, sample_r[0])
+        truncated = bool(why_r)
+        model_error = (
+            why_m[len(MODEL_ERROR_PREFIX) :] if why_m.startswith(MODEL_ERROR_PREFIX) else ""
+        )
+        terminated = bool(why_m) and not truncated
+        info = self._info(sample_m, sample_r, why_m if terminated else "")
+        info["model_out_of_bounds"], info["reference_out_of_bounds"] = why_m, why_r
+        info["physical_limit"] = truncated
+        if self.divergence_monitor is not None and not (terminated or truncated):
+            terminated = ask_monitor(self.divergence_monitor, info)
+        info["diverged"] = terminated and not model_error
+        info["model_error"] = model_error
+        if self._replay is not None and self._t >= len(self._replay):
+            truncated = True
+        reward = float(self.reward_fn(info))
+        self._observe(info)
+        self._info_last = info
+        if self.render_mode == "human":
+            self.render()
+        return self._obs.copy(), reward, terminated, truncated, info
+
+    def _observe(self, info: dict[str, Any]) -> None:
+        p = self.params
+        f = [math.hypot(info[f"force_{k}_axial_model_n"], info[f"force_{k}_radial_model_n"])
+             for k in POSITIONS]  # fmt: skip
+        values = (
+            info["road_left_m"] / p.max_road, info["road_right_m"] / p.max_road,
+            info["lateral_accel_m_per_s2"] / p.max_ay, info["body_y_m"] / p.max_body,
+            info["body_vy_m_per_s"] / p.v_scale, info["body_x_m"] / p.max_body,
+            info["roll_rad"] / p.max_roll, info["roll_rate_rad_per_s"] / p.roll_rate_scale,
+            (info["wheel_load_left_n"] - p.tyre_static_n) / p.tyre_static_n,
+            (info["wheel_load_right_n"] - p.tyre_static_n) / p.tyre_static_n,
+            *(x / p.force_limit for x in f), info["error_n"] / p.force_limit,
+            info["roll_error_rad"] / p.max_roll,
+        )  # fmt: skip
+        o = self._obs
+        for i, v in enumerate(values):
+            o[i] = 0.0 if v != v else (1.0 if v > 1.0 else (-1.0 if v < -1.0 else v))
+
+    def _info(self, sample_m, sample_r, reason: str) -> dict[str, Any]:
+        p = self.params
+        r_l, r_r, ay = (float(x) for x in self._inputs)
+        info: dict[str, Any] = {"time_s": self._t * p.dt, "step": self._t, "road_left_m": r_l,
+                                "road_right_m": r_r, "lateral_accel_m_per_s2": ay}  # fmt: skip
+        for j, (car, prefix) in enumerate(((self.car, ""), (self.twin, "reference_"))):
+            body = car_outputs(p, car, (r_l, r_r), self._prev_v[j], ay)
+            self._prev_v[j] = (body["body_vx_m_per_s"], body["body_vy_m_per_s"])
+            info.update({prefix + k: v for k, v in body.items()})
+        (q, _, f_m, _), f_r = sample_m, sample_r[2]
+        for i, k in enumerate(POSITIONS):
+            for c, (name, unit) in enumerate(COORD_KEYS):
+                key = f"force_{k}_{name}" if c < 2 else f"moment_{k}"
+                info[f"{key}_model_{unit}"] = float(f_m[i, c])
+                info[f"{key}_reference_{unit}"] = float(f_r[i, c])
+            info[f"deflection_{k}_axial_m"] = float(q[i, 0])
+            info[f"deflection_{k}_radial_m"] = float(q[i, 1])
+            info[f"rotation_{k}_rad"] = float(q[i, 2])
+        d = f_m[:, :2] - f_r[:, :2]
+        info["error_n"] = float(np.max(np.hypot(d[:, 0], d[:, 1])))
+        info["roll_error_rad"] = info["roll_rad"] - info["reference_roll_rad"]
+        info.update(model_out_of_bounds="", reference_out_of_bounds="", monitor_verdict=False,
+                    diverged=False, physical_limit=False, divergence_reason=reason,
+                    model_error="")  # fmt: skip
+        return info
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() without a render_mode; pass render_mode='rgb_array'")
+            return None
+        from bushenv.rigs.halfcar_scene import draw_halfcar
+
+        if self._canvas is None:
+            from bushenv.rigs.drawing import Canvas
+
+            self._canvas = Canvas(600, 400, self.render_mode, self.metadata["render_fps"], ENV_ID)
+        draw_halfcar(self._canvas, self.params, self.car, self.twin, self._info_last)
+        return self._canvas.frame()
+
+    def close(self) -> None:
+        if self._canvas is not None:
+            self._canvas.close()
+            self._canvas = None
+
+
+def _model_batches(models: Any):
+    """(model, batch size) of a car's pivots: one model with four histories, or four."""
+    if isinstance(models, dict):
+        return [(m, 1) for m in models.values()]
+    return [(models, len(POSITIONS))]
+
+
+def unit_actions3(action: Any) -> np.ndarray:
+    """A (3,) action cleaned as the other rigs' (NaN -> 0, clipped to [-1, 1]); anything that is
+    not three real numbers is refused naming the action space."""
+    arr = action if action.__class__ is np.ndarray else _array(action)
+    if arr is None or arr.dtype.kind not in "fiu" or arr.shape != (3,):
+        raise RigError(
+            f"{ENV_ID}: action {describe(action)} does not fit the action space Box(-1.0, 1.0, "
+            "(3,), float32): expected three real numbers (road left, road right, lateral load)"
+        )
+    a = arr.astype(np.float64)
+    a[np.isnan(a)] = 0.0
+    return np.clip(a, -1.0, 1.0)
+
+
+def replay_inputs(p: HalfCarParameters, options: dict[str, Any]) -> np.ndarray | None:
+    """(T, 3) replayed inputs (road left, road right, a_y) from ``reset`` options, or None."""
+    unknown = sorted(set(options) - set(REPLAY_KEYS))
+    if unknown:
+        raise RigError(f"{ENV_ID}: unknown reset option(s) {unknown}; known: {list(REPLAY_KEYS)}")
+    given = {k: v for k, v in options.items() if v is not None}
+    if not given:
+        return None
+    cols = {}
+    for k, v in given.items():
+        if k == "lateral_accel":
+            a = check_profile(k, v, k, p.max_ay, "|a_y| = {value:.6g} m/s^2 exceeds "
+                              f"max_lateral_accel_m_per_s2 {p.max_ay:.6g}", p.max_ay_step,
+                              "a change of {value:.6g} m/s^2 exceeds "
+                              f"max_lateral_accel_step_m_per_s2 {p.max_ay_step:.6g}")  # fmt: skip
+        else:
+            a = check_profile(k, v, k, p.max_road, "|h| = {value:.6g} m exceeds "
+                              f"max_road_height_m {p.max_road:.6g} m", p.max_road_step,
+                              "a change of {value:.6g} m exceeds "
+                              f"max_road_step_m {p.max_road_step:.6g} m")  # fmt: skip
+        if a.ndim != 1:
+            raise RigError(f"{ENV_ID}: reset option {k} must be (T,), got {a.shape}")
+        cols[k] = a
+    lengths = {k: len(a) for k, a in cols.items()}
+    if len(set(lengths.values())) > 1:
+        raise RigError(f"{ENV_ID}: replayed inputs differ in length: {lengths}")
+    t = next(iter(lengths.values()))
+    return np.stack([cols.get(k, np.zeros(t)) for k in REPLAY_KEYS], axis=1)
+
+
+def sample(car: HalfCar, models: Any, p: HalfCarParameters):
+    """(q, v, forces, why) of a car's four pivots at t_k: forces judged before they are applied
+    (not finite, beyond ``force_limit_n`` / ``moment_limit_nm``, the model raised) and held
+    only when they can be; why is "" if they were."""
+    car.update_damping()
+    q, v = car.bushing_motion()
+    try:
+        f = step_models(models, q, v)
+    except MODEL_ERRORS as exc:
+        return q, v, np.full((4, 3), np.nan), f"model raised {type(exc).__name__}: {exc}"
+    except Exception as exc:  # the model's own bug: ends the episode, not a divergence
+        return q, v, np.full((4, 3), np.nan), MODEL_ERROR_PREFIX + model_error_text(exc)
+    why = force_reason(p, f)
+    if not why:
+        car.hold(f, q, v)
+    return q, v, f, why
+
+
+def force_reason(p: HalfCarParameters, f: np.ndarray) -> str:
+    """Why sampled (4, 3) pivot forces cannot be applied ("" if they can)."""
+    limits = (p.force_limit, p.force_limit, p.moment_limit)
+    for i, k in enumerate(POSITIONS):
+        for c, (name, _) in enumerate(COORD_KEYS):
+            x = f[i, c]
+            if not math.isfinite(x):
+                return f"{k} bushing {name} {x!r} is not finite"
+            if abs(x) > limits[c]:
+                u = "N m" if c == 2 else "N"
+                return f"{k} bushing |{name}| = {abs(x):.6g} {u} exceeds {limits[c]:.6g} {u}"
+    return ""
+
+
+def car_outputs(p: HalfCarParameters, car: HalfCar, roads, prev_v, ay: float) -> dict[str, Any]:
+    """One car's body, wheel and geometry outputs after a step (plain floats)."""
+    c = car.chassis
+    (x, y), (vx, vy) = c.position, c.velocity
+    phi = c.angle
+    out = {
+        "body_y_m": y - p.h_cg, "body_x_m": x, "body_vx_m_per_s": vx, "body_vy_m_per_s": vy,
+        "body_vertical_accel_m_per_s2": float(vy - prev_v[1]) / p.dt,
+        "body_lateral_accel_m_per_s2": ay + float(vx - prev_v[0]) / p.dt,
+        "roll_rad": phi, "roll_rate_rad_per_s": c.angular_velocity,
+    }  # fmt: skip
+    contact_x = []
+    cos, sin = math.cos(phi), math.sin(phi)
+    for side, h in zip(SIDES, roads, strict=True):
+        s = SIGN[side]
+        corner = car.corners[side]
+        u = corner["upright"]
+        psi = u.angle
+        (wx, wy), wvy = u.position, u.velocity.y
+        cx, cy = wx + math.sin(psi) * p.r_w, wy - math.cos(psi) * p.r_w
+        cvy = wvy + u.angular_velocity * math.sin(psi) * p.r_w
+        contact_x.append(cx)
+        load = p.k_t * (h - cy) + (p.c_t * (-cvy) if corner["contact"] else 0.0)
+        load = max(p.tyre_static_n + load, 0.0)
+        out[f"wheel_load_{side}_n"] = load
+        out[f"wheel_lift_{side}"] = load <= 0.0
+        out[f"camber_{side}_rad"] = -s * psi
+        dx, dy = wx - x, wy - y  # the wheel centre in the body frame, its height change
+        out[f"travel_{side}_m"] = -sin * dx + cos * dy - (p.r_w - p.h_cg)
+    out["track_change_m"] = contact_x[0] - contact_x[1] - p.track
+    return out
+
+
+def out_of_bounds(p: HalfCarParameters, car: HalfCar, q: np.ndarray) -> str:
+    """Why a car left its physical bounds after a step ("" if it did not)."""
+    c = car.chassis
+    x, y = c.position
+    values = [x, y, c.angle, *q.ravel()]
+    for corner in car.corners.values():
+        values.extend(corner["upright"].position)
+    if not all(math.isfinite(v) for v in values):
+        return "state is not finite"
+    defl = float(np.max(np.abs(q[:, :2])))
+    if defl > p.max_deflection:
+        return f"bushing deflection {defl * 1e3:.4g} mm exceeds {p.max_deflection * 1e3:.4g} mm"
+    if abs(c.angle) > p.max_roll:
+        return f"body roll {c.angle:.4g} rad exceeds {p.max_roll:.4g} rad"
+    body = max(abs(x), abs(y - p.h_cg))
+    for side in SIDES:
+        w = car.corners[side]["upright"].position
+        dx, dy = w.x - x, w.y - y
+        travel = -math.sin(c.angle) * dx + math.cos(c.angle) * dy - (p.r_w - p.h_cg)
+        if abs(travel) > p.max_travel:
+            return f"{side} suspension travel {travel:.4g} m exceeds {p.max_travel:.4g} m"
+        body = max(body, abs(w.y - p.r_w))
+    if body > p.max_body:
+        return f"body or wheel displacement {body:.4g} m exceeds {p.max_body:.4g} m"
+    return ""
