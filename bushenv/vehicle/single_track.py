@@ -54,6 +54,7 @@ __all__ = [
     "lateral_load_transfer_n",
     "roll_angle_rad",
     "single_track_response",
+    "state_matrices",
     "steady_state_sideslip_gain",
     "steady_state_yaw_rate_gain_per_s",
     "steering_wheel_angle_for_lateral_acceleration_rad",
@@ -174,7 +175,11 @@ def steering_wheel_angle_for_lateral_acceleration_rad(
     return p.steering_ratio * (p.wheelbase_m + k * v * v) * lateral_acceleration_m_per_s2 / v**2
 
 
-def _continuous(p: VehicleParams, v: float) -> tuple[np.ndarray, np.ndarray]:
+def state_matrices(
+    speed_m_per_s: float, p: VehicleParams = DEFAULT_VEHICLE
+) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous ``dx/dt = A x + B delta_sw`` for x = (beta, r); A (2, 2), B (2,) per rad."""
+    v = positive("speed_m_per_s", speed_m_per_s)
     m, iz, a, b = p.mass_kg, p.yaw_inertia_kg_m2, p.a_m, p.b_m
     cf, cr = p.front_cornering_n_per_rad, p.rear_cornering_n_per_rad
     A = np.array(
@@ -198,7 +203,7 @@ def discrete_single_track(
     """
     v = positive("speed_m_per_s", speed_m_per_s)
     dt_s = positive("dt_s", dt_s)
-    A, B = _continuous(p, v)
+    A, B = state_matrices(v, p)
     M = np.zeros((4, 4))
     M[:2, :2], M[:2, 2], M[2, 3] = A, B, 1.0 / dt_s
     E = expm(M * dt_s)
