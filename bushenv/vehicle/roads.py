@@ -55,6 +55,7 @@ from bushenv.vehicle.checks import (
     positive,
     sample_count,
 )
+from bushenv.vehicle.single_track import DEFAULT_VEHICLE
 
 __all__ = [
     "ISO8608_BAND_CYCLES_PER_M",
@@ -83,9 +84,8 @@ ISO8608_CLASSES = ("A", "B", "C", "D", "E", "F", "G", "H")
 ISO8608_GD_N0_M3 = {c: 16e-6 * 4.0**i for i, c in enumerate(ISO8608_CLASSES)}
 # The band the standard's classification table covers (wavelengths 91 m to 0.35 m).
 ISO8608_BAND_CYCLES_PER_M = (0.011, 2.83)
-# Default distance between the wheel tracks; the single-track defaults' track width
-# (bushenv.vehicle.single_track.DEFAULT_VEHICLE.track_m).
-DEFAULT_TRACK_WIDTH_M = 1.565
+# Default distance between the wheel tracks: the default car's track width
+DEFAULT_TRACK_WIDTH_M = DEFAULT_VEHICLE.track_m
 
 
 def _road_class(road_class: str) -> float:
