@@ -103,14 +103,17 @@ def plain(obj: Any) -> Any:
 
 
 def save_profiles(path: str | os.PathLike, profiles: list[np.ndarray], meta: list[dict]) -> Path:
-    """Profiles of any lengths in one ``.npz`` (padded + lengths) with JSON metadata; atomic."""
+    """Profiles of any lengths in one ``.npz`` (padded + lengths) with JSON metadata; atomic.
+    Each profile is (T_i,) or (T_i, C) (C coordinates, the same for all); ``load_profiles``
+    gives them back so."""
     n = len(profiles)
-    T = max((p.size for p in profiles), default=1)
-    arr = np.zeros((T, max(n, 1)))
+    T = max((p.shape[0] for p in profiles), default=1)
+    trailing = profiles[0].shape[1:] if profiles else ()
+    arr = np.zeros((T, max(n, 1), *trailing))
     lengths = np.zeros(max(n, 1), dtype=np.int64)
     for i, p in enumerate(profiles):
-        arr[: p.size, i] = p
-        lengths[i] = p.size
+        arr[: p.shape[0], i] = p
+        lengths[i] = p.shape[0]
 
     def write(fh: IO[bytes]) -> None:
         np.savez_compressed(

@@ -26,7 +26,6 @@ A short pipeline through the one-axis search contracts, as the one-axis attack d
 
 from __future__ import annotations
 
-import json
 import time
 from collections import Counter
 from collections.abc import Callable
@@ -35,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bushenv.persist import atomic_write, json_default, load_profiles, write_json
+from bushenv.persist import load_profiles, save_profiles, write_json
 from bushenv.progress import Progress
 from bushenv.search.base import Searcher, SearchError
 from bushenv.search.campaign_config import CampaignConfig
@@ -130,29 +129,6 @@ def planar_search(
         said = None if progress is None else (lambda msg: progress(msg, ev.n_evaluations))
         result, covered = covered_search(s, ev, budget, seed, said)
     return (result, covered) if coverage else result
-
-
-def save_profiles3(path: Path, profiles: list[np.ndarray], meta: list[dict]) -> Path:
-    """(T_i, 3) profiles in ``persist.save_profiles``'s format (``profiles`` padded to
-    (T, B, 3), ``lengths``, ``count``, JSON ``meta``), so ``load_profiles`` reads them back
-    (T_i, 3) each; atomic."""
-    n = len(profiles)
-    arr = np.zeros((max((p.shape[0] for p in profiles), default=1), max(n, 1), 3))
-    lengths = np.zeros(max(n, 1), dtype=np.int64)
-    for i, p in enumerate(profiles):
-        arr[: p.shape[0], i] = p
-        lengths[i] = p.shape[0]
-
-    def write(fh) -> None:
-        np.savez_compressed(
-            fh,
-            profiles=arr,
-            lengths=lengths,
-            count=np.array(n),
-            meta=np.array(json.dumps(meta, default=json_default)),
-        )
-
-    return atomic_write(path, write)
 
 
 def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttack:
@@ -278,7 +254,7 @@ def _search_one(c, p: Planar, name: str, start: int, threads: int, progress: Pro
         profiles.append(result.worst.profile)
         meta.append({**result.worst.to_json(), "worst": True})
     path = Path(c.out) / "failures" / f"{p.models['target'].key}-{name}.npz"
-    save_profiles3(path, profiles, meta)
+    save_profiles(path, profiles, meta)
     summary["profiles_file"] = str(path.relative_to(c.out))
     return summary
 
