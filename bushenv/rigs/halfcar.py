@@ -16,6 +16,7 @@ import numpy as np
 from gymnasium import spaces
 
 from bushenv.rigs.actions import _array, check_options, check_profile, describe
+from bushenv.rigs.car_planar import reference_range_reason
 from bushenv.rigs.car_verdict import MODEL_ERROR_PREFIX
 from bushenv.rigs.common import (
     MODEL_ERRORS,
@@ -120,7 +121,8 @@ class HalfCarEnv(gym.Env):
     ``moment_{pivot}_{model|reference}_nm`` and ``deflection_{pivot}_{axial|radial}_m``,
     ``rotation_{pivot}_rad`` (model car). Verdict: ``error_n, roll_error_rad,
     model_out_of_bounds, reference_out_of_bounds, monitor_verdict, diverged, physical_limit,
-    divergence_reason, model_error``.
+    divergence_reason, model_error``, ``reference_outside_range`` (why a twin's pivot judges
+    beyond the rotation its law is calibrated for, "" if none does).
 
     ## Arguments
 
@@ -294,10 +296,21 @@ class HalfCarEnv(gym.Env):
         d = f_m[:, :2] - f_r[:, :2]
         info["error_n"] = float(np.max(np.hypot(d[:, 0], d[:, 1])))
         info["roll_error_rad"] = info["roll_rad"] - info["reference_roll_rad"]
+        info["reference_outside_range"] = self._range_reason(sample_r[0])
         info.update(model_out_of_bounds="", reference_out_of_bounds="", monitor_verdict=False,
                     diverged=False, physical_limit=False, divergence_reason=reason,
                     model_error="")  # fmt: skip
         return info
+
+    def _range_reason(self, q: np.ndarray) -> str:
+        """Why a twin's pivot judges by extrapolation ("" if none does): its rotation beyond the
+        range its law is calibrated for (``car_planar.reference_range_reason``)."""
+        refs = self.references
+        for i, k in enumerate(POSITIONS):
+            why = reference_range_reason(refs[k] if isinstance(refs, dict) else refs, q[i, 2])
+            if why:
+                return f"{k}: {why}"
+        return ""
 
     def render(self):
         if self.render_mode is None:
