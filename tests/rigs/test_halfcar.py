@@ -18,6 +18,7 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import bushenv  # noqa: F401  (registers the ids)
 from bushenv.rigs.common import RigError
+from bushenv.rigs.coupling import LONG_ARM_M
 from bushenv.rigs.halfcar_params import POSITIONS
 
 DT = 1.0 / 204.8
@@ -243,13 +244,54 @@ def test_the_steady_roll_gradient_is_the_analytic_one(model, tolerance):
     assert roll[-205:].std() < 1e-3 * abs(roll[-1])
 
 
+def _length_and_rate(s) -> tuple[float, float]:
+    """A spring's anchor distance and its lengthening rate."""
+    d = s.b.local_to_world(s.anchor_b) - s.a.local_to_world(s.anchor_a)
+    dv = s.b.velocity_at_local_point(s.anchor_b) - s.a.velocity_at_local_point(s.anchor_a)
+    n = d.normalized() if d.length > 0 else d
+    return d.length, dv.dot(n)
+
+
+def energy_terms(car) -> tuple[float, float, np.ndarray]:
+    """(stored energy J, dissipated power W, (2,) vertical tyre forces on the wheels N) of a
+    ``HalfCar`` with linear bushings: kinetic energy of every dynamic body, every spring's
+    1/2 k (L - L_rest)^2 (the rotary bushings' 1/2 k (theta - rest)^2), every damper's c v^2
+    with its physical c (not chipmunk's implicit-Euler coefficient)."""
+    p = car.p
+    stored = sum(
+        0.5 * b.mass * b.velocity.dot(b.velocity) + 0.5 * b.moment * b.angular_velocity**2
+        for k, b in car.bodies.items()
+        if not k.startswith("road")
+    )
+    power = 0.0
+    springs = []
+    for pivot in car.pivots:
+        springs += [(pivot[a].spring, pivot[a].c_in) for a in ("axial", "radial")]
+        r = pivot["rotation"]
+        theta = r.b.angle - r.a.angle
+        omega = r.b.angular_velocity - r.a.angular_velocity
+        stored += 0.5 * r.k_in * (theta - r.spring.rest_angle) ** 2
+        power += r.c_in * omega * omega
+    tyres = []
+    for corner in car.corners.values():
+        springs += [(corner["coil"], p.c_s), (corner["lateral"], p.c_y)]
+        springs += [(corner["lower_joint"], p.c_bj), (corner["upper_joint"], p.c_bj)]
+        length, rate = _length_and_rate(corner["tyre"])
+        stored += 0.5 * p.k_t * (LONG_ARM_M - length) ** 2
+        power += p.c_t * rate * rate
+        tyres.append(p.k_t * (LONG_ARM_M - length) - p.c_t * rate)
+    for spring, c in springs:
+        length, rate = _length_and_rate(spring)
+        stored += 0.5 * spring.stiffness * (length - spring.rest_length) ** 2
+        power += c * rate * rate
+    return stored, power, np.array(tyres)
+
+
 def test_the_passive_car_balances_road_work_against_dissipation_and_storage():
     """W = D + dE within 3 % of the road's work (measured 2.0 %): W = the integral of the tyre
     forces times the road speeds, D of every damper's c v^2 (bushings, coil-overs, ball joints,
     tyres), E the kinetic and every spring's energy. Sampled at 8 x 204.8 Hz (two sub-steps per
     step), a bump left and a pothole right, linear bushings."""
-    from halfcar_energy import energy_terms
-
     rate = 8
     dt = 1 / 204.8 / rate
     t = np.arange(int(1.5 / dt)) * dt
