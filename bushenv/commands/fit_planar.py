@@ -10,26 +10,14 @@ be of one kind.
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 from pathlib import Path
 from typing import Any
 
-from bushenv.planar.records import HEADER_TEXT, looks_planar
+from bushenv.planar.records import HEADER_TEXT
+from bushenv.records import record_coordinates
 
 PLANAR_LABEL = " (3-axis)"  # how the planar models own their flags in ``bushenv fit --help``
-
-
-def is_planar_csv(path: str) -> bool:
-    """Whether the file's first line is meant as a planar record header (any order, units in
-    brackets, or a misspelt one: ``looks_planar``); an unreadable file is not (the one-axis
-    loader then names its problem)."""
-    try:
-        with open(path, encoding="utf-8-sig", newline="") as fh:
-            first = next(csv.reader(fh), [])
-    except (OSError, UnicodeDecodeError, csv.Error):
-        return False
-    return looks_planar(first)
 
 
 def planar_records(args: argparse.Namespace) -> bool:
@@ -37,7 +25,7 @@ def planar_records(args: argparse.Namespace) -> bool:
     from bushenv.cli import CliError
 
     paths = [*args.train, *(args.validate or [])]
-    kinds = {p: is_planar_csv(p) for p in paths}
+    kinds = {p: record_coordinates(p) == 3 for p in paths}
     planar = [p for p, k in kinds.items() if k]
     if not planar:
         return False
