@@ -225,28 +225,6 @@ def _coords_of(displacement: np.ndarray) -> tuple[str, ...]:
     return tuple(f"q{i}" for i in range(displacement.shape[1]))
 
 
-def record_coordinates(path: str | os.PathLike) -> int:
-    """How many coordinates the record file's header is meant for: 3 for the three-axis header
-    (any order, units in brackets, or a misspelt one: ``bushenv.planar.records.looks_planar``),
-    else 1 (an unreadable file too: the one-axis loader then names its problem)."""
-    from bushenv.planar.records import looks_planar
-
-    try:
-        with open(path, encoding="utf-8-sig", newline="") as fh:
-            first = next(csv.reader(fh), [])
-    except (OSError, UnicodeDecodeError, csv.Error):
-        return 1
-    return 3 if looks_planar(first) else 1
-
-
-def load_record(path: str | os.PathLike) -> Record:
-    """A record of any number of coordinates: the header says which (``time,displacement,force``
-    or the three-axis header, ``bushenv.planar.records.HEADER``); each loader's checks apply."""
-    from bushenv.planar.records import load_planar_csv
-
-    return load_planar_csv(path) if record_coordinates(path) == 3 else load_csv(path)
-
-
 # ----- checks shared by load and save ----------------------------------------------------------
 def _check_columns(
     t: np.ndarray,
@@ -693,9 +671,10 @@ def save_csv(record: Record, path: str | os.PathLike, overwrite: bool = False) -
     """
     path = Path(path)
     if record.n_coords > 1:
-        from bushenv.planar.records import save_planar_csv
-
-        return save_planar_csv(path, record.time, record.q, record.f, overwrite=overwrite)
+        raise RecordError(
+            f"{record.label}: a record of {record.n_coords} coordinates has the three-axis "
+            "header; write it with bushenv.record_files.save_record"
+        )
     record.validate()
     if path.exists() and not overwrite:
         raise RecordError(f"{path} already exists; refusing to overwrite it (pass overwrite=True)")

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from bushenv.planar.records import HEADER_TEXT
-from bushenv.records import record_coordinates
+from bushenv.record_files import record_coordinates
 
 PLANAR_LABEL = " (3-axis)"  # how the planar models own their flags in ``bushenv fit --help``
 
