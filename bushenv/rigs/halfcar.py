@@ -19,16 +19,15 @@ from bushenv.rigs.actions import _array, check_options, check_profile, describe
 from bushenv.rigs.car_planar import reference_range_reason
 from bushenv.rigs.car_verdict import MODEL_ERROR_PREFIX
 from bushenv.rigs.common import (
-    MODEL_ERRORS,
     ForceDeviationReward,
     RigError,
     ask_monitor,
     call_reset,
     check_hook,
-    model_error_text,
 )
-from bushenv.rigs.halfcar_car import SIGN, HalfCar, HalfCarPair, step_models
-from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, SIDES, HalfCarParameters
+from bushenv.rigs.halfcar_car import HalfCar, HalfCarPair
+from bushenv.rigs.halfcar_outputs import PIVOT_KEYS, car_outputs, out_of_bounds, sample
+from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, HalfCarParameters
 from bushenv.rigs.specs import spec_kwargs
 
 OBS_SIZE = 16
@@ -180,7 +179,7 @@ class HalfCarEnv(gym.Env):
         self._inputs = np.zeros(3)  # road left, road right, a_y: the last step's
         self._t = 0
         self._replay: np.ndarray | None = None
-        self._prev_v = np.zeros((2, 2))  # (car, [vx, vy]) at the last step
+        self._prev_v = [(0.0, 0.0), (0.0, 0.0)]  # (car) -> (vx, vy) at the last step
         self._obs = np.zeros(OBS_SIZE, dtype=np.float32)
         self._canvas = None
         self._info_last: dict[str, Any] = {}
@@ -207,10 +206,10 @@ class HalfCarEnv(gym.Env):
         self.cars = HalfCarPair(self.params)  # fresh bodies: nothing from the last episode
         self._inputs = np.zeros(3)
         self._t = 0
-        self._prev_v[:] = 0.0
+        self._prev_v = [(0.0, 0.0), (0.0, 0.0)]
         self._obs[:] = 0.0
         zero = np.zeros((4, 3))
-        info = self._info((zero, zero, zero, ""), (zero, zero, zero, ""), "")
+        info = self._info((zero, zero, zero, ""), (zero, zero, zero, ""), *self._outputs(), "")
         self._info_last = info
         if self.render_mode == "human":
             self.render()
@@ -234,14 +233,15 @@ class HalfCarEnv(gym.Env):
         sample_m = sample(self.car, self.models, p)
         sample_r = sample(self.twin, self.references, p)
         self.cars.integrate(before[:2], now[:2], before[2], now[2])
-        why_m = sample_m[3] or out_of_bounds(p, self.car, sample_m[0])
-        why_r = sample_r[3] or out_of_bounds(p, self.twin, sample_r[0])
+        out_m, out_r = self._outputs()
+        why_m = sample_m[3] or out_of_bounds(p, out_m, sample_m[0])
+        why_r = sample_r[3] or out_of_bounds(p, out_r, sample_r[0])
         truncated = bool(why_r)
         model_error = (
             why_m[len(MODEL_ERROR_PREFIX) :] if why_m.startswith(MODEL_ERROR_PREFIX) else ""
         )
         terminated = bool(why_m) and not truncated
-        info = self._info(sample_m, sample_r, why_m if terminated else "")
+        info = self._info(sample_m, sample_r, out_m, out_r, why_m if terminated else "")
         info["model_out_of_bounds"], info["reference_out_of_bounds"] = why_m, why_r
         info["physical_limit"] = truncated
         if self.divergence_monitor is not None and not (terminated or truncated):
@@ -275,26 +275,32 @@ class HalfCarEnv(gym.Env):
         for i, v in enumerate(values):
             o[i] = 0.0 if v != v else (1.0 if v > 1.0 else (-1.0 if v < -1.0 else v))
 
-    def _info(self, sample_m, sample_r, reason: str) -> dict[str, Any]:
+    def _outputs(self) -> tuple[dict[str, Any], dict[str, Any]]:
+        """Both cars' ``car_outputs`` after a step (each remembers its body velocity)."""
+        p, roads, ay = self.params, self._inputs[:2].tolist(), float(self._inputs[2])
+        outs = []
+        for j, car in enumerate((self.car, self.twin)):
+            out = car_outputs(p, car, roads, self._prev_v[j], ay)
+            self._prev_v[j] = (out["body_vx_m_per_s"], out["body_vy_m_per_s"])
+            outs.append(out)
+        return outs[0], outs[1]
+
+    def _info(self, sample_m, sample_r, out_m, out_r, reason: str) -> dict[str, Any]:
         p = self.params
-        r_l, r_r, ay = (float(x) for x in self._inputs)
+        r_l, r_r, ay = self._inputs.tolist()
         info: dict[str, Any] = {"time_s": self._t * p.dt, "step": self._t, "road_left_m": r_l,
                                 "road_right_m": r_r, "lateral_accel_m_per_s2": ay}  # fmt: skip
-        for j, (car, prefix) in enumerate(((self.car, ""), (self.twin, "reference_"))):
-            body = car_outputs(p, car, (r_l, r_r), self._prev_v[j], ay)
-            self._prev_v[j] = (body["body_vx_m_per_s"], body["body_vy_m_per_s"])
-            info.update({prefix + k: v for k, v in body.items()})
-        (q, _, f_m, _), f_r = sample_m, sample_r[2]
-        for i, k in enumerate(POSITIONS):
-            for c, (name, unit) in enumerate(COORD_KEYS):
-                key = f"force_{k}_{name}" if c < 2 else f"moment_{k}"
-                info[f"{key}_model_{unit}"] = float(f_m[i, c])
-                info[f"{key}_reference_{unit}"] = float(f_r[i, c])
-            info[f"deflection_{k}_axial_m"] = float(q[i, 0])
-            info[f"deflection_{k}_radial_m"] = float(q[i, 1])
-            info[f"rotation_{k}_rad"] = float(q[i, 2])
-        d = f_m[:, :2] - f_r[:, :2]
-        info["error_n"] = float(np.max(np.hypot(d[:, 0], d[:, 1])))
+        info.update(out_m)
+        info.update(zip(_reference_keys(out_r), out_r.values(), strict=True))
+        q, f_m, f_r = sample_m[0].tolist(), sample_m[2].tolist(), sample_r[2].tolist()
+        for i, (force_keys, motion_keys) in enumerate(PIVOT_KEYS):
+            for c, (key_m, key_r) in enumerate(force_keys):
+                info[key_m] = f_m[i][c]
+                info[key_r] = f_r[i][c]
+            info.update(zip(motion_keys, q[i], strict=True))
+        info["error_n"] = max(
+            math.hypot(a[0] - b[0], a[1] - b[1]) for a, b in zip(f_m, f_r, strict=True)
+        )
         info["roll_error_rad"] = info["roll_rad"] - info["reference_roll_rad"]
         info["reference_outside_range"] = self._range_reason(sample_r[0])
         info.update(model_out_of_bounds="", reference_out_of_bounds="", monitor_verdict=False,
@@ -329,6 +335,17 @@ class HalfCarEnv(gym.Env):
         if self._canvas is not None:
             self._canvas.close()
             self._canvas = None
+
+
+_REFERENCE_KEYS: dict[tuple, tuple] = {}
+
+
+def _reference_keys(out: dict[str, Any]) -> tuple:
+    """The twin's info keys for ``out``'s (``reference_`` + key), built once."""
+    keys = tuple(out)
+    if keys not in _REFERENCE_KEYS:
+        _REFERENCE_KEYS[keys] = tuple("reference_" + k for k in keys)
+    return _REFERENCE_KEYS[keys]
 
 
 def _model_batches(models: Any):
@@ -380,95 +397,3 @@ def replay_inputs(p: HalfCarParameters, options: dict[str, Any]) -> np.ndarray |
         raise RigError(f"{ENV_ID}: replayed inputs differ in length: {lengths}")
     t = next(iter(lengths.values()))
     return np.stack([cols.get(k, np.zeros(t)) for k in REPLAY_KEYS], axis=1)
-
-
-def sample(car: HalfCar, models: Any, p: HalfCarParameters):
-    """(q, v, forces, why) of a car's four pivots at t_k: forces judged before they are applied
-    (not finite, beyond ``force_limit_n`` / ``moment_limit_nm``, the model raised) and held
-    only when they can be; why is "" if they were."""
-    car.update_damping()
-    q, v = car.bushing_motion()
-    try:
-        f = step_models(models, q, v)
-    except MODEL_ERRORS as exc:
-        return q, v, np.full((4, 3), np.nan), f"model raised {type(exc).__name__}: {exc}"
-    except Exception as exc:  # the model's own bug: ends the episode, not a divergence
-        return q, v, np.full((4, 3), np.nan), MODEL_ERROR_PREFIX + model_error_text(exc)
-    why = force_reason(p, f)
-    if not why:
-        car.hold(f, q, v)
-    return q, v, f, why
-
-
-def force_reason(p: HalfCarParameters, f: np.ndarray) -> str:
-    """Why sampled (4, 3) pivot forces cannot be applied ("" if they can)."""
-    limits = (p.force_limit, p.force_limit, p.moment_limit)
-    for i, k in enumerate(POSITIONS):
-        for c, (name, _) in enumerate(COORD_KEYS):
-            x = f[i, c]
-            if not math.isfinite(x):
-                return f"{k} bushing {name} {x!r} is not finite"
-            if abs(x) > limits[c]:
-                u = "N m" if c == 2 else "N"
-                return f"{k} bushing |{name}| = {abs(x):.6g} {u} exceeds {limits[c]:.6g} {u}"
-    return ""
-
-
-def car_outputs(p: HalfCarParameters, car: HalfCar, roads, prev_v, ay: float) -> dict[str, Any]:
-    """One car's body, wheel and geometry outputs after a step (plain floats)."""
-    c = car.chassis
-    (x, y), (vx, vy) = c.position, c.velocity
-    phi = c.angle
-    out = {
-        "body_y_m": y - p.h_cg, "body_x_m": x, "body_vx_m_per_s": vx, "body_vy_m_per_s": vy,
-        "body_vertical_accel_m_per_s2": float(vy - prev_v[1]) / p.dt,
-        "body_lateral_accel_m_per_s2": ay + float(vx - prev_v[0]) / p.dt,
-        "roll_rad": phi, "roll_rate_rad_per_s": c.angular_velocity,
-    }  # fmt: skip
-    contact_x = []
-    cos, sin = math.cos(phi), math.sin(phi)
-    for side, h in zip(SIDES, roads, strict=True):
-        s = SIGN[side]
-        corner = car.corners[side]
-        u = corner["upright"]
-        psi = u.angle
-        (wx, wy), wvy = u.position, u.velocity.y
-        cx, cy = wx + math.sin(psi) * p.r_w, wy - math.cos(psi) * p.r_w
-        cvy = wvy + u.angular_velocity * math.sin(psi) * p.r_w
-        contact_x.append(cx)
-        load = p.k_t * (h - cy) + (p.c_t * (-cvy) if corner["contact"] else 0.0)
-        load = max(p.tyre_static_n + load, 0.0)
-        out[f"wheel_load_{side}_n"] = load
-        out[f"wheel_lift_{side}"] = load <= 0.0
-        out[f"camber_{side}_rad"] = -s * psi
-        dx, dy = wx - x, wy - y  # the wheel centre in the body frame, its height change
-        out[f"travel_{side}_m"] = -sin * dx + cos * dy - (p.r_w - p.h_cg)
-    out["track_change_m"] = contact_x[0] - contact_x[1] - p.track
-    return out
-
-
-def out_of_bounds(p: HalfCarParameters, car: HalfCar, q: np.ndarray) -> str:
-    """Why a car left its physical bounds after a step ("" if it did not)."""
-    c = car.chassis
-    x, y = c.position
-    values = [x, y, c.angle, *q.ravel()]
-    for corner in car.corners.values():
-        values.extend(corner["upright"].position)
-    if not all(math.isfinite(v) for v in values):
-        return "state is not finite"
-    defl = float(np.max(np.abs(q[:, :2])))
-    if defl > p.max_deflection:
-        return f"bushing deflection {defl * 1e3:.4g} mm exceeds {p.max_deflection * 1e3:.4g} mm"
-    if abs(c.angle) > p.max_roll:
-        return f"body roll {c.angle:.4g} rad exceeds {p.max_roll:.4g} rad"
-    body = max(abs(x), abs(y - p.h_cg))
-    for side in SIDES:
-        w = car.corners[side]["upright"].position
-        dx, dy = w.x - x, w.y - y
-        travel = -math.sin(c.angle) * dx + math.cos(c.angle) * dy - (p.r_w - p.h_cg)
-        if abs(travel) > p.max_travel:
-            return f"{side} suspension travel {travel:.4g} m exceeds {p.max_travel:.4g} m"
-        body = max(body, abs(w.y - p.r_w))
-    if body > p.max_body:
-        return f"body or wheel displacement {body:.4g} m exceeds {p.max_body:.4g} m"
-    return ""

@@ -26,7 +26,11 @@ from bushenv.rigs.coupling import (
 )
 from bushenv.rigs.halfcar_params import POSITIONS, SIDES, HalfCarParameters, bar_inertia
 
-DAMPING_ANGLE_STEP = 0.005  # rad: dampers recomputed once a body turned this far (as car.py)
+# rad: the dampers' implicit-Euler coefficients are recomputed once a body turned this far since
+# the last time. The effective masses they use move by under 1 % at 0.02 rad here: at the arms'
+# inner ends the rotation enters as (r sin theta)^2 / I beside 1 / m (the quarter car, whose
+# swing arm carries the wheel, uses 0.005).
+DAMPING_ANGLE_STEP = 0.02
 SIGN = {"left": 1.0, "right": -1.0}
 
 
@@ -113,7 +117,8 @@ class HalfCar:
                       "lateral": lateral, "contact": True, **arms}  # fmt: skip
             tyre.force_func = self._tyre_law(corner)
             self.corners[side] = corner
-        self._damping_angles = np.zeros(len(self.bodies))
+        self._turning = tuple(b for k, b in self.bodies.items() if not k.startswith("road"))
+        self._damping_angles = [0.0] * len(self._turning)
         self._steps = space_stepper(space)
         self.update_damping(force=True)
 
@@ -148,8 +153,11 @@ class HalfCar:
     def update_damping(self, force: bool = False) -> None:
         """Implicit-Euler dampers for the current configuration (the effective masses change with
         the bodies' angles: recomputed once any turned by ``DAMPING_ANGLE_STEP``)."""
-        angles = np.array([b.angle for b in self.bodies.values()])
-        if not force and np.max(np.abs(angles - self._damping_angles)) < DAMPING_ANGLE_STEP:
+        angles = [b.angle for b in self._turning]
+        if not force and all(
+            abs(a - b) < DAMPING_ANGLE_STEP
+            for a, b in zip(angles, self._damping_angles, strict=True)
+        ):
             return
         self._damping_angles = angles
         p = self.p
@@ -248,7 +256,7 @@ class HalfCar:
             },
             "springs": springs,
             "contact": {side: c["contact"] for side, c in self.corners.items()},
-            "damping_angles": self._damping_angles.copy(),
+            "damping_angles": list(self._damping_angles),
         }
 
     def restore(self, snap: dict[str, Any]) -> None:
@@ -266,7 +274,7 @@ class HalfCar:
             c["contact"] = snap["contact"][side]
             for key in ("coil", "tyre", "lateral", "lower_joint", "upper_joint"):
                 c[key].rest_length, c[key].damping, c[key].stiffness = sp[f"{side}{key}"]
-        self._damping_angles = snap["damping_angles"].copy()
+        self._damping_angles = list(snap["damping_angles"])
 
     def __getstate__(self) -> dict[str, Any]:
         # the tyre's force_func and the chipmunk handles do not pickle: rebuild, then restore
