@@ -19,7 +19,7 @@ from bushenv.models import AXES
 from bushenv.progress import Progress
 from bushenv.search.campaign import CampaignConfig, run_attack
 from bushenv.search.campaign_report import format_table
-from bushenv.search.corpus import DEFAULT_CORPUS
+from bushenv.search.case_file import DEFAULT_CORPUS
 from bushenv.search.searchers import SEARCHERS
 from bushenv.search.targets import TARGETS
 

@@ -9,7 +9,7 @@ from typing import Any
 
 from bushenv.errors import BadInput
 from bushenv.judge import ScaleFlags
-from bushenv.search.corpus import DEFAULT_CORPUS
+from bushenv.search.case_file import DEFAULT_CORPUS
 from bushenv.search.searchers import SEARCHERS
 from bushenv.search.targets import TARGETS
 
