@@ -39,7 +39,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="model card (default: MODEL.card.json beside a model file, if there is one)",
     )
     parser.add_argument(
-        "--certificate", default=None, help="certificate.json of bushenv certify (default: none)"
+        "--certificate",
+        default=None,
+        help="certificate.json of bushenv certify, of this model (default: a NARX model is "
+        "certified at export)",
+    )
+    parser.add_argument(
+        "--reference",
+        default=None,
+        help="registered name or model file the certificate run at export compares the static "
+        "force with (default: none; wrong sign is judged against the deflection)",
+    )
+    parser.add_argument(
+        "--allow-failing",
+        action="store_true",
+        help="export a model that fails its certificate (the FMU carries the failing ranges, "
+        "raises in_flagged_range inside them and logs a warning)",
     )
     parser.add_argument(
         "--stroke-mm",
@@ -80,9 +95,19 @@ def run(args: argparse.Namespace) -> int:
         velocity_m_per_s=args.velocity_m_per_s,
         substeps=args.substeps,
         coords=args.axes,
+        reference=args.reference,
+        allow_failing=args.allow_failing,
     )
     env = done.facts.envelope
     print(done.path)
+    cert = done.certificate
+    if cert is not None and cert.fails:
+        print(
+            "WARNING: exported with --allow-failing although the model fails its certificate: "
+            f"{cert.failing or 'holds'}, flagged ranges {cert.ranges_text()} ({cert.source}); "
+            "the FMU's in_flagged_range is true while its input lies in one, and it logs a "
+            "warning"
+        )
     if not args.quiet:
         if done.coords == 1:
             io = "deflection in, force out"
@@ -93,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"FMI {done.fmi_version} FMU (co-simulation and model exchange; {io}) of the "
             f"{done.model!r} model, compiled with {done.compiler}; envelope {bounds} "
-            f"({env.source})",
+            f"({env.source}); certificate: {cert.verdict() if cert is not None else 'none'}",
             file=sys.stderr,
         )
     return 0

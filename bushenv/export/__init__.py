@@ -2,6 +2,12 @@
 bushing models. ``export_fmu`` writes one; ``bushenv export`` is its command (docs/export.md).
 """
 
-from bushenv.export.build import Exported, ExportError, c_compiler, export_fmu
+from bushenv.export.build import (
+    Exported,
+    ExportError,
+    FailingCertificate,
+    c_compiler,
+    export_fmu,
+)
 
-__all__ = ["ExportError", "Exported", "c_compiler", "export_fmu"]
+__all__ = ["ExportError", "Exported", "FailingCertificate", "c_compiler", "export_fmu"]

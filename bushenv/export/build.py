@@ -4,7 +4,9 @@
 (``model_c``) with the generated constants (``description.fmu_header``), compiles ``fmi2.c`` or
 ``fmi3.c`` with the system C compiler into ``binaries/<platform>/bushing.so``, and writes the
 archive atomically: modelDescription.xml, the binary, every source under ``sources/`` (with
-buildDescription.xml for FMI 3), and the card and certificate under ``documentation/``.
+buildDescription.xml for FMI 3), and the card and certificate under ``documentation/``. A NARX
+model's certificate is run (or read, ``certificate``) first: a model that fails it is refused
+unless ``allow_failing``, and its failing ranges go into the FMU (``export.certificate``).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from importlib import resources
 from pathlib import Path
 
 from bushenv.errors import BadInput
+from bushenv.export.certificate import Carried, carried_certificate
 from bushenv.export.description import (
     FMI_VERSIONS,
     MODEL_IDENTIFIER,
@@ -29,10 +32,10 @@ from bushenv.export.description import (
     fmu_header,
     model_description,
 )
-from bushenv.export.facts import Facts, facts_of, find_card
+from bushenv.export.facts import THREE_AXIS_STROKES, Facts, facts_of, find_card
 from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE_BY_COORDS, model_source
 from bushenv.models import ModelError, ModelSpec, file_hash, get_model, model_file
-from bushenv.persist import atomic_write
+from bushenv.persist import atomic_write, json_text
 
 CFLAGS = ("-shared", "-fPIC", "-O2", "-std=c99", "-ffp-contract=off", "-fvisibility=hidden")
 # The C of an FMU: bushenv's own in c/, the FMI standard's headers vendored unchanged in
@@ -77,6 +80,25 @@ class Exported:
     facts: Facts
     compiler: str
     coords: int = 1
+
+    @property
+    def certificate(self) -> Carried | None:
+        return self.facts.certificate
+
+
+class FailingCertificate(ExportError):
+    """The model fails its certificate and ``allow_failing`` was not given."""
+
+
+def refusal(model_label: str, cert: Carried) -> str:
+    """Why a model that fails its certificate is refused, and how to export it anyway."""
+    return (
+        f"{model_label} fails its certificate: {cert.failing or 'holds'}, flagged ranges "
+        f"{cert.ranges_text()} ({cert.source}). Not exported: its force there is not to be "
+        "trusted. Pass --allow-failing to export it anyway (the FMU carries the ranges, raises "
+        "in_flagged_range inside them and logs a warning), or see the holds with bushenv "
+        "certify MODEL"
+    )
 
 
 def c_compiler() -> str:
@@ -147,11 +169,16 @@ def export_fmu(
     velocity_m_per_s: float | None = None,
     substeps: int = BOUCWEN_SUBSTEPS,
     coords: int | None = None,
+    reference: str | os.PathLike | None = None,
+    allow_failing: bool = False,
 ) -> Exported:
     """Write ``out`` (.fmu): ``spec`` (a registered name, a model file or a model) as compiled C.
 
     ``card``: the model card (default: ``MODEL.card.json`` beside a model file, if any);
-    ``certificate``: a ``certificate.json`` of ``bushenv certify``; ``stroke_m``,
+    ``certificate``: a ``certificate.json`` of ``bushenv certify`` of this model (default: a
+    NARX model is certified here, against ``reference`` if given, else without one);
+    ``allow_failing``: export a model that fails its certificate (else FailingCertificate);
+    ``stroke_m``,
     ``velocity_m_per_s``: the envelope instead of the card's; ``substeps``: Bouc-Wen RK4
     sub-steps per sample; ``coords``: the number of coordinates a registered name is built
     over (None: a file's or a model's own, a name's one). The FMU has one input and one output
@@ -179,11 +206,23 @@ def export_fmu(
         card_path = find_card(spec, axis)
     if card_path is not None and not card_path.is_file():
         raise ExportError(f"{card_path}: no such model card")
+    cert = carried_certificate(
+        model,
+        spec,
+        axis,
+        path=certificate,
+        reference=reference,
+        stroke_m=stroke_m,
+        spans=THREE_AXIS_STROKES,
+    )
+    if cert.fails and not allow_failing:
+        label = str(spec) if isinstance(spec, str | os.PathLike) else f"the {model.name!r} model"
+        raise FailingCertificate(refusal(label, cert))
     facts = facts_of(
         model,
         file_hash(path) if path is not None and path.is_file() else None,
         card_path,
-        Path(certificate) if certificate is not None else None,
+        cert,
         stroke_m,
         velocity_m_per_s,
     )
@@ -216,6 +255,8 @@ def export_fmu(
         files["documentation/card.json"] = card_path.read_bytes()
     if certificate is not None:
         files["documentation/certificate.json"] = Path(certificate).read_bytes()
+    elif cert.document is not None:
+        files["documentation/certificate.json"] = json_text(cert.document).encode()
 
     def write(fh) -> None:
         with zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as zf:
@@ -232,4 +273,11 @@ def export_fmu(
     return Exported(out, fmi_version, model.name, facts, compiler, model.n_coords)
 
 
-__all__ = ["ExportError", "Exported", "ModelError", "c_compiler", "export_fmu"]
+__all__ = [
+    "ExportError",
+    "Exported",
+    "FailingCertificate",
+    "ModelError",
+    "c_compiler",
+    "export_fmu",
+]

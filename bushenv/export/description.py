@@ -3,7 +3,8 @@
 
 Every FMU has one interface, whatever the model kind, in co-simulation and model exchange.
 Value references: 0 time (FMI 3), 4 outside_envelope, 5 time_outside_envelope_s [s], 8 the
-sample time, 100.. the facts; per coordinate (``PORTS``) its input, optional velocity input
+sample time, 9 in_flagged_range (the certificate's boxes), 100.. the facts; per coordinate
+(``PORTS``) its input, optional velocity input
 (used once the master connects it), force output and envelope constants: one axis 1
 deflection [m], 2 velocity [m/s], 3 force [N], 6-7 the envelope; three axes 30-45.
 """
@@ -144,6 +145,15 @@ def variables(facts: Facts, dt: float, coords: int = 1) -> list[Variable]:
             "discrete",
             "time the input has spent outside the validity envelope",
             "s",
+        ),
+        Variable(
+            "in_flagged_range",
+            9,
+            "Boolean",
+            "output",
+            "discrete",
+            "the latest sample's input lies in a range where the model fails its certificate "
+            "(card.certificate_flagged)",
         ),
     ]
     for p, stroke, rate in zip(ports, strokes, rates, strict=True):
@@ -361,15 +371,21 @@ def fmu_header(token: str, facts: Facts, coords: int = 1) -> str:
     env = facts.envelope
     ports = PORTS[coords]
     strokes, rates = env.limits(coords)
-    flagged = [lit(v) for pair in env.flagged_m for v in pair] or ["0.0"]
+    # each box: its lower corner, then its upper corner, one value per coordinate
+    flagged = [lit(v) for b in env.flagged for v in (*b.lo, *b.hi)] or ["0.0"]
+    why = [_c_string(b.why) for b in env.flagged] or ['""']
     facts_c = ", ".join(_c_string(v) for _, v in facts.lines) or '""'
+    cert = facts.certificate
     lines = [
         f'#define FMU_TOKEN "{token}"',
         "#define HAS_VELOCITY 1 /* every FMU has the (optional) velocity inputs */",
         _c_array("double", "ENV_STROKE", [lit(v) for v in strokes]),
         _c_array("double", "ENV_VELOCITY", [lit(v) for v in rates]),
-        f"#define ENV_N_FLAGGED {len(env.flagged_m)}",
+        f"#define ENV_N_FLAGGED {len(env.flagged)}",
         _c_array("double", "ENV_FLAGGED", flagged),
+        _c_array("char *const", "ENV_FLAGGED_WHY", why),
+        f"#define CERT_FAILS {int(cert is not None and cert.fails)}",
+        f"#define CERT_VERDICT {_c_string('' if cert is None else cert.verdict())}",
         f"#define ENV_SOURCE {_c_string(env.source)}",
         f"#define N_FACTS {len(facts.lines)}",
         f"static const char *const FACTS[] = {{{facts_c}}};",

@@ -2,20 +2,20 @@
 
 The envelope is the stroke and velocity the model was fitted on: the largest |x| and |dx/dt| of
 its card's training records (as ``identify.card.record_entry`` measures them), else the papers'
-test machine (12.5 mm, 1.257 m/s), else flags; plus the displacement ranges its certificate
-(``bushenv certify``) flags: wrong-sign and static-off holds. The facts are one line each
-(model file hash, each record's hash, held-out errors, certificate verdicts), written into
+test machine (12.5 mm, 1.257 m/s), else flags; plus the deflection boxes its certificate flags
+(``export.certificate``: the holds that fail it). The facts are one line each (model file
+hash, each record's hash, held-out errors, the certificate's verdicts and boxes), written into
 modelDescription.xml as string constants and as an annotation.
 """
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from bushenv import excitation as ex
+from bushenv.export.certificate import Carried, Flagged
 from bushenv.identify.card import CardError, card_paths, load_card
 from bushenv.models import BushingModel, ModelError, model_file
 
@@ -32,14 +32,14 @@ THREE_AXIS_RATES = (
 
 @dataclass(frozen=True)
 class Envelope:
-    """Where the exported model may be driven; ``flagged_m``: [lo, hi] ranges of x, m.
+    """Where the exported model may be driven; ``flagged``: the certificate's boxes.
 
     One coordinate: ``stroke_m`` and ``velocity_m_per_s``. Several: ``strokes`` and ``rates``,
     one per coordinate (m or rad; m/s or rad/s)."""
 
     stroke_m: float = ex.MAX_DISPLACEMENT_M
     velocity_m_per_s: float = ex.MAX_VELOCITY_M_PER_S
-    flagged_m: tuple[tuple[float, float], ...] = ()
+    flagged: tuple[Flagged, ...] = ()
     source: str = "the papers' test machine (no model card)"
     strokes: tuple[float, ...] = ()
     rates: tuple[float, ...] = ()
@@ -53,10 +53,11 @@ class Envelope:
 
 @dataclass(frozen=True)
 class Facts:
-    """The envelope and the (name, one-line value) facts of one export."""
+    """The envelope, the (name, one-line value) facts and the certificate of one export."""
 
     envelope: Envelope
     lines: tuple[tuple[str, str], ...] = field(default_factory=tuple)
+    certificate: Carried | None = None
 
 
 def find_card(spec: str | os.PathLike | BushingModel, axis: str) -> Path | None:
@@ -68,25 +69,11 @@ def find_card(spec: str | os.PathLike | BushingModel, axis: str) -> Path | None:
     return json_path if json_path.is_file() else None
 
 
-def read_certificate(path: str | os.PathLike) -> dict:
-    """A ``certificate.json`` written by ``bushenv certify`` (its summary is what we use)."""
-    p = Path(path)
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ModelError(f"{p}: no such certificate file") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ModelError(f"{p}: not a certificate (unreadable JSON: {exc})") from None
-    if not isinstance(doc, dict) or not isinstance(doc.get("summary"), dict):
-        raise ModelError(f"{p}: not a certificate written by bushenv certify (no summary)")
-    return doc
-
-
 def facts_of(
     model: BushingModel,
     model_sha256: str | None,
     card_path: Path | None = None,
-    certificate_path: Path | None = None,
+    certificate: Carried | None = None,
     stroke_m: float | None = None,
     velocity_m_per_s: float | None = None,
 ) -> Facts:
@@ -95,42 +82,33 @@ def facts_of(
     lines = [("model", model.name), ("sample_rate_hz", f"{1 / model.dt:.10g}")]
     lines.append(("model_sha256", model_sha256 or "none (a preset, not a file)"))
     if model.n_coords != 1:
-        return _three_axis(model, lines, card_path, certificate_path, stroke_m, velocity_m_per_s)
+        return _three_axis(model, lines, card_path, certificate, stroke_m, velocity_m_per_s)
     env = Envelope()
     if card_path is not None:
         env, card_lines = _from_card(card_path, model_sha256)
         lines += card_lines
     else:
         lines.append(("card", "none: no MODEL.card.json beside the model file"))
-    flagged: list[tuple[float, float]] = []
-    if certificate_path is not None:
-        summary = read_certificate(certificate_path)["summary"]
-        for key in ("wrong_sign_ranges_m", "static_off_ranges_m"):
-            flagged += [(float(lo), float(hi)) for lo, hi in summary.get(key, [])]
-        verdicts = ", ".join(
-            f"{k}={summary[k]}" for k in ("passes_holds", "passes_passivity") if k in summary
-        )
-        lines.append(("certificate", f"{Path(certificate_path).name}: {verdicts}"))
-        lines.append(("certificate_flagged_ranges_m", json.dumps(flagged)))
-    else:
-        lines.append(("certificate", "none"))
+    flagged = () if certificate is None else certificate.flagged
+    lines += [("certificate", "none")] if certificate is None else certificate.lines()
     source = env.source
     if stroke_m is not None or velocity_m_per_s is not None:
         source += "; overridden by --stroke-mm / --velocity-m-per-s"
     env = Envelope(
         stroke_m if stroke_m is not None else env.stroke_m,
         velocity_m_per_s if velocity_m_per_s is not None else env.velocity_m_per_s,
-        tuple(flagged),
+        flagged,
         source,
     )
+    ranges = [[b.lo[0], b.hi[0]] for b in env.flagged]
     lines.append(
         (
             "envelope",
             f"|x| <= {env.stroke_m:.6g} m, |v| <= {env.velocity_m_per_s:.6g}"
-            f" m/s, flagged x ranges {list(env.flagged_m)} ({env.source})",
+            f" m/s, flagged x ranges {ranges} ({env.source})",
         )
     )
-    return Facts(env, tuple(lines))
+    return Facts(env, tuple(lines), certificate)
 
 
 def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, list]:
@@ -169,14 +147,13 @@ def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, lis
     return Envelope(stroke, speed, (), f"the training records of {card_path.name}"), lines
 
 
-def _three_axis(model, lines, card_path, certificate_path, stroke_m, velocity_m_per_s) -> Facts:
-    """A model over several coordinates carries the three-axis test machine's envelope; its
-    card's and certificate's ranges are one-axis quantities, not read into the FMU yet."""
+def _three_axis(model, lines, card_path, certificate, stroke_m, velocity_m_per_s) -> Facts:
+    """A model over several coordinates carries the three-axis test machine's envelope and the
+    boxes of its certificate (``certify_vector``); its card is not read into the FMU yet."""
     given = [
         name
         for name, value in (
             ("--card", card_path),
-            ("--certificate", certificate_path),
             ("--stroke-mm", stroke_m),
             ("--velocity-m-per-s", velocity_m_per_s),
         )
@@ -185,16 +162,19 @@ def _three_axis(model, lines, card_path, certificate_path, stroke_m, velocity_m_
     if given:
         raise ModelError(
             f"{' and '.join(given)}: a three-axis FMU carries the three-axis test machine's "
-            "envelope; cards, certificates and envelope overrides go into one-axis FMUs only"
+            "envelope; cards and envelope overrides go into one-axis FMUs only"
         )
     source = "the three-axis test machine (BushRig3-v0's stroke and rate; no model card)"
-    env = Envelope(source=source, strokes=THREE_AXIS_STROKES, rates=THREE_AXIS_RATES)
+    flagged = () if certificate is None else certificate.flagged
+    env = Envelope(
+        flagged=flagged, source=source, strokes=THREE_AXIS_STROKES, rates=THREE_AXIS_RATES
+    )
     lines.append(("coordinates", ", ".join(model.coords)))
     lines.append(("card", "none: three-axis cards are not read into FMUs"))
-    lines.append(("certificate", "none"))
+    lines += [("certificate", "none")] if certificate is None else certificate.lines()
     bounds = ", ".join(
         f"|{c}| <= {s:.6g} {u}, rate <= {r:.6g} {u}/s"
         for c, u, s, r in zip(model.coords, model.units, env.strokes, env.rates, strict=True)
     )
     lines.append(("envelope", f"{bounds} ({source})"))
-    return Facts(env, tuple(lines))
+    return Facts(env, tuple(lines), certificate)

@@ -42,7 +42,7 @@ def test_every_kind_has_the_same_inputs_and_outputs_in_both_forms(fmu, kind, ver
     inputs_ = sorted(v.name for v in md.modelVariables if v.causality == "input")
     outputs = sorted(v.name for v in md.modelVariables if v.causality == "output")
     assert inputs_ == ["deflection", "velocity"]
-    assert outputs == ["force", "outside_envelope", "time_outside_envelope_s"]
+    assert outputs == ["force", "in_flagged_range", "outside_envelope", "time_outside_envelope_s"]
     assert md.coSimulation is not None and md.modelExchange is not None
     assert md.numberOfContinuousStates == 0
     assert md.version == "2"  # the interface version: docs/export.md

@@ -36,7 +36,8 @@ def fmu3(tmp_path_factory):
     def get(kind, version):
         if (kind, version) not in made:
             out = folder / f"{kind}-{version}.fmu"
-            made[kind, version] = export_fmu(_model(kind), out, version).path
+            # the untrained networks fail their certificates: carried, not refused
+            made[kind, version] = export_fmu(_model(kind), out, version, allow_failing=True).path
         return made[kind, version]
 
     return get
@@ -120,16 +121,15 @@ def test_the_cli_exports_a_three_axis_preset_and_refuses_a_kind_without_c(tmp_pa
     assert "exportable kinds over 3 coordinates: linear, nn, nn-axis, hybrid" in err
 
 
-def test_a_three_axis_file_with_a_certificate_is_refused_naming_why(tmp_path, capsys):
+def test_a_three_axis_file_with_a_card_is_refused_naming_why(tmp_path, capsys):
     from bushenv.cli import main
 
     model = tmp_path / "h3.npz"
-    _model("hybrid").save(model)
-    argv = ["export", str(model), "--certificate", "c.json", "--out", str(tmp_path / "h.fmu")]
+    _model("nn-axis").save(model)
+    argv = ["export", str(model), "--card", str(model), "--allow-failing", "--out",
+            str(tmp_path / "h.fmu")]  # fmt: skip
     assert main(argv) == 2
-    assert "cards, certificates and envelope overrides go into one-axis FMUs only" in (
-        capsys.readouterr().err
-    )
+    assert "cards and envelope overrides go into one-axis FMUs only" in capsys.readouterr().err
 
 
 def test_a_rotation_beyond_the_machines_range_is_flagged_and_logged_naming_it(fmu3):

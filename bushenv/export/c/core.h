@@ -28,8 +28,10 @@
    states the error of each case.
 
    Envelope (model.h, generated): a sample is outside when for a coordinate i |x_i| >
-   ENV_STROKE[i], |x_i,n - x_i,(n-1)| / dt > ENV_VELOCITY[i], or (one coordinate) x lies in a
-   range the model's certificate flags. */
+   ENV_STROKE[i], |x_i,n - x_i,(n-1)| / dt > ENV_VELOCITY[i], or x lies in a box the model's
+   certificate flags (ENV_FLAGGED: per box its lower corner, then its upper one; a failing
+   hold's cell). Such a sample also sets in_flagged_range; each entry into a box is logged, and
+   a model that fails its certificate says so once, when initialisation ends. */
 #include <stdio.h>
 #include <string.h>
 
@@ -45,6 +47,7 @@ typedef struct {
     double force[NC];        /* its forces */
     int outside;             /* the last counted sample is outside the envelope */
     long n_outside;          /* counted samples outside */
+    int flagged;             /* 1 + the flagged box the last counted sample is in, or 0 */
 } CoreRun;
 
 typedef struct {
@@ -63,7 +66,7 @@ typedef struct {
     int me;                       /* model exchange */
     core_log_fn log;
     void *log_env;
-    char message[512];
+    char message[1024];
 } Core;
 
 static void core_reset(Core *c, double t0) {
@@ -101,9 +104,16 @@ static void core_restart(Core *c, double t0) {
     c->me = me;
 }
 
-static int core_in_flagged(double x) {
-    for (int i = 0; i < ENV_N_FLAGGED; i++)
-        if (x >= ENV_FLAGGED[2 * i] && x <= ENV_FLAGGED[2 * i + 1]) return 1;
+#define WHY_FLAGGED "in a range the certificate flags"
+
+/* 1 + the first flagged box that holds x, or 0. */
+static int core_in_flagged(const double *x) {
+    for (int k = 0; k < ENV_N_FLAGGED; k++) {
+        const double *lo = ENV_FLAGGED + 2 * NC * k, *hi = lo + NC;
+        int in = 1;
+        for (int i = 0; i < NC && in; i++) in = x[i] >= lo[i] && x[i] <= hi[i];
+        if (in) return k + 1;
+    }
     return 0;
 }
 
@@ -117,7 +127,7 @@ static const char *core_outside_why(const double *x, const double *x_prev, int f
             return "rate beyond the fitted range";
     }
     *which = 0;
-    if (NC == 1 && core_in_flagged(x[0])) return "in a range the certificate flags";
+    if (core_in_flagged(x)) return WHY_FLAGGED;
     return NULL;
 }
 
@@ -140,6 +150,7 @@ static int core_sample(Core *c, CoreRun *r, double ts, const double *x, const do
     }
     r->outside = core_outside_why(x, r->x_last, r->n == 0, &which) != NULL;
     r->n_outside += r->outside;
+    r->flagged = core_in_flagged(x);
     for (int i = 0; i < NC; i++) r->x_last[i] = x[i];
     r->n += 1;
     return 0;
@@ -190,20 +201,57 @@ static void core_log_entry(Core *c, double ts, const char *why, int i, const dou
     c->log(c->log_env, 1, c->message);
 }
 
+/* Log an entry into flagged box k - 1 at sample time ts. */
+static void core_log_flagged(Core *c, double ts, int k, const double *x) {
+    if (!c->log || k <= 0) return;
+    const double *lo = ENV_FLAGGED + 2 * NC * (k - 1), *hi = lo + NC;
+    size_t used = (size_t)snprintf(c->message, sizeof c->message,
+                                   "t = %.6g s: input enters a range where the model fails its "
+                                   "certificate (%s):", ts, ENV_FLAGGED_WHY[k - 1]);
+    for (int i = 0; i < NC && used < sizeof c->message; i++)
+        used += (size_t)snprintf(c->message + used, sizeof c->message - used,
+                                 "%s %s = %.6g %s in [%.6g, %.6g]", i ? "," : "", COORD_SYMBOLS[i],
+                                 x[i], COORD_UNITS[i], lo[i], hi[i]);
+    if (used < sizeof c->message)
+        snprintf(c->message + used, sizeof c->message - used,
+                 "; its force there is not to be trusted (card.certificate)");
+    c->log(c->log_env, 1, c->message);
+}
+
+/* Log the entries of one sample: into the envelope's outside (not for a flagged box alone,
+   which core_log_flagged says better), and into a flagged box. */
+static void core_log_sample(Core *c, double ts, const double *x, const char *why, int which,
+                            int was_outside, int flagged, int was_flagged) {
+    if (why && !was_outside && why != WHY_FLAGGED) core_log_entry(c, ts, why, which, x);
+    if (flagged && !was_flagged) core_log_flagged(c, ts, flagged, x);
+}
+
+/* Once, when initialisation ends: a model exported although it fails its certificate. */
+static void core_log_certificate(Core *c) {
+    if (!CERT_FAILS || !c->log) return;
+    snprintf(c->message, sizeof c->message,
+             "this model fails its certificate and was exported with --allow-failing: %s; "
+             "in_flagged_range is true while the input lies in one of its %d flagged ranges",
+             CERT_VERDICT, ENV_N_FLAGGED);
+    c->log(c->log_env, 1, c->message);
+}
+
 /* Commit the samples up to t_now and log each entry into the outside of the envelope. */
 static int core_commit(Core *c) {
     CoreRun before = c->done;
     if (core_pending(c)) return -1;
     /* re-walk only to find entries (cheap: the envelope test, not the model) */
-    int was_outside = before.outside, which;
+    int was_outside = before.outside, was_flagged = before.flagged, which;
     double x_prev[NC];
     for (int i = 0; i < NC; i++) x_prev[i] = before.x_last[i];
     for (long n = before.n; n < c->pending.n; n++) {
         double ts = c->t0 + (double)n * MODEL_DT_S, x[NC], v[NC];
         core_input(c, ts, x, v);
         const char *why = core_outside_why(x, x_prev, n == 0, &which);
-        if (why && !was_outside) core_log_entry(c, ts, why, which, x);
+        int flagged = core_in_flagged(x);
+        core_log_sample(c, ts, x, why, which, was_outside, flagged, was_flagged);
         was_outside = why != NULL;
+        was_flagged = flagged;
         for (int i = 0; i < NC; i++) x_prev[i] = x[i];
     }
     c->done = c->pending;
@@ -239,7 +287,8 @@ static int core_me_event(Core *c) {
         if (core_sample(c, &c->done, ts, c->x_now, c->v_now)) return -1;
         const char *why =
             core_outside_why(c->x_now, c->before.x_last, c->before.n == 0, &which);
-        if (why && !c->before.outside) core_log_entry(c, ts, why, which, c->x_now);
+        core_log_sample(c, ts, c->x_now, why, which, c->before.outside, c->done.flagged,
+                        c->before.flagged);
     }
     c->pending_valid = 0;
     return 0;

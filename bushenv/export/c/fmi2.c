@@ -84,6 +84,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     Instance *m = (Instance *)c;
     m->initialised = 1;
     m->core.started = 1;
+    core_log_certificate(&m->core);
     return fmi2OK;
 }
 fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }

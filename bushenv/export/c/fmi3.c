@@ -77,7 +77,9 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean tol_defined, 
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance c) {
-    ((Instance *)c)->core.started = 1;
+    Instance *m = (Instance *)c;
+    m->core.started = 1;
+    core_log_certificate(&m->core);
     return fmi3OK;
 }
 fmi3Status fmi3EnterEventMode(fmi3Instance c) { (void)c; return fmi3OK; }

@@ -6,6 +6,7 @@
 #define VR_OUTSIDE 4
 #define VR_TIME_OUTSIDE 5
 #define VR_SAMPLE_TIME 8
+#define VR_IN_FLAGGED 9
 #define VR_FACTS 100
 
 /* The coordinate whose variable in ``table`` is ``vr``, or -1. */
@@ -35,10 +36,10 @@ static int var_get_real(Core *c, unsigned vr, double *out) {
 }
 
 static int var_get_boolean(Core *c, unsigned vr, int *out) {
-    if (vr != VR_OUTSIDE) return 1;
+    if (vr != VR_OUTSIDE && vr != VR_IN_FLAGGED) return 1;
     const CoreRun *r = core_outputs(c);
     if (!r) return -1;
-    *out = r->outside;
+    *out = vr == VR_OUTSIDE ? r->outside : r->flagged != 0;
     return 0;
 }
 
