@@ -1,5 +1,5 @@
 """``bushenv certify``: hold-stability and passivity certificates of a NARX model, of one
-coordinate or of several (``bushenv.certify.vector``: holds on a grid of deflection vectors).
+coordinate or of several (``bushenv.planar.certificate``: holds on a grid of deflection vectors).
 
 Writes DIR/certificate.json and three plots (static force, spectral radius, Im K); prints a
 summary on stdout and progress on stderr. Exits as a test runner does: 0 when the certificate
@@ -232,9 +232,14 @@ def _vector_span(args: argparse.Namespace, model) -> tuple[tuple[float, ...], st
 
 
 def _run_vector(args: argparse.Namespace, model, out: Path, target: Path) -> int:
-    """The certificate over C > 1 coordinates (``bushenv.certify.vector``): holds on a grid of
+    """The certificate over C > 1 coordinates (``bushenv.planar.certificate``): holds on a grid of
     deflection vectors, wrong sign without a reference, passivity as a matrix test."""
-    from bushenv.certify.vector import VectorOptions, certify_vector, per_coordinate, radius_plot
+    from bushenv.planar.certificate import (
+        VectorOptions,
+        certify_vector,
+        per_coordinate,
+        radius_plot,
+    )
 
     if args.reference not in (None, "none"):
         raise CertifyError(

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from bushenv.certify.network import CertifyError
-from bushenv.certify.vector import VectorOptions, certify_vector, per_coordinate, wrong_sign
 from bushenv.cli import main
+from bushenv.planar.certificate import VectorOptions, certify_vector, per_coordinate, wrong_sign
 from bushenv.planar.linear import PlanarLinear
 from bushenv.planar.narx import N_IN, PlanarNarx
 
