@@ -193,7 +193,7 @@ def coordinate_result(setup, diagnoses: dict, couplings: dict, left_out: dict) -
     top = carrying[0] if carrying else None
     first = next(iter(diagnoses.values()))
     if top is None:
-        answer = "none: the baseline explains every coordinate down to the force's noise"
+        answer = "none: the baseline explains every diagnosed coordinate down to the noise"
     else:
         answer = f"{top['coordinate']}: {top['effect']}"
         if top["coupled_to"]:

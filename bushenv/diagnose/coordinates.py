@@ -166,9 +166,17 @@ def check_coordinate_records(trains: list, tests: list, t_names: list, names: li
 def linear_baseline(trains: list, c: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """(K, C) of the ``linear`` form over ``c`` coordinates identified on ``trains``."""
     from bushenv.identify.options import options_of
-    from bushenv.models import MODELS
+    from bushenv.models import MODELS, ModelError
 
-    form = MODELS[LINEAR].form(c)
+    try:
+        form = MODELS[LINEAR].form(c)
+    except ModelError:
+        have = ", ".join(str(n) for n in MODELS[LINEAR].coordinate_counts())
+        raise DiagnoseError(
+            f"records of {c} coordinates: the baseline is the linear model over them, which "
+            f"bushenv.models.MODELS has for {have} coordinate(s) only (register its form for "
+            f"{c})"
+        ) from None
     opts = options_of(form.options_class(), None, LINEAR)
     hist = [(np.asarray(r.q, float), np.asarray(r.f, float)) for r in trains]
     model, _ = form.fit_function()(hist, dt, opts, 0, None)

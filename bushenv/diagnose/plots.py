@@ -87,8 +87,8 @@ def spectrum_plot(result: dict[str, Any], out: Path, names: list[str]) -> None:
         a1.loglog(f[1:], pa[1:], ls="--", label=f"{pred['name']} augmented")
         a2.semilogx(f[1:], coh[1:], label=pred["name"])
     force_unit = units_of(result)[2]
-    a1.set_ylabel(f"residual PSD, {force_unit}²/Hz" if " " not in force_unit else
-                  f"residual PSD, ({force_unit})²/Hz")  # fmt: skip
+    squared = f"({force_unit})²" if " " in force_unit else f"{force_unit}²"
+    a1.set_ylabel(f"residual PSD, {squared}/Hz")
     a1.legend(fontsize=7)
     a2.set_ylabel("coherence with input")
     a2.set_xlabel("frequency, Hz")

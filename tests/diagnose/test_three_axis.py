@@ -128,6 +128,9 @@ def test_other_baselines_and_mixed_records_are_refused_by_the_library():
     one = Record.from_arrays(train.q[:, 0], train.f[:, 0], train.dt, name="one")
     with pytest.raises(DiagnoseError, match="TEST one has 1 coordinate"):
         diagnose(train, [one])
+    two = [PlanarRecord(r.time, r.q[:, :2], r.f[:, :2], n) for r, n in ((train, "a"), (test, "b"))]
+    with pytest.raises(DiagnoseError, match="records of 2 coordinates: .* for 1, 3 coordinate"):
+        diagnose(two[0], [two[1]])  # generic over C: refused only for want of a linear form
 
 
 @pytest.fixture(scope="module")
