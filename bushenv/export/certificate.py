@@ -391,7 +391,7 @@ def _run_one(model, spec, axis, reference, stroke_m) -> tuple[dict, str]:
 
 
 def _run_vector(model, spans: tuple[float, ...]) -> tuple[dict, str]:
-    from bushenv.certify.vector import VectorOptions, certify_vector, per_coordinate
+    from bushenv.planar.certificate import VectorOptions, certify_vector, per_coordinate
 
     opts = VectorOptions(tuple(spans), per_coordinate(201, model.n_coords))
     doc, _ = certify_vector(model, opts)

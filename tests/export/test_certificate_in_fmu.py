@@ -243,3 +243,86 @@ def test_kinds_without_a_recurrence_say_they_have_no_certificate(tmp_path, capsy
     assert f"certificate: none: a '{kind}' model has no recurrence to certify" in err
     with zipfile.ZipFile(out) as zf:
         assert "documentation/certificate.json" not in zf.namelist()
+
+
+def _three_axis_network(pushing: bool):
+    """A small three-axis network over (axial, radial, rotation). ``pushing``: each output a
+    tanh of its own coordinate (the force has the sign of the deflection: passes); else random
+    small weights, whose static force pulls outward at most holds (wrong sign: fails)."""
+    from bushenv.planar.narx import N_IN, PlanarNarx
+
+    rng = np.random.default_rng(0)
+    w1, w_out = rng.normal(0, 0.05, (9, N_IN)), rng.normal(0, 0.3, (3, 9))
+    if pushing:
+        w1, w_out = np.zeros((9, N_IN)), np.zeros((3, 9))
+        w1[:3, :3] = w_out[:, :3] = np.eye(3)
+    return PlanarNarx(
+        q_offset=np.zeros(3), q_scale=np.array([2e-3, 2e-3, 0.05]), f_offset=np.zeros(3),
+        f_scale=np.array([500.0, 2000.0, 150.0]), w1=w1, b1=np.zeros(9), w_out=w_out,
+        b_out=np.zeros(3),
+    )  # fmt: skip
+
+
+def _drive_q(fmu_path, q):
+    """Set-then-read of held deflection vectors q (T, 3): in_flagged_range per sample."""
+    with opened(fmu_path) as (s, vr, three):
+        setf = s.setFloat64 if three else s.setReal
+        names = ("deflection_axial", "deflection_radial", "rotation")
+        flag = np.empty(len(q), bool)
+        for k, qk in enumerate(q):
+            setf([vr[n] for n in names], [float(a) for a in qk])
+            flag[k] = s.getBoolean([vr["in_flagged_range"]])[0]
+            s.doStep(currentCommunicationPoint=k * PAPER_DT, communicationStepSize=PAPER_DT)
+    return flag
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_a_three_axis_network_that_fails_is_refused_and_flags_its_boxes(tmp_path, version):
+    from bushenv.export.facts import THREE_AXIS_STROKES
+    from bushenv.planar.certificate import VectorOptions, certify_vector
+
+    model = _three_axis_network(pushing=False)
+    with pytest.raises(FailingCertificate, match="wrong-sign holds") as refused:
+        export_fmu(model, tmp_path / "n3.fmu", version)
+    assert "--allow-failing" in str(refused.value)
+    done = export_fmu(model, tmp_path / "n3.fmu", version, allow_failing=True)
+    doc, _ = certify_vector(model, VectorOptions(THREE_AXIS_STROKES, 7))
+    # by hand: each listed (failing) hold vector, +- half the grid spacing per coordinate
+    half = np.array(THREE_AXIS_STROKES) / 6
+    boxes = [(np.array(h["q"]) - half, np.array(h["q"]) + half) for h in doc["holds"]]
+    flagged, _, _ = _flagged_fact(done.path)
+    assert len(flagged) == len(boxes) == doc["summary"]["wrong_sign_holds"] > 0
+    assert np.allclose([b for pair in flagged for b in pair], [b for pair in boxes for b in pair])
+    rng = np.random.default_rng(1)
+    q = rng.uniform(-1, 1, (60, 3)) * np.array(THREE_AXIS_STROKES)
+    q = np.repeat(q, 2, axis=0)  # each held two samples (the rate limit is not the point)
+    want = np.array([any(np.all((p >= lo) & (p <= hi)) for lo, hi in boxes) for p in q])
+    assert want.any() and (~want).any()
+    assert np.array_equal(_drive_q(done.path, q), want)
+
+
+def test_a_three_axis_network_that_passes_exports_without_a_flag(tmp_path, capsys):
+    path = _three_axis_network(pushing=True).save(tmp_path / "push3.npz")
+    out = tmp_path / "push3.fmu"
+    assert main(["export", str(path), "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.strip() == str(out) and "holds passes" in captured.err
+    assert "7^3 hold vectors" in captured.err
+    flagged, _, _ = _flagged_fact(out)
+    assert flagged == []
+
+
+def test_a_three_axis_certificate_given_is_carried_and_one_of_another_network_refused(
+    tmp_path, capsys
+):
+    path = _three_axis_network(pushing=False).save(tmp_path / "n3.npz")
+    argv = ["certify", str(path), "--stroke-mm", "12.5", "--rotation-mrad", "150", "--holds",
+            "343", "--out", str(tmp_path / "c"), "--quiet"]  # fmt: skip
+    assert main(argv) == 1
+    cert = tmp_path / "c" / "certificate.json"
+    given = export_fmu(path, tmp_path / "a.fmu", certificate=cert, allow_failing=True)
+    ran = export_fmu(path, tmp_path / "b.fmu", allow_failing=True)
+    assert given.facts.envelope.flagged == ran.facts.envelope.flagged
+    other = _three_axis_network(pushing=True).save(tmp_path / "push3.npz")
+    with pytest.raises(ModelError, match="another model: its fixed points at"):
+        export_fmu(other, tmp_path / "o.fmu", certificate=cert)
