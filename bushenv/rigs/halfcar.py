@@ -15,7 +15,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from bushenv.rigs.actions import _array, check_options, check_profile, describe
+from bushenv.rigs.actions import check_options
 from bushenv.rigs.car_planar import reference_range_reason
 from bushenv.rigs.car_verdict import MODEL_ERROR_PREFIX
 from bushenv.rigs.common import (
@@ -26,13 +26,13 @@ from bushenv.rigs.common import (
     check_hook,
 )
 from bushenv.rigs.halfcar_car import HalfCar, HalfCarPair
+from bushenv.rigs.halfcar_inputs import replay_inputs, unit_actions3
 from bushenv.rigs.halfcar_outputs import PIVOT_KEYS, car_outputs, out_of_bounds, sample
 from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, HalfCarParameters
 from bushenv.rigs.specs import spec_kwargs
 
 OBS_SIZE = 16
 COORD_KEYS = (("axial", "n"), ("radial", "n"), ("moment", "nm"))
-REPLAY_KEYS = ("road_left", "road_right", "lateral_accel")
 
 
 class HalfCarEnv(gym.Env):
@@ -233,7 +233,7 @@ class HalfCarEnv(gym.Env):
         sample_m = sample(self.car, self.models, p)
         sample_r = sample(self.twin, self.references, p)
         self.cars.integrate(before[:2], now[:2], before[2], now[2])
-        out_m, out_r = self._outputs()
+        out_m, out_r = self._outputs((now[:2] - before[:2]) / p.dt)
         why_m = sample_m[3] or out_of_bounds(p, out_m, sample_m[0])
         why_r = sample_r[3] or out_of_bounds(p, out_r, sample_r[0])
         truncated = bool(why_r)
@@ -275,12 +275,14 @@ class HalfCarEnv(gym.Env):
         for i, v in enumerate(values):
             o[i] = 0.0 if v != v else (1.0 if v > 1.0 else (-1.0 if v < -1.0 else v))
 
-    def _outputs(self) -> tuple[dict[str, Any], dict[str, Any]]:
-        """Both cars' ``car_outputs`` after a step (each remembers its body velocity)."""
+    def _outputs(self, road_v=(0.0, 0.0)) -> tuple[dict[str, Any], dict[str, Any]]:
+        """Both cars' ``car_outputs`` after a step whose roads moved at ``road_v`` (m/s; each
+        car remembers its body velocity)."""
         p, roads, ay = self.params, self._inputs[:2].tolist(), float(self._inputs[2])
+        road_v = [float(v) for v in road_v]
         outs = []
         for j, car in enumerate((self.car, self.twin)):
-            out = car_outputs(p, car, roads, self._prev_v[j], ay)
+            out = car_outputs(p, car, roads, road_v, self._prev_v[j], ay)
             self._prev_v[j] = (out["body_vx_m_per_s"], out["body_vy_m_per_s"])
             outs.append(out)
         return outs[0], outs[1]
@@ -353,47 +355,3 @@ def _model_batches(models: Any):
     if isinstance(models, dict):
         return [(m, 1) for m in models.values()]
     return [(models, len(POSITIONS))]
-
-
-def unit_actions3(action: Any) -> np.ndarray:
-    """A (3,) action cleaned as the other rigs' (NaN -> 0, clipped to [-1, 1]); anything that is
-    not three real numbers is refused naming the action space."""
-    arr = action if action.__class__ is np.ndarray else _array(action)
-    if arr is None or arr.dtype.kind not in "fiu" or arr.shape != (3,):
-        raise RigError(
-            f"{ENV_ID}: action {describe(action)} does not fit the action space Box(-1.0, 1.0, "
-            "(3,), float32): expected three real numbers (road left, road right, lateral load)"
-        )
-    a = arr.astype(np.float64)
-    a[np.isnan(a)] = 0.0
-    return np.clip(a, -1.0, 1.0)
-
-
-def replay_inputs(p: HalfCarParameters, options: dict[str, Any]) -> np.ndarray | None:
-    """(T, 3) replayed inputs (road left, road right, a_y) from ``reset`` options, or None."""
-    unknown = sorted(set(options) - set(REPLAY_KEYS))
-    if unknown:
-        raise RigError(f"{ENV_ID}: unknown reset option(s) {unknown}; known: {list(REPLAY_KEYS)}")
-    given = {k: v for k, v in options.items() if v is not None}
-    if not given:
-        return None
-    cols = {}
-    for k, v in given.items():
-        if k == "lateral_accel":
-            a = check_profile(k, v, k, p.max_ay, "|a_y| = {value:.6g} m/s^2 exceeds "
-                              f"max_lateral_accel_m_per_s2 {p.max_ay:.6g}", p.max_ay_step,
-                              "a change of {value:.6g} m/s^2 exceeds "
-                              f"max_lateral_accel_step_m_per_s2 {p.max_ay_step:.6g}")  # fmt: skip
-        else:
-            a = check_profile(k, v, k, p.max_road, "|h| = {value:.6g} m exceeds "
-                              f"max_road_height_m {p.max_road:.6g} m", p.max_road_step,
-                              "a change of {value:.6g} m exceeds "
-                              f"max_road_step_m {p.max_road_step:.6g} m")  # fmt: skip
-        if a.ndim != 1:
-            raise RigError(f"{ENV_ID}: reset option {k} must be (T,), got {a.shape}")
-        cols[k] = a
-    lengths = {k: len(a) for k, a in cols.items()}
-    if len(set(lengths.values())) > 1:
-        raise RigError(f"{ENV_ID}: replayed inputs differ in length: {lengths}")
-    t = next(iter(lengths.values()))
-    return np.stack([cols.get(k, np.zeros(t)) for k in REPLAY_KEYS], axis=1)

@@ -61,8 +61,12 @@ def force_reason(p: HalfCarParameters, f: np.ndarray) -> str:
     return ""
 
 
-def car_outputs(p: HalfCarParameters, car: HalfCar, roads, prev_v, ay: float) -> dict[str, Any]:
-    """One car's body, wheel and geometry outputs after a step (plain floats and bools)."""
+def car_outputs(
+    p: HalfCarParameters, car: HalfCar, roads, road_v, prev_v, ay: float
+) -> dict[str, Any]:
+    """One car's body, wheel and geometry outputs after a step (plain floats and bools):
+    ``roads`` the road heights (left, right; m), ``road_v`` their speeds over the step (the
+    tyre dampers' input), ``prev_v`` the body's (vx, vy) a step ago, ``ay`` the lateral load."""
     c = car.chassis
     (x, y), (vx, vy) = c.position, c.velocity
     phi = c.angle
@@ -74,7 +78,7 @@ def car_outputs(p: HalfCarParameters, car: HalfCar, roads, prev_v, ay: float) ->
     }  # fmt: skip
     contact_x = []
     cos, sin = math.cos(phi), math.sin(phi)
-    for side, h in zip(SIDES, roads, strict=True):
+    for side, h, vh in zip(SIDES, roads, road_v, strict=True):
         corner = car.corners[side]
         u = corner["upright"]
         psi = u.angle
@@ -82,7 +86,7 @@ def car_outputs(p: HalfCarParameters, car: HalfCar, roads, prev_v, ay: float) ->
         cx, cy = wx + math.sin(psi) * p.r_w, wy - math.cos(psi) * p.r_w
         cvy = wvy + u.angular_velocity * math.sin(psi) * p.r_w
         contact_x.append(cx)
-        load = p.k_t * (h - cy) + (p.c_t * (-cvy) if corner["contact"] else 0.0)
+        load = p.k_t * (h - cy) + (p.c_t * (vh - cvy) if corner["contact"] else 0.0)
         load = max(p.tyre_static_n + load, 0.0)
         out[f"wheel_load_{side}_n"] = load
         out[f"wheel_lift_{side}"] = load <= 0.0

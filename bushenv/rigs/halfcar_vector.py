@@ -22,9 +22,12 @@ from bushenv.rigs.vector_base import ArrayVectorEnv
 
 
 class HalfCarVectorEnv(ArrayVectorEnv):
-    """N half cars (``HalfCarEnv``) with the scalar env's actions, observations, rewards, hooks
-    and info keys as (N,) arrays (strings as object arrays). ``reset(options=...)`` takes the
+    """N half cars (``HalfCarEnv``) with the scalar env's actions, observations, rewards and
+    info keys as (N,) arrays (strings as object arrays). ``reset(options=...)`` takes the
     scalar env's options, each (T,) (every column replays it) or (T, N) (one column each).
+    Unlike the array vector envs, the hooks (``reward_fn``, ``divergence_monitor``) are called
+    by each column with its own plain-value info, and a column's autoreset returns it to agent
+    control (its replay is not restarted).
 
     >>> import gymnasium as gym
     >>> import numpy as np
