@@ -32,7 +32,6 @@ from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, HalfCarParameters
 from bushenv.rigs.specs import spec_kwargs
 
 OBS_SIZE = 16
-COORD_KEYS = (("axial", "n"), ("radial", "n"), ("moment", "nm"))
 
 
 class HalfCarEnv(gym.Env):
