@@ -173,6 +173,46 @@ def test_the_docstring_examples_run():
         assert result.attempted > 0 and result.failed == 0
 
 
+def test_mirrored_inputs_give_mirrored_outputs():
+    """Left and right roads swapped and the lateral load reversed: roll, lateral displacement
+    and every left quantity come out as the mirrored right one (the right side's bushing
+    coordinates are mirrored, so a pivot's forces equal its mirror pivot's), within 1e-5 of
+    each signal's peak (measured 8e-7: the solver takes the springs in order, the reference's
+    friction carries the rounding)."""
+    m = manoeuvre()
+    mirrored = {"road_left": m["road_right"], "road_right": m["road_left"],
+                "lateral_accel": -m["lateral_accel"]}  # fmt: skip
+    a = [s[4] for s in rollout(make(), m)]
+    b = [s[4] for s in rollout(make(), mirrored)]
+    pairs = [("roll_rad", "roll_rad", -1.0), ("body_x_m", "body_x_m", -1.0),
+             ("body_y_m", "body_y_m", 1.0), ("track_change_m", "track_change_m", 1.0)]  # fmt: skip
+    for left, right in (("left", "right"), ("right", "left")):
+        pairs += [(f"{k}_{left}_{u}", f"{k}_{right}_{u}", 1.0) for k, u in
+                  (("wheel_load", "n"), ("camber", "rad"), ("travel", "m"))]  # fmt: skip
+        for arm in ("lower", "upper"):
+            for key in ("force_{}_axial_{}_n", "force_{}_radial_{}_n", "moment_{}_{}_nm"):
+                for role in ("model", "reference"):
+                    pairs.append((key.format(f"{arm}_{left}", role),
+                                  key.format(f"{arm}_{right}", role), 1.0))  # fmt: skip
+    for ka, kb, sign in pairs:
+        x = np.array([i[ka] for i in a])
+        y = sign * np.array([i[kb] for i in b])
+        assert np.abs(x - y).max() <= 1e-5 * np.abs(x).max(), (ka, kb)
+
+
+def test_a_wheel_over_a_deep_pothole_lifts_off_and_lands():
+    """The left road drops 60 mm at its rate limit and climbs back at 3 mm per step: the left
+    wheel lifts (load 0, ``wheel_lift_left``; 13 steps), then lands and carries its load again;
+    nothing is terminated."""
+    k = np.arange(200)
+    road = -np.clip(np.minimum(0.05 * (k - 10), 0.003 * (40 - k) + 0.06), 0.0, 0.06)
+    steps = rollout(make(), {"road_left": road}, n=200)
+    lifted = [s[4]["wheel_lift_left"] for s in steps]
+    assert any(lifted) and not lifted[-1] and not any(s[2] for s in steps)
+    assert all(s[4]["wheel_load_left_n"] == 0.0 for s in steps if s[4]["wheel_lift_left"])
+    assert steps[-1][4]["wheel_load_left_n"] > 0.25 * make().unwrapped.params.tyre_static_n
+
+
 # ----- physics ------------------------------------------------------------------------------------
 def test_with_identical_tracks_the_half_car_is_two_quarter_cars_within_5_percent():
     """QuarterCar-v0 set up as one corner of the half car (its sprung half, the corner's wheel
