@@ -32,7 +32,13 @@ from bushenv.export.description import (
     fmu_header,
     model_description,
 )
-from bushenv.export.facts import THREE_AXIS_STROKES, Facts, facts_of, find_card
+from bushenv.export.facts import (
+    THREE_AXIS_STROKES,
+    Facts,
+    facts_of,
+    find_card,
+    refuse_three_axis_overrides,
+)
 from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE_BY_COORDS, model_source
 from bushenv.models import ModelError, ModelSpec, file_hash, get_model, model_file
 from bushenv.persist import atomic_write, json_text
@@ -206,6 +212,8 @@ def export_fmu(
         card_path = find_card(spec, axis)
     if card_path is not None and not card_path.is_file():
         raise ExportError(f"{card_path}: no such model card")
+    if model.n_coords != 1:
+        refuse_three_axis_overrides(card_path, stroke_m, velocity_m_per_s)
     cert = carried_certificate(
         model,
         spec,

@@ -333,6 +333,11 @@ def carried_certificate(
             "NARX networks: nn, hybrid)",
             units=units,
         )
+    if path is not None and reference is not None:
+        raise ModelError(
+            f"--reference {reference} with --certificate {path}: the reference is for the "
+            "certificate run at export; a given certificate was made against its own"
+        )
     if path is not None:
         doc = read_document(path)
         check_belongs(doc, model, path)

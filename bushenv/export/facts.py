@@ -147,9 +147,9 @@ def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, lis
     return Envelope(stroke, speed, (), f"the training records of {card_path.name}"), lines
 
 
-def _three_axis(model, lines, card_path, certificate, stroke_m, velocity_m_per_s) -> Facts:
-    """A model over several coordinates carries the three-axis test machine's envelope and the
-    boxes of its certificate (``certify_vector``); its card is not read into the FMU yet."""
+def refuse_three_axis_overrides(card_path, stroke_m, velocity_m_per_s) -> None:
+    """A three-axis FMU carries the machine's envelope: a card or envelope override is refused
+    (checked before the export certifies the model, so it fails fast)."""
     given = [
         name
         for name, value in (
@@ -164,6 +164,12 @@ def _three_axis(model, lines, card_path, certificate, stroke_m, velocity_m_per_s
             f"{' and '.join(given)}: a three-axis FMU carries the three-axis test machine's "
             "envelope; cards and envelope overrides go into one-axis FMUs only"
         )
+
+
+def _three_axis(model, lines, card_path, certificate, stroke_m, velocity_m_per_s) -> Facts:
+    """A model over several coordinates carries the three-axis test machine's envelope and the
+    boxes of its certificate (``certify_vector``); its card is not read into the FMU yet."""
+    refuse_three_axis_overrides(card_path, stroke_m, velocity_m_per_s)
     source = "the three-axis test machine (BushRig3-v0's stroke and rate; no model card)"
     flagged = () if certificate is None else certificate.flagged
     env = Envelope(

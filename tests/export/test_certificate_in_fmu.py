@@ -233,6 +233,8 @@ def test_a_given_certificate_of_the_model_is_carried_and_one_of_another_is_refus
         export_fmu("nn", tmp_path / "n.fmu", certificate=cert)
     with pytest.raises(ModelError, match="a 'linear' model has no certificate"):
         export_fmu("linear", tmp_path / "l.fmu", certificate=cert)
+    with pytest.raises(ModelError, match="a given certificate was made against its own"):
+        export_fmu(path, tmp_path / "r.fmu", certificate=cert, reference="rubber")
 
 
 @pytest.mark.parametrize("kind", ("linear", "boucwen"))
@@ -326,3 +328,12 @@ def test_a_three_axis_certificate_given_is_carried_and_one_of_another_network_re
     other = _three_axis_network(pushing=True).save(tmp_path / "push3.npz")
     with pytest.raises(ModelError, match="another model: its fixed points at"):
         export_fmu(other, tmp_path / "o.fmu", certificate=cert)
+
+
+def test_a_reference_given_is_what_the_certificate_run_at_export_compares_with(tmp_path):
+    done = export_fmu("hybrid", tmp_path / "h.fmu", reference="rubber")
+    assert "reference rubber" in done.certificate.source and not done.certificate.fails
+    with zipfile.ZipFile(done.path) as zf:
+        doc = json.loads(zf.read("documentation/certificate.json"))
+    assert doc["settings"]["wrong_sign_against"] == "the reference's static force"
+    assert all(h["reference_static_force_n"] is not None for h in doc["holds"])
