@@ -231,7 +231,8 @@ static void core_log_certificate(Core *c) {
     if (!CERT_FAILS || !c->log) return;
     snprintf(c->message, sizeof c->message,
              "this model fails its certificate and was exported with --allow-failing: %s; "
-             "in_flagged_range is true while the input lies in one of its %d flagged ranges",
+             "in_flagged_range is true while the input lies in a flagged range (%d, listed in "
+             "card.certificate_flagged)",
              CERT_VERDICT, ENV_N_FLAGGED);
     c->log(c->log_env, 1, c->message);
 }
