@@ -175,7 +175,7 @@ def check_deterministic(name: str) -> None:
 
 def check_report_is_plain(name: str) -> None:
     """``parameters`` and ``describe`` give what report.json and report.md can hold."""
-    from bushenv.diagnose.report import json_safe
+    from bushenv.diagnose.report_files import json_safe
 
     effect = get_effect(name)
     _, scales = probes()

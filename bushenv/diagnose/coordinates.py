@@ -30,7 +30,7 @@ test's (studies/2026-11-diagnose-three-axis).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -203,8 +203,11 @@ def diagnose_coordinates(
     cross: bool | None = None,
     effects: Sequence[str] | None = None,
     train_names: Sequence[str] | None = None,
+    engine: Callable[..., dict[str, Any]],
 ) -> dict[str, Any]:
     """Which coordinate carries the gap, which effect closes it there, how far (module doc).
+    ``engine`` is the one-axis diagnosis run on each coordinate (``bushenv.diagnose.fit.
+    diagnose``, which hands records of several coordinates here).
 
     Returns a JSON-ready dict (docs/diagnose.md, "Three-axis records") plus ``"predictions"``
     (per judged record: ``time`` (T,), ``q``, ``force_measured``, ``force_baseline``,
@@ -253,7 +256,7 @@ def diagnose_coordinates(
                 "diagnosed")  # fmt: skip
             continue
         say(f"coordinate {name} ({i + 1}/{c})")
-        d = diagnose(
+        d = engine(
             [setup.view(n, i) for n in tr],
             [setup.view(n, i) for n in te],
             progress=lambda msg, name=name: say(f"{name}: {msg}"),
@@ -272,14 +275,6 @@ def diagnose_coordinates(
             "no coordinate moves in both a TRAIN and a TEST record: nothing to diagnose"
         )
     return coordinate_result(setup, diagnoses, couplings, left_out)
-
-
-def diagnose(*args: Any, **kwargs: Any) -> dict[str, Any]:
-    """The one-axis engine, ``bushenv.diagnose.fit.diagnose`` (imported late: it dispatches
-    records of several coordinates here)."""
-    from bushenv.diagnose.fit import diagnose as engine
-
-    return engine(*args, **kwargs)
 
 
 def _coupling(setup: Setup, i: int, d: dict[str, Any]) -> dict[str, Any]:

@@ -110,7 +110,7 @@ def coordinates_markdown(data: dict[str, Any]) -> str:
 
 def write_coordinates_report(result: dict[str, Any], out: Path) -> None:
     """report.json, report.md, coordinates.png, predictions/ and one folder per coordinate."""
-    from bushenv.diagnose.report import json_safe, write_report
+    from bushenv.diagnose.report_files import json_safe, write_report
 
     out.mkdir(parents=True, exist_ok=True)
     (out / "predictions").mkdir(exist_ok=True)

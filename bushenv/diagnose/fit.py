@@ -196,6 +196,7 @@ def diagnose(
             cross=cross,
             effects=effects,
             train_names=train_names,
+            engine=diagnose,
         )
     say = progress or (lambda msg: None)
     if not trains:

@@ -10,20 +10,15 @@ touched. Three-axis records (every file; a mix is refused) go the same way, writ
 
 from __future__ import annotations
 
-import io
-import json
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import diagnose
-from bushenv.diagnose.plots import make_plots
-from bushenv.persist import write_text
+from bushenv.diagnose.report_files import write_report
+from bushenv.record_files import record_coordinates
 from bushenv.record_rates import one_rate
 
 Say = Callable[[str], None]
@@ -108,25 +103,10 @@ def run_diagnosis(config: DiagnoseConfig, say: Say | None = None) -> dict[str, A
     return result
 
 
-def _is_three_axis(path: str) -> bool:
-    """Whether the file's header is meant as a three-axis record's (``looks_planar``: seven
-    columns or a three-axis column name); an unreadable file is not (its loader says why)."""
-    import csv
-
-    from bushenv.planar.records import looks_planar
-
-    try:
-        with open(path, encoding="utf-8-sig", newline="") as fh:
-            first = next(csv.reader(fh), [])
-    except (OSError, UnicodeDecodeError, csv.Error):
-        return False
-    return looks_planar(first)
-
-
 def three_axis_files(paths: tuple[str, ...]) -> bool:
     """True when every record file is three-axis, False when none is; a mix is refused
     naming a file of each kind."""
-    kinds = {p: _is_three_axis(p) for p in paths}
+    kinds = {p: record_coordinates(p) == 3 for p in paths}
     three = [p for p, k in kinds.items() if k]
     one = [p for p, k in kinds.items() if not k]
     if three and one:
@@ -172,42 +152,3 @@ def check_out_dir(out: Path, force: bool) -> None:
             f"--out {out}: folder already exists; refusing to write into it (pass --force to "
             "replace the report's own files there; nothing else is touched)"
         )
-
-
-# ----- writing -----------------------------------------------------------------------------
-def json_safe(obj: Any) -> Any:
-    """Plain JSON values; non-finite numbers become None."""
-    if isinstance(obj, dict):
-        return {k: json_safe(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [json_safe(v) for v in obj]
-    if isinstance(obj, float | np.floating):
-        return float(obj) if math.isfinite(obj) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
-
-
-def write_predictions(pred: dict[str, Any], path: Path) -> None:
-    cols = ("time", "force_measured", "force_baseline", "force_augmented")
-    data = np.column_stack([np.asarray(pred[c], dtype=np.float64) for c in cols])
-    text = io.StringIO()
-    np.savetxt(text, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
-    write_text(path, text.getvalue())
-
-
-def write_report(result: dict[str, Any], out: Path) -> None:
-    """report.json, report.md, plots and predictions/<stem>.csv under ``out``."""
-    from bushenv.diagnose.markdown import markdown
-
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "predictions").mkdir(exist_ok=True)
-    for pred in result["predictions"]:
-        write_predictions(pred, out / "predictions" / f"{pred['name']}.csv")
-    data = {k: v for k, v in result.items() if k != "predictions"}
-    data["predictions"] = [f"predictions/{p['name']}.csv" for p in result["predictions"]]
-    data["plots"] = make_plots(result, out)
-    write_text(out / "report.json", json.dumps(json_safe(data), indent=2) + "\n")
-    write_text(out / "report.md", markdown(data))
