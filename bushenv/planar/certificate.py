@@ -197,6 +197,6 @@ def radius_plot(doc: dict[str, Any], grid: dict[str, Any], path: Any, title: str
         fig.colorbar(mesh, ax=ax, label="largest spectral radius (max over the others)")
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    from bushenv.persist import write_figure
+
+    return write_figure(fig, path)
