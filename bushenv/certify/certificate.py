@@ -19,7 +19,7 @@ import bushenv.certify.energy as en
 from bushenv.certify.fixed_points import FixedPoints, Fold, fixed_points, folds
 from bushenv.certify.ghosts import Ghosts, ghosts
 from bushenv.certify.holds import AVERAGE_S, HOLD_S, HoldRun, free_runs, reference_static_force
-from bushenv.certify.network import CertifyError, NarxNet, narx_net
+from bushenv.certify.network import CertifyError, NarxNet, describe, narx_net
 from bushenv.certify.passivity import (
     SETTLE_S,
     SINE_S,
@@ -359,15 +359,7 @@ def _document(net, opts, holds, fo, pas, scan, timing) -> dict:
         "passes_passivity": not non_passive,
     }
     return {
-        "model": {
-            "name": net.model_name,
-            "hidden": [int(net.w1.shape[0])] + ([int(net.w2.shape[0])] if net.two_layers else []),
-            "n_past_x": net.n_past_x,
-            "n_past_f": net.n_past_f,
-            "dt_s": net.dt_s,
-            "k_n_per_m": net.k_n_per_m,
-            "c_ns_per_m": net.c_ns_per_m,
-        },
+        "model": describe(net),
         "settings": {
             "holds": opts.holds,
             "stroke_m": opts.stroke_m,

@@ -175,3 +175,17 @@ def lag_gradients(net: NarxNet, c: np.ndarray, y: np.ndarray) -> tuple[np.ndarra
     else:
         g = net.w_out * g
     return g @ net.y_columns, g @ net.x_columns
+
+
+def describe(net: NarxNet) -> dict:
+    """What a certificate records of the network it certifies (its shape, rate and backbone),
+    so a certificate can be matched to a model later."""
+    return {
+        "name": net.model_name,
+        "hidden": [int(net.w1.shape[0])] + ([int(net.w2.shape[0])] if net.two_layers else []),
+        "n_past_x": net.n_past_x,
+        "n_past_f": net.n_past_f,
+        "dt_s": net.dt_s,
+        "k_n_per_m": net.k_n_per_m,
+        "c_ns_per_m": net.c_ns_per_m,
+    }

@@ -220,19 +220,10 @@ def check_belongs(doc: dict, model: BushingModel, path: str | os.PathLike) -> No
     mine = doc["model"]
     if model.n_coords == 1:
         from bushenv.certify.fixed_points import fixed_points
-        from bushenv.certify.network import narx_net
+        from bushenv.certify.network import describe, narx_net
 
         net = narx_net(model)
-        want = {
-            "name": net.model_name,
-            "hidden": [int(net.w1.shape[0])] + ([int(net.w2.shape[0])] if net.two_layers else []),
-            "n_past_x": net.n_past_x,
-            "n_past_f": net.n_past_f,
-            "dt_s": net.dt_s,
-            "k_n_per_m": net.k_n_per_m,
-            "c_ns_per_m": net.c_ns_per_m,
-        }
-        _same_params(path, mine, want)
+        _same_params(path, mine, describe(net))
         holds = doc["holds"]
         spread = np.linspace(0, len(holds) - 1, min(CHECKED_HOLDS, len(holds)))
         pick = sorted({int(i) for i in spread})
