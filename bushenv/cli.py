@@ -35,6 +35,7 @@ COMMANDS = {
     "certify": ("bushenv.commands.certify", "hold-stability and passivity certificates of a NARX"),
     "zoo": ("bushenv.commands.zoo", "population study: how often NARX models fail, by recipe"),
     "export": ("bushenv.commands.export", "a model as an FMU (FMI 2.0 / 3.0, compiled C)"),
+    "vehicle": ("bushenv.commands.vehicle", "standard manoeuvres: bushing kinds in a half car"),
 }
 
 

@@ -1,0 +1,145 @@
+"""``bushenv vehicle``: the standard manoeuvres in HalfCar-v0 with linear, hybrid and network
+bushings in all four arm pivots against the reference bushing; the table of vehicle-level
+differences beside the bushings' component-level error, and seed 000's "almost identical"
+finding judged.
+
+    bushenv vehicle --out DIR [--kinds linear,hybrid,nn] [--hybrid FILE] [--nn FILE]
+
+Writes DIR/report.json, DIR/report.md (the finding first) and DIR/<manoeuvre>.png; bushings
+not given as files are identified on the coupled reference's records and kept in
+DIR/bushings/ (a rerun with the same seed and budget reuses them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from bushenv.models import names_for
+from bushenv.persist import write_json, write_text
+from bushenv.progress import Progress, format_seconds
+
+EXAMPLE = "bushenv vehicle --out runs/vehicle"
+
+
+def _names(text: str) -> list[str]:
+    return [t.strip() for t in text.split(",") if t.strip()]
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    from bushenv.vehicle.bushings import DEFAULT_KINDS
+    from bushenv.vehicle.manoeuvres import NAMES
+    from bushenv.vehicle.study import IDENTICAL_PCT
+
+    p.add_argument("--out", required=True, metavar="DIR", help="folder for the report")
+    p.add_argument(
+        "--manoeuvres",
+        type=_names,
+        default=list(NAMES),
+        metavar="LIST",
+        help=f"comma-separated, of: {', '.join(NAMES)} (default: all)",
+    )
+    p.add_argument(
+        "--duration-s",
+        type=float,
+        default=None,
+        metavar="S",
+        help="every manoeuvre this long (default: each its own, 3-7.7 s)",
+    )
+    p.add_argument(
+        "--kinds",
+        type=_names,
+        default=list(DEFAULT_KINDS),
+        metavar="LIST",
+        help=f"bushing kinds in the model cars, of: "
+        f"{', '.join(names_for(3, fittable=True))} (default: "
+        f"{','.join(DEFAULT_KINDS)})",
+    )
+    for kind in names_for(3, fittable=True):
+        p.add_argument(
+            f"--{kind}",
+            dest=f"file_{kind.replace('-', '_')}",
+            metavar="FILE",
+            default=None,
+            help=f"a three-axis {kind} model file instead of identifying one",
+        )
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="identification seed (records, noise, network initialisation) and the ISO 8608 road's",
+    )
+    p.add_argument(
+        "--identification-s",
+        type=float,
+        default=40.0,
+        metavar="S",
+        help="seconds of each random identification record (the coupled sets: half)",
+    )
+    p.add_argument(
+        "--identical-pct",
+        type=float,
+        default=IDENTICAL_PCT,
+        metavar="PCT",
+        help="'almost identical': the hybrid car within this %% of the linear car's peak",
+    )
+    p.add_argument("--no-plots", action="store_true", help="no figures")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+
+
+def run(args: argparse.Namespace) -> int:
+    from bushenv.cli import CliError
+    from bushenv.rigs.halfcar_params import ENV_ID
+    from bushenv.rigs.specs import spec_kwargs
+    from bushenv.vehicle.bushings import Recipe, check_kinds, vehicle_bushings
+    from bushenv.vehicle.manoeuvres import standard_manoeuvres
+    from bushenv.vehicle.report import markdown, plot_manoeuvre
+    from bushenv.vehicle.study import run_vehicle
+
+    t0 = time.perf_counter()
+    if args.duration_s is not None and not args.duration_s > 0.1:
+        raise CliError(f"--duration-s must be > 0.1 s, got {args.duration_s}")
+    if not args.identification_s >= 5:
+        raise CliError(f"--identification-s must be >= 5 s, got {args.identification_s}")
+    kinds = check_kinds(args.kinds)
+    files = {k: getattr(args, f"file_{k.replace('-', '_')}") for k in names_for(3, fittable=True)}
+    files = {k: f for k, f in files.items() if f is not None}
+    unused = sorted(set(files) - set(kinds))
+    if unused:
+        raise CliError(f"--{unused[0]} FILE given but {unused[0]} is not in --kinds "
+                       f"{','.join(kinds)}")  # fmt: skip
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    progress = Progress(quiet=args.quiet, label="vehicle")
+    dt = float(spec_kwargs(ENV_ID, {})["dt_s"])
+    manoeuvres = standard_manoeuvres(dt, args.seed, args.manoeuvres, args.duration_s)
+    recipe = Recipe(dt, args.seed, args.identification_s)
+    bushings = vehicle_bushings(kinds, recipe, out / "bushings", files, say=progress.say)
+    steps = sum(m.samples for m in manoeuvres) * len(kinds)
+    progress.say(f"{len(manoeuvres)} manoeuvres x {len(kinds)} bushing kinds: {steps} car "
+                 "steps beside the reference twin")  # fmt: skip
+    report, runs = run_vehicle(
+        manoeuvres, {k: b.model for k, b in bushings.items()}, "rubber", progress,
+        args.identical_pct,
+    )  # fmt: skip
+    report["bushings"] = {k: b.describe() for k, b in bushings.items()}
+    report["settings"] = {"seed": args.seed, "identification_s": args.identification_s,
+                          "duration_s": args.duration_s, "manoeuvres": list(args.manoeuvres),
+                          "kinds": list(kinds)}  # fmt: skip
+    figures = []
+    if not args.no_plots:
+        for m in manoeuvres:
+            path = out / f"{m.name}.png"
+            plot_manoeuvre(m, {k: runs[(m.name, k)] for k in kinds}, path)
+            figures.append(str(path))
+    report["figures"] = [Path(f).name for f in figures]
+    report["wall_time_s"] = time.perf_counter() - t0
+    write_json(out / "report.json", report)
+    write_text(out / "report.md", markdown(report, figures))
+    progress.say(f"done in {format_seconds(report['wall_time_s'])}")
+    text = markdown(report).split("\n## ")[0]
+    print(text.strip())
+    print(f"report: {out / 'report.md'}, {out / 'report.json'}", file=sys.stdout)
+    return 0
