@@ -250,3 +250,26 @@ def transfer(vehicle: float | None, component: float | None) -> float | None:
     if vehicle is None or component is None or not component > 0 or math.isnan(vehicle):
         return None
     return vehicle / component
+
+
+def at_rest(run: CarRun, manoeuvre: Manoeuvre) -> dict[str, Any]:
+    """What the model car does before the manoeuvre's first input, standing on a flat road
+    (its twin stays at rest there): the RMS of its dynamic wheel loads (N) and roll (rad) and
+    the wheel load's dominant frequency (Hz; None when below 1 N RMS or under 0.25 s)."""
+    moving = np.flatnonzero(
+        np.any(manoeuvre.road_m != 0, axis=1) | (manoeuvre.lateral_accel_m_per_s2 != 0)
+    )
+    n = min(int(moving[0]) if moving.size else manoeuvre.samples, run.steps)
+    load = run.model["wheel_load"][:n]
+    out: dict[str, Any] = {"seconds": n * run.dt_s, "wheel_load_rms_n": None,
+                           "roll_rms_rad": None, "frequency_hz": None}  # fmt: skip
+    if n < 2:
+        return out
+    rms = float(np.sqrt(np.mean(load**2)))
+    out.update(wheel_load_rms_n=rms,
+               roll_rms_rad=float(np.sqrt(np.mean(run.model["roll"][:n] ** 2))))  # fmt: skip
+    if rms >= 1.0 and n * run.dt_s >= 0.25:
+        x = load[:, 0] - load[:, 0].mean()
+        spectrum = np.abs(np.fft.rfft(x * np.hanning(n)))
+        out["frequency_hz"] = float(np.fft.rfftfreq(n, run.dt_s)[1 + np.argmax(spectrum[1:])])
+    return out

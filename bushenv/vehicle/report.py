@@ -17,6 +17,7 @@ SHORT = {"wheel_load": "wheel load", "roll": "roll", "roll_rate": "roll rate",
          "camber": "camber", "track_change": "track", "vertical_accel": "a_z",
          "lateral_accel": "a_y"}  # fmt: skip
 COORD_SHORT = {"axial": "F_ax", "radial": "F_rad", "rotation": "M"}
+AT_REST_N = 5.0  # a model car's wheel load RMS before any input worth a line
 
 
 def _pct(v: float | None) -> str:
@@ -32,26 +33,66 @@ def _end(row: dict[str, Any]) -> str:
     return f"{what} at {end['time_s']:.2f} s"
 
 
+def _verdict_text(f: dict[str, Any], car: str) -> str:
+    w = f["worst"]
+    return (
+        f"{car}: the {f['kind']} car differs from the linear car by up to **{w['peak_pct']:.1f} "
+        f"%** of the linear car's peak ({SHORT.get(w['output'], w['output'])}, {w['manoeuvre']}"
+        f"; median {f['median_peak_pct']:.1f} %, {f['within_threshold']} figures within "
+        f"{f['threshold_pct']:g} %); worst per output: "
+        + ", ".join(f"{SHORT.get(k, k)} {v['peak_pct']:.1f} % ({v['manoeuvre']})"
+                    for k, v in f["worst_by_output"].items())
+    )  # fmt: skip
+
+
 def finding_lines(report: dict[str, Any]) -> list[str]:
     """The report's first lines: seed 000's finding reproduced or refuted, with numbers."""
-    f = report["finding"]
+    f, up = report["finding"], report.get("finding_upper_only", {"status": "not judged"})
     if f["status"] == "not judged":
         return [f'Seed 000\'s "almost identical" finding: not judged ({f["why"]}).']
-    w, ref = f["worst"], f["against_reference"]
+    ref = f["against_reference"]
+    judged = ", ".join(SHORT.get(k, k) for k in f["judged"])
     lines = [
         f"**Seed 000's finding (§5.3, §6: a hybrid bushing gives vehicle responses \"almost "
-        f"identical\" to the linear one's): {f['status'].upper()}.** With hybrid and linear "
-        f"bushings in all four arm pivots, the hybrid car differs from the linear car by up to "
-        f"**{w['peak_pct']:.1f} %** of the linear car's peak ({SHORT.get(w['output'], w['output'])}"
-        f", {w['manoeuvre']}; median {f['median_peak_pct']:.1f} % over the manoeuvres and the "
-        f'judged outputs: {", ".join(f["judged"])}); "almost identical" taken as within '
-        f"{f['threshold_pct']:g} %.",
-        f"Against the reference bushing (the coupled rubber) both cars differ far more: linear "
-        f"median {_pct(ref['linear']['median_peak_pct'])} % (max "
-        f"{_pct(ref['linear']['max_peak_pct'])} %), hybrid median "
-        f"{_pct(ref['hybrid']['median_peak_pct'])} % (max {_pct(ref['hybrid']['max_peak_pct'])} "
-        "%) of the reference car's peak, same outputs.",
-    ]
+        f"identical\" to the linear one's): {f['status'].upper()} with the hybrid in all four "
+        f"arm pivots"
+        + (f", {up['status'].upper()} with it in the upper arm pivots only (seed 000's car)**."
+           if up["status"] != "not judged" else "**.")
+        + f" \"Almost identical\" taken as within {f['threshold_pct']:g} % of the linear car's "
+        f"peak in every judged output ({judged}) of every manoeuvre.",
+        "",
+        f"- {_verdict_text(f, 'All four pivots')}.",
+    ]  # fmt: skip
+    if up["status"] != "not judged":
+        lines.append(f"- {_verdict_text(up, 'Upper pivots only')}.")
+    lines.append(
+        f"- Against the reference bushing (the coupled rubber): linear car median "
+        f"{_pct(ref['linear']['median_peak_pct'])} % (max {_pct(ref['linear']['max_peak_pct'])} "
+        f"%), hybrid car median {_pct(ref['hybrid']['median_peak_pct'])} % (max "
+        f"{_pct(ref['hybrid']['max_peak_pct'])} %) of the reference car's peak, same outputs."
+    )
+    return lines
+
+
+def at_rest_lines(report: dict[str, Any]) -> list[str]:
+    """Model cars that moved before any input (self-excited, or pushed by an invented force)."""
+    found = {}
+    for r in report["rows"]:
+        rest = r["at_rest"]
+        if (rest["wheel_load_rms_n"] or 0.0) >= AT_REST_N:
+            found.setdefault(r["kind"], []).append(r)
+    lines = []
+    for kind, rows in found.items():
+        worst_row = max(rows, key=lambda r: r["at_rest"]["wheel_load_rms_n"])
+        rest = worst_row["at_rest"]
+        freq = rest["frequency_hz"]
+        lines.append(
+            f"- **{kind}** car at rest, before any input, in {len(rows)} of "
+            f"{sum(x['kind'] == kind for x in report['rows'])} manoeuvres: wheel load up to "
+            f"{rest['wheel_load_rms_n']:.0f} N RMS ({worst_row['manoeuvre']}, first "
+            f"{rest['seconds']:.2f} s"
+            + (f", dominant {freq:.1f} Hz" if freq else "") + "); the reference car: 0 N."
+        )  # fmt: skip
     return lines
 
 
@@ -114,6 +155,10 @@ def markdown(report: dict[str, Any], figures: list[str] | None = None) -> str:
     """``report.md``: the finding first, then what was judged, the tables, the definitions."""
     lines = ["# Bushing models in a car: the standard manoeuvres in HalfCar-v0", ""]
     lines += finding_lines(report) + [""] + divergence_lines(report) + [""]
+    rest = at_rest_lines(report)
+    if rest:
+        lines += ["Model cars that moved standing on a flat road with no lateral load:", "",
+                  *rest, ""]  # fmt: skip
     t = report.get("wall_time_s", report["run_seconds"])
     lines += [
         f"{len(report['manoeuvres'])} manoeuvres x {len(report['kinds'])} bushing kinds "

@@ -159,3 +159,21 @@ def test_command_refuses_an_unknown_kind_and_a_file_for_a_kind_not_run(tmp_path,
     assert "spline" in capsys.readouterr().err
     assert main(["vehicle", "--out", out, "--kinds", "linear", "--nn", "a.npz"]) == 2
     assert "--nn FILE given" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("scale", "status"), [(1.01, "reproduced"), (2.0, "refuted")])
+def test_with_hybrid_and_linear_the_finding_is_judged_also_in_seed_000s_car(
+    linearisation, scale, status
+):
+    near = PlanarLinear(scale * linearisation.k_matrix, linearisation.c_matrix, dt=DT)
+    manoeuvres = standard_manoeuvres(DT, 0, ["pothole"], duration_s=1.5)
+    report, runs = run_vehicle(manoeuvres, {"linear": linearisation, "hybrid": near}, "rubber")
+    assert report["kinds"] == ["linear", "hybrid", "hybrid-upper"]
+    assert set(runs) == {("pothole", k) for k in report["kinds"]}
+    for finding in (report["finding"], report["finding_upper_only"]):
+        assert finding["status"] == status
+        assert set(finding["worst_by_output"]) <= {*JUDGED, "a_w_Wk"}
+    assert (
+        report["finding"]["worst"]["peak_pct"] >= report["finding_upper_only"]["worst"]["peak_pct"]
+    )
+    assert f"{status.upper()} with the hybrid in all four" in markdown(report)
