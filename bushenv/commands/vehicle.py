@@ -89,6 +89,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
 
 
+def _shown(entry: dict, out: Path) -> dict:
+    """A bushing's entry with its file relative to the report's folder when inside it."""
+    path = Path(entry["file"])
+    try:
+        return {**entry, "file": str(path.resolve().relative_to(out.resolve()))}
+    except ValueError:
+        return entry
+
+
 def run(args: argparse.Namespace) -> int:
     from bushenv.cli import CliError
     from bushenv.rigs.halfcar_params import ENV_ID
@@ -121,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
         manoeuvres, {k: b.model for k, b in bushings.items()}, "rubber", progress,
         args.identical_pct,
     )  # fmt: skip
-    report["bushings"] = {k: b.describe() for k, b in bushings.items()}
+    report["bushings"] = {k: _shown(b.describe(), out) for k, b in bushings.items()}
     if UPPER_ONLY in report["kinds"]:
         report["bushings"][UPPER_ONLY] = {
             "kind": UPPER_ONLY, "model": "linear / hybrid / linear / hybrid", "file": "-",
