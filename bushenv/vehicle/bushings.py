@@ -119,7 +119,7 @@ def vehicle_bushings(
                 )
             if say:
                 say(f"identifying {kind} (seed {recipe.seed}, default options)")
-            result = fit_planar(histories, kind, {}, recipe.dt_s, recipe.seed)
+            result = fit_planar(histories, kind, {}, recipe.dt_s, recipe.seed, say)
             cache.mkdir(parents=True, exist_ok=True)
             result.model.save(path)
             meta = {"key": key, "fit_seconds": result.seconds, "info": plain(result.info)}

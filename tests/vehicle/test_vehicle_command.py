@@ -72,6 +72,7 @@ def test_report_holds_every_output_and_coordinate_per_manoeuvre_and_kind(short_r
                 row["vehicle"][name]
             )
         assert row["vehicle"]["a_w_Wk"]["baseline"] > 0
+        assert row["vehicle"]["wheel_load"]["rms_pct"] is not None
         assert set(row["component"]["open_loop"]) == {"axial", "radial", "rotation"}
         assert row["transfer"] > 0
     assert [p["kind"] for p in report["pairs"]] == ["linear-2x-stiff"] * 2
@@ -91,10 +92,11 @@ def test_the_table_tells_the_linearisation_from_a_2x_stiff_bushing(short_report)
                 1.5 * lin["component"]["open_loop"][c]["rms_pct"]
             )
         assert stiff["worst_judged_rms_pct"] > lin["worst_judged_rms_pct"]
+        stated = [o for o in OUTPUT_NAMES if lin["vehicle"][o]["rms_pct"] is not None]
         larger = [
-            o for o in OUTPUT_NAMES if stiff["vehicle"][o]["rms_pct"] > lin["vehicle"][o]["rms_pct"]
+            o for o in stated if stiff["vehicle"][o]["rms_pct"] > lin["vehicle"][o]["rms_pct"]
         ]
-        assert len(larger) >= 5, (name, larger)
+        assert len(stated) >= 5 and len(larger) >= len(stated) - 1, (name, stated, larger)
         assert all(lin["vehicle"][o]["rms_pct"] < 20.0 for o in JUDGED), name
 
 
