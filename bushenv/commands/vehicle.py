@@ -105,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     from bushenv.vehicle.bushings import Recipe, check_kinds, vehicle_bushings
     from bushenv.vehicle.manoeuvres import standard_manoeuvres
     from bushenv.vehicle.report import markdown, plot_manoeuvre
-    from bushenv.vehicle.study import UPPER_ONLY, run_vehicle
+    from bushenv.vehicle.study import REFERENCE_CAR, UPPER_ONLY, run_vehicle
 
     t0 = time.perf_counter()
     if args.duration_s is not None and not args.duration_s > 0.1:
@@ -144,7 +144,8 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_plots:
         for m in manoeuvres:
             path = out / f"{m.name}.png"
-            plot_manoeuvre(m, {k: runs[(m.name, k)] for k in report["kinds"]}, path)
+            cars = [*report["kinds"], REFERENCE_CAR]
+            plot_manoeuvre(m, {k: runs[(m.name, k)] for k in cars if (m.name, k) in runs}, path)
             figures.append(str(path))
     report["figures"] = [Path(f).name for f in figures]
     report["wall_time_s"] = time.perf_counter() - t0

@@ -12,6 +12,7 @@ from bushenv.persist import write_figure
 from bushenv.planar.base import COORDS
 from bushenv.vehicle.compare import OUTPUTS, CarRun
 from bushenv.vehicle.manoeuvres import Manoeuvre
+from bushenv.vehicle.study import REFERENCE_CAR
 
 SHORT = {"wheel_load": "wheel load", "roll": "roll", "roll_rate": "roll rate",
          "camber": "camber", "track_change": "track", "vertical_accel": "a_z",
@@ -225,7 +226,8 @@ def markdown(report: dict[str, Any], figures: list[str] | None = None) -> str:
 
 def plot_manoeuvre(manoeuvre: Manoeuvre, runs: dict[str, CarRun], path: str | Path) -> Path:
     """Input, body roll and both wheel loads against time: the reference car (black) and each
-    model car (``runs``: label -> run of this manoeuvre); a car that ended early is marked."""
+    model car (``runs``: label -> run of this manoeuvre, ``REFERENCE_CAR`` a run of the
+    reference alone); a car that ended early is marked."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -241,6 +243,7 @@ def plot_manoeuvre(manoeuvre: Manoeuvre, runs: dict[str, CarRun], path: str | Pa
         ax[0].plot(t_in, manoeuvre.lateral_accel_m_per_s2, label="a_y (single-track model)")
         ax[0].set_ylabel("lateral load a_y [m/s$^2$]")
     ref = max(runs.values(), key=lambda r: r.steps)
+    runs = {k: r for k, r in runs.items() if k != REFERENCE_CAR}
     panels = [(1, "roll", 0, np.degrees, "body roll [deg]"),
               (2, "wheel_load", 0, lambda x: x / 1e3, "dynamic wheel load left [kN]"),
               (3, "wheel_load", 1, lambda x: x / 1e3, "dynamic wheel load right [kN]")]  # fmt: skip

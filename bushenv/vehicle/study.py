@@ -38,6 +38,7 @@ JUDGED = ("wheel_load", "roll", "camber", "track_change")
 PAPER_PAIR = ("hybrid", "linear")  # seed 000 §5.3 compares these two cars
 # seed 000 §5.3 put its hybrid in the upper control arm's pivot only: that car, the others linear
 UPPER_ONLY = "hybrid-upper"
+REFERENCE_CAR = "reference"  # runs' key of a car with the reference bushing in both (plots)
 
 
 def upper_only(lower: Any, upper: Any) -> dict[str, Any]:
@@ -142,7 +143,9 @@ def run_vehicle(
     paper_car: bool = True,
 ) -> tuple[dict[str, Any], dict[tuple[str, str], CarRun]]:
     """Run every manoeuvre with each of ``bushings`` (label -> model, name or file) in all four
-    pivots against ``reference``; the report and the runs by (manoeuvre, label).
+    pivots against ``reference``; the report and the runs by (manoeuvre, label) (and by
+    (manoeuvre, ``REFERENCE_CAR``) where every model car ended early: the reference's whole
+    history, for the figures).
 
     ``progress``: a ``bushenv.progress.Progress`` (its ``total`` set here to the steps to run)
     or None. ``paper_car``: with both a ``hybrid`` and a ``linear`` bushing, also the car of
@@ -176,6 +179,10 @@ def run_vehicle(
                 status = (f"ENDED at {end['time_s']:.2f} s: {end['reason']}"
                           if end.get("reason") else "ran to the end")  # fmt: skip
                 progress.update(done, f"{m.name}: {label} car {status}", force=True)
+        if all(runs[(m.name, k)].steps < m.samples for k in bushings):
+            # every model car ended early: the reference car alone, for its whole history
+            runs[(m.name, REFERENCE_CAR)] = run_car(m, reference, reference, REFERENCE_CAR,
+                                                    overrides)  # fmt: skip
         for label in bushings:
             if label != PAPER_PAIR[1] and PAPER_PAIR[1] in bushings:
                 pairs.append(_pair(runs[(m.name, label)], runs[(m.name, PAPER_PAIR[1])]))

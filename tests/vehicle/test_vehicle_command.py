@@ -118,6 +118,7 @@ def test_a_car_that_leaves_its_bounds_is_reported_not_raised():
     assert row["end"]["reason"] and row["steps"] < row["samples"]
     assert "TERMINATED" in markdown(report)
     assert runs[("pothole", "negative")].steps == row["steps"]
+    assert runs[("pothole", "reference")].steps == row["samples"]  # for the figures
 
 
 def test_two_runs_give_the_same_numbers(short_report, linearisation):
