@@ -72,12 +72,18 @@ def axis_metrics(
     return out
 
 
+def _stem(record: Any) -> str:
+    """A record's short name: its file's stem, else its own name (a record made in memory)."""
+    return Path(record.path).stem if record.path is not None else Path(record.name).stem
+
+
 def record_entry(record: Any, role: str, model: Any, card_dir: Path) -> dict[str, Any]:
-    """A card's description of a ``PlanarRecord`` and the model's per-axis metrics on it."""
-    path = Path(record.source) if record.source else None
+    """A card's description of a three-axis ``Record`` and the model's per-axis metrics on it;
+    ``file`` is its path relative to the card (None for a record made in memory)."""
+    path = Path(record.path) if record.path is not None else None
     entry = {
         "role": role,
-        "name": path.stem if path else "",
+        "name": _stem(record),
         "file": os.path.relpath(path, card_dir) if path else None,
         "sha256": sha256_file(path) if path and path.is_file() else None,
         "samples": int(record.time.size),
@@ -144,7 +150,7 @@ def save_planar_fit(
             "model": backbone.name,
             "records": [
                 {
-                    "name": Path(r.source).stem if r.source else "",
+                    "name": _stem(r),
                     "metrics": axis_metrics(r.f, backbone.copy().simulate(r.q), r.q),
                 }
                 for r in held_out

@@ -91,3 +91,15 @@ def test_a_fit_card_lists_the_combinations_and_names_held_out_records_beyond_the
 def test_combined_is_refused_for_one_axis_naming_the_fix(tmp_path, capsys):
     assert main(["measure", "--programme", "combined", "--out", str(tmp_path)]) == 2
     assert "add --axes 3" in capsys.readouterr().err
+
+
+def test_a_record_made_in_memory_is_named_on_the_card_not_taken_for_a_file(tmp_path):
+    from bushenv.planar.card import record_entry
+    from bushenv.planar.linear import PlanarLinear
+    from bushenv.records import Record
+
+    motion = dict(held_sweeps(1.0, DT, duration_s=2.0))["axial_held_+_radial_sweep"]
+    model = PlanarLinear.preset()
+    rec = Record(np.arange(len(motion)) * DT, motion, model.simulate(motion), name="held, sweep")
+    entry = record_entry(rec, "held-out", model, tmp_path)
+    assert entry["file"] is None and entry["name"] == "held, sweep" and entry["sha256"] is None
