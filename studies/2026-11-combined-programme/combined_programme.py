@@ -1,4 +1,4 @@
-"""Issue 37 point 4: three-axis fits with and without the combined programme, judged on
+"""Three-axis fits with and without the combined programme, judged on
 combined motions they did not see, on the coupled reference and on an outside bushing.
 
 Usage (from the repository root, venv active)::
@@ -51,7 +51,7 @@ DT_S = 1.0 / 204.8  # RPC III sample time (seed 000 §4.1)
 PEAK = np.array([2.0e-3, 2.0e-3, 0.05])  # deflection at amplitude index n = 1, m, m, rad
 COORDS = ("axial", "radial", "rotation")
 UNITS = ("N", "N", "N m")
-TARGET = 0.06  # issue 37 point 4: hybrid within 6 % RMS on every coordinate in range
+TARGET = 0.06  # the hybrid within 6 % RMS on every coordinate in range
 
 
 # ---------------------------------------------------------------------------------------------
