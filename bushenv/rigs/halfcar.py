@@ -38,7 +38,7 @@ class HalfCarEnv(gym.Env):
     """
     ## Description
 
-    A roll-plane front axle seen from the front (issue 39; seeds 000 §5.3 and 001 §5 drove
+    A roll-plane front axle seen from the front (seeds 000 §5.3 and 001 §5 drove
     full cars with bushing models over bumps, potholes and pulse steer). A sprung body (lateral,
     vertical, roll) sits on two double wishbones; each has a lower and an upper arm whose inner
     pivots hang on the body *through bushings* (no joint: each pivot is one three-coordinate

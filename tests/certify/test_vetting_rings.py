@@ -1,4 +1,4 @@
-"""The vetting and the certificate agree (issue 40, point 1): a reference is simulated through
+"""The vetting and the certificate agree: a reference is simulated through
 the holds its own certificate lists, each reached after a sine inside its envelope, against a
 threshold tied to its own noise and force scale."""
 

@@ -1,4 +1,4 @@
-"""A wrong-sign static force needs no reference: a passive bushing pushes back (issue 40, 5)."""
+"""A wrong-sign static force needs no reference: a passive bushing pushes back."""
 
 import json
 

@@ -1,4 +1,4 @@
-"""An FMU carries its certificate (issue 40, point 3): a NARX model that fails it is refused
+"""An FMU carries its certificate: a NARX model that fails it is refused
 unless told, and its FMU flags the failing ranges, as ranges and as an output, and logs them."""
 
 import importlib.util

@@ -1,4 +1,4 @@
-"""The attack's table explains every column and every line it prints (issue 40, point 6)."""
+"""The attack's table explains every column and every line it prints."""
 
 import re
 
