@@ -102,7 +102,7 @@ def vehicle_bushings(
     for kind in kinds:
         if kind in files:
             path = Path(files[kind])
-            wanted = f"bushenv vehicle --{kind}"
+            wanted = f"the vehicle comparison's {kind} bushing"
             model = load_model(path, dt=recipe.dt_s, coords=3, wanted_by=wanted)
             out[kind] = VehicleBushing(kind, model, str(path), sha256_file(path), f"given: {path}")
             continue
