@@ -36,6 +36,10 @@ COMMANDS = {
     "zoo": ("bushenv.commands.zoo", "population study: how often NARX models fail, by recipe"),
     "export": ("bushenv.commands.export", "a model as an FMU (FMI 2.0 / 3.0, compiled C)"),
     "vehicle": ("bushenv.commands.vehicle", "standard manoeuvres: bushing kinds in a half car"),
+    "vehicle-transfer": (
+        "bushenv.commands.vehicle_transfer",
+        "error-transfer map: which bushing errors reach the half car",
+    ),
 }
 
 
