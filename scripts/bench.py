@@ -854,7 +854,7 @@ def bench_planar(fig: Figures, quick: bool) -> None:
     import bushenv  # noqa: F401  registers the envs
     from bushenv.excitation import random_rpc
     from bushenv.models import get_model
-    from bushenv.planar.narx import PlanarNarx
+    from bushenv.models.planar_narx import PlanarNarx
 
     print("\n== planar: BushRig3-v0 beside BushRig-v0, MIMO free run beside one axis (same run)")
     n = 2000 if quick else 20000

@@ -22,14 +22,14 @@ import numpy as np
 
 from bushenv.metrics import max_error_ratio, rms_ratio
 from bushenv.models.base import PAPER_DT, velocity_of
-from bushenv.planar.base import COORDS
+from bushenv.models.planar_base import COORDS
+from bushenv.models.planar_hybrid_bw import compose
+from bushenv.models.planar_linear import fit_linear
 from bushenv.planar.boucwen_fit import fit_planar_boucwen
-from bushenv.planar.hybrid_bw import compose
-from bushenv.planar.linear import fit_linear
 from bushenv.planar.programme import programme, random_independent
-from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.train import TrainOptions, fit_planar_network
 from bushenv.progress import Progress
+from bushenv.reference.planar import PlanarRubber
 
 MODELS = ("linear", "nn-axis", "nn", "hybrid", "boucwen", "hybrid-bw")
 TABLE3 = {  # seed 000 Table 3, RMS ratio / MAX in %, linear / NN / hybrid

@@ -23,10 +23,10 @@ import numpy as np
 
 from bushenv.models import MODELS, load_model
 from bushenv.models.base import PAPER_DT, velocity_of
-from bushenv.planar import PlanarModelError
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_linear import fit_linear
+from bushenv.models.planar_narx import PlanarNarx
 from bushenv.planar.fixed_points import fixed_points, fold_crossings, grid
-from bushenv.planar.linear import fit_linear
-from bushenv.planar.narx import PlanarNarx
 from bushenv.planar.passivity import passivity
 from bushenv.planar.programme import random_independent
 from bushenv.progress import Progress

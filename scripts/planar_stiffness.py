@@ -14,8 +14,8 @@ import argparse
 
 import numpy as np
 
-from bushenv.planar.elastic import elastic_force, tangent_stiffness
-from bushenv.planar.reference import PlanarRubber
+from bushenv.reference.planar import PlanarRubber
+from bushenv.reference.planar_elastic import elastic_force, tangent_stiffness
 
 PRELOADS_M = (0.0, 2.0e-3, 4.0e-3)
 AXIAL_M = 2.0e-3  # held axial deflection: K_ar is proportional to it

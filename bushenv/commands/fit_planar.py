@@ -102,7 +102,7 @@ def run_planar(args: argparse.Namespace, out: Path, given: dict[str, Any]) -> in
 def summary(card: dict[str, Any], out: Path) -> str:
     """What ``bushenv fit`` prints for a 3-axis fit: files and per-axis metrics."""
     from bushenv.identify.card import card_paths
-    from bushenv.planar.base import COORDS
+    from bushenv.models.planar_base import COORDS
 
     json_path, md_path = card_paths(out)
     src = card["source"]

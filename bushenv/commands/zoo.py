@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from bushenv.execution import get_backend
-from bushenv.planar.narx import STRUCTURES
+from bushenv.models.planar_narx import STRUCTURES
 from bushenv.planar.train_options import HYBRID_TRAININGS
 from bushenv.progress import Progress
 from bushenv.search.matrix import parse_seeds

@@ -112,7 +112,7 @@ def coordinate_count(rec: Any) -> int:
 def coordinates_of(rec: Any, c: int) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
     """(names, displacement units, force units) of the C coordinates: the record's own
     ``coords`` / ``units`` / ``force_units`` if it has them, the three-axis bushing's for C = 3."""
-    from bushenv.planar.base import COORDS, FORCE_UNITS, UNITS
+    from bushenv.models.planar_base import COORDS, FORCE_UNITS, UNITS
 
     if c == 3:
         default = (COORDS, UNITS, FORCE_UNITS)

@@ -286,7 +286,7 @@ def is_narx(model: BushingModel) -> bool:
         from bushenv.models.narx import NarxBushing
 
         return isinstance(model, NarxBushing)
-    from bushenv.planar.narx import PlanarNarx
+    from bushenv.models.planar_narx import PlanarNarx
 
     return isinstance(model, PlanarNarx)
 

@@ -133,7 +133,8 @@ def names_for(coords: int = 1, fittable: bool = False) -> tuple[str, ...]:
 
 
 MODELS: Registry[ModelEntry] = Registry("model", ModelError)
-P = "bushenv.planar."  # the three-coordinate forms
+M = "bushenv.models."  # the three-coordinate forms
+T = "bushenv.planar."  # their training options, until they join the one-axis kin
 FITS = "bushenv.planar.fitting:"
 OPTS = "bushenv.identify.options:"
 MODELS.add(
@@ -143,7 +144,7 @@ MODELS.add(
         "Kelvin-Voigt spring and dashpot, F = k x + c v (seed 000 eqs 1-3)",
         fit="bushenv.identify.linear:fit_linear",
         options="bushenv.identify.options:NoOptions",
-        wider={3: Form(P + "linear:PlanarLinear", FITS + "fit_linear", OPTS + "NoOptions")},
+        wider={3: Form(M + "planar_linear:PlanarLinear", FITS + "fit_linear", OPTS + "NoOptions")},
     ),
 )
 MODELS.add(
@@ -156,7 +157,9 @@ MODELS.add(
         shipped=True,
         wider={
             3: Form(
-                P + "narx:PlanarNarx", FITS + "fit_nn", P + "train_options:PlanarNetworkOptions"
+                M + "planar_narx:PlanarNarx",
+                FITS + "fit_nn",
+                T + "train_options:PlanarNetworkOptions",
             )
         },  # fmt: skip
     ),
@@ -168,9 +171,9 @@ MODELS.add(
         "three single-axis NARX networks in one model, seed 000 §4.2's kind in three axes",
         wider={
             3: Form(
-                P + "narx:PlanarNarxPerAxis",
+                M + "planar_narx:PlanarNarxPerAxis",
                 FITS + "fit_nn_axis",
-                P + "train_options:PlanarNetworkOptions",
+                T + "train_options:PlanarNetworkOptions",
             )
         },  # fmt: skip
     ),
@@ -185,9 +188,9 @@ MODELS.add(
         shipped=True,
         wider={
             3: Form(
-                P + "narx:PlanarHybrid",
+                M + "planar_narx:PlanarHybrid",
                 FITS + "fit_hybrid",
-                P + "train_options:PlanarHybridOptions",
+                T + "train_options:PlanarHybridOptions",
             )
         },  # fmt: skip
     ),
@@ -224,9 +227,9 @@ MODELS.add(
         shipped=True,
         wider={
             3: Form(
-                P + "boucwen:PlanarBoucWen",
+                M + "boucwen.planar:PlanarBoucWen",
                 FITS + "fit_boucwen",
-                P + "boucwen_fit:PlanarBoucWenOptions",
+                T + "boucwen_fit:PlanarBoucWenOptions",
             )
         },  # fmt: skip
     ),
@@ -238,7 +241,7 @@ MODELS.add(
         "vector Bouc-Wen backbone plus a MIMO NARX network on its residual",
         wider={
             3: Form(
-                P + "hybrid_bw:PlanarBoucWenHybrid",
+                M + "planar_hybrid_bw:PlanarBoucWenHybrid",
                 FITS + "fit_hybrid_bw",
                 FITS + "PlanarHybridBWOptions",
             )
@@ -252,7 +255,7 @@ MODELS.add(
         "the reference rubber bushing (bushenv/reference); as a reference without its "
         "measurement chain",
         reference_preset={"measurement": False},
-        wider={3: Form(P + "reference:PlanarRubber")},
+        wider={3: Form("bushenv.reference.planar:PlanarRubber")},
     ),
 )
 MODELS.alias("reference", "rubber")  # the three-axis rubber's name in files written before

@@ -31,9 +31,9 @@ import numpy as np
 
 from bushenv.identify.options import option
 from bushenv.models.base import velocity_of
-from bushenv.planar import relaxation
-from bushenv.planar.base import COORDS, PlanarModelError
-from bushenv.planar.boucwen import PlanarBoucWen
+from bushenv.models.boucwen import relaxation
+from bushenv.models.boucwen.planar import PlanarBoucWen
+from bushenv.models.planar_base import COORDS, PlanarModelError
 
 SEARCH_ETA = (1.0, 6.0)
 SEARCH_BETA = (0.5, 3.0)

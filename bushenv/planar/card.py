@@ -42,8 +42,8 @@ import numpy as np
 from bushenv.identify.card import card_paths, sha256_file
 from bushenv.identify.options import as_dict
 from bushenv.metrics import all_metrics
+from bushenv.models.planar_base import COORDS, FORCE_UNITS
 from bushenv.persist import plain, write_json, write_text
-from bushenv.planar.base import COORDS, FORCE_UNITS
 from bushenv.planar.records import only_noise
 
 CARD_FORMAT = "bushenv-planar-model-card"

@@ -68,8 +68,8 @@ def certify_vector(
     """The certificate document of a NARX ``model`` over C > 1 coordinates, and the grid of
     the largest spectral radius per hold (for ``radius_plot``)."""
     from bushenv.certify.network import CertifyError
+    from bushenv.models.planar_narx import PlanarNarx
     from bushenv.planar.fixed_points import fixed_points, fold_crossings, grid
-    from bushenv.planar.narx import PlanarNarx
     from bushenv.planar.passivity import passivity
 
     if not isinstance(model, PlanarNarx):

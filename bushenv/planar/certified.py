@@ -39,8 +39,8 @@ from typing import Any, ClassVar
 import numpy as np
 import torch
 
+from bushenv.models.planar_narx import N_PAST_F, N_PAST_Q, PlanarNarx
 from bushenv.planar.fixed_points import HeldNetwork, fixed_points, grid
-from bushenv.planar.narx import N_PAST_F, N_PAST_Q, PlanarNarx
 from bushenv.planar.static_estimate import COUPLING, PlanarStaticEstimate
 
 STROKE = (12.5e-3, 12.5e-3, 0.15)  # BushRig3-v0's stroke (m, m, rad): the box the search drives

@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 
 from bushenv.identify.options import option, option_like, options_of
+from bushenv.models.planar_base import PlanarModel, PlanarModelError
 from bushenv.models.registry import MODELS, names_for
-from bushenv.planar.base import PlanarModel, PlanarModelError
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
 from bushenv.planar.train_options import (
     PlanarHybridOptions,
@@ -82,7 +82,7 @@ class PlanarFitResult:
 
 def fit_linear(histories, dt, opts, seed, say):
     from bushenv.models.base import velocity_of
-    from bushenv.planar.linear import fit_linear
+    from bushenv.models.planar_linear import fit_linear
 
     q = np.vstack([h[0] for h in histories])
     v = np.vstack([velocity_of(h[0], dt) for h in histories])
@@ -153,7 +153,7 @@ def fit_boucwen(histories, dt, opts, seed, say):
 
 
 def fit_hybrid_bw(histories, dt, opts, seed, say):
-    from bushenv.planar.hybrid_bw import compose
+    from bushenv.models.planar_hybrid_bw import compose
     from bushenv.planar.train import fit_planar_network
 
     backbone, info = fit_planar_boucwen(histories, dt, opts.backbone_options(), say=say)

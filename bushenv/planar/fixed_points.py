@@ -35,8 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bushenv.planar.base import PlanarModelError
-from bushenv.planar.narx import N_PAST_F, N_PAST_Q, PlanarNarx
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_narx import N_PAST_F, N_PAST_Q, PlanarNarx
 
 INITIAL_SPLITS = 5  # per output, 125 boxes per hold to start; odd, and the split below is
 SPLIT = 0.4871  # off-centre, so a root at a symmetric point (often y = 0) never sits on a face

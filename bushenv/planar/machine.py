@@ -26,7 +26,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from bushenv.planar.base import PlanarModel, PlanarModelError
+from bushenv.models.planar_base import PlanarModel, PlanarModelError
 from bushenv.planar.programme import (
     PEAK_AT_N1,
     held_sweeps,
@@ -34,7 +34,7 @@ from bushenv.planar.programme import (
     random_correlated,
     random_independent,
 )
-from bushenv.planar.reference import PlanarRubber
+from bushenv.reference.planar import PlanarRubber
 
 KINDS = ("papers", "random", "combined")
 # what a 3-axis identification uses of the papers' programme at n = 1 (``bushenv reproduce

@@ -42,10 +42,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bushenv.certify.passivity import negative_bands
-from bushenv.planar.base import PlanarModel, PlanarModelError
+from bushenv.models.planar_base import PlanarModel, PlanarModelError
+from bushenv.models.planar_linear import PlanarLinear
+from bushenv.models.planar_narx import PlanarNarx
 from bushenv.planar.fixed_points import HeldNetwork, fixed_points
-from bushenv.planar.linear import PlanarLinear
-from bushenv.planar.narx import PlanarNarx
 
 AMPLITUDES = np.array([2e-3, 2e-3, 0.05])  # D: n = 1 peaks, m, m, rad
 RAMP_S = 0.5  # half-cosine ramp to the hold

@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from bushenv.identify.plots import LOOP_WINDOW_S, safe_name
+from bushenv.models.planar_base import COORDS
 from bushenv.persist import save_figure
-from bushenv.planar.base import COORDS
 
 SCALE = (1e3, 1e3, 1e3)  # m -> mm, m -> mm, rad -> mrad
 DEFLECTION = ("axial [mm]", "radial [mm]", "rotation [mrad]")

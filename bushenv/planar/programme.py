@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from bushenv.excitation import chirp, random_rpc
-from bushenv.planar.reference import THETA_N1_RAD
+from bushenv.reference.planar import THETA_N1_RAD
 
 PEAK_AT_N1 = np.array([2.0e-3, 2.0e-3, THETA_N1_RAD])
 CORRELATION = 0.8  # share of the common drive in the correlated set
@@ -76,7 +76,7 @@ def held_sweeps(n_index: float, dt: float, duration_s: float = 10.0) -> list:
     """Every held combination a vehicle loads a bushing in: each coordinate held at +- n x its
     n = 1 peak (``PEAK_AT_N1``) while each other one is swept (0.5-5 Hz, n x its peak), the
     third at rest: 12 named (T, 3) motions (``coverage.every_combination``'s list)."""
-    from bushenv.planar.base import COORDS
+    from bushenv.models.planar_base import COORDS
 
     out = []
     for held in range(3):

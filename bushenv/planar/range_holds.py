@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.models.planar_narx import PlanarNarx
 from bushenv.planar.fixed_points import fixed_points, fold_crossings, grid
-from bushenv.planar.narx import PlanarNarx
 
 GRID_POINTS = 5  # per coordinate: 125 holds, the zero deflection among them
 

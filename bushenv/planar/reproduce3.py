@@ -41,12 +41,12 @@ import numpy as np
 
 from bushenv.identify.options import option_fields
 from bushenv.metrics import esr, max_error, max_error_ratio, rms_ratio
-from bushenv.planar.base import COORDS
+from bushenv.models.planar_base import COORDS
 from bushenv.planar.fitting import fit_planar, options_class
 from bushenv.planar.machine import IDENTIFICATIONS, N_VERIFY, coupled_sets
 from bushenv.planar.programme import programme, random_correlated, random_independent
-from bushenv.planar.reference import PlanarRubber
 from bushenv.progress import Progress
+from bushenv.reference.planar import PlanarRubber
 
 MODELS = ("linear", "nn-axis", "hybrid", "boucwen", "hybrid-bw")
 EFFORT = {"linear": 0.1, "nn-axis": 10.0, "hybrid": 15.0, "boucwen": 25.0, "hybrid-bw": 40.0}

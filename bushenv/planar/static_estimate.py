@@ -36,7 +36,7 @@ from scipy.signal import butter, sosfiltfilt
 
 from bushenv.errors import DIVERGENCE_RAISES
 from bushenv.identify.static_estimate import FILTER_ORDER, slow_cutoff_hz
-from bushenv.planar.base import COORDS, PlanarModelError
+from bushenv.models.planar_base import COORDS, PlanarModelError
 from bushenv.scales import STATIC_HOLD_S, STATIC_PROBE_M
 
 FLOOR_FRACTION = 0.01  # of a channel's RMS force: below it a held force has no sign

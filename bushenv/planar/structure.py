@@ -32,9 +32,9 @@ import numpy as np
 import torch
 
 from bushenv.models.base import velocity_of
-from bushenv.planar.base import PlanarModelError
-from bushenv.planar.linear import PlanarLinear
-from bushenv.planar.narx import N_PAST_F, N_PAST_Q, STRUCTURES, input_axes
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_linear import PlanarLinear
+from bushenv.models.planar_narx import N_PAST_F, N_PAST_Q, STRUCTURES, input_axes
 
 SIGNS = np.array([[a, b, c] for a in (1, -1) for b in (1, -1) for c in (1, -1)], dtype=float)
 NQ = 3 * (N_PAST_Q + 1)

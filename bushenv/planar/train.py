@@ -29,9 +29,9 @@ import numpy as np
 import torch
 
 from bushenv.models.base import velocity_of
-from bushenv.planar.base import PlanarModelError
-from bushenv.planar.linear import fit_linear
-from bushenv.planar.narx import KINDS, N_PAST_F, N_PAST_Q, PlanarNarx, axis_masks
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_linear import fit_linear
+from bushenv.models.planar_narx import KINDS, N_PAST_F, N_PAST_Q, PlanarNarx, axis_masks
 from bushenv.planar.structure import (
     StructuredNet,
     fit_diagonal_linear,

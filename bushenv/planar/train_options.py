@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 from bushenv.identify.narx_options import SWITCH, NarxOptions
 from bushenv.identify.options import option, option_like
-from bushenv.planar.base import PlanarModelError
-from bushenv.planar.narx import N_PAST_F, N_PAST_Q, STRUCTURES
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_narx import N_PAST_F, N_PAST_Q, STRUCTURES
 
 VAL_MIN_SAMPLES = 10  # a validation tail shorter than this says nothing (as bushenv.identify)
 

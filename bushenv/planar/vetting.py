@@ -32,7 +32,7 @@ import numpy as np
 
 from bushenv.identify.card import card_paths
 from bushenv.metrics import rms_ratio
-from bushenv.planar.base import COORDS, PlanarModel
+from bushenv.models.planar_base import COORDS, PlanarModel
 from bushenv.scales import STIFFNESS_MISMATCH
 from bushenv.vetting import (
     DEPART_FRACTION,

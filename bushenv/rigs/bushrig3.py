@@ -225,7 +225,7 @@ class BushRig3Env(gym.Env):
     plane: it drives axial and radial translation and the in-plane rotation at once, under
     displacement control (the motion is prescribed; no force feeds back into it). The planar
     model under test (``model``) and the planar reference (``reference``, the coupled rubber of
-    ``bushenv.planar.reference`` without load-cell noise) see the same motion side by side.
+    ``bushenv.reference.planar`` without load-cell noise) see the same motion side by side.
 
     ## Action Space
     ``Box(-1, 1, (3,), float32)``: per coordinate the change of the commanded position as a

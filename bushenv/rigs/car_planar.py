@@ -26,7 +26,7 @@ def rotation_split(model) -> tuple[float, float]:
     its held remainder small: a linear model's is exactly zero, as in the one-axis split.
     Held explicitly, even 3000 N m/rad on the arm (about 1.1 kg m^2 about its centre of mass)
     is omega dt = 0.26: the rotation is not where the coupling trap lies; accuracy is."""
-    from bushenv.planar.linear import PlanarLinear
+    from bushenv.models.planar_linear import PlanarLinear
 
     k = getattr(model, "k_matrix", None)
     if k is None:

@@ -15,7 +15,8 @@ from bushenv.rigs.halfcar_car import SIGN, HalfCar, step_models
 from bushenv.rigs.halfcar_params import POSITIONS, SIDES, HalfCarParameters
 
 COORD_KEYS = (("axial", "n"), ("radial", "n"), ("moment", "nm"))
-# per pivot: the (model, reference) keys of axial, radial, moment, then the deflection keys
+# per pivot: the (model, reference) keys of axial, radial, moment, then the deflection keys of
+# the model car and of the reference twin
 PIVOT_KEYS = tuple(
     (
         tuple(
@@ -24,6 +25,8 @@ PIVOT_KEYS = tuple(
             for c, (name, unit) in enumerate(COORD_KEYS)
         ),
         (f"deflection_{k}_axial_m", f"deflection_{k}_radial_m", f"rotation_{k}_rad"),
+        (f"reference_deflection_{k}_axial_m", f"reference_deflection_{k}_radial_m",
+         f"reference_rotation_{k}_rad"),
     )
     for k in POSITIONS
 )  # fmt: skip

@@ -186,7 +186,7 @@ class HalfCarParameters:
         self.v_scale = self.max_road_step / self.dt
         self.roll_rate_scale = 2 * self.v_scale / self.track
         self.h_rc = self.geometry.roll_centre_height()
-        from bushenv.planar.linear import PlanarLinear
+        from bushenv.models.planar_linear import PlanarLinear
 
         preset = PlanarLinear.preset(dt=self.dt)  # the split coupling's in-sub-step part
         self.k_in, self.c_in = np.diag(preset.k_matrix).copy(), np.diag(preset.c_matrix).copy()

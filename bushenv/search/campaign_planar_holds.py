@@ -34,7 +34,7 @@ __all__ = ["NAME", "PlanarHolds", "listed_holds3", "step_and_hold3"]
 def listed_holds3(model, limits: Rig3Limits, floors: np.ndarray) -> list[dict] | None:
     """The suspect holds of the module doc: [{"q": (3,) m, m, rad, "kinds"}]; None for a
     model that is not a planar network."""
-    from bushenv.planar.base import PlanarModelError
+    from bushenv.models.planar_base import PlanarModelError
     from bushenv.planar.fixed_points import fixed_points, grid
     from bushenv.vetting import SIGN_FRACTION
 

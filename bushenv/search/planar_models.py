@@ -135,7 +135,7 @@ def fitted_planar_linear(reference, limits: Rig3Limits, q: list[np.ndarray] | No
     ``seed``, ``seed`` + 1, + 2) scaled to ``limits``' stroke and kept within its rate, as
     the one-axis control is fitted (``identify.linear.fitted_linear``)."""
     from bushenv.models.base import velocity_of
-    from bushenv.planar.linear import fit_linear
+    from bushenv.models.planar_linear import fit_linear
 
     dt = reference.dt
     if not q:

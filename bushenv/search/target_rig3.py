@@ -300,7 +300,7 @@ class Rig3Target(Target):
     def check_models(self, kind: str):
         """(model, reference) the contract checks run: ``active`` a planar Kelvin-Voigt with
         negative damping, ``passive`` one 20 % softer, both against the planar linear preset."""
-        from bushenv.planar.linear import PlanarLinear
+        from bushenv.models.planar_linear import PlanarLinear
 
         ref = PlanarLinear.preset()
         if kind == "active":

@@ -19,7 +19,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from bushenv.errors import BushenvError
-from bushenv.planar.base import COORDS
+from bushenv.models.planar_base import COORDS
 from bushenv.rigs.halfcar import HalfCarEnv
 from bushenv.rigs.halfcar_params import POSITIONS, resolve_bushings
 from bushenv.vehicle.comfort import weighted_rms

@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from bushenv.models.planar_base import COORDS
 from bushenv.persist import write_figure
-from bushenv.planar.base import COORDS
 from bushenv.vehicle.compare import OUTPUTS, CarRun
 from bushenv.vehicle.manoeuvres import Manoeuvre
 from bushenv.vehicle.study import REFERENCE_CAR

@@ -32,7 +32,7 @@ from bushenv import metrics
 from bushenv.models.base import PAPER_DT
 from bushenv.planar.fitting import fit_planar
 from bushenv.planar.programme import random_correlated, random_independent
-from bushenv.planar.reference import PlanarRubber
+from bushenv.reference.planar import PlanarRubber
 from bushenv.search.campaign_planar import DEFAULT_REFERENCE, planar_search, tally
 from bushenv.search.families_planar import COORDS
 from bushenv.search.planar_models import resolve_planar_spec

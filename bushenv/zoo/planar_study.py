@@ -16,7 +16,7 @@ from itertools import product
 from pathlib import Path
 from typing import Any
 
-from bushenv.planar.narx import KINDS
+from bushenv.models.planar_narx import KINDS
 from bushenv.planar.train_options import PlanarHybridOptions
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells

@@ -361,7 +361,7 @@ def unseen_motions(dt: float, seed: int, held: float, swept: float, f_hz, durati
 
 def unseen_measured(args: argparse.Namespace, outside: OutsideBushing) -> tuple[dict, dict]:
     """The unseen motions, and their forces measured on each bushing (own noise seeds)."""
-    from bushenv.planar.reference import PlanarRubber
+    from bushenv.reference.planar import PlanarRubber
 
     dt = DT_S
     unseen = unseen_motions(dt, args.seed, args.held, args.swept, tuple(args.f_hz), args.unseen_s)
@@ -540,8 +540,8 @@ def worst(result: dict) -> tuple[float, str, str]:
 def run(args: argparse.Namespace) -> dict:
     from bushenv.identify.coverage import coverage, not_shown
     from bushenv.planar.fitting import fit_planar
-    from bushenv.planar.reference import PlanarRubber
     from bushenv.progress import Progress, format_seconds
+    from bushenv.reference.planar import PlanarRubber
 
     dt, seed = DT_S, args.seed
     kinds = tuple(args.models)

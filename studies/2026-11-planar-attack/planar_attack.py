@@ -19,10 +19,10 @@ import torch
 
 from bushenv.models.base import PAPER_DT
 from bushenv.planar.programme import random_independent
-from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.train import fit_planar_network
 from bushenv.planar.train_options import NOISY_FEEDBACK_TRAINING, PlanarNetworkOptions
 from bushenv.progress import Progress
+from bushenv.reference.planar import PlanarRubber
 from bushenv.search.campaign_config import CampaignConfig
 from bushenv.search.campaign_planar import run_planar_attack
 

@@ -30,9 +30,9 @@ import torch
 from bushenv.models import load_model
 from bushenv.models.base import PAPER_DT
 from bushenv.planar.programme import random_independent
-from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.train import fit_planar_network
 from bushenv.progress import Progress
+from bushenv.reference.planar import PlanarRubber
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.searchers import RandomSearch
 from bushenv.zoo.planar_cell import driven_failed

@@ -31,8 +31,8 @@ from bushenv.persist import write_figure
 from bushenv.planar import reproduce3 as r3
 from bushenv.planar.fitting import fit_planar
 from bushenv.planar.machine import coupled_sets
-from bushenv.planar.reference import PlanarRubber
 from bushenv.progress import Progress
+from bushenv.reference.planar import PlanarRubber
 
 SCALES = (1.0, 1.25, 1.5, 1.75)
 HOLDS = ((2e-3, 0, 0), (0, 2e-3, 0), (0, 0, 0.05), (2e-3, 2e-3, 0.05))

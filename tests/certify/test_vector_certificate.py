@@ -8,9 +8,9 @@ import pytest
 
 from bushenv.certify.network import CertifyError
 from bushenv.cli import main
+from bushenv.models.planar_linear import PlanarLinear
+from bushenv.models.planar_narx import N_IN, PlanarNarx
 from bushenv.planar.certificate import VectorOptions, certify_vector, per_coordinate, wrong_sign
-from bushenv.planar.linear import PlanarLinear
-from bushenv.planar.narx import N_IN, PlanarNarx
 
 SPAN = (3e-3, 3e-3, 0.075)
 

@@ -251,7 +251,7 @@ def _three_axis_network(pushing: bool):
     """A small three-axis network over (axial, radial, rotation). ``pushing``: each output a
     tanh of its own coordinate (the force has the sign of the deflection: passes); else random
     small weights, whose static force pulls outward at most holds (wrong sign: fails)."""
-    from bushenv.planar.narx import N_IN, PlanarNarx
+    from bushenv.models.planar_narx import N_IN, PlanarNarx
 
     rng = np.random.default_rng(0)
     w1, w_out = rng.normal(0, 0.05, (9, N_IN)), rng.normal(0, 0.3, (3, 9))

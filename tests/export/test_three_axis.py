@@ -15,7 +15,7 @@ ROUNDING = 1e-9
 
 
 def _model(kind):
-    from bushenv.planar.narx import PlanarHybrid, PlanarNarx, PlanarNarxPerAxis
+    from bushenv.models.planar_narx import PlanarHybrid, PlanarNarx, PlanarNarxPerAxis
 
     made = {
         "linear": lambda: get_model("linear", coords=3),

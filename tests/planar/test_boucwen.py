@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.base import PlanarModelError
-from bushenv.planar.boucwen import PlanarBoucWen
+from bushenv.models.boucwen.planar import PlanarBoucWen
+from bushenv.models.planar_base import PlanarModelError
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
 from bushenv.planar.programme import random_independent
 
@@ -98,8 +98,8 @@ def test_the_clock_stops_the_search_and_says_so():
 
 
 def test_hybrid_bw_is_its_backbone_plus_its_network():
-    from bushenv.planar.hybrid_bw import PlanarBoucWenHybrid
-    from bushenv.planar.narx import PlanarNarx
+    from bushenv.models.planar_hybrid_bw import PlanarBoucWenHybrid
+    from bushenv.models.planar_narx import PlanarNarx
 
     model = PlanarBoucWenHybrid.untrained(seed=3)
     net = PlanarNarx(**{k: model.params[k] for k in PlanarNarx.param_names})

@@ -10,8 +10,8 @@ from gymnasium.utils.env_checker import check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import bushenv  # noqa: F401  (registers the envs)
-from bushenv.planar.linear import PlanarLinear
-from bushenv.planar.narx import N_IN, PlanarNarx
+from bushenv.models.planar_linear import PlanarLinear
+from bushenv.models.planar_narx import N_IN, PlanarNarx
 from bushenv.rigs import bushrig3
 from bushenv.rigs.common import RigError
 
@@ -141,7 +141,7 @@ def test_the_docstring_example_runs():
 def test_a_column_reset_takes_a_hybrid_bw_backbone_to_rest_too():
     """The vector env's autoreset: the Bouc-Wen backbone's hysteresis and relaxation of the
     reset column go back to rest, the other column's stay."""
-    from bushenv.planar.hybrid_bw import PlanarBoucWenHybrid
+    from bushenv.models.planar_hybrid_bw import PlanarBoucWenHybrid
 
     model = PlanarBoucWenHybrid.untrained(seed=0)
     gain = np.diag([1e5, 3e5, 500.0])[None]

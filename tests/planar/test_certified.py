@@ -7,7 +7,7 @@ import pytest
 import torch
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.base import PlanarModelError
+from bushenv.models.planar_base import PlanarModelError
 from bushenv.planar.certified import (
     PlanarCertifiedHolds,
     PlanarProblem,
@@ -16,9 +16,9 @@ from bushenv.planar.certified import (
 )
 from bushenv.planar.fitting import PlanarNetworkOptions, fit_planar
 from bushenv.planar.programme import random_independent
-from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.static_estimate import planar_static_estimate
 from bushenv.planar.train import _Net
+from bushenv.reference.planar import PlanarRubber
 
 
 @pytest.fixture(scope="module")
@@ -99,7 +99,7 @@ def test_the_term_is_zero_for_a_network_that_holds_right_and_positive_otherwise(
 
 
 def _model(net, problem):
-    from bushenv.planar.narx import PlanarHybrid
+    from bushenv.models.planar_narx import PlanarHybrid
 
     return PlanarHybrid(
         k_matrix=problem.k,

@@ -200,7 +200,7 @@ def test_a_hybrid_card_sets_its_network_against_its_backbone_alone(records, tmp_
 
 
 def test_the_card_warns_where_the_network_is_worse_than_its_backbone_on_unseen_records():
-    from bushenv.planar.base import COORDS
+    from bushenv.models.planar_base import COORDS
     from bushenv.planar.card import backbone_lines
 
     def metrics(rms):

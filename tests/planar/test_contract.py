@@ -7,8 +7,8 @@ from bushenv.models.checks import CHECKS
 
 
 def test_a_broken_three_axis_model_fails_the_contract():
+    from bushenv.models.planar_linear import PlanarLinear
     from bushenv.models.registry import Form
-    from bushenv.planar.linear import PlanarLinear
 
     class Drifting(PlanarLinear):
         """Its step and its batched run disagree: a counter outside the state."""

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.reference import PlanarRubber
+from bushenv.reference.planar import PlanarRubber
 
 
 @pytest.fixture(scope="module")

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from bushenv.models import MODELS
-from bushenv.planar import PlanarModelError
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_narx import N_IN, PlanarNarx, PlanarNarxPerAxis
 from bushenv.planar.fixed_points import HeldNetwork, fixed_points, fold_crossings, grid
-from bushenv.planar.narx import N_IN, PlanarNarx, PlanarNarxPerAxis
 
 SCALE = np.array([2e-3, 2e-3, 0.05])
 

@@ -6,7 +6,7 @@ import pytest
 from bushenv.excitation import random_rpc
 from bushenv.identify.options import options_of
 from bushenv.metrics import rms_ratio
-from bushenv.planar import PlanarModelError
+from bushenv.models.planar_base import PlanarModelError
 from bushenv.planar.fitting import options_class
 from bushenv.planar.train import TrainOptions, fit_planar_network
 from bushenv.planar.train_options import NOISY_FEEDBACK_TRAINING, default_options

@@ -6,10 +6,10 @@ import pytest
 from bushenv.excitation import random_rpc
 from bushenv.metrics import rms_ratio
 from bushenv.models import load_model
-from bushenv.planar import PlanarModelError
-from bushenv.planar.narx import N_IN, PlanarHybrid, PlanarNarx, PlanarNarxPerAxis, axis_masks
-from bushenv.planar.reference import THETA_N1_RAD, PlanarRubber
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_narx import N_IN, PlanarHybrid, PlanarNarx, PlanarNarxPerAxis, axis_masks
 from bushenv.planar.train import TrainOptions, fit_planar_network
+from bushenv.reference.planar import THETA_N1_RAD, PlanarRubber
 
 DT = 1 / 204.8
 PEAKS = np.array([2e-3, 2e-3, THETA_N1_RAD])

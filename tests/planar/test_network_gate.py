@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 from bushenv.models.base import PAPER_DT
+from bushenv.models.planar_linear import PlanarLinear
 from bushenv.planar.fitting import fit_planar
-from bushenv.planar.linear import PlanarLinear
 from bushenv.planar.programme import random_correlated
-from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.train import TrainOptions, fit_planar_network
+from bushenv.reference.planar import PlanarRubber
 
 OPT = TrainOptions(hidden=9, teacher_steps=100, free_run_steps=25, windows=8, window=32)
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from bushenv.models import MODELS
+from bushenv.models.planar_linear import PlanarLinear
+from bushenv.models.planar_narx import PlanarNarx
 from bushenv.planar.fixed_points import fixed_points, grid
-from bushenv.planar.linear import PlanarLinear
-from bushenv.planar.narx import PlanarNarx
 from bushenv.planar.passivity import (
     AMPLITUDES,
     loss_matrix,

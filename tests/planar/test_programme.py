@@ -11,7 +11,7 @@ from bushenv.planar.programme import (
     random_correlated,
     random_independent,
 )
-from bushenv.planar.reference import MAX_ROTATION_RAD
+from bushenv.reference.planar import MAX_ROTATION_RAD
 
 DT = 1 / 204.8
 

@@ -5,8 +5,8 @@ import pytest
 
 from bushenv.errors import BadInput
 from bushenv.models import MODELS, load_model
-from bushenv.planar import PlanarModelError
-from bushenv.planar.linear import PlanarLinear, fit_linear
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_linear import PlanarLinear, fit_linear
 
 K = np.array([[380e3, 1e3, 0.0], [2e3, 1500e3, 5e3], [0.0, 40.0, 1500.0]])
 C = np.diag([4.4e3, 15e3, 15.0])

@@ -5,9 +5,9 @@ import json
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
+from bushenv.models.planar_linear import PlanarLinear
 from bushenv.planar.card import save_planar_fit
 from bushenv.planar.fitting import PlanarFitResult
-from bushenv.planar.linear import PlanarLinear
 from bushenv.planar.programme import random_independent
 from bushenv.planar.range_holds import describe, range_holds
 from bushenv.planar.records import PlanarRecord

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from bushenv.models import load_model
-from bushenv.planar import PlanarModelError
-from bushenv.planar.elastic import elastic_force, tangent_stiffness
-from bushenv.planar.reference import PlanarRubber
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.reference.planar import PlanarRubber
+from bushenv.reference.planar_elastic import elastic_force, tangent_stiffness
 from bushenv.reference.rubber import RubberBushing
 
 DT = 1 / 204.8

@@ -6,8 +6,8 @@ import pytest
 
 from bushenv.models import load_model
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.base import PlanarModelError
-from bushenv.planar.boucwen import PlanarBoucWen
+from bushenv.models.boucwen.planar import PlanarBoucWen
+from bushenv.models.planar_base import PlanarModelError
 from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
 from bushenv.planar.programme import random_independent
 
@@ -99,7 +99,7 @@ def test_the_selection_drops_short_branches_that_do_not_carry_beyond_the_trainin
     1.5x that amplitude; the selection, judging on the training records' largest deflections,
     drops them."""
     from bushenv.planar.programme import random_correlated
-    from bushenv.planar.reference import PlanarRubber
+    from bushenv.reference.planar import PlanarRubber
 
     ref = PlanarRubber.preset(seed=0)
     train = [(q, ref.simulate(q)) for q in (random_independent(1.0, 5.0, PAPER_DT, 0),
@@ -154,7 +154,7 @@ def test_branches_slower_than_the_records_are_warned_of_and_a_hold_separates_the
     deflection and its gain cannot be told from the static stiffness. A held preload (the
     sweep holds radial and swings rotation) separates it on those two coordinates only."""
     from bushenv.models.base import velocity_of
-    from bushenv.planar import relaxation
+    from bushenv.models.boucwen import relaxation
     from bushenv.planar.programme import preload_sweep, random_correlated
 
     taus = PlanarBoucWenOptions().taus()

@@ -10,7 +10,7 @@ from bushenv.cli import main
 from bushenv.metrics import rms_ratio
 from bushenv.models.base import PAPER_DT
 from bushenv.planar.fitting import fit_planar
-from bushenv.planar.reference import PlanarRubber
+from bushenv.reference.planar import PlanarRubber
 
 
 def test_planar_only_writes_its_own_report_and_the_table_beside_table3(

@@ -8,16 +8,16 @@ import pytest
 import torch
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.base import PlanarModelError
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_narx import PlanarHybrid, input_axes
 from bushenv.planar.certified import PlanarCertifiedHolds, PlanarProblem
 from bushenv.planar.fitting import fit_planar
 from bushenv.planar.fixed_points import HeldNetwork, fixed_points
-from bushenv.planar.narx import PlanarHybrid, input_axes
 from bushenv.planar.programme import random_independent
-from bushenv.planar.reference import PlanarRubber
 from bushenv.planar.static_estimate import planar_static_estimate
 from bushenv.planar.structure import SIGNS, StructuredNet, fit_diagonal_linear
 from bushenv.planar.train import _Net
+from bushenv.reference.planar import PlanarRubber
 
 Q_SCALE = np.array([2e-3, 2e-3, 0.05])
 F_SCALE = np.array([300.0, 1000.0, 100.0])

@@ -6,7 +6,7 @@ import numpy as np
 
 from bushenv.cli import main
 from bushenv.models import MODELS
-from bushenv.planar.linear import PlanarLinear
+from bushenv.models.planar_linear import PlanarLinear
 from bushenv.planar.vetting import held_vectors, vet_planar_reference
 
 STROKE = np.array([0.0125, 0.0125, 0.15])

@@ -256,7 +256,7 @@ def test_with_identical_tracks_the_half_car_is_two_quarter_cars_within_5_percent
 
 def stiff_linear(factor=10.0):
     """The planar linear preset with its translational stiffness and damping x ``factor``."""
-    from bushenv.planar.linear import PlanarLinear
+    from bushenv.models.planar_linear import PlanarLinear
 
     pre = PlanarLinear.preset()
     k, c = pre.k_matrix.copy(), pre.c_matrix.copy()

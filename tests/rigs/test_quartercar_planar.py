@@ -11,7 +11,7 @@ from gymnasium.utils.env_checker import check_env as gym_check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 from bushenv.models.linear import TABLE1
-from bushenv.planar.linear import PlanarLinear
+from bushenv.models.planar_linear import PlanarLinear
 from bushenv.rigs.common import RigError
 
 STEP = 0.05  # max_road_step_m of the spec
@@ -133,7 +133,7 @@ def test_info_says_when_the_reference_arm_bushing_judges_beyond_its_calibrated_r
     (up to 0.26 rad on these): info names the steps its forces are an extrapolation."""
     from test_quartercar import LOOSE, worst_roads
 
-    from bushenv.planar.reference import MAX_ROTATION_RAD
+    from bushenv.reference.planar import MAX_ROTATION_RAD
 
     roads = worst_roads(600, np.random.default_rng(0))
     loose = dict(LOOSE, arm_moment_limit_nm=1e12)

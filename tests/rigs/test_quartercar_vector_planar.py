@@ -11,8 +11,8 @@ from test_quartercar_planar import diagonal_linear3
 from test_quartercar_vector import bump_then_rough_road, make_vec
 
 from bushenv import excitation
-from bushenv.planar.hybrid_bw import PlanarBoucWenHybrid
-from bushenv.planar.linear import PlanarLinear
+from bushenv.models.planar_hybrid_bw import PlanarBoucWenHybrid
+from bushenv.models.planar_linear import PlanarLinear
 from bushenv.rigs.quartercar_batch import QuarterCarBatch
 from bushenv.rigs.quartercar_vector import QuarterCarVectorEnv
 from bushenv.rigs.sb3 import make_sb3_vec_env
@@ -280,7 +280,7 @@ def test_planar_batch_columns_equal_the_same_roads_run_one_by_one():
 def test_info_says_where_the_reference_judges_beyond_its_calibrated_rotation():
     from test_quartercar import LOOSE, worst_roads
 
-    from bushenv.planar.reference import MAX_ROTATION_RAD
+    from bushenv.reference.planar import MAX_ROTATION_RAD
 
     road = worst_roads(600, np.random.default_rng(0))[:, 15]
     _, vector = run_both(road, arm_bushing="linear", arm_moment_limit_nm=1e12, **LOOSE)

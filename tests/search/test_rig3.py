@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.linear import PlanarLinear
+from bushenv.models.planar_linear import PlanarLinear
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.families import FAMILIES, pad_batch
 from bushenv.search.families_planar import COORDS, rig3_limits
@@ -153,7 +153,7 @@ def test_shrinking_puts_the_axes_that_do_not_matter_at_rest():
 def test_the_controls_are_never_flagged_against_the_coupled_reference():
     """The planar Table-1 linear model and the measured reference (load-cell noise) against
     the coupled reference: no planar family's corners, centre or random points flag them."""
-    from bushenv.planar.reference import PlanarRubber
+    from bushenv.reference.planar import PlanarRubber
     from bushenv.search.checks import family_profiles
 
     target = TARGETS["rig3"]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from bushenv.cli import main
-from bushenv.planar.linear import PlanarLinear
+from bushenv.models.planar_linear import PlanarLinear
 from bushenv.search.corpus import case_files, check, load_case
 
 

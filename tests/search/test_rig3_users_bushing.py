@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from bushenv.cli import main
+from bushenv.models.planar_linear import PlanarLinear, fit_linear
 from bushenv.persist import load_profiles
-from bushenv.planar.linear import PlanarLinear, fit_linear
 from bushenv.planar.records import load_planar_csv
 from bushenv.search.families import FAMILIES
 from bushenv.search.families_planar import COORDS, Rig3Limits, machine_limits

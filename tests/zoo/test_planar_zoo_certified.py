@@ -126,7 +126,7 @@ def test_a_tiny_certified_study_runs_end_to_end(tmp_path):
 def test_the_network_share_of_a_silent_hybrid_is_zero_and_of_a_live_one_is_not():
     import numpy as np
 
-    from bushenv.planar.narx import PlanarHybrid, PlanarNarx
+    from bushenv.models.planar_narx import PlanarHybrid, PlanarNarx
     from bushenv.zoo.planar_cell import _network_share, planar_records
 
     live = PlanarHybrid.untrained(seed=0)

@@ -1,7 +1,7 @@
 """Three-axis validation cases: the coupled reference rubber with one effect withheld from the
 linear baseline, on one coordinate (or, for the coupled ones, on several).
 
-``make_case(spec, seed)`` builds a ``bushenv.planar.reference.PlanarRubber`` whose only
+``make_case(spec, seed)`` builds a ``bushenv.reference.planar.PlanarRubber`` whose only
 physical effect is the spec's (its load-cell noise always on), with a magnitude drawn from
 ``seed``, and measures a TRAIN record (random on every coordinate, independent drives, n = 1,
 20 s) and a TEST record (random, correlated drives, n = 1.5, 20 s), each with its own noise
@@ -29,10 +29,10 @@ from typing import Any
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.base import COORDS
+from bushenv.models.planar_base import COORDS
 from bushenv.planar.programme import PEAK_AT_N1, random_correlated, random_independent
 from bushenv.planar.records import PlanarRecord
-from bushenv.planar.reference import PlanarRubber
+from bushenv.reference.planar import PlanarRubber
 
 N_TRAIN, N_TEST = 1.0, 1.5
 DURATION_S = 20.0

@@ -25,8 +25,8 @@ from typing import Any
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
-from bushenv.planar.kernels import planar_narx_kernel
+from bushenv.models.planar_base import PlanarModel, PlanarModelError, as_matrix
+from bushenv.models.planar_kernels import planar_narx_kernel
 
 N_PAST_Q = 5  # seed 000 §4.2
 N_PAST_F = 5
@@ -189,7 +189,7 @@ class PlanarHybrid(PlanarNarx):
         return self.k_matrix, self.c_matrix
 
     def backbone_alone(self) -> PlanarModel:
-        from bushenv.planar.linear import PlanarLinear
+        from bushenv.models.planar_linear import PlanarLinear
 
         return PlanarLinear(self.k_matrix, self.c_matrix, dt=self.dt)
 

@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
-from bushenv.planar.kernels import planar_linear_kernel
-from bushenv.planar.reference import ROTATION_K_NM_PER_RAD
+from bushenv.models.planar_base import PlanarModel, PlanarModelError, as_matrix
+from bushenv.models.planar_kernels import planar_linear_kernel
+from bushenv.reference.planar import ROTATION_K_NM_PER_RAD
 
 
 class PlanarLinear(PlanarModel):

@@ -22,7 +22,7 @@ import numba as nb
 import numpy as np
 from scipy.signal import lfilter
 
-from bushenv.planar.base import PlanarModelError, as_matrix
+from bushenv.models.planar_base import PlanarModelError, as_matrix
 
 
 def coefficients(tau: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:

@@ -48,8 +48,18 @@ import numba as nb
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
-from bushenv.planar.elastic import E_D, E_GA, E_LA, E_LR, E_LT, E_TM, E_UC, N_EPAR, elastic_force
+from bushenv.models.planar_base import PlanarModel, PlanarModelError, as_matrix
+from bushenv.reference.planar_elastic import (
+    E_D,
+    E_GA,
+    E_LA,
+    E_LR,
+    E_LT,
+    E_TM,
+    E_UC,
+    N_EPAR,
+    elastic_force,
+)
 from bushenv.reference.rubber import PRESETS as ONE_AXIS
 
 EFFECTS = ("coupling", "hardening", "relaxation", "friction", "noise")

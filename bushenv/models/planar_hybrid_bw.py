@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.boucwen import PlanarBoucWen
-from bushenv.planar.narx import PlanarNarx
+from bushenv.models.boucwen.planar import PlanarBoucWen
+from bushenv.models.planar_narx import PlanarNarx
 
 BACKBONE_PARAMS = PlanarBoucWen.param_names
 

@@ -43,8 +43,8 @@ import numba as nb
 import numpy as np
 
 from bushenv.models.base import PAPER_DT
-from bushenv.planar import relaxation
-from bushenv.planar.base import PlanarModel, PlanarModelError, as_matrix
+from bushenv.models.boucwen import relaxation
+from bushenv.models.planar_base import PlanarModel, PlanarModelError, as_matrix
 
 SUBSTEP = 0.1  # path length of one RK4 substep in scaled deflection (accurate: |h lambda| < 0.5)
 MAX_SUBSTEPS = 2000
@@ -183,8 +183,8 @@ class PlanarBoucWen(PlanarModel):
     def preset(cls, dt: float = PAPER_DT) -> PlanarBoucWen:
         """The linear preset (seed 000 Table 1, the assumed rotation) plus the reference's
         friction as one hysteretic element: h = its friction force, d = its slip deflection."""
-        from bushenv.planar.linear import PlanarLinear
-        from bushenv.planar.reference import _preset
+        from bushenv.models.planar_linear import PlanarLinear
+        from bushenv.reference.planar import _preset
 
         lin, ref = PlanarLinear.preset(dt), _preset()
         return cls(
