@@ -4,10 +4,16 @@ differences beside the bushings' component-level error, and seed 000's "almost i
 finding judged.
 
     bushenv vehicle --out DIR [--kinds linear,hybrid,nn] [--hybrid FILE] [--nn FILE]
+    bushenv vehicle --search --out DIR [--budget N] [--searchers random,cma] [--corpus DIR]
 
 Writes DIR/report.json, DIR/report.md (the finding first) and DIR/<manoeuvre>.png; bushings
 not given as files are identified on the coupled reference's records and kept in
 DIR/bushings/ (a rerun with the same seed and budget reuses them).
+
+With ``--search`` the adversary runs instead (``bushenv/vehicle/adversary.py``): per bushing
+kind, the searchers look within the standards' bounds for the manoeuvre with the largest
+wheel-load difference to the reference car; DIR/adversary.json, DIR/adversary.md,
+DIR/adversary-*.png and the finds as regression cases in DIR/cases/ (and ``--corpus``).
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from bushenv.persist import write_json, write_text
 from bushenv.progress import Progress, format_seconds
 
 EXAMPLE = "bushenv vehicle --out runs/vehicle"
+SEARCH_BUDGET = 48  # car runs per searcher and kind: about 2 min for three kinds on 2 cores
 
 
 def _names(text: str) -> list[str]:
@@ -85,6 +92,32 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="PCT",
         help="'almost identical': the hybrid car within this %% of the linear car's peak",
     )
+    p.add_argument(
+        "--search",
+        action="store_true",
+        help="run the adversary instead of the comparison: search the standards' bounds for "
+        "the manoeuvre with the largest wheel-load difference to the reference car",
+    )
+    p.add_argument(
+        "--budget",
+        type=int,
+        default=None,
+        metavar="N",
+        help=f"with --search: car runs per searcher per bushing kind (default {SEARCH_BUDGET})",
+    )
+    p.add_argument(
+        "--searchers",
+        type=_names,
+        default=["random", "cma"],
+        metavar="LIST",
+        help="with --search: comma-separated, of random, cma (default: both)",
+    )
+    p.add_argument(
+        "--corpus",
+        default=None,
+        metavar="DIR",
+        help="with --search: also keep the found manoeuvres as cases in this corpus folder",
+    )
     p.add_argument("--no-plots", action="store_true", help="no figures")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
 
@@ -113,6 +146,8 @@ def run(args: argparse.Namespace) -> int:
     if not args.identification_s >= 5:
         raise CliError(f"--identification-s must be >= 5 s, got {args.identification_s}")
     kinds = check_kinds(args.kinds)
+    if not args.search and (args.corpus is not None or args.budget is not None):
+        raise CliError("--budget and --corpus are options of --search; add --search")
     files = {k: getattr(args, f"file_{k.replace('-', '_')}") for k in names_for(3, fittable=True)}
     files = {k: f for k, f in files.items() if f is not None}
     unused = sorted(set(files) - set(kinds))
@@ -126,6 +161,8 @@ def run(args: argparse.Namespace) -> int:
     manoeuvres = standard_manoeuvres(dt, args.seed, args.manoeuvres, args.duration_s)
     recipe = Recipe(dt, args.seed, args.identification_s)
     bushings = vehicle_bushings(kinds, recipe, out / "bushings", files, say=progress.say)
+    if args.search:
+        return _search(args, bushings, out, progress, t0)
     report, runs = run_vehicle(
         manoeuvres, {k: b.model for k, b in bushings.items()}, "rubber", progress,
         args.identical_pct,
@@ -155,4 +192,38 @@ def run(args: argparse.Namespace) -> int:
     text = markdown(report).split("\n## ")[0]
     print(text.strip())
     print(f"report: {out / 'report.md'}, {out / 'report.json'}", file=sys.stdout)
+    return 0
+
+
+def _search(args: argparse.Namespace, bushings: dict, out: Path, progress, t0: float) -> int:
+    """``--search``: the adversary, its report, figures and cases."""
+    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.halfcar_params import ENV_ID
+    from bushenv.vehicle.adversary import REFERENCE, AdversaryConfig, run_adversary
+    from bushenv.vehicle.adversary_cases import save_cases
+    from bushenv.vehicle.adversary_report import markdown, plot_found, plot_search
+
+    budget = SEARCH_BUDGET if args.budget is None else args.budget
+    config = AdversaryConfig(tuple(args.searchers), budget, args.seed)
+    models = {k: b.model for k, b in bushings.items()}
+    report, kept = run_adversary(models, config, progress)
+    report["bushings"] = {k: _shown(b.describe(), out) for k, b in bushings.items()}
+    reference = resolve_planar(REFERENCE, next(iter(models.values())).dt, "reference",
+                               env_id=ENV_ID)  # fmt: skip
+    dirs = [out / "cases"] + ([Path(args.corpus)] if args.corpus else [])
+    report["cases"] = save_cases(kept, bushings, reference, args.seed, dirs)
+    figures = []
+    if not args.no_plots:
+        figures.append(str(plot_search(report, kept, out / "adversary-search.png")))
+        for kind, k in kept.items():
+            if k["found"] is not None:
+                path = out / f"adversary-found-{kind}.png"
+                figures.append(str(plot_found(kind, k, models[kind], REFERENCE, path)))
+    report["figures"] = [Path(f).name for f in figures]
+    report["wall_time_s"] = time.perf_counter() - t0
+    write_json(out / "adversary.json", report)
+    write_text(out / "adversary.md", markdown(report, figures))
+    progress.say(f"done in {format_seconds(report['wall_time_s'])}")
+    print(markdown(report).split("\n## ")[0].strip())
+    print(f"report: {out / 'adversary.md'}, {out / 'adversary.json'}; cases: {out / 'cases'}")
     return 0

@@ -13,6 +13,8 @@ evaluator, shrinking, campaigns and the corpus ask the target; none of them comp
 | quartercar | road height under the wheel, m   | ``QuarterCarBatch``: the car, model vs twin      |
 | rig3       | (T, 3) axial m, radial m, rot rad| planar model vs the coupled planar reference,    |
 |            |                                  | judged per coordinate (``target_rig3.py``)       |
+| halfcar    | (T, 3) road left m, road right m,| HalfCar-v0, model car vs reference twin, judged  |
+|            | lateral acceleration m/s^2       | on the wheel load (``target_halfcar.py``)        |
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from bushenv.scales import MACHINE
 from bushenv.search.base import SearchError
 from bushenv.search.roads import quarter_car_responses
 from bushenv.search.target_base import Responses, Target
+from bushenv.search.target_halfcar import HalfCarTarget
 from bushenv.search.target_rig3 import Rig3Target
 
 
@@ -104,6 +107,7 @@ TARGETS: Registry[Target] = Registry("target", SearchError)
 TARGETS.add("rig", RigTarget())
 TARGETS.add("quartercar", QuarterCarTarget())
 TARGETS.add("rig3", Rig3Target())
+TARGETS.add("halfcar", HalfCarTarget())
 
 
 def get_target(target: str | Target) -> Target:
