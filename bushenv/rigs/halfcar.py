@@ -116,8 +116,10 @@ class HalfCarEnv(gym.Env):
     roll_rate_rad_per_s, track_change_m``, per side ``wheel_load_{side}_n`` (total, >= 0),
     ``wheel_lift_{side}`` (bool), ``camber_{side}_rad`` (top outward positive),
     ``travel_{side}_m``; per pivot ``force_{pivot}_{axial|radial}_{model|reference}_n``,
-    ``moment_{pivot}_{model|reference}_nm`` and ``deflection_{pivot}_{axial|radial}_m``,
-    ``rotation_{pivot}_rad`` (model car). Verdict: ``error_n, roll_error_rad,
+    ``moment_{pivot}_{model|reference}_nm``, ``deflection_{pivot}_{axial|radial}_m``,
+    ``rotation_{pivot}_rad`` (model car) and ``reference_deflection_{pivot}_{axial|radial}_m``,
+    ``reference_rotation_{pivot}_rad`` (its twin; all sampled at the step's start, where the
+    forces are). Verdict: ``error_n, roll_error_rad,
     model_out_of_bounds, reference_out_of_bounds, monitor_verdict, diverged, physical_limit,
     divergence_reason, model_error``, ``reference_outside_range`` (why a twin's pivot judges
     beyond the rotation its law is calibrated for, "" if none does).
@@ -293,12 +295,14 @@ class HalfCarEnv(gym.Env):
                                 "road_right_m": r_r, "lateral_accel_m_per_s2": ay}  # fmt: skip
         info.update(out_m)
         info.update(zip(_reference_keys(out_r), out_r.values(), strict=True))
-        q, f_m, f_r = sample_m[0].tolist(), sample_m[2].tolist(), sample_r[2].tolist()
-        for i, (force_keys, motion_keys) in enumerate(PIVOT_KEYS):
+        q, q_r = sample_m[0].tolist(), sample_r[0].tolist()
+        f_m, f_r = sample_m[2].tolist(), sample_r[2].tolist()
+        for i, (force_keys, motion_keys, reference_keys) in enumerate(PIVOT_KEYS):
             for c, (key_m, key_r) in enumerate(force_keys):
                 info[key_m] = f_m[i][c]
                 info[key_r] = f_r[i][c]
             info.update(zip(motion_keys, q[i], strict=True))
+            info.update(zip(reference_keys, q_r[i], strict=True))
         info["error_n"] = max(
             math.hypot(a[0] - b[0], a[1] - b[1]) for a, b in zip(f_m, f_r, strict=True)
         )

@@ -1,0 +1,234 @@
+"""HalfCarBatch: the HalfCar-v0 car for many manoeuvres at once, as arrays (searches over roads
+and steering, the error-transfer map).
+
+The car is the env's: ``halfcar_batch_layout`` reads the pymunk ``HalfCar``'s bodies, anchors,
+rest lengths and element order into arrays, and ``halfcar_batch_kernels`` steps them with
+chipmunk's own scheme (the kernel's docstring gives the one difference: every damper implicit
+Euler at the current configuration). The coupling is the env's split: at every model step each
+pivot's model gets (q, v) (axial m, radial m, rotation rad; the env's frames) of the arm's inner
+end relative to the chassis and the remainder F - (k_in q + c_in v) is held over the sub-steps
+(as a shifted rest length or rest angle) while k_in q + c_in v acts inside them. The bushing
+models step as one batch: a model given once for all four pivots runs 4 B histories (car b,
+pivot i is history 4 b + i), a table of four models B histories each.
+
+Interface::
+
+    batch = HalfCarBatch(B, model="linear", reference="rubber")  # any HalfCar-v0 kwarg
+    out = batch.step(road_left, road_right, lateral_accel)        # each (B,): m, m, m/s^2
+    out = batch.simulate(road_left=(T,) or (T, B), road_right=..., lateral_accel=..., keys=...)
+
+``step`` returns (B,) arrays under the env's ``info`` keys (``RESULT_KEYS``: inputs, each car's
+body, wheel and geometry outputs, the twin's with ``reference_``, every pivot's forces and
+deflections in both cars, ``error_n``, ``roll_error_rad``, ``diverged``, ``physical_limit``).
+``simulate`` runs whole manoeuvres from rest (checked against the env's limits, as
+``reset(options=...)``) and returns (T, B) arrays of ``keys`` (default all) plus ``diverged``,
+``divergence_step`` (-1 if none) and ``physical_limit`` (B,). A car that leaves its bounds stops
+moving (its later samples repeat its last state); its verdict is the env's: the model car out
+of bounds while its twin is not. Agreement with the pymunk env: docs/envs.md ("HalfCar-v0").
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from bushenv.errors import ModelRaised
+from bushenv.rigs.common import MODEL_ERRORS, RigError, positive_int, reset_columns
+from bushenv.rigs.coupling import LONG_ARM_M
+from bushenv.rigs.halfcar_batch_kernels import PY, VY, bushing_motion_kernel, substeps_kernel
+from bushenv.rigs.halfcar_batch_layout import ROAD, layout
+from bushenv.rigs.halfcar_batch_outputs import RESULT_KEYS, car_outputs, out_of_bounds, result
+from bushenv.rigs.halfcar_inputs import replay_inputs
+from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, SIDES, HalfCarParameters
+from bushenv.rigs.specs import spec_kwargs
+
+ITERATIONS = 10  # chipmunk's damper sweeps per sub-step: pymunk's default, as the env's space
+
+
+class HalfCarBatch:
+    """B half cars and, with ``with_reference``, B twins on the reference bushings (columns:
+    the model cars, then the twins). See the module docstring for the interface."""
+
+    def __init__(self, num_cars: int, *, with_reference: bool = True, **spec_overrides: Any):
+        self.num_cars = n = positive_int("num_cars", num_cars)
+        self.params = p = HalfCarParameters(spec_kwargs(ENV_ID, spec_overrides))
+        self.groups = [("model", p.models)]
+        if with_reference:
+            self.groups.append(("reference", p.references))
+        self.with_reference = with_reference
+        cols = n * len(self.groups)
+        tables = [layout(p, role) for role, _ in self.groups]
+        t = self._table = tables[0]
+        self._rest0 = np.repeat(np.stack([x.rest for x in tables]), n, axis=0).T.copy()
+        self._stiff = np.repeat(np.stack([x.stiff for x in tables]), n, axis=0).T.copy()
+        self._damp = np.repeat(np.stack([x.damp for x in tables]), n, axis=0).T.copy()
+        self._split = np.repeat(np.stack([x.split for x in tables]), n, axis=0)  # (cols, 4, 2, 3)
+        self._state0 = np.repeat(t.state[:, :, None], cols, axis=2)
+        self.state = self._state0.copy()
+        self.rest = self._rest0.copy()
+        self.contact = np.ones((2, cols))
+        self.active = np.ones(cols, dtype=bool)
+        self.diverged = np.zeros(n, dtype=bool)
+        self.reference_out = np.zeros(n, dtype=bool)
+        self.raised = {role: "" for role, _ in self.groups}
+        self._q = np.zeros((cols, 4, 3))
+        self._v = np.zeros((cols, 4, 3))
+        self._inputs = np.zeros((3, n))
+        self._prev_v = np.zeros((2, cols))
+        self._t = 0
+        self.reset()
+
+    # ----- episodes ---------------------------------------------------------------------------
+    def reset(self) -> None:
+        """Every car back to rest on flat roads, no lateral load; the models' histories too."""
+        self.reset_columns(np.ones(self.num_cars, dtype=bool))
+        self._t = 0
+
+    def reset_columns(self, mask: np.ndarray) -> None:
+        """Cars ``mask`` (B,) bool (and their twins) back to rest, their models' histories
+        too; the other cars go on as they are."""
+        n = self.num_cars
+        mask = np.asarray(mask, dtype=bool).reshape(n)
+        both = np.tile(mask, len(self.groups))
+        self.state[:, :, both] = self._state0[:, :, both]
+        self.rest[:, both] = self._rest0[:, both]
+        self.contact[:, both] = 1.0
+        self.active[both] = True
+        self._prev_v[:, both] = 0.0
+        self._inputs[:, mask] = 0.0
+        self.diverged[mask] = False
+        self.reference_out[mask] = False
+        rows = np.repeat(mask, len(POSITIONS))
+        for _, models in self.groups:
+            if isinstance(models, dict):
+                for m in models.values():
+                    if mask.all():
+                        m.reset(n)
+                    else:
+                        reset_columns(m, mask)
+            elif mask.all():
+                models.reset(n * len(POSITIONS))
+            else:
+                reset_columns(models, rows)
+
+    # ----- one model step ---------------------------------------------------------------------
+    def step(self, road_left, road_right, lateral_accel) -> dict[str, np.ndarray]:
+        """One model step to the inputs (each (B,) or a scalar: m, m, m/s^2): the env's
+        ``step`` for B cars. Returns (B,) arrays under ``RESULT_KEYS``."""
+        p, n = self.params, self.num_cars
+        now = np.empty((3, n))
+        for i, x in enumerate((road_left, road_right, lateral_accel)):
+            now[i] = np.broadcast_to(np.asarray(x, dtype=np.float64), (n,))
+        before, self._inputs = self._inputs, now
+        bushing_motion_kernel(
+            self.state, self._table.pivot_arm, self._table.pivot_sign,
+            self._table.pivot_anchor_arm, self._table.pivot_anchor_chassis, self._q, self._v,
+        )  # fmt: skip
+        q, v = self._q.copy(), self._v.copy()
+        forces, why = self._sample(q, v)
+        g = len(self.groups)
+        for k, side in enumerate(SIDES):
+            self.state[VY, ROAD[side]] = np.tile((now[k] - before[k]) / p.dt, g)
+        gx = np.tile(-(before[2] + now[2]) / 2, g)
+        h_car = np.where(self.active, p.h, 0.0)
+        t = self._table
+        substeps_kernel(
+            self.state, self.rest, self._stiff, self._damp, self.contact, gx, h_car,
+            p.substeps, ITERATIONS, t.kind, t.ia, t.ib, t.side, t.anchors, t.m_inv, t.i_inv,
+            p.k_t, -p.tyre_static_n, p.c_t, p.k_y, p.c_y,
+        )  # fmt: skip
+        for k, side in enumerate(SIDES):  # the road exactly where the step put it, at rest
+            r = ROAD[side]
+            self.state[PY, r] = np.where(self.active, np.tile(now[k], g), self.state[PY, r])
+            self.state[VY, r] = 0.0
+        self._t += 1
+        roads = np.tile(now[:2], g)
+        road_v = np.tile((now[:2] - before[:2]) / p.dt, g)
+        ay = np.tile(now[2], g)
+        out = car_outputs(p, self.state, self.contact, roads, road_v, self._prev_v, ay)
+        bad = (why | out_of_bounds(p, out, q)) & self.active
+        self.active &= ~bad
+        if self.with_reference:
+            self.reference_out |= bad[n:]
+            self.diverged |= bad[:n] & ~self.reference_out
+        else:
+            self.diverged |= bad[:n]
+        return result(self, now, out, q, forces)
+
+    def _sample(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every car's (cols, 4, 3) pivot forces at t_k and why they cannot be applied ((cols,)
+        bool: raised, not finite, beyond the limits); the others' remainders held."""
+        p, n = self.params, self.num_cars
+        forces = np.empty_like(q)
+        for g, (role, models) in enumerate(self.groups):
+            cols = slice(g * n, (g + 1) * n)
+            self.raised[role] = ""
+            try:
+                if isinstance(models, dict):
+                    for i, k in enumerate(POSITIONS):
+                        forces[cols, i] = models[k].step(q[cols, i].copy(), v[cols, i].copy())
+                else:
+                    f = models.step(q[cols].reshape(-1, 3), v[cols].reshape(-1, 3))
+                    forces[cols] = np.asarray(f).reshape(n, len(POSITIONS), 3)
+            except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
+                forces[cols] = np.nan
+                self.raised[role] = f"model raised {type(exc).__name__}: {exc}"
+            except ModelRaised:
+                raise
+            except Exception as exc:  # the model's own bug: an error, never a verdict
+                raise ModelRaised(f"{role} (half car pivots)", exc) from exc
+        limits = np.array([p.force_limit, p.force_limit, p.moment_limit])
+        with np.errstate(invalid="ignore"):
+            ok = (np.abs(forces) <= limits).all(axis=(1, 2))  # False where NaN
+        k_in, c_in = self._split[:, :, 0], self._split[:, :, 1]
+        held = forces - (k_in * q + c_in * v)
+        t = self._table
+        sign = t.pivot_sign
+        for i in range(len(POSITIONS)):
+            for c in range(2):
+                e = t.bushing_rows[i, c]
+                self.rest[e, ok] = LONG_ARM_M - held[ok, i, c] / k_in[ok, i, c]
+            e = t.bushing_rows[i, 2]  # the rotary spring is unmirrored: chipmunk's own angle
+            self.rest[e, ok] = sign[i] * held[ok, i, 2] / k_in[ok, i, 2]
+        return forces, ~ok
+
+    # ----- whole manoeuvres -------------------------------------------------------------------
+    def simulate(
+        self, road_left=None, road_right=None, lateral_accel=None, keys=None
+    ) -> dict[str, np.ndarray]:
+        """Whole manoeuvres from rest: each input (T,) (every car) or (T, B), the absent ones
+        zero; returns (T, B) arrays of ``keys`` (default ``RESULT_KEYS``) plus ``diverged``,
+        ``divergence_step`` and ``physical_limit`` (B,)."""
+        n = self.num_cars
+        given = {"road_left": road_left, "road_right": road_right, "lateral_accel": lateral_accel}
+        cols = {k: np.asarray(x, dtype=np.float64) for k, x in given.items() if x is not None}
+        if not cols:
+            raise RigError(f"{ENV_ID}: simulate needs at least one of {list(given)}")
+        for k, x in cols.items():
+            if x.ndim not in (1, 2) or (x.ndim == 2 and x.shape[1] != n):
+                raise RigError(f"{ENV_ID}: {k} must be (T,) or (T, {n}), got {x.shape}")
+        length = {x.shape[0] for x in cols.values()}
+        if len(length) > 1:
+            raise RigError(f"{ENV_ID}: the inputs differ in length: {sorted(length)}")
+        T = length.pop()
+        full = {k: np.broadcast_to(x.reshape(T, -1), (T, n)) for k, x in cols.items()}
+        for j in range(n):  # the env's limits on a replayed manoeuvre, column by column
+            replay_inputs(self.params, {k: x[:, j] for k, x in full.items()})
+        inputs = [full.get(k, np.zeros((T, n))) for k in given]
+        keys = RESULT_KEYS if keys is None else tuple(keys)
+        unknown = sorted(set(keys) - set(RESULT_KEYS))
+        if unknown:
+            raise RigError(f"{ENV_ID}: unknown output key(s) {unknown}; known: {RESULT_KEYS}")
+        self.reset()
+        rows = {k: np.empty((T, n)) for k in keys}
+        first = np.full(n, -1)
+        for t in range(T):
+            out = self.step(inputs[0][t], inputs[1][t], inputs[2][t])
+            first[(first < 0) & out["diverged"]] = t
+            for k in keys:
+                rows[k][t] = out[k]
+        rows["diverged"] = self.diverged.copy()
+        rows["divergence_step"] = first
+        rows["physical_limit"] = self.reference_out.copy()
+        return rows

@@ -1,0 +1,113 @@
+"""What ``HalfCarBatch`` reads off its cars each step, as arrays: ``halfcar_outputs``' body,
+wheel and geometry outputs and its bounds, for every column at once, and the step's result
+under the env's ``info`` keys."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from bushenv.rigs.halfcar_batch_kernels import ANG, PX, PY, VX, VY, W
+from bushenv.rigs.halfcar_batch_layout import UPRIGHT
+from bushenv.rigs.halfcar_outputs import PIVOT_KEYS
+from bushenv.rigs.halfcar_params import SIDES, HalfCarParameters
+
+SIGN = {"left": 1.0, "right": -1.0}
+CAR_KEYS = (
+    "body_y_m", "body_x_m", "body_vx_m_per_s", "body_vy_m_per_s",
+    "body_vertical_accel_m_per_s2", "body_lateral_accel_m_per_s2", "roll_rad",
+    "roll_rate_rad_per_s",
+    *(f"{k}_{side}{u}" for side in SIDES
+      for k, u in (("wheel_load", "_n"), ("wheel_lift", ""), ("camber", "_rad"),
+                   ("travel", "_m"), ("wheel", "_y_m"))),
+    "track_change_m",
+)  # fmt: skip
+INPUT_KEYS = ("road_left_m", "road_right_m", "lateral_accel_m_per_s2")
+RESULT_KEYS = (
+    *INPUT_KEYS,
+    *CAR_KEYS,
+    *("reference_" + k for k in CAR_KEYS),
+    *(k for force_keys, _, _ in PIVOT_KEYS for pair in force_keys for k in pair),
+    *(k for _, motion, reference in PIVOT_KEYS for k in (*motion, *reference)),
+    "error_n", "roll_error_rad", "diverged", "physical_limit",
+)  # fmt: skip
+
+
+def car_outputs(
+    p: HalfCarParameters, S: np.ndarray, contact: np.ndarray, roads, road_v, prev_v, ay
+) -> dict[str, np.ndarray]:
+    """``halfcar_outputs.car_outputs`` of every column of state ``S`` after a step: ``roads``,
+    ``road_v`` (2, N) the road heights and their speeds over the step, ``prev_v`` (2, N) the
+    bodies' (vx, vy) a step ago (updated), ``ay`` (N,) the lateral load."""
+    x, y, vx, vy = S[PX, 0], S[PY, 0], S[VX, 0], S[VY, 0]
+    phi = S[ANG, 0]
+    out = {
+        "body_y_m": y - p.h_cg, "body_x_m": x.copy(), "body_vx_m_per_s": vx.copy(),
+        "body_vy_m_per_s": vy.copy(), "body_vertical_accel_m_per_s2": (vy - prev_v[1]) / p.dt,
+        "body_lateral_accel_m_per_s2": ay + (vx - prev_v[0]) / p.dt,
+        "roll_rad": phi.copy(), "roll_rate_rad_per_s": S[W, 0].copy(),
+    }  # fmt: skip
+    prev_v[0], prev_v[1] = vx, vy
+    cos, sin = np.cos(phi), np.sin(phi)
+    contact_x = []
+    for k, side in enumerate(SIDES):
+        u = UPRIGHT[side]
+        psi = S[ANG, u]
+        wx, wy = S[PX, u], S[PY, u]
+        sp, cp = np.sin(psi), np.cos(psi)
+        cx, cy = wx + sp * p.r_w, wy - cp * p.r_w
+        cvy = S[VY, u] + S[W, u] * sp * p.r_w
+        contact_x.append(cx)
+        load = p.k_t * (roads[k] - cy) + np.where(contact[k] > 0, p.c_t * (road_v[k] - cvy), 0.0)
+        load = np.maximum(p.tyre_static_n + load, 0.0)
+        out[f"wheel_load_{side}_n"] = load
+        out[f"wheel_lift_{side}"] = load <= 0.0
+        out[f"camber_{side}_rad"] = -SIGN[side] * psi
+        out[f"travel_{side}_m"] = -sin * (wx - x) + cos * (wy - y) - (p.r_w - p.h_cg)
+        out[f"wheel_{side}_y_m"] = wy - p.r_w
+    out["track_change_m"] = contact_x[0] - contact_x[1] - p.track
+    return out
+
+
+def out_of_bounds(p: HalfCarParameters, out: dict[str, np.ndarray], q: np.ndarray) -> np.ndarray:
+    """(N,) bool: ``halfcar_outputs.out_of_bounds`` of every column (``q`` (N, 4, 3) the
+    pivots' deflections at the step's start)."""
+    body = np.stack([out["body_x_m"], out["body_y_m"], out["wheel_left_y_m"],
+                     out["wheel_right_y_m"]])  # fmt: skip
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(body).all(axis=0) | ~np.isfinite(out["roll_rad"])
+        bad |= ~np.isfinite(q).all(axis=(1, 2))
+        bad |= np.abs(q[:, :, :2]).max(axis=(1, 2)) > p.max_deflection
+        bad |= np.abs(out["roll_rad"]) > p.max_roll
+        for side in SIDES:
+            bad |= np.abs(out[f"travel_{side}_m"]) > p.max_travel
+        bad |= np.abs(body).max(axis=0) > p.max_body
+    return bad
+
+
+def result(batch: Any, now: np.ndarray, out: dict[str, np.ndarray], q, forces) -> dict:
+    """The step's (B,) arrays under ``RESULT_KEYS`` (the reference keys only with twins)."""
+    n = batch.num_cars
+    res: dict[str, np.ndarray] = dict(zip(INPUT_KEYS, now.copy(), strict=True))
+    twins = batch.with_reference
+    for k, v in out.items():
+        res[k] = v[:n]
+        if twins:
+            res["reference_" + k] = v[n:]
+    for i, (force_keys, motion, reference) in enumerate(PIVOT_KEYS):
+        for c, (key_m, key_r) in enumerate(force_keys):
+            res[key_m] = forces[:n, i, c]
+            if twins:
+                res[key_r] = forces[n:, i, c]
+        for c in range(3):
+            res[motion[c]] = q[:n, i, c]
+            if twins:
+                res[reference[c]] = q[n:, i, c]
+    if twins:
+        d = forces[:n, :, :2] - forces[n:, :, :2]
+        res["error_n"] = np.hypot(d[..., 0], d[..., 1]).max(axis=1)
+        res["roll_error_rad"] = res["roll_rad"] - res["reference_roll_rad"]
+    res["diverged"] = batch.diverged.copy()
+    res["physical_limit"] = batch.reference_out.copy()
+    return res
