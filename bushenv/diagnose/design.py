@@ -133,7 +133,7 @@ class ColumnStore:
             elif block == DAMPER:
                 cols = prep.signals.v[:, None].copy()
             else:
-                cols = get_effect(block[0]).columns(prep.signals, block[1], self.scales)
+                cols = get_effect(block[0]).block_columns(prep.signals, block[1], self.scales)
             self._cols[key] = np.ascontiguousarray(cols)
         return self._cols[key]
 

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose import evidence, regimes, rule
+from bushenv.diagnose import evidence, partner, regimes, rule
 from bushenv.diagnose.candidates import candidate_sets, get_effect
 from bushenv.diagnose.coordinates import coordinate_count, diagnose_coordinates
 from bushenv.diagnose.design import ColumnStore, Prepared
@@ -126,7 +126,12 @@ def _judge_all(run: Run, effects, say: Progress, ctx: rule.Context) -> tuple[lis
         r["members"] = sorted(r["members"], key=order.index)
         r["effect"] = "+".join(r["members"])
     rule.mark_pairs(singles, pairs, ctx)
-    return singles, rule.rank(pairs, order, ctx)
+    pairs = rule.rank(pairs, order, ctx)
+    say("which: each partner beside the other's richest form")
+    partner.check_partners(
+        pairs, lambda c: run.row(judge(run.store, c, run.folds, run.linear_base)), ctx
+    )
+    return singles, pairs
 
 
 def _test_only_hint(run: Run, te: list[Prepared], singles: list[dict]) -> list[dict]:

@@ -9,7 +9,7 @@ record in the cross mode (all others fit, that one is judged).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -17,7 +17,7 @@ from scipy import linalg
 from scipy.optimize import lsq_linear, minimize_scalar
 
 from bushenv.diagnose.design import DAMPER, SPRING, Block, ColumnStore, Prepared
-from bushenv.diagnose.effects.base import Combination
+from bushenv.diagnose.effects.base import Combination, Nuisance
 from bushenv.diagnose.effects.timeshift import shift_columns
 
 
@@ -40,6 +40,8 @@ class Fit:
     mse: float  # on the records fitted
     n: int  # samples fitted
     force_ms: float  # mean square of the force fitted (for a relative fitting error)
+    nuisance: tuple[Block, ...] = ()  # per-record blocks (a warm start), fitted per record
+    nuisance_w: dict = field(default_factory=dict)  # record uid -> its own weights
 
     @property
     def delay_s(self) -> float:
@@ -83,6 +85,15 @@ def blocks_of(store: ColumnStore, combo: Combination, shapes: tuple, linear_base
     return tuple(blocks)
 
 
+def nuisance_of(store: ColumnStore, combo: Combination, shapes: tuple) -> tuple[Block, ...]:
+    """The per-record blocks of ``combo`` at ``shapes`` (a warm start), if any."""
+    out = []
+    for m, s in zip(combo.members, shapes, strict=True):
+        if m.columns_count(Nuisance(s), store.scales) > 0:
+            out.append((m.name, Nuisance(s)))
+    return tuple(out)
+
+
 def fit(
     store: ColumnStore,
     combo: Combination,
@@ -90,27 +101,48 @@ def fit(
     records: tuple[Prepared, ...],
     linear_base: bool,
 ) -> Fit:
-    """Weights of ``combo`` at ``shapes`` by bounded least squares on ``records``."""
+    """Weights of ``combo`` at ``shapes`` by bounded least squares on ``records``; per-record
+    blocks (``nuisance_of``) get weights of their own on each record, fitted jointly."""
     blocks = blocks_of(store, combo, shapes, linear_base)
+    nuis = nuisance_of(store, combo, shapes)
     delay = sum(m.delay_s(s) for m, s in zip(combo.members, shapes, strict=True))
-    g = sum(store.gram(p, blocks) for p in records)
-    b = np.zeros(g.shape[0])
-    yy = 0.0
-    for p in records:
-        bp, yp = store.rhs(p, blocks, delay)
-        b = b + bp
+    p_ = sum(store.columns_count(b) for b in blocks)
+    q = sum(store.columns_count(b) for b in nuis)
+    size = p_ + q * len(records)
+    g, b, yy = np.zeros((size, size)), np.zeros(size), 0.0
+    for i, p in enumerate(records):
+        gp = store.gram(p, blocks + nuis)
+        bp, yp = store.rhs(p, blocks + nuis, delay)
+        o = p_ + i * q
+        g[:p_, :p_] += gp[:p_, :p_]
+        b[:p_] += bp[:p_]
         yy += yp
+        if q:
+            g[:p_, o : o + q], g[o : o + q, :p_] = gp[:p_, p_:], gp[p_:, :p_]
+            g[o : o + q, o : o + q], b[o : o + q] = gp[p_:, p_:], bp[p_:]
     n = sum(p.n for p in records)
-    theta = bounded_lstsq(g, b, store.lower(blocks), n)
-    mse = max(float(yy - 2 * theta @ b + theta @ g @ theta) / n, 0.0)
+    lower = np.concatenate([store.lower(blocks), np.zeros(size - p_)])
+    w = bounded_lstsq(g, b, lower, n)
+    mse = max(float(yy - 2 * w @ b + w @ g @ w) / n, 0.0)
     force_ms = float(sum(np.sum(p.force**2) for p in records)) / n
-    return Fit(combo, tuple(shapes), blocks, theta, mse, n, force_ms)
+    own = {p.uid: w[p_ + i * q : p_ + (i + 1) * q] for i, p in enumerate(records)} if q else {}
+    return Fit(combo, tuple(shapes), blocks, w[:p_], mse, n, force_ms, nuis, own)
 
 
 def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
-    """The fitted model's force on one record (N), (T,)."""
+    """The fitted model's force on one record (N), (T,). A per-record block gets the weights
+    the record was fitted with, or, on a judged record, the mean of the fitted records' (its
+    own start is not known before it is judged: fitting it there would give every judged
+    record a spring and damper of its own)."""
     a = store.design(prep, f.blocks)
-    return shift_columns(prep.b0 + a @ f.theta, f.delay_s, prep.dt)
+    out = prep.b0 + a @ f.theta
+    if f.nuisance:
+        wn = store.design(prep, f.nuisance)
+        own = f.nuisance_w.get(prep.uid)
+        if own is None:
+            own = np.mean(list(f.nuisance_w.values()), axis=0)
+        out = out + wn @ own
+    return shift_columns(out, f.delay_s, prep.dt)
 
 
 def _product(grids: list[list]) -> list[tuple]:
@@ -232,4 +264,7 @@ def parameters(store: ColumnStore, f: Fit, linear_base: bool) -> dict[str, Any]:
     for m, s in zip(f.combo.members, f.shapes, strict=True):
         if m.name not in out:
             out[m.name] = m.parameters(s, store.scales, np.zeros(0))
+        if any(b[0] == m.name for b in f.nuisance):
+            ws = list(f.nuisance_w.values())
+            out[m.name].update(m.nuisance_parameters(s, store.scales, ws))
     return out

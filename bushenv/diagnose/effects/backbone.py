@@ -9,6 +9,7 @@ import numpy as np
 from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 KNOTS = (0.25, 0.5, 0.8)  # fractions of the largest deflection
+RICH_KNOTS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)  # the richest form's
 GRID = 4001  # points of the tangent's integral table
 EXAMPLE_GROWTH = 1.5  # tangent 2.5 k at the last knot: about 78 % more force at the top
 
@@ -55,6 +56,15 @@ def _integrated(mag: np.ndarray, scales: Scales) -> np.ndarray:
     return np.stack([np.interp(mag, s, table[:, j]) for j in range(h.shape[1])], axis=1)
 
 
+def _ramp_integral(mag: np.ndarray, a: float, b: float | None) -> np.ndarray:
+    """int_0^mag of a tangent that rises linearly from 0 at ``a`` to 1 at ``b`` and stays 1
+    (``b`` == ``a``: a step at ``a``), in m."""
+    if b is None or b <= a:
+        return np.maximum(mag - a, 0.0)
+    u = np.clip(mag, a, b)
+    return (u - a) ** 2 / (2 * (b - a)) + np.maximum(mag - b, 0.0)
+
+
 def _two_sided(scales: Scales) -> bool:
     return bool(scales.x_pos) and bool(scales.x_neg)
 
@@ -92,6 +102,27 @@ class Hardening(Effect):
                 [cols, np.maximum(x, 0.0)[:, None], np.minimum(x, 0.0)[:, None]], axis=1
             )
         return cols
+
+    def rich_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        """Tangent hats on knots every 10 % of the range, growth up to (x/x90)^6, and, when
+        both sides are loaded, each side's own constant and quadratic growth of the tangent:
+        any monotone backbone, asymmetric too (all weights tangent stiffnesses >= 0)."""
+        x = s.x
+        top = max([q[-1] for q in (scales.x_pos, scales.x_neg) if q] or [scales.sigma_x])
+        k = [0.0] + [f * max(top, 1e-12) for f in RICH_KNOTS]
+        mag = np.abs(x)
+        cols = [mag - _ramp_integral(mag, 0.0, k[1])]  # tangent 1 at 0, falling to 0 at k1
+        for i in range(1, len(k) - 1):  # hats rising from k[i-1] to k[i], falling to k[i+1]
+            cols.append(_ramp_integral(mag, k[i - 1], k[i]) - _ramp_integral(mag, k[i], k[i + 1]))
+        cols.append(_ramp_integral(mag, k[-2], k[-1]))  # the plateau beyond the last knot
+        r = mag / k[-1]
+        cols += [k[-1] * r**3 / 3, k[-1] * r**5 / 5, k[-1] * r**7 / 7]
+        out = np.sign(x)[:, None] * np.stack(cols, axis=1)
+        if _two_sided(scales):
+            for side in (np.maximum(x, 0.0), np.minimum(x, 0.0)):
+                extra = np.stack([side, side**3 / (3 * k[-1] ** 2)], axis=1)
+                out = np.concatenate([out, extra], axis=1)
+        return out
 
     def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
         """The spring k (the hats and the plateau sum to a constant tangent) plus a

@@ -175,6 +175,36 @@ class Effect(ABC):
         """Time shift of the whole predicted force (only the delay has one)."""
         return 0.0
 
+    def rich_shapes(self, scales: Scales) -> list:
+        """The shapes of the richest admissible form (default: the usual ones)."""
+        return self.shapes(scales)
+
+    def rich_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        """Regressors of the effect's richest admissible form: a wider spectrum, more
+        elements, a freer shape within the same physics (default: the usual columns).
+        A partner is named beside this effect only when it adds to this form."""
+        return self.columns(s, shape, scales)
+
+    def nuisance_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        """(T, q) columns whose weights (>= 0) each record has of its own, fitted on that
+        record even when it is judged (a state the record starts in that no other record
+        can tell: the heat of a specimen that ran before). Default: none."""
+        return np.zeros((s.x.size, 0))
+
+    def nuisance_parameters(self, shape: Any, scales: Scales, ws: list) -> dict[str, Any]:
+        """The per-record weights ``ws`` in physical terms (default: none)."""
+        return {}
+
+    def block_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        """``columns``; ``rich_columns`` for a ``Richest`` shape, ``nuisance_columns`` for a
+        ``Nuisance`` one (of the rich shape too): what the fits call."""
+        if isinstance(shape, Nuisance):
+            inner = shape.inner.inner if isinstance(shape.inner, Richest) else shape.inner
+            return self.nuisance_columns(s, inner, scales)
+        if isinstance(shape, Richest):
+            return self.rich_columns(s, shape.inner, scales)
+        return self.columns(s, shape, scales)
+
     def forward(
         self, s: Signals, force: np.ndarray, shape: Any, w: np.ndarray, scales: Scales
     ) -> np.ndarray:
@@ -204,10 +234,26 @@ class Effect(ABC):
 PROBE_SAMPLES = 16
 
 
+@dataclass(frozen=True)
+class Richest:
+    """A shape marker: the effect's richest admissible form at shape ``inner``
+    (``Effect.rich_columns``), used only to test whether a partner adds to it."""
+
+    inner: Any
+
+
+@dataclass(frozen=True)
+class Nuisance:
+    """A shape marker: the effect's per-record columns at shape ``inner``
+    (``Effect.nuisance_columns``), whose weights each record has of its own."""
+
+    inner: Any
+
+
 @lru_cache(maxsize=4096)
 def _probed_count(cls: type[Effect], shape: Any, scales: Scales) -> int:
     x = scales.sigma_x * np.sin(np.linspace(0.0, 3.0, PROBE_SAMPLES))
-    return int(cls().columns(Signals(x, scales.dt), shape, scales).shape[1])
+    return int(cls().block_columns(Signals(x, scales.dt), shape, scales).shape[1])
 
 
 RESERVED_NAMES = ("none",)  # the answer "no effect"; "+" joins the names of a pair

@@ -9,6 +9,7 @@ import numpy as np
 from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 DELAY_GRID_S = tuple(float(d) for d in 1e-3 * np.geomspace(0.25, 40.0, 25))
+RICH_DELAY_GRID_S = tuple(float(d) for d in 1e-3 * np.geomspace(0.1, 60.0, 48))
 EXAMPLE_DELAY_S = 6e-3  # between grid values: the shape search must refine it
 
 
@@ -27,6 +28,9 @@ class Delay(Effect):
 
     def shapes(self, scales: Scales) -> list:
         return list(DELAY_GRID_S)
+
+    def rich_shapes(self, scales: Scales) -> list:
+        return list(RICH_DELAY_GRID_S)
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         return np.zeros((s.x.size, 0))  # no weights: the shift is all of it

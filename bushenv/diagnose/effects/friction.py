@@ -11,6 +11,8 @@ from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 DAHL_FRACTIONS = np.array([0.003, 0.01, 0.03, 0.1, 0.3, 1.0])  # x_j / sigma_x
 PAYNE_MEMORY_S = (2.0, 20.0)  # decay times of the amplitude envelope
+RICH_FRACTIONS = np.geomspace(0.001, 3.0, 15)  # the richest form: a denser, wider Iwan set
+RICH_MEMORY_S = (0.5, 2.0, 8.0, 30.0, 120.0)
 EXAMPLE_SLIP = (0.03, 0.45)  # slip length / sigma_x, slip force / (k sigma_x)
 
 
@@ -44,6 +46,18 @@ def amplitude_envelope(x, decay):  # pragma: no cover - compiled
     return out
 
 
+def _friction_columns(s: Signals, scales: Scales, fractions, memories_s) -> np.ndarray:
+    xs = np.asarray(fractions) * scales.sigma_x
+    out = np.empty((s.x.size, xs.size + len(memories_s)))
+    dahl = np.empty((s.x.size, xs.size))
+    dahl_states(s.x, xs, dahl)
+    out[:, : xs.size] = dahl
+    for m, tau in enumerate(memories_s):
+        env = amplitude_envelope(s.x, float(np.exp(-s.dt / tau)))
+        out[:, xs.size + m] = -s.x * env / scales.sigma_x
+    return out
+
+
 class Friction(Effect):
     """Dahl elements of several slip lengths plus stiffness lost with the recent amplitude.
 
@@ -67,15 +81,10 @@ class Friction(Effect):
     )
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
-        xs = DAHL_FRACTIONS * scales.sigma_x
-        out = np.empty((s.x.size, xs.size + len(PAYNE_MEMORY_S)))
-        dahl = np.empty((s.x.size, xs.size))
-        dahl_states(s.x, xs, dahl)
-        out[:, : xs.size] = dahl
-        for m, tau in enumerate(PAYNE_MEMORY_S):
-            env = amplitude_envelope(s.x, float(np.exp(-s.dt / tau)))
-            out[:, xs.size + m] = -s.x * env / scales.sigma_x
-        return out
+        return _friction_columns(s, scales, DAHL_FRACTIONS, PAYNE_MEMORY_S)
+
+    def rich_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        return _friction_columns(s, scales, RICH_FRACTIONS, RICH_MEMORY_S)
 
     def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
         """One stiff element (slip at 3 % of sigma_x, slip force 0.45 k sigma_x): nearly a

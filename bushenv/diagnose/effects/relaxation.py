@@ -12,6 +12,9 @@ from bushenv.diagnose.effects.base import Effect, Scales, Signals
 PER_DECADE = 3  # Maxwell branches per decade of relaxation time
 TAU_MIN_S = 1e-2  # shorter times look like damping and a negative mass (a delay)
 TAU_MAX_S = 1e4
+RICH_PER_DECADE = 6  # the richest form: twice as dense, from 5 ms to 10 x the longest record
+RICH_TAU_MIN_S = 5e-3
+RICH_SPAN = 10.0
 EXAMPLE_BRANCHES = ((0.1, 0.5), (1.0, 0.3))  # (tau_s, k_i / k) of a typical rubber
 
 
@@ -23,13 +26,15 @@ def maxwell_state(x: np.ndarray, dt: float, tau: float) -> np.ndarray:
     return x - signal.lfilter(b, [1.0, -a], x)
 
 
-def tau_grid_s(scales: Scales) -> np.ndarray:
-    """Relaxation times from max(2 dt, TAU_MIN_S) to twice the longest record, PER_DECADE per
-    decade (s)."""
-    lo = max(2.0 * scales.dt, TAU_MIN_S)
-    hi = min(max(2.0 * scales.duration_s, 4.0 * lo), TAU_MAX_S)
-    n = int(np.floor(np.log10(hi / lo) * PER_DECADE)) + 1
-    return lo * 10.0 ** (np.arange(n) / PER_DECADE)
+def tau_grid_s(
+    scales: Scales, tau_min_s: float = TAU_MIN_S, span: float = 2.0, per_decade: int = PER_DECADE
+) -> np.ndarray:
+    """Relaxation times from max(2 dt, ``tau_min_s``) to ``span`` x the longest record,
+    ``per_decade`` per decade (s)."""
+    lo = max(2.0 * scales.dt, tau_min_s)
+    hi = min(max(span * scales.duration_s, 4.0 * lo), TAU_MAX_S)
+    n = int(np.floor(np.log10(hi / lo) * per_decade)) + 1
+    return lo * 10.0 ** (np.arange(n) / per_decade)
 
 
 class Relaxation(Effect):
@@ -54,6 +59,10 @@ class Relaxation(Effect):
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         return np.stack([maxwell_state(s.x, s.dt, t) for t in tau_grid_s(scales)], axis=1)
+
+    def rich_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        taus = tau_grid_s(scales, RICH_TAU_MIN_S, RICH_SPAN, RICH_PER_DECADE)
+        return np.stack([maxwell_state(s.x, s.dt, t) for t in taus], axis=1)
 
     def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
         """Two branches, k_i = 0.5 k and 0.3 k, at the grid's times nearest 0.1 s and 1 s."""

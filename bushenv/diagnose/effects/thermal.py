@@ -10,6 +10,7 @@ from scipy import signal
 from bushenv.diagnose.effects.base import Effect, Scales, Signals
 
 TIME_CONSTANTS_S = (10.0, 30.0, 100.0, 300.0, np.inf)
+RICH_TIME_CONSTANTS_S = (5.0, 10.0, 20.0, 30.0, 60.0, 100.0, 200.0, 300.0, 600.0, 1000.0, np.inf)
 HEATING = ("viscous", "hysteretic")  # heat input ~ v^2 (a damper) or ~ |v| (friction)
 EXAMPLE_LOSS = 0.3  # stiffness lost by the end of the longest record
 EXAMPLE_DAMPING_S = 0.01  # the damping lost with it, as for c = k x 10 ms
@@ -46,9 +47,10 @@ class Thermal(Effect):
     name = "thermal"
     form = (
         "-theta (b_k x + b_c v) - exp(-t / tau_th) (s_k x + s_c v), theta' = P - theta / tau_th, "
-        "P = v^2 or abs(v) v_rms (s_k, s_c: lost at the start of a record that starts warm)"
+        "P = v^2 or abs(v) v_rms (s_k, s_c: lost at the start of a record that starts warm, "
+        "each record its own)"
     )
-    weights = "b_k, b_c, s_k, s_c >= 0"
+    weights = "b_k, b_c >= 0; s_k, s_c >= 0 per record"
     telling_test = (
         "a long constant-amplitude sine with rests (a stiffness that falls while it runs "
         "and recovers in the rests)"
@@ -61,11 +63,23 @@ class Thermal(Effect):
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         heating, tau = shape
         theta = heating_state(s.v, s.dt, tau, heating, scales.v_rms)
-        cols = [-theta * s.x, -theta * s.v]
-        if np.isfinite(tau):  # a record that starts warm cools with the same leak
-            warm = np.exp(-np.arange(s.x.size) * s.dt / tau) * warm_heat(tau, scales)
-            cols += [-warm * s.x, -warm * s.v]
-        return np.stack(cols, axis=1)
+        return np.stack([-theta * s.x, -theta * s.v], axis=1)
+
+    def nuisance_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        """A record that starts warm cools with the same leak: its stiffness and damping lost
+        at the start, its own (records run in any order start at different heats)."""
+        tau = shape[1] if isinstance(shape, tuple) else shape
+        if not np.isfinite(tau):
+            return np.zeros((s.x.size, 0))
+        warm = np.exp(-np.arange(s.x.size) * s.dt / tau) * warm_heat(tau, scales)
+        return np.stack([-warm * s.x, -warm * s.v], axis=1)
+
+    def rich_shapes(self, scales: Scales) -> list:
+        return list(RICH_TIME_CONSTANTS_S)
+
+    def rich_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        """Both heating laws at once, on a finer time-constant grid."""
+        return np.concatenate([self.columns(s, (h, shape), scales) for h in HEATING], axis=1)
 
     def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
         """Viscous heating without a leak: 30 % of the stiffness (and of a damping of
@@ -75,6 +89,8 @@ class Thermal(Effect):
         return ("viscous", np.inf), np.array([b_k, EXAMPLE_DAMPING_S * b_k])
 
     def describe(self, shape: Any) -> str:
+        if not isinstance(shape, tuple):  # the richest form: both heating laws
+            return f"thermal (viscous and hysteretic heating, tau_th={shape:g} s)"
         return f"thermal ({shape[0]} heating, tau_th={shape[1]:g} s)"
 
     def parameters(self, shape: Any, scales: Scales, w: np.ndarray) -> dict[str, Any]:
@@ -83,11 +99,16 @@ class Thermal(Effect):
             "time_constant_s": float(shape[1]),
             "stiffness_loss_n_per_m_per_heat": float(w[0]),
             "damping_loss_ns_per_m_per_heat": float(w[1]),
-            "stiffness_lost_at_start_n_per_m": float(w[2] * warm_heat(shape[1], scales))
-            if len(w) > 2
-            else 0.0,
-            "damping_lost_at_start_ns_per_m": float(w[3] * warm_heat(shape[1], scales))
-            if len(w) > 3
-            else 0.0,
             "heat_unit": "m^2/s (integral of v^2 or |v| v_rms)",
+        }
+
+    def nuisance_parameters(self, shape: Any, scales: Scales, ws: list) -> dict[str, Any]:
+        """Each record's stiffness and damping lost at its start (its own warm start)."""
+        unit = warm_heat(shape[1], scales) if np.isfinite(shape[1]) else 0.0
+        k = [float(w[0] * unit) for w in ws if len(w)]
+        c = [float(w[1] * unit) for w in ws if len(w)]
+        return {
+            "stiffness_lost_at_start_n_per_m": float(np.mean(k)) if k else 0.0,
+            "damping_lost_at_start_ns_per_m": float(np.mean(c)) if c else 0.0,
+            "stiffness_lost_at_start_per_record_n_per_m": k,
         }

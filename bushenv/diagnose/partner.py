@@ -1,0 +1,83 @@
+"""A second effect only when the first's whole family cannot explain it.
+
+A pair ``{A, B}`` that passes the pair rule (``rule.mark_pairs``) is tested once more: each
+member is fitted beside the *other's richest admissible form* (``Effect.rich_columns``: a
+denser, wider relaxation spectrum; more Dahl elements and amplitude memories; a backbone with
+knots every 10 % and its own growth per side; both heating laws on a finer time-constant grid;
+a finer delay grid) and must still close a significant share of what that form leaves above
+the noise. A partner that only mends the first effect's usual form where it does not fit the
+true one exactly (a relaxation spectrum of another shape leaving a structured remainder that
+a backbone or a friction soaks up) adds nothing to the richest form and is not named.
+
+The threshold ``BEYOND_RICH_MIN`` is calibrated on single-effect cases whose forms no
+candidate shares (``validation/partner_cases.py``); its false-positive rate is measured there
+(studies/2026-11-diagnosis-validation).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from bushenv.diagnose.candidates import get_effect
+from bushenv.diagnose.effects.base import Combination
+from bushenv.diagnose.effects.rich import RichForm
+from bushenv.diagnose.evidence import cut_z
+from bushenv.diagnose.rule import CLEAR_CUT, Z_NAME, Context
+
+# A member closes at least this share of what the other's richest form leaves above the noise.
+BEYOND_RICH_MIN = 1.0 / 3.0
+PAIRS_TRIED = 3  # passing pairs tested, best first; those further down are not named
+
+RowOf = Callable[[Combination], dict[str, Any]]
+
+
+def _rich(name: str) -> RichForm:
+    return RichForm(get_effect(name))
+
+
+def member_beyond_rich(member: str, other: str, row_of: RowOf, ctx: Context, cache: dict) -> dict:
+    """How much ``member`` adds to ``other``'s richest form: ``z`` of the cut, ``share`` of
+    what the rich form leaves above the noise that the pair closes, and the verdict."""
+    if other not in cache:
+        cache[other] = row_of(Combination((_rich(other),)))
+    base = cache[other]
+    both = row_of(Combination((_rich(other), get_effect(member))))
+    z = float(cut_z(ctx.force, base["_pred"], both["_pred"], ctx.edges))
+    share = float(ctx.closes(both["gap_after"], base["gap_after"]))
+    adds = bool((z >= Z_NAME or share >= CLEAR_CUT) and share >= BEYOND_RICH_MIN)
+    return {
+        "member": member,
+        "beside_richest": other,
+        "richest_gap": float(base["gap_after"]),
+        "gap_with_member": float(both["gap_after"]),
+        "z": z,
+        "share": share,
+        "adds": adds,
+    }
+
+
+def check_partners(pairs: list[dict], row_of: RowOf, ctx: Context) -> None:
+    """On ranked ``pairs``: the first ``PAIRS_TRIED`` that would pass keep passing only when
+    each member adds to the other's richest form (``beyond_richest`` in the row); passing
+    pairs further down are not named (``beyond_richest`` None)."""
+    cache: dict[str, dict] = {}
+    tried = 0
+    for r in pairs:
+        r["passes_pair_rule"] = bool(r.get("passes"))
+        if not r.get("_passes_unless_lag"):
+            continue
+        if tried >= PAIRS_TRIED:
+            r["beyond_richest"] = None
+            r["passes"] = r["_passes_unless_lag"] = False
+            continue
+        tried += 1
+        a, b = r["members"]
+        checks = [member_beyond_rich(b, a, row_of, ctx, cache)]
+        if checks[0]["adds"]:
+            checks.append(member_beyond_rich(a, b, row_of, ctx, cache))
+        r["beyond_richest"] = checks
+        if not all(c["adds"] for c in checks):
+            r["passes"] = r["_passes_unless_lag"] = False
+        elif r["passes"]:
+            break  # the answer's pair: those below it are not needed

@@ -1,0 +1,110 @@
+"""The partner test's false-positive rate, on single effects in forms no candidate shares.
+
+    python studies/2026-11-diagnosis-validation/diagnose_partners.py --seed 1 --out p1.json
+    python studies/2026-11-diagnosis-validation/diagnose_partners.py --summary p1.json p2.json
+
+Runs ``diagnose`` (default mode) on ``validation/partner_cases.py`` cases and keeps, per case,
+the answer, the answer the pair rule alone would give (the first pair that passed it, before
+the richest-form test) and every tested pair's figures (``beyond_richest``). The summary: the
+answers naming an effect that is not there, with and without the richest-form test, singles
+named exactly, pairs both in the top two, poor-TRAIN cases, and the partners' shares beside the
+richest form on true pairs and on invented ones (what ``partner.BEYOND_RICH_MIN`` is set from).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+from bushenv.diagnose.fit import diagnose
+from bushenv.diagnose.rule import AMBIGUOUS, OUTSIDE
+from bushenv.diagnose.validation.partner_cases import make_partner_case
+
+
+def named_set(named: str) -> set[str]:
+    return set() if named in ("none", AMBIGUOUS, OUTSIDE) else set(named.split("+"))
+
+
+def run(seed: int, cases: int, start: int) -> list[dict]:
+    rows = []
+    t0 = time.monotonic()
+    for n, i in enumerate(range(start, start + cases)):
+        case = make_partner_case(seed, i)
+        r = diagnose(case.train, case.tests)
+        before = next((p["effect"] for p in r["pairs"] if p.get("passes_pair_rule")), None)
+        rows.append(
+            {
+                "case": i,
+                "label": case.label_text,
+                "named": r["effect"],
+                "named_by_pair_rule": before or r["effect"],
+                "top_two": r["top_two"],
+                "poor_train": case.drawn["poor_train"],
+                "visible": case.drawn["visible"],
+                "tested": [
+                    {"pair": p["effect"], "checks": p["beyond_richest"]}
+                    for p in r["pairs"]
+                    if p.get("beyond_richest")
+                ],
+            }
+        )
+        done = n + 1
+        eta = (time.monotonic() - t0) / done * (cases - done)
+        print(f"case {done}/{cases} {case.label_text:<22} -> {r['effect']:<22} "
+              f"(about {eta:.0f} s left)", file=sys.stderr)  # fmt: skip
+    return rows
+
+
+def summary(rows: list[dict]) -> str:
+    label = [set() if r["label"] == "none" else set(r["label"].split("+")) for r in rows]
+    out = [f"{len(rows)} cases"]
+    for key in ("named", "named_by_pair_rule"):
+        wrong = sum(bool(named_set(r[key]) - lab) for r, lab in zip(rows, label, strict=True))
+        out.append(f"{key}: answers naming an absent effect {wrong} of {len(rows)} "
+                   f"({100 * wrong / len(rows):.1f} %)")  # fmt: skip
+    singles = [r for r in rows if "+" not in r["label"]]
+    exact = sum(r["named"] == r["label"] for r in singles)
+    out.append(f"singles named exactly {exact} of {len(singles)}")
+    poor = [r for r in singles if r["poor_train"]]
+    right = sum(r["named"] == r["label"] for r in poor)
+    outside = sum(r["named"] == OUTSIDE for r in poor)
+    out.append(f"poor TRAIN named exactly {right} of {len(poor)}; outside_candidates {outside}")
+    pairs = [r for r in rows if "+" in r["label"]]
+    hit = sum(set(r["top_two"]) == set(r["label"].split("+")) and r["named"] != "none"
+              for r in pairs)  # fmt: skip
+    exact_p = sum(named_set(r["named"]) == set(r["label"].split("+")) for r in pairs)
+    out.append(f"pairs both in top two {hit} of {len(pairs)}; named exactly {exact_p}")
+    for kind in ("true", "invented"):
+        shares = []
+        for r, lab in zip(rows, label, strict=True):
+            for t in r["tested"]:
+                for c in t["checks"]:
+                    true = c["member"] in lab and c["beside_richest"] in lab
+                    if true == (kind == "true"):
+                        shares.append(round(c["share"], 2))
+        out.append(f"{kind} partners' shares beside the richest form: {sorted(shares)}")
+    return "\n".join(out)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--cases", type=int, default=40)
+    ap.add_argument("--start", type=int, default=0)
+    ap.add_argument("--out", default="partners.json")
+    ap.add_argument("--summary", nargs="*", help="only summarise these JSON files")
+    a = ap.parse_args(argv)
+    if a.summary:
+        rows = [row for p in a.summary for row in json.load(open(p, encoding="utf-8"))]
+    else:
+        rows = run(a.seed, a.cases, a.start)
+        with open(a.out, "w", encoding="utf-8") as f:
+            json.dump(rows, f, indent=1)
+    print(summary(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
