@@ -58,7 +58,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=list(HELD_MULTIPLES),
         metavar="LIST",
         help="every single error also run at these multiples of --size-pct, held out of the "
-        "predictor (default: -1, the sign reversed)",
+        "predictor (default: -1, the sign reversed; write a list with a minus first as "
+        "--held=-1,2)",
     )
     p.add_argument(
         "--manoeuvres",

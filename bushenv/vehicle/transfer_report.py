@@ -64,13 +64,22 @@ def findings(report: dict[str, Any]) -> dict[str, Any]:
             else None
             for n in names
         }
+    in_car = np.asarray(report["in_car_component_pct"], dtype=float)  # (J, M)
+    kinds = dict.fromkeys(c[2] for c in report["components"])
+    in_car_by_kind = {}
+    for kind in kinds:
+        v = in_car[[j for j, c in enumerate(report["components"]) if c[2] == kind]]
+        v = v[np.isfinite(v)]
+        in_car_by_kind[kind] = (
+            [float(np.percentile(v, q)) for q in (10, 50, 90)] if v.size else None
+        )
     checks = report["checks"]
     combined = checks.get("combined", {})
     ranks = {k: v["influence"]["overall"] for k, v in checks["singles"].items()}
     med = combined.get("median_relative_error")
     return {
         "size_pct": s0, "components": rows, "never_reach": never, "amplified": amplified,
-        "median_of_largest_by": groups,
+        "median_of_largest_by": groups, "in_car_component_by_kind": in_car_by_kind,
         "predictor": {
             "median_relative_error": med, "combinations": len(checks["combinations"]),
             "cells": combined.get("cells"), "spearman_cells": combined.get("spearman"),
@@ -121,6 +130,13 @@ def markdown(report: dict[str, Any], found: dict[str, Any], figures: list[str]) 
     for axis, vals in found["median_of_largest_by"].items():
         lines.append(f"- Median over components of the largest change, by {axis}: "
                      + ", ".join(f"{k} {_f(v)} %" for k, v in vals.items()) + ".")  # fmt: skip
+    lines.append(
+        f"- The same {s0:g} % on the bench is another error in the car (the erring law driven "
+        "by the reference car's pivot motion; 10th / 50th / 90th percentile over pivots, "
+        "coordinates and manoeuvres): "
+        + ", ".join(f"{k} {'/'.join(_f(x, 2) for x in v)} %" if v else f"{k} n/a"
+                    for k, v in found["in_car_component_by_kind"].items()) + "."
+    )  # fmt: skip
     ranks = ", ".join(f"{_f(v)} at {float(k) * s0:+g} %" for k, v in p["influence_rank"].items())
     med = p["median_relative_error"]
     med_text = "n/a" if med is None else _f(100 * med)
