@@ -1,35 +1,39 @@
-"""The quarter car of QuarterCar-v0: its parameters, its pymunk bodies, and its bounds.
+"""The quarter car of QuarterCar-v0: its parameters and its pymunk bodies.
 
 ``CarParameters`` checks the spec's kwargs (shared by the pymunk env, the array integrator
-``quartercar_batch`` and the vector env); ``Car`` builds one car in a pymunk space, ``CarPair``
-steps a model car beside its reference twin; ``car_verdict``
-decides an episode's end from both cars' bushing forces (``divergence.force_termination``) and
-bounds, for one car pair (floats) or N pairs ((N,) arrays) alike.
+``quartercar_batch`` and the vector env) and resolves the arm's bushing models
+(``car_bushings``: one per axis, or one over the arm's three coordinates); ``Car`` builds one
+car in a pymunk space, ``CarPair`` steps a model car beside its reference twin, its bushing
+sampled alike whatever its number of coordinates. ``car_verdict`` decides an episode's end from
+both cars' bushing forces and bounds.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from typing import Any
 
 import numpy as np
 import pymunk
 
-from bushenv.divergence import force_termination
 from bushenv.models import BushingModel
 from bushenv.models.linear import TABLE1
 from bushenv.rigs.actions import check_profile
-from bushenv.rigs.car_verdict import CAR, MODEL_ERROR_PREFIX, force_reason  # noqa: F401
+from bushenv.rigs.car_bushings import (
+    ARM_COORDS,
+    AXES,
+    arm_models,
+    axis_label,
+    axis_models,
+    carried,
+)
+from bushenv.rigs.car_verdict import MODEL_ERROR_PREFIX, force_reason, moment_reason
 from bushenv.rigs.common import (
     MODEL_ERRORS,
     RigError,
     model_error_text,
-    model_label,
     positive,
     positive_int,
-    resolve_model,
-    resolve_reference,
 )
 from bushenv.rigs.coupling import (
     LONG_ARM_M,
@@ -40,39 +44,8 @@ from bushenv.rigs.coupling import (
     space_stepper,
 )
 
-AXES = ("radial", "axial")  # radial: vertical at the arm's inner end; axial: along the arm
 DAMPING_ANGLE_STEP = 0.005  # rad; see Car.update_damping
 BODIES = ("chassis", "unsprung", "road")
-
-
-def axis_models(
-    spec: Any, dt: float, reference: bool, trust_reference: bool = False
-) -> dict[str, BushingModel]:
-    """One model per bushing axis: a name or path (the same for both axes, each axis' own
-    preset or file), or a dict ``{"radial": ..., "axial": ...}`` of names, paths or objects.
-    References go through the one judging setup (vetted, ``rigs.common.resolve_reference``)."""
-
-    def resolve(s: Any, axis: str, dt: float) -> BushingModel:
-        if reference:
-            return resolve_reference(s, axis, dt, trust_reference=trust_reference, where=CAR)
-        return resolve_model(s, axis, dt)
-
-    if isinstance(spec, dict):
-        missing = [a for a in AXES if a not in spec]
-        if missing or set(spec) - set(AXES):
-            raise RigError(f"a per-axis model needs exactly the keys {AXES}, got {sorted(spec)}")
-        return {a: resolve(spec[a], a, dt) for a in AXES}
-    if isinstance(spec, BushingModel):
-        raise RigError(
-            "a model object is for one axis; pass {'radial': obj_r, 'axial': obj_a} instead"
-        )
-    return {a: resolve(spec, a, dt) for a in AXES}
-
-
-def axis_label(models: dict[str, BushingModel], spec: Any) -> str:
-    if isinstance(spec, str | os.PathLike):
-        return model_label(models["radial"], spec)
-    return "/".join(models[a].name for a in AXES)
 
 
 def check_road(profile: Any, max_height_m: float, max_step_m: float) -> np.ndarray:
@@ -135,15 +108,14 @@ class CarParameters:
         # the split coupling's in-sub-step linear part: the Table-1 Kelvin-Voigt bushing
         self.k_in = {a: TABLE1[a]["k_n_per_m"] for a in AXES}
         self.c_in = {a: TABLE1[a]["c_ns_per_m"] for a in AXES}
-        # a planar arm bushing: one three-axis model for axial, radial and the arm's rotation
+        # the arm's bushing: one model per axis, or one over ARM_COORDS (``arm_bushing``)
         self.arm_bushing = kwargs.get("arm_bushing", "")
         self.planar = not (isinstance(self.arm_bushing, str) and self.arm_bushing == "")
         self.moment_limit = g("arm_moment_limit_nm", kwargs.get("arm_moment_limit_nm", 2500.0))
         self.rotation_in: dict[str, tuple[float, float]] = {}  # car role -> (k_in, c_in)
+        self.carried: dict[str, tuple[int, ...]] = {}  # model key -> its ARM_COORDS
         if resolve_models and self.planar:
-            from bushenv.rigs.car_planar import resolve_arm
-
-            resolve_arm(self, kwargs)
+            arm_models(self, kwargs)
         elif resolve_models:
             self.models = axis_models(kwargs["model"], self.dt, reference=False)
             self.references = axis_models(
@@ -154,6 +126,14 @@ class CarParameters:
             )
             self.model_name = axis_label(self.models, kwargs["model"])
             self.reference_name = axis_label(self.references, kwargs["reference"])
+        if resolve_models:
+            self.carried = {k: carried(k, m) for k, m in self.models.items()}
+
+    def split(self, role: str) -> list[tuple[float, float]]:
+        """(k_in, c_in) per ``ARM_COORDS`` inside the sub-steps for car ``role`` ("model" or
+        "reference"): the Table-1 axes, the rotation's split when the bushing carries it."""
+        rotation = self.rotation_in.get(role, (0.0, 0.0))
+        return [(self.k_in[a], self.c_in[a]) for a in ARM_COORDS[:2]] + [rotation]
 
 
 class Car:
@@ -347,28 +327,42 @@ class CarPair:
         self._space_steps = self._steppers()
 
     def sample(self, car: Car, models: dict[str, BushingModel]):
-        """(motion, forces, why) of ``car`` at t_k: the bushing's (x, v) per axis, both axis
-        models' forces, and why they cannot be applied ("" if they can). A force that raised,
-        is not finite or exceeds ``force_limit_n`` is judged *before* it is applied and never
-        applied (the car keeps the last held remainder, so its state stays finite); otherwise
-        the remainders are held for the coming step."""
+        """(motion, forces, why) of ``car`` at t_k: the bushing's (x, v) per axis, its forces
+        (radial, axial N; the moment N m when it carries the rotation), and why they cannot be
+        applied ("" if they can). A force that raised, is not finite or exceeds its limit is
+        judged *before* it is applied and never applied (the car keeps the last held
+        remainder, so its state stays finite); otherwise the remainders are held for the
+        coming step."""
         car.update_damping()
         motion = car.bushing_motion()
-        if "arm" in models:
-            from bushenv.rigs.car_planar import sample_planar
-
-            return motion, *sample_planar(self.p, car, models["arm"], motion)
         xr, vr, xa, va = motion
+        turn = car.bushing_rotation() if car.rotation is not None else (0.0, 0.0)
+        q, w = (xa, xr, turn[0]), (va, vr, turn[1])
+        n = 2 if car.rotation is None else 3
+        f: list[Any] = [0.0] * len(ARM_COORDS)
         try:
-            forces = (models["radial"].step(xr, vr), models["axial"].step(xa, va))
+            for key, model in models.items():
+                index = self.p.carried[key]
+                if len(index) == 1:
+                    f[index[0]] = model.step(q[index[0]], w[index[0]])
+                    continue
+                out = model.step(np.array([q[i] for i in index]), np.array([w[i] for i in index]))
+                for j, i in enumerate(index):
+                    f[i] = float(out[j])
         except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
-            return motion, (math.nan, math.nan), f"model raised {type(exc).__name__}: {exc}"
+            return motion, (math.nan,) * n, f"model raised {type(exc).__name__}: {exc}"
         except Exception as exc:  # the model's own bug: ends the episode, not a divergence
-            return motion, (math.nan, math.nan), MODEL_ERROR_PREFIX + model_error_text(exc)
-        why = force_reason(*forces, self.p.force_limit)
+            return motion, (math.nan,) * n, MODEL_ERROR_PREFIX + model_error_text(exc)
+        forces = (f[1], f[0], f[2])[:n]
+        p = self.p
+        why = force_reason(forces[0], forces[1], p.force_limit)
+        if n == 3:
+            why = why or moment_reason(forces[2], p.moment_limit)
         if not why:
             car.radial.hold(forces[0], xr, vr)
             car.axial.hold(forces[1], xa, va)
+            if n == 3:
+                car.rotation.hold(forces[2], *turn)
         return motion, forces, why
 
     def integrate(self, h0: float, h: float) -> None:
@@ -384,55 +378,3 @@ class CarPair:
         for car in (self.car, self.twin):  # exact road position, no drift from integrating
             car.road.position = (p.L, h)
             car.road.velocity = (0.0, 0.0)
-
-
-def beyond_bounds(p: CarParameters, yc, yw, xr, xa):
-    """Whether a car's state left its physical bounds: chassis and wheel heights ``yc``, ``yw``
-    and bushing deflections ``xr``, ``xa`` (m; floats or (N,) arrays) not finite, a deflection
-    beyond ``max_bushing_deflection_m``, travel beyond ``max_suspension_travel_m`` or a body
-    beyond ``max_body_displacement_m``."""
-    with np.errstate(invalid="ignore"):
-        finite = np.isfinite(yc) & np.isfinite(yw) & np.isfinite(xr) & np.isfinite(xa)
-        deflection = (np.abs(xr) > p.max_deflection) | (np.abs(xa) > p.max_deflection)
-        travel = np.abs(yw - yc) > p.max_travel
-        body = (np.abs(yc) > p.max_body) | (np.abs(yw) > p.max_body)
-    return ~finite | deflection | travel | body
-
-
-def car_verdict(p: CarParameters, forces_model, forces_reference, bounds_model, bounds_reference):
-    """(terminated, truncated) of the model car beside its twin.
-
-    ``forces_*``: (2,) or (2, N) radial and axial bushing forces, N (with a planar arm bushing
-    (3,) or (3, N), the moment last, N m, judged by ``arm_moment_limit_nm``); ``bounds_*``: the
-    cars' ``beyond_bounds``. The force criteria are ``divergence.force_termination``'s (not
-    finite, or beyond ``force_limit_n`` while the twin's is within); the twin beyond its own
-    bounds or force limit truncates (the road is too harsh to judge), and that comes first."""
-    limit = p.force_limit
-    if len(forces_model) == 3:  # a planar arm bushing: radial, axial, moment
-        limit = np.array([p.force_limit, p.force_limit, p.moment_limit])
-        limit = limit[:, None] if np.ndim(forces_model) == 2 else limit
-    non_finite, model_over, reference_over = force_termination(
-        forces_model, forces_reference, limit
-    )
-    twin_out = reference_over.any(axis=0) | bounds_reference
-    model_out = non_finite.any(axis=0) | model_over.any(axis=0) | bounds_model
-    return model_out & ~twin_out, twin_out
-
-
-def out_of_bounds(p: CarParameters, yc, yw, xr, xa, fr, fa) -> str:
-    """Why a car's state left its physical bounds ("" if it did not)."""
-    values = (yc, yw, xr, xa, fr, fa)
-    if not all(math.isfinite(v) for v in values):
-        return "state or bushing force is not finite"
-    if abs(fr) > p.force_limit or abs(fa) > p.force_limit:
-        return f"|bushing force| = {max(abs(fr), abs(fa)):.6g} N exceeds {p.force_limit:.6g} N"
-    if abs(xr) > p.max_deflection or abs(xa) > p.max_deflection:
-        return (
-            f"bushing deflection {max(abs(xr), abs(xa)) * 1e3:.4g} mm exceeds "
-            f"{p.max_deflection * 1e3:.4g} mm"
-        )
-    if abs(yw - yc) > p.max_travel:
-        return f"suspension travel {abs(yw - yc):.4g} m exceeds {p.max_travel:.4g} m"
-    if abs(yc) > p.max_body or abs(yw) > p.max_body:
-        return f"body displacement {max(abs(yc), abs(yw)):.4g} m exceeds {p.max_body:.4g} m"
-    return ""

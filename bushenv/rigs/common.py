@@ -120,6 +120,8 @@ def shared_state_rows(model: BushingModel, probe_steps: int = 24) -> np.ndarray:
     declared = getattr(model, "shared_state_rows", None)
     n = model.n_state
     mask = np.zeros(n, dtype=bool)
+    if callable(getattr(model, "reset_columns", None)):  # it resets its own columns
+        return mask
     if declared is not None:
         mask[list(declared)] = True
         return mask

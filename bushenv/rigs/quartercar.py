@@ -15,20 +15,15 @@ import numpy as np
 from gymnasium import spaces
 
 from bushenv.rigs.actions import check_options, unit_action
-from bushenv.rigs.car import (
-    AXES,
+from bushenv.rigs.car import Car, CarPair, CarParameters, check_road
+from bushenv.rigs.car_bushings import AXES, axis_label, axis_models
+from bushenv.rigs.car_verdict import (
     MODEL_ERROR_PREFIX,
-    Car,
-    CarPair,
-    CarParameters,
-    axis_label,
-    axis_models,
     beyond_bounds,
     car_verdict,
-    check_road,
     out_of_bounds,
+    reference_range_reason,
 )
-from bushenv.rigs.car_planar import reference_range_reason
 from bushenv.rigs.common import (
     ForceDeviationReward,
     RigError,

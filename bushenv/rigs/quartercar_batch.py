@@ -11,13 +11,17 @@ dampers -- except that the three dampers are solved together as implicit Euler,
 its own (``implicit_euler_damping``). The bushing coupling is the env's: at every model step the
 axis models get (x, v) of the arm's inner end relative to the chassis, and the remainder
 F - (k_in x + c_in v) is held over the sub-steps while k_in x + c_in v acts inside them.
-With ``arm_bushing`` (one planar model per car, ``quartercar_batch_planar``) the model also
-gets the arm's rotation and its rate, and its moment is split the same way about theta: a
-rotary spring-damper (``car_planar.rotation_split``) inside the sub-steps, the remainder held,
-as ``coupling.SplitRotation`` does in the pymunk car.
+The bushing models are the pymunk car's (``car_bushings``), sampled alike whatever their
+number of coordinates: one model per axis, or one per car over axial, radial and the arm's
+rotation (``arm_bushing``; the chassis does not rotate, so the rotation is the unsprung body's
+angle), whose moment is split the same way about theta -- a rotary spring-damper
+(``car_bushings.rotation_split``) inside the sub-steps (the compiled kernel's rotary term), the
+remainder held, as ``coupling.SplitRotation`` does in the pymunk car. A bushing's forces are
+applied all together or not at all: where one raised, is not finite or is beyond its limit,
+that bushing holds nothing and its car is judged.
 
 Its agreement with the pymunk env is stated and tested in docs/envs.md (axis models) and
-docs/planar.md (a planar arm bushing).
+docs/planar.md (a bushing that carries the arm's rotation).
 
 Like the env the batch can carry a twin car with the reference bushing (``with_reference``).
 """
@@ -29,7 +33,8 @@ from typing import Any
 import numpy as np
 
 from bushenv.errors import ModelRaised
-from bushenv.rigs.car import AXES, CarParameters, axis_models, check_road
+from bushenv.rigs.car import CarParameters, check_road
+from bushenv.rigs.car_bushings import AXES, axis_models
 from bushenv.rigs.common import (
     MODEL_ERRORS,
     RigError,
@@ -37,13 +42,16 @@ from bushenv.rigs.common import (
     reset_columns,
     shared_state_rows,
 )
-from bushenv.rigs.quartercar_batch_planar import PlanarArm
 from bushenv.rigs.quartercar_kernels import (  # noqa: F401  (the state rows, for the vector env)
+    F_AXIAL,
     F_MOMENT,
+    F_RADIAL,
     OM,
     TH,
     VY_C,
     VY_U,
+    X_AXIAL,
+    X_RADIAL,
     X_U,
     Y_C,
     Y_U,
@@ -54,6 +62,16 @@ from bushenv.rigs.quartercar_kernels import (  # noqa: F401  (the state rows, fo
 from bushenv.rigs.specs import spec_kwargs
 
 ENV_ID = "QuarterCar-v0"
+# per ARM_COORDS (axial, radial, rotation): its force's row in a step's forces, its held row
+FORCE_ROWS = (F_AXIAL, F_RADIAL, F_MOMENT)
+HELD_ROWS = (1, 0, 2)
+# the info keys a bushing that carries the arm's rotation adds
+ROTATION_KEYS = (
+    "arm_rotation_rad",
+    "moment_model_nm",
+    "reference_arm_rotation_rad",
+    "moment_reference_nm",
+)
 
 
 class QuarterCarBatch:
@@ -82,15 +100,21 @@ class QuarterCarBatch:
         self.references = p.references if with_reference else None
         self._prm = parameter_vector(p)
         cars = 2 if with_reference else 1
-        self.arm = PlanarArm(p, self.num_cars, cars) if p.planar else None
-        self._rotation = np.zeros((2, cars * self.num_cars))  # no rotary term without it
-        if self.arm is not None:
-            self._rotation = self.arm.rotation
-        self._rows = 5 if self.arm is not None else 4  # F_RADIAL .. X_AXIAL (, F_MOMENT)
+        n = self.num_cars
+        self.groups = [("model", slice(0, n), self.models)]
+        if with_reference:
+            self.groups.append(("reference", slice(n, 2 * n), self.references))
+        self.rotation = p.planar  # the bushing carries the arm's rotation (a moment)
+        self._rotation = np.zeros((2, cars * n))  # the rotary split; none without rotation
+        self._split = {}  # car role -> (k_in, c_in) per ARM_COORDS
+        for role, cols, _ in self.groups:
+            self._split[role] = p.split(role)
+            if self.rotation:
+                self._rotation[:, cols] = np.array(self._split[role][2])[:, None]
+        self._rows = 5 if self.rotation else 4  # F_RADIAL .. X_AXIAL (, F_MOMENT)
         self._shared: dict[tuple[str, str], np.ndarray] = {}
         self.raised = {"model": "", "reference": ""}
         # the cars' arrays (columns: the model cars, then their twins); reset fills them
-        n = self.num_cars
         self.state = np.zeros((8, cars * n))
         self.road = np.zeros(cars * n)
         self.held = np.zeros((3, cars * n))
@@ -131,14 +155,11 @@ class QuarterCarBatch:
         self.active[both] = True
         self.diverged[mask] = False
         self.reference_out[mask] = False
-        if self.arm is not None:
-            self.arm.reset_columns(mask)
-            return
-        for group, models in (("model", self.models), ("reference", self.references)):
-            for axis, m in (models or {}).items():
-                if (group, axis) not in self._shared:  # probed once, on the first autoreset
-                    self._shared[group, axis] = shared_state_rows(m)
-                reset_columns(m, mask, self._shared[group, axis])
+        for group, _, models in self.groups:
+            for key, m in models.items():
+                if (group, key) not in self._shared:  # probed once, on the first autoreset
+                    self._shared[group, key] = shared_state_rows(m)
+                reset_columns(m, mask, self._shared[group, key])
 
     def step(self, road: np.ndarray) -> dict[str, np.ndarray]:
         p, n = self.params, self.num_cars
@@ -146,10 +167,7 @@ class QuarterCarBatch:
         bushing_motion_kernel(self.state, self._prm, self._motion)
         xr, vr, xa, va = self._motion
         forces = np.empty((self._rows, self.state.shape[1]))
-        if self.arm is not None:
-            self.arm.sample(self.state, self._motion, forces, self.held, self.raised)
-        else:
-            self._sample_axes(forces)
+        self._sample(forces)
         road_all = np.concatenate([road] * (2 if self.references is not None else 1))
         road_v = (road_all - self.road) / p.dt
         substeps_kernel(
@@ -173,31 +191,50 @@ class QuarterCarBatch:
         out["physical_limit"] = self.reference_out.copy()
         return out
 
-    def _sample_axes(self, forces: np.ndarray) -> None:
-        """The two axis models at t_k: their forces and deflections into ``forces``, the
-        remainders held (zero where a force cannot be applied)."""
-        p, n = self.params, self.num_cars
+    def _sample(self, forces: np.ndarray) -> None:
+        """Every car's bushing models at t_k: their forces and the deflections into ``forces``,
+        the remainders F - (k_in x + c_in v) held (zero for a bushing whose forces cannot be
+        applied: all of its coordinates, or none)."""
+        p = self.params
         xr, vr, xa, va = self._motion
-        groups = [("model", slice(0, n), self.models)]
-        if self.references is not None:
-            groups.append(("reference", slice(n, 2 * n), self.references))
-        for group, cols, models in groups:
+        th, om = self.state[TH], self.state[OM]
+        q, w = (xa, xr, th), (va, vr, om)
+        limits = (p.force_limit, p.force_limit, p.moment_limit)
+        for group, cols, models in self.groups:
             self.raised[group] = ""
-            for row, axis, x, v in ((0, "radial", xr, vr), (1, "axial", xa, va)):
-                try:
-                    f = np.asarray(models[axis].step(x[cols].copy(), v[cols].copy()))
-                except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
-                    f = np.full(n, np.nan)
-                    self.raised[group] = f"model raised {type(exc).__name__}: {exc}"
-                except Exception as exc:  # the model's own bug: an error, never a divergence
-                    raise ModelRaised(f"{group} ({axis})", exc) from exc
-                forces[row, cols] = f
-                forces[row + 2, cols] = x[cols]
-                held = f - (p.k_in[axis] * x[cols] + p.c_in[axis] * v[cols])
-                # a force beyond the limit (or not finite) is the verdict, never applied
+            split = self._split[group]
+            for key, model in models.items():
+                index = p.carried[key]
+                f = self._forces(group, key, model, index, [q[i][cols] for i in index],
+                                 [w[i][cols] for i in index])  # fmt: skip
                 with np.errstate(invalid="ignore", over="ignore"):
-                    ok = np.isfinite(held) & (np.abs(f) <= p.force_limit)
-                self.held[row, cols] = np.where(ok, held, 0.0)
+                    rest = [
+                        f[j] - (split[i][0] * q[i][cols] + split[i][1] * w[i][cols])
+                        for j, i in enumerate(index)
+                    ]
+                    ok = np.isfinite(rest[0])
+                    for j, i in enumerate(index):
+                        ok = ok & np.isfinite(rest[j]) & (np.abs(f[j]) <= limits[i])
+                for j, i in enumerate(index):
+                    forces[FORCE_ROWS[i], cols] = f[j]
+                    self.held[HELD_ROWS[i], cols] = np.where(ok, rest[j], 0.0)
+            forces[X_RADIAL, cols], forces[X_AXIAL, cols] = xr[cols], xa[cols]
+
+    def _forces(self, group: str, key: str, model, index, x: list, v: list) -> list:
+        """The forces of bushing ``key`` of the ``group`` cars, one (B,) array per coordinate
+        it carries (NaN where the model refused: ``raised[group]`` says why)."""
+        try:
+            if len(index) == 1:
+                return [np.asarray(model.step(x[0].copy(), v[0].copy()))]
+            f = model.step(np.stack(x, axis=1), np.stack(v, axis=1))
+            return [f[:, j] for j in range(len(index))]
+        except MODEL_ERRORS as exc:  # a model refusing to go on, 1/0, overflow, ...
+            self.raised[group] = f"model raised {type(exc).__name__}: {exc}"
+            return [np.full(x[0].shape, np.nan)] * len(index)
+        except ModelRaised:  # the model's own bug, already named: an error, not a verdict
+            raise
+        except Exception as exc:  # the model's own bug: an error, never a divergence
+            raise ModelRaised(f"{group} ({key})", exc) from exc
 
     def _summary(self, forces, xr, xa) -> tuple[dict[str, np.ndarray], np.ndarray]:
         """The step's outputs (the env's info keys) and every car's wheel height (B or 2B,)."""
@@ -233,8 +270,13 @@ class QuarterCarBatch:
                 out["force_radial_model_n"] - out["force_radial_reference_n"],
                 out["force_axial_model_n"] - out["force_axial_reference_n"],
             )
-        if self.arm is not None:
-            out.update(self.arm.summary(s, forces, n, self.references is not None))
+        if self.rotation:  # the arm's rotation after the step (as the pymunk env reports
+            # it) and the moments sampled at its start
+            out["arm_rotation_rad"] = s[TH, :n].copy()
+            out["moment_model_nm"] = forces[F_MOMENT, :n].copy()
+            if self.references is not None:
+                out["reference_arm_rotation_rad"] = s[TH, n:].copy()
+                out["moment_reference_nm"] = forces[F_MOMENT, n:].copy()
         return out, wheel_y
 
     def _out_of_bounds(self, forces, wheel_y) -> np.ndarray:
@@ -244,7 +286,7 @@ class QuarterCarBatch:
             bad = ~np.isfinite(forces).all(axis=0) | ~np.isfinite(s).all(axis=0)
             bad |= (np.abs(forces[0]) > p.force_limit) | (np.abs(forces[1]) > p.force_limit)
             bad |= (np.abs(forces[2]) > p.max_deflection) | (np.abs(forces[3]) > p.max_deflection)
-            if self.arm is not None:
+            if self.rotation:
                 bad |= np.abs(forces[F_MOMENT]) > p.moment_limit
             bad |= np.abs(yw - yc) > p.max_travel
             bad |= (np.abs(yc) > p.max_body) | (np.abs(yw) > p.max_body)

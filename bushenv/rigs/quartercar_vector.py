@@ -20,20 +20,19 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from bushenv.rigs.actions import check_options, unit_actions
-from bushenv.rigs.car import (
-    AXES,
-    Car,
+from bushenv.rigs.car import Car, check_road
+from bushenv.rigs.car_bushings import AXES
+from bushenv.rigs.car_verdict import (
     beyond_bounds,
     car_verdict,
-    check_road,
     force_reason,
+    moment_reason,
     out_of_bounds,
+    reference_range_reason,
 )
-from bushenv.rigs.car_planar import moment_reason, reference_range_reason
 from bushenv.rigs.common import ForceDeviationReward, RigError, call_reset, check_hook
 from bushenv.rigs.quartercar import ENV_ID, OBS_SIZE, QuarterCarEnv, observation_values
-from bushenv.rigs.quartercar_batch import TH, X_U, Y_C, Y_U, QuarterCarBatch
-from bushenv.rigs.quartercar_batch_planar import PLANAR_KEYS
+from bushenv.rigs.quartercar_batch import ROTATION_KEYS, TH, X_U, Y_C, Y_U, QuarterCarBatch
 from bushenv.rigs.vector_base import ArrayVectorEnv
 
 TEXT_KEYS = ("model_out_of_bounds", "reference_out_of_bounds", "divergence_reason", "model_error")
@@ -96,7 +95,7 @@ class QuarterCarVectorEnv(ArrayVectorEnv):
         n = self.num_envs
         self.batch = QuarterCarBatch(n, with_reference=True, **spec_overrides)
         self.params = p = self.batch.params
-        self._batch_keys = BATCH_KEYS + (PLANAR_KEYS if p.planar else ())
+        self._batch_keys = BATCH_KEYS + (ROTATION_KEYS if p.planar else ())
         self._text_keys = TEXT_KEYS + (("reference_outside_range",) if p.planar else ())
         self.metadata = {**self.metadata, "render_fps": 1.0 / p.dt}
         self._overrides = dict(spec_overrides)
