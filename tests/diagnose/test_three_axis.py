@@ -103,7 +103,7 @@ def test_rotation_parameters_carry_rotation_units():
 
 
 def test_a_coordinate_held_still_in_a_record_is_left_out_of_its_diagnosis_only():
-    from bushenv.planar.programme import preload_sweep
+    from bushenv.motions import preload_sweep
     from bushenv.reference.planar import PlanarRubber
 
     train, test, _ = case("friction@radial")

@@ -30,7 +30,7 @@ import numpy as np
 
 from bushenv.models.base import PAPER_DT
 from bushenv.models.planar_base import COORDS
-from bushenv.planar.programme import PEAK_AT_N1, random_correlated, random_independent
+from bushenv.motions import PEAK_AT_N1, random_correlated, random_independent
 from bushenv.planar.records import PlanarRecord
 from bushenv.reference.planar import PlanarRubber
 
