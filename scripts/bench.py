@@ -9,7 +9,8 @@
 Figures: batched free-run throughput of each model at B = 1, 64, 1024; single-step latency;
 the comparisons a user would make (scripts/bench_compare.py: the Bouc-Wen free run beside
 scipy's solve_ivp at the same accuracy, the NARX network beside the same network in torch);
-env steps/s of BushRig-v0 and QuarterCar-v0 (single and vectorised) beside CartPole-v1 (single
+env steps/s of BushRig-v0 and QuarterCar-v0 (single and vectorised), HalfCar-v0 beside
+QuarterCar-v0 and its batched form beside itself beside CartPole-v1 (single
 and its numpy-vectorised form); the papers' verification task (6.44 s at 204.8 Hz) and
 identification times, with the identified models' accuracy on an unseen n = 1 record (the
 papers' protocol) and on an n = 1.5 record (extrapolation), beside the sensor-noise floor;
@@ -906,6 +907,83 @@ def bench_planar(fig: Figures, quick: bool) -> None:
     )
 
 
+def _halfcar_manoeuvre(steps: int, dt: float) -> dict:
+    """A road sweep (10 mm, 0.5-5 Hz) under both wheels out of phase and a 3 m/s^2 slalom:
+    within every bound, so no episode ends inside a timed block."""
+    t = np.arange(steps) * dt
+    phase = 2 * np.pi * (0.5 * t + 0.5 * 4.5 * t * t / t[-1])
+    ay = 3.0 * np.sin(2 * np.pi * 0.5 * t)
+    return {"road_left": 0.01 * np.sin(phase), "road_right": -0.01 * np.sin(phase),
+            "lateral_accel": ay}  # fmt: skip
+
+
+def _replay_block(env, options: dict, steps: int) -> float:
+    """Seconds per step of ``env`` replaying ``options`` for ``steps`` steps after its reset."""
+    env.reset(seed=0, options=options)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        env.step(None)
+    return (time.perf_counter() - t0) / steps
+
+
+def bench_halfcar(fig: Figures, quick: bool) -> None:
+    """Targets: a HalfCar-v0 step at most 3x a QuarterCar-v0 step (defaults: linear model,
+    rubber twin; both replay the same road, interleaved blocks, the median of the blocks'
+    ratios), and HalfCarBatch at least 20x the scalar env per car-step (a car and its twin)."""
+    import gymnasium as gym
+
+    import bushenv  # noqa: F401  registers the envs
+    from bushenv.rigs.halfcar_batch import HalfCarBatch
+
+    print("\n== half car: HalfCar-v0 beside QuarterCar-v0, HalfCarBatch beside HalfCar-v0")
+    steps, blocks = (100, 2) if quick else (300, 9)
+    half = gym.make("HalfCar-v0").unwrapped
+    quarter = gym.make("QuarterCar-v0").unwrapped
+    m = _halfcar_manoeuvre(steps, half.params.dt)
+    sec_h, sec_q = [], []
+    for _ in range(blocks):
+        sec_h.append(_replay_block(half, m, steps))
+        sec_q.append(_replay_block(quarter, {"excitation": m["road_left"]}, steps))
+    ratio = float(np.median(np.array(sec_h) / np.array(sec_q)))
+    fig.add("halfcar.HalfCar-v0.single", 1 / float(np.median(sec_h)), "steps/s")
+    fig.add("halfcar.QuarterCar-v0.single", 1 / float(np.median(sec_q)), "steps/s")
+    fig.add(
+        "halfcar.HalfCar-v0.step_time_over_quartercar",
+        ratio,
+        "ratio",
+        None if quick else 3.0,
+        better="lower",
+        note=f"median of {blocks} interleaved blocks of {steps} replayed steps; "
+        f"blocks' ratios {min(np.divide(sec_h, sec_q)):.2f}-{max(np.divide(sec_h, sec_q)):.2f}",
+    )
+    n = 64 if quick else 256
+    scale = np.linspace(0.5, 1.0, n)
+    inputs = {k: v[:, None] * scale for k, v in m.items()}
+    batches = {threads: HalfCarBatch(n, threads=threads) for threads in (1, 2)}
+    sec_b: dict[int, list[float]] = {1: [], 2: []}
+    for batch in batches.values():
+        batch.simulate(**{k: v[:5] for k, v in inputs.items()})  # compiled kernels, caches
+    for _ in range(max(1, blocks // 3)):  # interleaved with the scalar env's blocks
+        for threads, batch in batches.items():
+            t0 = time.perf_counter()
+            batch.simulate(**inputs, keys=("roll_rad", "wheel_load_left_n"))
+            sec_b[threads].append((time.perf_counter() - t0) / (steps * n))
+        sec_h.append(_replay_block(half, m, steps))
+    single = float(np.median(sec_h))
+    for threads, secs in sec_b.items():
+        label = f"halfcar.batch.B{n}" + ("" if threads == 1 else f".threads{threads}")
+        car_step = float(np.median(secs))
+        fig.add(label, 1 / car_step, "car-steps/s", note="a car and its twin per car-step")
+        fig.add(
+            f"{label}_speedup_vs_single",
+            single / car_step,
+            "x",
+            None if quick or threads > 1 else 20.0,
+            note=f"per car-step: HalfCarBatch({n}, threads={threads}).simulate beside "
+            "HalfCar-v0.step (one thread), the same manoeuvre, median of interleaved blocks",
+        )
+
+
 SECTIONS = {
     "models": bench_models,
     "scipy": bench_compare.bench_scipy,
@@ -922,6 +1000,7 @@ SECTIONS = {
     "diagnose": bench_diagnose,
     "fmu": bench_fmu.bench_fmu,
     "planar": bench_planar,
+    "halfcar": bench_halfcar,
 }
 
 

@@ -16,8 +16,7 @@ import numpy as np
 from gymnasium import spaces
 
 from bushenv.rigs.actions import check_options
-from bushenv.rigs.car_planar import reference_range_reason
-from bushenv.rigs.car_verdict import MODEL_ERROR_PREFIX
+from bushenv.rigs.car_verdict import MODEL_ERROR_PREFIX, reference_range_reason
 from bushenv.rigs.common import (
     ForceDeviationReward,
     RigError,
@@ -60,8 +59,10 @@ class HalfCarEnv(gym.Env):
         h_k = clip(h_{k-1} + a_side * max_road_step_m, +-max_road_height_m)       (each side)
         a_y,k = clip(a_y,k-1 + a_2 * max_lateral_accel_step_m_per_s2, +-max_lateral_accel)
 
-    (50 mm, 0.25 m/s^2 per step; +-150 mm, +-8 m/s^2 by default). a_y > 0 accelerates the car
-    to its left (a left turn): every body feels -m a_y. NaN counts as 0, beyond +-1 as +-1.
+    (50 mm, 0.4 m/s^2 per step; +-150 mm, +-8 m/s^2 by default: 0.4 m/s^2 per step is 82
+    m/s^3, the standards' fastest steering, NHTSA's fishhook at 720 deg/s, needing 0.375).
+    a_y > 0 accelerates the car to its left (a left turn): every body feels -m a_y. NaN counts
+    as 0, beyond +-1 as +-1.
 
     ## Observation Space
 
@@ -155,7 +156,9 @@ class HalfCarEnv(gym.Env):
 
     ## Version History
 
-    - v0: the car of ``envs/HalfCar-v0.toml``.
+    - v0: the car of ``envs/HalfCar-v0.toml``; ``max_lateral_accel_step_m_per_s2`` raised
+      from 0.25 to 0.4 m/s^2 so the standards' steering events replay as they are (the
+      action's a_y step scales with it); info carries the twin's deflections.
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 204.8}
@@ -315,7 +318,7 @@ class HalfCarEnv(gym.Env):
 
     def _range_reason(self, q: np.ndarray) -> str:
         """Why a twin's pivot judges by extrapolation ("" if none does): its rotation beyond the
-        range its law is calibrated for (``car_planar.reference_range_reason``)."""
+        range its law is calibrated for (``car_verdict.reference_range_reason``)."""
         refs = self.references
         for i, k in enumerate(POSITIONS):
             why = reference_range_reason(refs[k] if isinstance(refs, dict) else refs, q[i, 2])

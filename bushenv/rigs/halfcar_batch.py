@@ -13,22 +13,27 @@ pivot i is history 4 b + i), a table of four models B histories each.
 
 Interface::
 
-    batch = HalfCarBatch(B, model="linear", reference="rubber")  # any HalfCar-v0 kwarg
+    batch = HalfCarBatch(B, model="linear", reference="rubber", threads=1)  # any env kwarg
     out = batch.step(road_left, road_right, lateral_accel)        # each (B,): m, m, m/s^2
     out = batch.simulate(road_left=(T,) or (T, B), road_right=..., lateral_accel=..., keys=...)
 
 ``step`` returns (B,) arrays under the env's ``info`` keys (``RESULT_KEYS``: inputs, each car's
 body, wheel and geometry outputs, the twin's with ``reference_``, every pivot's forces and
-deflections in both cars, ``error_n``, ``roll_error_rad``, ``diverged``, ``physical_limit``).
+deflections in both cars, ``error_n``, ``roll_error_rad``, ``diverged``, ``physical_limit``,
+and ``reference_outside_range`` -- a bool here: a twin pivot beyond the rotation its law is
+calibrated for, where the env says why).
 ``simulate`` runs whole manoeuvres from rest (checked against the env's limits, as
 ``reset(options=...)``) and returns (T, B) arrays of ``keys`` (default all) plus ``diverged``,
 ``divergence_step`` (-1 if none) and ``physical_limit`` (B,). A car that leaves its bounds stops
 moving (its later samples repeat its last state); its verdict is the env's: the model car out
-of bounds while its twin is not. Agreement with the pymunk env: docs/envs.md ("HalfCar-v0").
+of bounds while its twin is not. ``threads=2`` steps the cars' physics in two threads (bit for
+bit the same numbers); ``with_reference=False`` leaves the twins out. Agreement with the
+pymunk env: docs/envs.md ("HalfCar-v0").
 """
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -44,14 +49,19 @@ from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, SIDES, HalfCarParamet
 from bushenv.rigs.specs import spec_kwargs
 
 ITERATIONS = 10  # chipmunk's damper sweeps per sub-step: pymunk's default, as the env's space
+MIN_THREAD_COLUMNS = 32  # a thread's fewest columns: below, a thread costs more than it saves
 
 
 class HalfCarBatch:
     """B half cars and, with ``with_reference``, B twins on the reference bushings (columns:
     the model cars, then the twins). See the module docstring for the interface."""
 
-    def __init__(self, num_cars: int, *, with_reference: bool = True, **spec_overrides: Any):
+    def __init__(
+        self, num_cars: int, *, with_reference: bool = True, threads: int = 1, **spec_overrides: Any
+    ):
         self.num_cars = n = positive_int("num_cars", num_cars)
+        self.threads = positive_int("threads", threads)
+        self._pool = None
         self.params = p = HalfCarParameters(spec_kwargs(ENV_ID, spec_overrides))
         self.groups = [("model", p.models)]
         if with_reference:
@@ -72,6 +82,15 @@ class HalfCarBatch:
         self.diverged = np.zeros(n, dtype=bool)
         self.reference_out = np.zeros(n, dtype=bool)
         self.raised = {role: "" for role, _ in self.groups}
+        # each twin pivot's calibrated rotation (rad; inf where its law states none)
+        refs = (
+            p.references
+            if isinstance(p.references, dict)
+            else dict.fromkeys(POSITIONS, p.references)
+        )
+        self.calibrated_rotation = np.array(
+            [getattr(refs[k], "calibrated_rotation_rad", None) or np.inf for k in POSITIONS]
+        )  # fmt: skip
         self._q = np.zeros((cols, 4, 3))
         self._v = np.zeros((cols, 4, 3))
         self._inputs = np.zeros((3, n))
@@ -131,13 +150,7 @@ class HalfCarBatch:
         for k, side in enumerate(SIDES):
             self.state[VY, ROAD[side]] = np.tile((now[k] - before[k]) / p.dt, g)
         gx = np.tile(-(before[2] + now[2]) / 2, g)
-        h_car = np.where(self.active, p.h, 0.0)
-        t = self._table
-        substeps_kernel(
-            self.state, self.rest, self._stiff, self._damp, self.contact, gx, h_car,
-            p.substeps, ITERATIONS, t.kind, t.ia, t.ib, t.side, t.anchors, t.m_inv, t.i_inv,
-            p.k_t, -p.tyre_static_n, p.c_t, p.k_y, p.c_y,
-        )  # fmt: skip
+        self._integrate(gx, np.where(self.active, p.h, 0.0))
         for k, side in enumerate(SIDES):  # the road exactly where the step put it, at rest
             r = ROAD[side]
             self.state[PY, r] = np.where(self.active, np.tile(now[k], g), self.state[PY, r])
@@ -155,6 +168,31 @@ class HalfCarBatch:
         else:
             self.diverged |= bad[:n]
         return result(self, now, out, q, forces)
+
+    def _integrate(self, gx: np.ndarray, h_car: np.ndarray) -> None:
+        """The sub-steps of every column; with ``threads`` > 1 the columns split in as many
+        ranges, each stepped in its own thread (the kernel releases the GIL)."""
+        p, t = self.params, self._table
+        args = (
+            self.state, self.rest, self._stiff, self._damp, self.contact, gx, h_car,
+            p.substeps, ITERATIONS, t.kind, t.ia, t.ib, t.side, t.anchors, t.m_inv, t.i_inv,
+            p.k_t, -p.tyre_static_n, p.c_t, p.k_y, p.c_y,
+        )  # fmt: skip
+        cols = self.state.shape[2]
+        parts = min(self.threads, cols // MIN_THREAD_COLUMNS)
+        if parts <= 1:
+            substeps_kernel(*args, 0, cols)
+            return
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(self.threads)
+        edges = np.linspace(0, cols, parts + 1).astype(int)
+        jobs = [self._pool.submit(substeps_kernel, *args, lo, hi)
+                for lo, hi in zip(edges[:-1], edges[1:], strict=True)]  # fmt: skip
+        for job in jobs:
+            job.result()
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {**self.__dict__, "_pool": None}
 
     def _sample(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every car's (cols, 4, 3) pivot forces at t_k and why they cannot be applied ((cols,)

@@ -51,10 +51,11 @@ def _one_minus_exp(x):  # pragma: no cover - compiled
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def substeps_kernel(
     S, rest, stiff, damp, contact, gx, h_car, n_sub, iterations,
-    kind, ia, ib, side, anchors, m_inv, i_inv, k_tyre, lift, c_tyre, k_lat, c_lat,
+    kind, ia, ib, side, anchors, m_inv, i_inv, k_tyre, lift, c_tyre, k_lat, c_lat, b_lo, b_hi,
 ):  # fmt: skip  # pragma: no cover - compiled
-    """Advance every car (column of ``S``) by ``n_sub`` sub-steps of ``h_car`` (N,) s (0 holds a
-    car still).
+    """Advance the cars ``b_lo`` to ``b_hi - 1`` (columns of ``S``; the others untouched, so
+    two threads may step two ranges) by ``n_sub`` sub-steps of ``h_car`` (N,) s (0 holds a car
+    still).
 
     Per car: ``rest``, ``stiff``, ``damp`` (E, N) each element's rest length (rest angle for a
     rotary spring), stiffness and damping coefficient c (physical, N s/m or N m s/rad);
@@ -69,7 +70,7 @@ def substeps_kernel(
     the loops over cars."""
     n_el = kind.shape[0]
     n_body = m_inv.shape[0]
-    n = S.shape[2]
+    n = b_hi
     # ONE local array for the chunk (state, scratch, parameters, contacts, load, step), so that
     # the compiler relates every access by a row offset and vectorises (arrays apart it would
     # have to check at run time, pair by pair, and gives up)
@@ -77,9 +78,9 @@ def substeps_kernel(
     o_par = o_sc + N_SCRATCH * n_el  # rest, stiffness, damping of element e: o_par + 3 e + ...
     o_ct = o_par + 3 * n_el  # contact left, right; then landed left, right; the load; the step
     o_g, o_h = o_ct + 4, o_ct + 5
-    w = min(CHUNK, (n + 7) // 8 * 8)  # a chunk's width: small batches pad to 8 cars at most
+    w = min(CHUNK, (n - b_lo + 7) // 8 * 8)  # a chunk's width: small batches pad to 8 cars
     L = np.zeros((o_h + 1, w))
-    for b0 in range(0, n, w):
+    for b0 in range(b_lo, n, w):
         for i in range(w):
             b = b0 + i if b0 + i < n else b0
             L[o_h, i] = h_car[b] if b0 + i < n else 0.0

@@ -30,7 +30,7 @@ RESULT_KEYS = (
     *("reference_" + k for k in CAR_KEYS),
     *(k for force_keys, _, _ in PIVOT_KEYS for pair in force_keys for k in pair),
     *(k for _, motion, reference in PIVOT_KEYS for k in (*motion, *reference)),
-    "error_n", "roll_error_rad", "diverged", "physical_limit",
+    "error_n", "roll_error_rad", "reference_outside_range", "diverged", "physical_limit",
 )  # fmt: skip
 
 
@@ -108,6 +108,7 @@ def result(batch: Any, now: np.ndarray, out: dict[str, np.ndarray], q, forces) -
         d = forces[:n, :, :2] - forces[n:, :, :2]
         res["error_n"] = np.hypot(d[..., 0], d[..., 1]).max(axis=1)
         res["roll_error_rad"] = res["roll_rad"] - res["reference_roll_rad"]
+        res["reference_outside_range"] = (np.abs(q[n:, :, 2]) > batch.calibrated_rotation).any(1)
     res["diverged"] = batch.diverged.copy()
     res["physical_limit"] = batch.reference_out.copy()
     return res

@@ -69,6 +69,19 @@ def test_the_batch_agrees_with_the_pymunk_env_on_loads_roll_and_bushing_forces(k
     for k in ("reference_roll_rad", "reference_wheel_load_left_n", "error_n"):
         peak = np.abs(env[k] - env[k][0]).max()
         assert np.abs(env[k] - out[k][:, 0]).max() <= AGREEMENT * peak, k
+    assert not out["reference_outside_range"].any()
+
+
+def test_the_twin_beyond_its_calibrated_rotation_is_flagged_as_the_env_flags_it():
+    """A 100 mm road rise at the rate limit: the upper arms turn past +-0.15 rad; the batch's
+    flag is the env's ``reference_outside_range`` being said, step by step."""
+    road = np.minimum(0.05 * np.arange(60), 0.1)
+    inputs = {"road_left": road, "road_right": road}
+    env = gym.make("HalfCar-v0", max_episode_steps=-1).unwrapped
+    env.reset(seed=0, options=inputs)
+    said = [env.step(None)[4]["reference_outside_range"] != "" for _ in range(60)]
+    flag = HalfCarBatch(1).simulate(**inputs, keys=("reference_outside_range",))
+    assert any(said) and list(flag["reference_outside_range"][:, 0].astype(bool)) == said
 
 
 def test_each_car_of_a_batch_is_the_car_alone_bit_for_bit():
@@ -82,6 +95,15 @@ def test_each_car_of_a_batch_is_the_car_alone_bit_for_bit():
         alone = HalfCarBatch(1, model="linear").simulate(**{k: v[:, j] for k, v in inputs.items()})
         for k in ("roll_rad", "wheel_load_left_n", "force_lower_right_radial_reference_n"):
             np.testing.assert_array_equal(together[k][:, j], alone[k][:, 0], err_msg=k)
+
+
+def test_two_threads_give_the_numbers_of_one():
+    inputs = {k: np.repeat(v[:120, None], 40, axis=1) * np.linspace(0.2, 1, 40)
+              for k, v in manoeuvre(120).items()}  # fmt: skip
+    one = HalfCarBatch(40, model="linear").simulate(**inputs)
+    two = HalfCarBatch(40, model="linear", threads=2).simulate(**inputs)
+    for k in ("roll_rad", "wheel_load_right_n", "force_upper_left_radial_reference_n"):
+        np.testing.assert_array_equal(one[k], two[k], err_msg=k)
 
 
 def test_a_column_reset_returns_that_car_to_rest_and_leaves_the_others():

@@ -17,7 +17,8 @@ KEYS = tuple(
 def run(model: str, n: int = 120) -> list[dict]:
     env = gym.make("HalfCar-v0", model=model).unwrapped
     k = np.arange(n)
-    env.reset(seed=0, options={"road_left": 0.02 * np.sin(k / 8), "lateral_accel": np.minimum(0.1 * k, 4.0)})
+    inputs = {"road_left": 0.02 * np.sin(k / 8), "lateral_accel": np.minimum(0.1 * k, 4.0)}
+    env.reset(seed=0, options=inputs)
     return [env.step(None)[4] for _ in range(n)]
 
 
