@@ -1,10 +1,12 @@
-"""HalfCarVectorEnv: N HalfCar-v0 envs stepped in turn behind Gymnasium's vector API.
+"""HalfCarVectorEnv: N HalfCar-v0 car pairs as arrays (``vector_entry_point``).
 
-No array integrator yet: each column is a ``HalfCarEnv`` (bit-equal to one made alone), so a
-car-step costs what the scalar env's does; a batched form (the quarter car's
-``QuarterCarBatch`` for this car: ~7 bodies, 4 three-axis bushings per car) is what would make
-it cheaper. The autoreset modes, ``max_episode_steps`` and ``info`` arrays with ``_key`` masks
-are ``vector_base.ArrayVectorEnv``'s.
+The cars are ``HalfCarBatch`` (the HalfCar-v0 car as one compiled array integrator, a model car
+and its reference twin per column); actions, observations, rewards, hooks, info keys, reset
+options and the episode's end are ``HalfCarEnv``'s, on (N,) arrays. The integrator makes every
+damper implicit Euler at the current configuration where the pymunk car refreshes its
+coefficients every 0.02 rad, so a column follows the pymunk env within 1 % of each output's
+peak (tests/rigs/test_halfcar_vector.py, docs/envs.md), not bit for bit. The autoreset modes,
+``max_episode_steps`` and the ``_key`` masks are ``vector_base.ArrayVectorEnv``'s.
 """
 
 from __future__ import annotations
@@ -13,21 +15,37 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
 
 from bushenv.rigs.actions import check_options
-from bushenv.rigs.common import RigError
+from bushenv.rigs.car_verdict import reference_range_reason
+from bushenv.rigs.common import ForceDeviationReward, RigError, call_reset, check_hook
 from bushenv.rigs.halfcar import OBS_SIZE, HalfCarEnv
-from bushenv.rigs.halfcar_params import ENV_ID
+from bushenv.rigs.halfcar_batch import HalfCarBatch
+from bushenv.rigs.halfcar_batch_kernels import ANG, PX, PY
+from bushenv.rigs.halfcar_batch_layout import BODIES
+from bushenv.rigs.halfcar_batch_outputs import RESULT_KEYS
+from bushenv.rigs.halfcar_inputs import REPLAY_KEYS, replay_inputs
+from bushenv.rigs.halfcar_outputs import PIVOT_KEYS, force_reason, out_of_bounds
+from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS
 from bushenv.rigs.vector_base import ArrayVectorEnv
+
+TEXT_KEYS = ("model_out_of_bounds", "reference_out_of_bounds", "divergence_reason", "model_error",
+             "reference_outside_range")  # fmt: skip
+FLAG_KEYS = ("monitor_verdict", "diverged", "physical_limit")
+INFO_KEYS = tuple(k for k in RESULT_KEYS if k not in (*FLAG_KEYS, "reference_outside_range"))
 
 
 class HalfCarVectorEnv(ArrayVectorEnv):
-    """N half cars (``HalfCarEnv``) with the scalar env's actions, observations, rewards and
-    info keys as (N,) arrays (strings as object arrays). ``reset(options=...)`` takes the
-    scalar env's options, each (T,) (every column replays it) or (T, N) (one column each).
-    Unlike the array vector envs, the hooks (``reward_fn``, ``divergence_monitor``) are called
-    by each column with its own plain-value info, and a column's autoreset returns it to agent
-    control (its replay is not restarted).
+    """N HalfCar-v0 car pairs as arrays.
+
+    Arguments as ``HalfCarEnv`` plus ``num_envs``, ``max_episode_steps`` (default: the spec's
+    2048), ``autoreset_mode`` (``NEXT_STEP`` by default, or ``SAME_STEP``) and ``threads``
+    (``HalfCarBatch``'s). ``info`` holds (N,) arrays under ``HalfCarEnv``'s keys (strings as
+    object arrays); ``reset(options=...)`` takes the scalar env's options, each (T,) (every
+    column) or (T, N). The hooks get the info arrays and return (N,) arrays. A model whose
+    batched step raises a bug of its own (``ModelRaised``) ends every column: it propagates.
 
     >>> import gymnasium as gym
     >>> import numpy as np
@@ -44,83 +62,188 @@ class HalfCarVectorEnv(ArrayVectorEnv):
         *,
         max_episode_steps: int | None = None,
         episode_steps: int | None = None,
-        autoreset_mode: Any = "NextStep",
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         render_mode: str | None = None,
         reward_fn=None,
         divergence_monitor=None,
+        threads: int = 1,
         **overrides: Any,
     ) -> None:
         super().__init__(
             ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode
         )
-        self.render_mode = render_mode
-        self.envs = [
-            HalfCarEnv(reward_fn=reward_fn, divergence_monitor=divergence_monitor, **overrides)
-            for _ in range(self.num_envs)
-        ]
-        self.reward_fn, self.divergence_monitor = None, None  # the columns call the hooks
-        self.metadata = {**self.metadata, "render_fps": self.envs[0].metadata["render_fps"]}
-        self.single_action_space = self.envs[0].action_space
-        self.single_observation_space = self.envs[0].observation_space
         n = self.num_envs
-        self.action_space = spaces.Box(-1.0, 1.0, shape=(n, 3), dtype=np.float32)
-        self.observation_space = spaces.Box(-1.0, 1.0, shape=(n, OBS_SIZE), dtype=np.float32)
-        self._rest = self.envs[0]._info_last or None
+        self.batch = HalfCarBatch(n, threads=threads, **overrides)
+        self.params = p = self.batch.params
+        self._overrides = dict(overrides)
+        self.render_mode = render_mode
+        self.metadata = {**self.metadata, "render_fps": 1.0 / p.dt}
+        self.single_action_space = spaces.Box(-1.0, 1.0, shape=(3,), dtype=np.float32)
+        self.single_observation_space = spaces.Box(-1.0, 1.0, (OBS_SIZE,), dtype=np.float32)
+        self.action_space = batch_space(self.single_action_space, n)
+        self.observation_space = batch_space(self.single_observation_space, n)
+        self.reward_fn = check_hook("reward_fn", reward_fn) or ForceDeviationReward(
+            p.force_scale, p.reward_cap
+        )
+        self.divergence_monitor = check_hook("divergence_monitor", divergence_monitor)
+        self._inputs = np.zeros((3, n))
+        self._replay: np.ndarray | None = None  # (T, 3, N)
+        self._columns = np.arange(n)
+        self._render_env: HalfCarEnv | None = None
+        self._last_info: dict[str, Any] | None = None
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
-        options = check_options(ENV_ID, options)
+        super().reset(seed=seed)
+        n = self.num_envs
+        self._replay = _replay(self.params, check_options(ENV_ID, options), n)
+        self._end[:] = self.max_episode_steps
+        if self._replay is not None:
+            self._end[:] = min(self._replay.shape[0], self.max_episode_steps)
+        self.batch.reset()
+        call_reset(self.reward_fn)
+        call_reset(self.divergence_monitor)
+        self._inputs[:] = 0.0
         self._t[:] = 0
         self._prev_done[:] = False
-        obs, infos = [], []
-        for i, env in enumerate(self.envs):
-            o, info = env.reset(seed=None if seed is None else seed + i,
-                                options=_column(options, i, self.num_envs))  # fmt: skip
-            obs.append(o)
-            infos.append(info)
-        self._rest = infos[0]
-        n = min((len(e._replay) for e in self.envs if e._replay is not None), default=None)
-        self._end[:] = self.max_episode_steps if n is None else min(n, self.max_episode_steps)
-        return np.stack(obs), self._masks(_stack(infos))
+        info = {}
+        for key, value in self._rest_info().items():
+            info[key] = np.full(n, value, dtype=object if isinstance(value, str) else None)
+        self._last_info = None
+        return np.zeros((n, OBS_SIZE), dtype=np.float32), self._masks(info)
 
     def step(self, actions):
-        a = np.asarray(actions, dtype=np.float32)
-        if a.shape != (self.num_envs, 3):
-            raise RigError(f"{ENV_ID}: actions must have shape ({self.num_envs}, 3), got {a.shape}")
-        results = [env.step(a[i]) for i, env in enumerate(self.envs)]
+        p, n = self.params, self.num_envs
+        if self._replay is None:
+            a = np.asarray(actions, dtype=np.float64)
+            if a.shape != (n, 3):
+                raise RigError(f"{ENV_ID}: actions must have shape ({n}, 3), got {a.shape}")
+            a = np.clip(np.nan_to_num(a, nan=0.0), -1.0, 1.0).T
+            step = np.array([p.max_road_step, p.max_road_step, p.max_ay_step])[:, None]
+            limit = np.array([p.max_road, p.max_road, p.max_ay])[:, None]
+            now = np.clip(self._inputs + a * step, -limit, limit)
+        else:
+            now = self._replay[np.minimum(self._t, self._end - 1), :, self._columns].T
+        self._inputs = now
         self._t += 1
-        obs = np.stack([r[0] for r in results])
-        reward = np.array([r[1] for r in results])
-        terminated = np.array([r[2] for r in results])
-        truncated = np.array([r[3] for r in results])
-        info = _stack([r[4] for r in results])
-        return self._end_step(obs, reward, terminated, truncated, self._masks(info))
+        out = self.batch.step(now[0], now[1], now[2])
+        info = self._last_info = self._info(out)
+        terminated, truncated = out["diverged"], out["physical_limit"]
+        for side, bad in (("model", terminated), ("reference", truncated)):
+            for i in np.flatnonzero(bad):
+                info[f"{side}_out_of_bounds"][i] = self._why(side, info, i)
+        info["divergence_reason"][terminated] = info["model_out_of_bounds"][terminated]
+        info["physical_limit"][:] = truncated
+        if self.divergence_monitor is not None:
+            verdict = np.asarray(self.divergence_monitor(info), dtype=bool)
+            verdict = np.broadcast_to(verdict, (n,)) & ~(terminated | truncated)
+            info["monitor_verdict"][:] = verdict
+            info["divergence_reason"][verdict] = "divergence monitor"
+            terminated = terminated | verdict
+        info["diverged"] = terminated.copy()
+        reward = np.asarray(self.reward_fn(info), dtype=np.float64).copy()
+        obs = observations(p, info)
+        return self._end_step(obs, reward, terminated.copy(), truncated.copy(), self._masks(info))
+
+    def _info(self, out: dict[str, np.ndarray]) -> dict[str, Any]:
+        """The step's info arrays (verdict fields at rest; the twin's range said where it is
+        beyond)."""
+        n = self.num_envs
+        info: dict[str, Any] = {"time_s": self._t * self.params.dt, "step": self._t.copy()}
+        info.update({k: out[k] for k in INFO_KEYS})
+        for key in TEXT_KEYS:
+            info[key] = np.full(n, "", dtype=object)
+        for key in FLAG_KEYS:
+            info[key] = np.zeros(n, dtype=bool)
+        refs = self.params.references
+        for i in np.flatnonzero(out["reference_outside_range"]):
+            for k, (_, _, motion) in zip(POSITIONS, PIVOT_KEYS, strict=True):
+                ref = refs[k] if isinstance(refs, dict) else refs
+                why = reference_range_reason(ref, float(info[motion[2]][i]))
+                if why:
+                    info["reference_outside_range"][i] = f"{k}: {why}"
+                    break
+        return info
+
+    def _why(self, side: str, info: dict[str, Any], i: int) -> str:
+        """Why car ``side`` of column ``i`` left its bounds, in ``HalfCarEnv``'s words."""
+        prefix = "" if side == "model" else "reference_"
+        keys = ("body_x_m", "body_y_m", "wheel_left_y_m", "wheel_right_y_m", "roll_rad",
+                "travel_left_m", "travel_right_m")  # fmt: skip
+        out = {k: float(info[prefix + k][i]) for k in keys}
+        forces = np.array([[info[key[side == "reference"]][i] for key in force_keys]
+                           for force_keys, _, _ in PIVOT_KEYS])  # fmt: skip
+        motion = 1 if side == "model" else 2
+        q = np.array([[info[k][i] for k in keys3[motion]] for keys3 in PIVOT_KEYS])
+        return (
+            self.batch.raised[side]
+            or force_reason(self.params, forces)
+            or out_of_bounds(self.params, out, q)
+            or "out of bounds"
+        )
 
     def _reset_columns(self, mask: np.ndarray) -> None:
-        for i in np.flatnonzero(mask):
-            self.envs[i].reset()
+        self.batch.reset_columns(mask)
+        self._inputs[:, mask] = 0.0
 
     def _rest_info(self) -> dict[str, Any]:
-        return {k: v for k, v in self._rest.items() if not k.startswith("_")}
+        rest: dict[str, Any] = {"time_s": 0.0, "step": 0}
+        rest.update(dict.fromkeys(INFO_KEYS, 0.0))
+        for side in ("left", "right"):
+            for prefix in ("", "reference_"):
+                rest[f"{prefix}wheel_load_{side}_n"] = self.params.tyre_static_n
+                rest[f"{prefix}wheel_lift_{side}"] = False
+        rest.update(dict.fromkeys(TEXT_KEYS, ""))
+        rest.update(dict.fromkeys(FLAG_KEYS, False))
+        return rest
 
     def render(self):
-        return None if self.render_mode is None else self.envs[0].render()
+        """A frame of column 0: a ``HalfCarEnv`` drawing with its bodies set from the batch."""
+        if self.render_mode is None:
+            return None
+        if self._render_env is None:
+            self._render_env = HalfCarEnv(render_mode="rgb_array", **self._overrides)
+        env, s, n = self._render_env, self.batch.state, self.num_envs
+        for car, col in ((env.car, 0), (env.twin, n)):
+            for k, name in enumerate(BODIES):
+                car.bodies[name].position = (float(s[PX, k, col]), float(s[PY, k, col]))
+                car.bodies[name].angle = float(s[ANG, k, col])
+        last = self._last_info or {}
+        env._info_last = {k: v[0].item() for k, v in last.items() if isinstance(v, np.ndarray)}
+        return (env.render(),)
 
     def close_extras(self, **kwargs: Any) -> None:
-        for env in self.envs:
-            env.close()
+        if self._render_env is not None:
+            self._render_env.close()
 
 
-def _column(options: dict[str, Any], i: int, n: int) -> dict[str, Any]:
-    out = {}
-    for k, v in options.items():
-        a = np.asarray(v) if v is not None else None
-        out[k] = a[:, i] if a is not None and a.ndim == 2 and a.shape[1] == n else v
-    return out
+def observations(p: Any, info: dict[str, Any]) -> np.ndarray:
+    """(N, 16) float32: ``HalfCarEnv``'s observation of every column's info."""
+    f = [np.hypot(info[f"force_{k}_axial_model_n"], info[f"force_{k}_radial_model_n"])
+         for k in POSITIONS]  # fmt: skip
+    rows = (
+        info["road_left_m"] / p.max_road, info["road_right_m"] / p.max_road,
+        info["lateral_accel_m_per_s2"] / p.max_ay, info["body_y_m"] / p.max_body,
+        info["body_vy_m_per_s"] / p.v_scale, info["body_x_m"] / p.max_body,
+        info["roll_rad"] / p.max_roll, info["roll_rate_rad_per_s"] / p.roll_rate_scale,
+        (info["wheel_load_left_n"] - p.tyre_static_n) / p.tyre_static_n,
+        (info["wheel_load_right_n"] - p.tyre_static_n) / p.tyre_static_n,
+        *(x / p.force_limit for x in f), info["error_n"] / p.force_limit,
+        info["roll_error_rad"] / p.max_roll,
+    )  # fmt: skip
+    obs = np.nan_to_num(np.stack(rows, axis=1), nan=0.0, posinf=1.0, neginf=-1.0)
+    return np.clip(obs, -1.0, 1.0).astype(np.float32)
 
 
-def _stack(infos: list[dict[str, Any]]) -> dict[str, Any]:
-    out = {}
-    for k in infos[0]:
-        values = [d[k] for d in infos]
-        out[k] = np.array(values, dtype=object if isinstance(values[0], str) else None)
-    return out
+def _replay(p: Any, options: dict[str, Any], n: int) -> np.ndarray | None:
+    """(T, 3, N) replayed inputs from the options ((T,) or (T, N) each), or None."""
+    given = {k: np.asarray(v, dtype=np.float64) for k, v in options.items() if v is not None}
+    if not given:
+        return None
+    for k, v in given.items():
+        if k in REPLAY_KEYS and (v.ndim not in (1, 2) or (v.ndim == 2 and v.shape[1] != n)):
+            raise RigError(f"{ENV_ID}: reset option {k} must be (T,) or (T, {n}), got {v.shape}")
+    columns = []
+    for j in range(n):
+        one = {k: (v[:, j] if v.ndim == 2 else v) for k, v in given.items()}
+        columns.append(replay_inputs(p, one))  # the scalar env's checks, its error messages
+    return np.stack(columns, axis=2)

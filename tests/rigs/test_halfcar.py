@@ -150,22 +150,6 @@ def test_render_gives_frames_and_survives_pickling():
     assert np.array_equal(pickle.loads(pickle.dumps(env)).render(), frame)
 
 
-def test_the_vector_env_equals_the_scalar_envs_and_autoresets():
-    n = 2
-    venv = gym.make_vec("HalfCar-v0", num_envs=n, vectorization_mode="vector_entry_point",
-                        max_episode_steps=40)  # fmt: skip
-    acts = random_actions(45)
-    obs, info = venv.reset(seed=0)
-    assert obs.shape == (n, 16) and info["roll_rad"].shape == (n,)
-    single = rollout(make(), actions=acts, n=40)
-    for k in range(40):
-        obs, reward, terminated, truncated, info = venv.step(np.stack([acts[k]] * n))
-        assert np.array_equal(obs[0], single[k][0]) and np.array_equal(obs[1], single[k][0])
-    assert truncated.all()
-    obs, reward, *_ = venv.step(np.stack([acts[0]] * n))  # NextStep: the reset observation
-    assert not obs.any() and not reward.any()
-
-
 def test_the_docstring_examples_run():
     for name in ("halfcar", "halfcar_vector"):
         mod = importlib.import_module(f"bushenv.rigs.{name}")
