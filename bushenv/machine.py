@@ -1,59 +1,44 @@
-"""The virtual test machine: runs the papers' test programme on any bushing model.
+"""The virtual test machine: runs a programme on any bushing model, of any number of coordinates.
 
 A model (``bushenv.models.BushingModel``; the reference specimen is ``"rubber"``) is driven by
 prescribed displacement like the one-axis MTS machine of seed 001 §3.1, within the limits of
-seed 002 Table 1 (``bushenv.excitation``: +-12.5 mm stroke, 1.26 m/s, 25 kN dynamic force). The
-force is the model's free-run response (``model.simulate``; velocity by central differences,
-as for any record that holds displacement only). Every run gives a ``bushenv.records.Record``.
-
-The programme (seed 001 §3.2, seed 000 §5.2):
-
-| test           | function               | excitation                                      |
-|----------------|------------------------|-------------------------------------------------|
-| harmonic       | ``harmonic_programme`` | sines 1, 5, 10, 15, 20 Hz x 0.5-4 mm, 10 s each |
-| identification | ``random_test``        | RPC-like random, n = 1 (2 mm peak), 40 s        |
-| verification   | ``random_test``        | RPC-like random, n = 1.5 (3 mm peak), 20 s      |
-| step           | ``step_test``          | 4 mm step after 0.5 s at rest, held 10 s        |
-
-Durations: the papers' random records lasted 8.22 s (identification) and 6.44 s (verification)
-(seed 002 §5); we default to 40 s and 20 s so that identification sees every part of the
-spectrum many times (40 s at 204.8 Hz is 8192 samples) and verification is still long enough
-for the thermal and relaxation memory of the reference bushing to show. The verification drive
-uses a different seed from the identification drive (``seed + 1``), as the papers' two records
-were different drives.
+seed 002 Table 1 (``bushenv.excitation``: +-12.5 mm stroke, 1.26 m/s, 25 kN dynamic force; on
+a bushing of several coordinates the limits hold for each translational one, a rotation has
+none). The force is the model's free-run response (``model.simulate``; velocity by central
+differences, as for any record that holds displacement only). Every run gives a
+``bushenv.records.Record``; the programmes are ``bushenv.programmes``.
 
 ``run`` refuses (``MachineError``) an excitation the machine cannot drive and flags
 (``Record.info["force_limit_exceeded"]`` and a ``MachineWarning``) a force above the 25 kN
-dynamic capacity. ``run_programme`` simulates items of equal length together as one (T, B)
-batch.
+dynamic capacity. ``run_programme`` simulates items of equal length together as one batch,
+or, given a factory of models, each item on a fresh model of its own (the reference's load
+cell then measures each record with its own noise seed, ``reference_for``).
 
-Command line: ``bushenv measure`` (see ``EXAMPLE``) writes one CSV per programme item.
+Command line: ``bushenv measure`` writes one CSV per programme item.
 """
 
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.errors import BadInput
-from bushenv.models.base import DT_TOLERANCE, PAPER_DT, BushingModel
+from bushenv.models.base import DT_TOLERANCE, BushingModel
+from bushenv.programmes import (
+    IDENTIFICATION_N,
+    STEP_HOLD_S,
+    STEP_PRE_S,
+    STEP_SIZE_M,
+    ProgrammeItem,
+    default_random_duration,
+    harmonic_programme,
+    random_item,
+    step_item,
+)
 from bushenv.records import Record
-
-HARMONIC_FREQUENCIES_HZ = (1.0, 5.0, 10.0, 15.0, 20.0)  # seed 001 §3.2.1
-HARMONIC_AMPLITUDES_M = (0.5e-3, 1.0e-3, 2.0e-3, 3.0e-3, 4.0e-3)
-HARMONIC_DURATION_S = 10.0
-IDENTIFICATION_N = 1.0  # seed 001 §3.2.2, Figs. 12-15
-VERIFICATION_N = 1.5
-IDENTIFICATION_DURATION_S = 40.0  # papers: 8.22 s (seed 002 §5); see the module docstring
-VERIFICATION_DURATION_S = 20.0  # papers: 6.44 s
-STEP_SIZE_M = 4.0e-3  # seed 000 §5.2
-STEP_HOLD_S = 10.0
-STEP_PRE_S = 0.5
-PROGRAMMES = ("harmonic", "random", "step", "papers")
 
 
 class MachineError(BadInput):
@@ -64,89 +49,23 @@ class MachineWarning(UserWarning):
     """A run exceeded the machine's force capacity (the record is kept, flagged)."""
 
 
-@dataclass(frozen=True, eq=False)
-class ProgrammeItem:
-    """One test of a programme: a ``name`` (the record's file stem), displacement ``x`` (T,)
-    in m sampled at ``dt`` s."""
-
-    name: str
-    x: np.ndarray
-    dt: float
-
-
-# ----- programmes ------------------------------------------------------------------------------
-def _mm(value_m: float) -> str:
-    return f"{value_m * 1e3:g}mm"
-
-
-def harmonic_programme(
-    dt: float = PAPER_DT,
-    frequencies_hz: Sequence[float] = HARMONIC_FREQUENCIES_HZ,
-    amplitudes_m: Sequence[float] = HARMONIC_AMPLITUDES_M,
-    duration_s: float = HARMONIC_DURATION_S,
-) -> list[ProgrammeItem]:
-    """The harmonic tests of seed 001 §3.2.1: every frequency x every amplitude, 10 s each.
-
-    Items are ordered by frequency then amplitude and named ``sine_10hz_2mm``; all share one
-    length, so ``run_programme`` simulates them as one batch.
-    """
-    items = []
-    for f in frequencies_hz:
-        ex.check_frequency(f)
-        for a in amplitudes_m:
-            items.append(ProgrammeItem(f"sine_{f:g}hz_{_mm(a)}", ex.sine(f, a, duration_s, dt), dt))
-    return items
-
-
-def random_item(
-    n_index: float, duration_s: float, seed: int, dt: float = PAPER_DT
-) -> ProgrammeItem:
-    """The RPC-like random drive with index n (peak n * 2 mm), named ``random_n1_40s_seed0``."""
-    x = ex.random_rpc(n_index, duration_s, dt, seed)
-    return ProgrammeItem(f"random_n{n_index:g}_{duration_s:g}s_seed{seed}", x, dt)
-
-
-def step_item(
-    size_m: float = STEP_SIZE_M,
-    hold_s: float = STEP_HOLD_S,
-    dt: float = PAPER_DT,
-    pre_s: float = STEP_PRE_S,
-    rise_s: float | None = None,
-) -> ProgrammeItem:
-    """The step test of seed 000 §5.2: ``pre_s`` at rest, a step of ``size_m``, held ``hold_s``.
-
-    ``rise_s=None``: an ideal one-sample step when the machine can move that fast at ``dt``
-    (4 mm at 204.8 Hz: 0.82 m/s), else the shortest half-cosine rise within
-    ``MAX_VELOCITY_M_PER_S`` (its peak speed is pi/2 * size / rise).
-    """
-    if rise_s is None:
-        rise_s = 0.0
-        if abs(size_m) / dt > ex.MAX_VELOCITY_M_PER_S:
-            rise_s = 0.5 * np.pi * abs(size_m) / ex.MAX_VELOCITY_M_PER_S * (1 + 1e-6)
-    x = ex.step_hold(size_m, hold_s, dt, pre_s=pre_s, rise_s=rise_s)
-    return ProgrammeItem(f"step_{_mm(size_m)}_hold{hold_s:g}s", x, dt)
-
-
-def papers_programme(dt: float = PAPER_DT, seed: int = 0) -> list[ProgrammeItem]:
-    """Everything the papers measured: harmonic grid, identification (n = 1, 40 s, ``seed``),
-    verification (n = 1.5, 20 s, ``seed + 1``) and the 4 mm step held 10 s."""
-    return [
-        *harmonic_programme(dt),
-        random_item(IDENTIFICATION_N, IDENTIFICATION_DURATION_S, seed, dt),
-        random_item(VERIFICATION_N, VERIFICATION_DURATION_S, seed + 1, dt),
-        step_item(dt=dt),
-    ]
-
-
-# ----- running ---------------------------------------------------------------------------------
-def check_excitation(x: np.ndarray, dt: float, name: str = "excitation") -> np.ndarray:
-    """``x`` as a float (T,) or (T, B) array the machine can drive, else ``MachineError``."""
+def check_excitation(
+    x: np.ndarray, dt: float, name: str = "excitation", units: Sequence[str] = ("m",)
+) -> np.ndarray:
+    """``x`` as a float (T,) or (T, B) array the machine can drive, or (T, C) over the
+    coordinates of ``units`` (the stroke and velocity limits hold for each one in m), else
+    ``MachineError``."""
     a = np.asarray(x, dtype=np.float64)
-    if a.ndim not in (1, 2) or a.shape[0] < 2:
+    c = len(units)
+    if a.ndim not in ((1, 2) if c == 1 else (2,)) or a.shape[0] < 2:
+        want = "(T,)" if c == 1 else f"(T, {c})"
         raise MachineError(
-            f"{name}: expected displacement of shape (T,) with T >= 2, got {a.shape}"
+            f"{name}: expected displacement of shape {want} with T >= 2, got {a.shape}"
         )
-    ok, reason = ex.within_limits(a, dt)
+    if c > 1 and a.shape[1] != c:
+        raise MachineError(f"{name}: expected (T, {c}) for {c} coordinates, got {a.shape}")
+    moved = a if c == 1 else a[:, [u == "m" for u in units]]
+    ok, reason = ex.within_limits(moved, dt)
     if not ok:
         raise MachineError(
             f"{name}: outside the test machine's limits: {reason} "
@@ -155,14 +74,21 @@ def check_excitation(x: np.ndarray, dt: float, name: str = "excitation") -> np.n
     return a
 
 
-def _record(name: str, x: np.ndarray, force: np.ndarray, dt: float) -> Record:
-    peak = float(np.max(np.abs(force))) if np.all(np.isfinite(force)) else float("inf")
+def _record(
+    name: str, x: np.ndarray, force: np.ndarray, dt: float, force_units: Sequence[str] = ("N",)
+) -> Record:
+    finite = bool(np.all(np.isfinite(force)))
+    f = force.reshape(len(force), -1)
+    newtons = f[:, [u == "N" for u in force_units]]
+    peak = float(np.max(np.abs(newtons))) if finite and newtons.size else float("inf")
     over = peak > ex.MAX_DYNAMIC_FORCE_N
     info = {
-        "max_abs_force_n": peak,
+        "max_abs_force_n": peak if finite else float("inf"),
         "force_limit_exceeded": bool(over),
-        "force_finite": bool(np.all(np.isfinite(force))),
+        "force_finite": finite,
     }
+    if f.shape[1] > 1:  # every coordinate's, in its own unit (N or N m)
+        info["max_abs_force"] = np.abs(f).max(axis=0).tolist() if finite else None
     if over:
         warnings.warn(
             MachineWarning(
@@ -175,35 +101,46 @@ def _record(name: str, x: np.ndarray, force: np.ndarray, dt: float) -> Record:
 
 
 def run(model: BushingModel, x: np.ndarray, name: str = "excitation") -> Record:
-    """Drive ``model`` with displacement ``x`` (T,) in m at ``model.dt``; returns the Record.
+    """Drive ``model`` with displacement ``x`` (T,) in m, or (T, C) over its coordinates, at
+    ``model.dt``; returns the Record.
 
     Refuses (``MachineError``) anything outside the machine's stroke or velocity; flags a force
     above 25 kN in ``record.info`` and with a ``MachineWarning``.
     """
-    a = check_excitation(x, model.dt, name)
-    if a.ndim != 1:
+    a = check_excitation(x, model.dt, name, model.units)
+    if model.n_coords == 1 and a.ndim != 1:
         raise MachineError(f"{name}: run takes one profile (T,); use run_programme for several")
     force = model.simulate(a)
-    return _record(name, a, force, model.dt)
+    return _record(name, a, force, model.dt, model.force_units)
+
+
+ModelSource = BushingModel | Callable[[int], BushingModel]
 
 
 def run_programme(
-    model: BushingModel, items: Sequence[ProgrammeItem], progress=None
+    model: ModelSource, items: Sequence[ProgrammeItem], progress=None
 ) -> list[Record]:
-    """Run every item on ``model``; items of equal length go through ``simulate`` as one (T, B)
-    batch. Returns records in the order of ``items``. ``progress(message)`` is called per batch.
+    """Run every item; returns records in the order of ``items``. ``progress(message)`` is
+    called per batch (per item with a factory).
 
-    Every item is checked against the machine limits and ``model.dt`` before anything runs.
+    ``model``: one model, through whose ``simulate`` items of equal length go as one batch
+    ((T, B), or (T, B, C) over C coordinates); or a factory ``model(k)`` of a fresh model for
+    item k (``reference_for``: each record measured with its own noise). Every item is checked
+    against the machine limits and the model's dt before anything runs.
     """
-    for item in items:
-        if abs(item.dt - model.dt) > DT_TOLERANCE * model.dt:
+    models = [model(k) for k in range(len(items))] if callable(model) else None
+    for k, item in enumerate(items):
+        m = models[k] if models is not None else model
+        if abs(item.dt - m.dt) > DT_TOLERANCE * m.dt:
             raise MachineError(
-                f"{item.name}: sampled at dt={item.dt:.6g} s but the model runs at "
-                f"dt={model.dt:.6g} s"
+                f"{item.name}: sampled at dt={item.dt:.6g} s but the model runs at dt={m.dt:.6g} s"
             )
-        check_excitation(item.x, model.dt, item.name)
-        if np.ndim(item.x) != 1:
+        check_excitation(item.x, m.dt, item.name, m.units)
+        if m.n_coords == 1 and np.ndim(item.x) != 1:
             raise MachineError(f"{item.name}: expected (T,), got {np.shape(item.x)}")
+    if models is not None:
+        pairs = enumerate(zip(models, items, strict=True))
+        return [_run_one(m, item, k, len(items), progress) for k, (m, item) in pairs]
     groups: dict[int, list[int]] = {}
     for i, item in enumerate(items):
         groups.setdefault(len(item.x), []).append(i)
@@ -213,13 +150,38 @@ def run_programme(
         batch = np.stack([np.asarray(items[i].x, dtype=np.float64) for i in members], axis=1)
         forces = model.simulate(batch)
         for column, i in enumerate(members):
-            records[i] = _record(items[i].name, batch[:, column], forces[:, column], model.dt)
+            records[i] = _record(
+                items[i].name, batch[:, column], forces[:, column], model.dt, model.force_units
+            )
         done += len(members)
         if progress is not None:
             progress(
                 f"simulated {len(members)} item(s) of {length} samples ({done}/{len(items)} done)"
             )
     return records  # type: ignore[return-value]
+
+
+def _run_one(model: BushingModel, item: ProgrammeItem, k: int, n: int, progress) -> Record:
+    """One item on its own model, from rest."""
+    x = np.asarray(item.x, dtype=np.float64)
+    record = _record(item.name, x, model.simulate(x), model.dt, model.force_units)
+    if progress is not None:
+        progress(f"simulated [{k + 1}/{n}] {item.name}: {len(x)} samples")
+    return record
+
+
+def reference_for(
+    name: str, n_coords: int, seed: int, dt: float, axis: str = "axial"
+) -> Callable[[int], BushingModel]:
+    """Registered model ``name`` of ``n_coords`` coordinates with its measurement chain, noise
+    seed ``1000 * seed + k`` for record k, so no two records share their noise."""
+    from bushenv.models import get_model
+
+    def model_for(k: int) -> BushingModel:
+        noise = {"seed": 1000 * seed + k}
+        return get_model(name, axis=axis, dt=dt, coords=n_coords, preset=noise)
+
+    return model_for
 
 
 def harmonic_test(model: BushingModel, **programme_kwargs) -> list[Record]:
@@ -243,11 +205,6 @@ def random_test(
     return run(model, item.x, name=item.name)
 
 
-def default_random_duration(n_index: float) -> float:
-    """40 s for identification-size drives (n <= 1), 20 s for larger (verification) ones."""
-    return IDENTIFICATION_DURATION_S if n_index <= IDENTIFICATION_N else VERIFICATION_DURATION_S
-
-
 def step_test(
     model: BushingModel,
     size_m: float = STEP_SIZE_M,
@@ -261,6 +218,3 @@ def step_test(
     """
     item = step_item(size_m, hold_s, model.dt, pre_s, rise_s)
     return run(model, item.x, name=item.name)
-
-
-# ----- command line ----------------------------------------------------------------------------

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from bushenv import excitation as ex
-from bushenv import machine
+from bushenv import machine, programmes
 from bushenv.cli import main as cli_main
 from bushenv.models.base import PAPER_DT
 from bushenv.models.linear import LinearBushing
@@ -17,7 +17,7 @@ def linear():
 
 
 def test_harmonic_programme_is_seed001_grid_of_25_ten_second_sines():
-    items = machine.harmonic_programme()
+    items = programmes.harmonic_programme()
     assert len(items) == 25
     assert items[0].name == "sine_1hz_0.5mm" and items[-1].name == "sine_20hz_4mm"
     assert {len(i.x) for i in items} == {2048}
@@ -38,8 +38,8 @@ def test_run_gives_record_with_model_force_and_time_axis(linear):
 
 
 def test_run_programme_batches_equal_length_items_and_matches_single_runs(linear):
-    items = machine.harmonic_programme(frequencies_hz=(1.0, 15.0), amplitudes_m=(1e-3, 3e-3))
-    items.append(machine.step_item(dt=PAPER_DT, hold_s=1.0))
+    items = programmes.harmonic_programme(frequencies_hz=(1.0, 15.0), amplitudes_m=(1e-3, 3e-3))
+    items.append(programmes.step_item(dt=PAPER_DT, hold_s=1.0))
     messages = []
     records = machine.run_programme(linear, items, progress=messages.append)
     assert [r.name for r in records] == [i.name for i in items]
@@ -59,11 +59,11 @@ def test_run_refuses_excitation_beyond_stroke_or_velocity(linear):
 
 
 def test_run_programme_refuses_before_running_anything(linear):
-    good = machine.step_item(hold_s=1.0)
-    bad = machine.ProgrammeItem("fast", ex.sine(30.0, 10e-3, 1.0, PAPER_DT), PAPER_DT)
+    good = programmes.step_item(hold_s=1.0)
+    bad = programmes.ProgrammeItem("fast", ex.sine(30.0, 10e-3, 1.0, PAPER_DT), PAPER_DT)
     with pytest.raises(machine.MachineError, match="fast"):
         machine.run_programme(linear, [good, bad])
-    other_rate = machine.step_item(hold_s=1.0, dt=1 / 1024)
+    other_rate = programmes.step_item(hold_s=1.0, dt=1 / 1024)
     with pytest.raises(machine.MachineError, match="dt="):
         machine.run_programme(linear, [other_rate])
 
@@ -94,7 +94,7 @@ def test_step_test_is_4mm_held_10s_and_linear_force_settles_at_k_times_step(line
 
 
 def test_papers_programme_holds_harmonic_identification_verification_and_step():
-    names = [i.name for i in machine.papers_programme(seed=5)]
+    names = [i.name for i in programmes.papers_programme(seed=5)]
     assert len(names) == 28
     assert names[-3:] == ["random_n1_40s_seed5", "random_n1.5_20s_seed6", "step_4mm_hold10s"]
 
@@ -130,10 +130,10 @@ def test_measure_cli_step_programme_uses_axis_and_rate(tmp_path):
 
 
 def test_step_item_is_ideal_when_drivable_and_rate_limited_otherwise():
-    ideal = machine.step_item(4e-3, 1.0, PAPER_DT)
+    ideal = programmes.step_item(4e-3, 1.0, PAPER_DT)
     assert np.count_nonzero(np.diff(ideal.x)) == 1
     for size in (4e-3, 10e-3, -12e-3):
-        fast = machine.step_item(size, 1.0, 1 / 2048)
+        fast = programmes.step_item(size, 1.0, 1 / 2048)
         assert ex.within_limits(fast.x, 1 / 2048) == (True, "")
         assert fast.x[-1] == size
 
@@ -145,7 +145,7 @@ def test_reference_rubber_runs_the_papers_programme():
     rubber = get_model("rubber", axis="axial")
     with warnings.catch_warnings():
         warnings.simplefilter("error", machine.MachineWarning)
-        records = machine.run_programme(rubber, machine.papers_programme(seed=0))
+        records = machine.run_programme(rubber, programmes.papers_programme(seed=0))
     assert len(records) == 28
     for record in records:
         assert record.info["force_finite"]

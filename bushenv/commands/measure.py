@@ -1,37 +1,37 @@
-"""``bushenv measure``: run a test programme on a model and write CSV records (``machine.py``)."""
+"""``bushenv measure``: run a test programme on a model of C coordinates and write CSV records
+(``bushenv.machine``, ``bushenv.programmes``)."""
 
 from __future__ import annotations
 
 import argparse
+import inspect
 import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from bushenv.machine import (
+from bushenv.machine import MachineError, MachineWarning, reference_for, run_programme
+from bushenv.models.base import PAPER_DT
+from bushenv.persist import write_json
+from bushenv.programmes import (
     IDENTIFICATION_N,
     PROGRAMMES,
     STEP_HOLD_S,
     STEP_SIZE_M,
-    MachineError,
-    MachineWarning,
-    ProgrammeItem,
-    default_random_duration,
-    harmonic_programme,
-    papers_programme,
-    random_item,
-    run_programme,
-    step_item,
+    programme_items,
 )
-from bushenv.models.base import PAPER_DT
-from bushenv.persist import write_json
-from bushenv.records import RecordError, save_csv
+from bushenv.record_files import save_record
+from bushenv.records import RecordError
 
 EXAMPLE = (
     "bushenv measure --model rubber --axis axial --programme random --n 1 --duration 40 "
     "--seed 0 --out records/"
 )
+
+
+def _forms(n_coords: int) -> str:
+    return "; ".join(f"{k}: {v[n_coords]}" for k, v in PROGRAMMES.items() if n_coords in v)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -44,25 +44,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=int,
         default=1,
         choices=(1, 3),
-        help="3: the 3-axis programme on a planar model (--model: the planar reference by "
-        "default, a planar preset or .npz), 3-axis CSV records (default: 1)",
+        help="the bushing's coordinates: 3 measures axial, radial and rotation at once "
+        "(--model: the coupled reference by default, a three-axis preset or .npz) into "
+        "three-axis CSV records (default: 1)",
     )
     parser.add_argument(
         "--programme",
         default="papers",
-        choices=(*PROGRAMMES, "combined"),
-        help="harmonic: 25 sines; random: one RPC-like record (--n, --duration, --seed); "
-        "step: one held step (--step-mm, --hold); papers: harmonic + random n=1 40 s + "
-        "random n=1.5 20 s (seed+1) + 4 mm step (default); with --axes 3: papers, random, or "
-        "combined (each coordinate held at +- n x its n = 1 peak while each other one is "
-        "swept, 10 s each or --duration)",
+        choices=tuple(PROGRAMMES),
+        help=f"one axis: {_forms(1)} (default papers); with --axes 3: {_forms(3)}",
     )
     parser.add_argument("--n", type=float, default=IDENTIFICATION_N, help="random index n")
     parser.add_argument(
         "--duration",
         type=float,
         default=None,
-        help="random record length, s (default 40 for n <= 1, else 20)",
+        help="random record length, s (default 40 for n <= 1, else 20; combined: 10 each)",
     )
     parser.add_argument("--seed", type=int, default=0, help="seed of the random drive")
     parser.add_argument("--step-mm", type=float, default=STEP_SIZE_M * 1e3, help="step size, mm")
@@ -78,23 +75,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 
-def programme_items(args: argparse.Namespace, dt: float) -> list[ProgrammeItem]:
-    if args.programme == "harmonic":
-        return harmonic_programme(dt)
-    if args.programme == "random":
-        duration = default_random_duration(args.n) if args.duration is None else args.duration
-        return [random_item(args.n, duration, args.seed, dt)]
-    if args.programme == "step":
-        return [step_item(args.step_mm * 1e-3, args.hold, dt)]
-    return papers_programme(dt, seed=args.seed)
+def _model(args: argparse.Namespace, dt: float):
+    """The model measured, or a factory of one per record: a registered model whose preset
+    measures with noise gets its own noise seed per record (``machine.reference_for``)."""
+    from bushenv.models import MODELS, get_model
+
+    wanted_by = "bushenv measure" + (f" --axes {args.axes}" if args.axes != 1 else "")
+    model = get_model(args.model, axis=args.axis, dt=dt, coords=args.axes, wanted_by=wanted_by)
+    name = args.model
+    if name in MODELS and "seed" in inspect.signature(type(model).preset).parameters:
+        return model, reference_for(name, args.axes, args.seed, dt, args.axis)
+    return model, model
 
 
 def cli_run(args: argparse.Namespace) -> int:
-    from bushenv.models import get_model
     from bushenv.progress import Progress
 
     progress = Progress(quiet=args.quiet)
-
     if not (np.isfinite(args.rate) and args.rate > 0):
         raise MachineError(f"--rate must be a positive number of Hz, got {args.rate!r}")
     if args.seed < 0:
@@ -102,17 +99,21 @@ def cli_run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise MachineError(f"--out {out}: exists and is not a folder")
-    if args.axes == 3:
-        from bushenv.commands.measure_planar import run_planar
-
-        return run_planar(args)
-    if args.programme == "combined":
+    if args.axes != 1 and args.axis != "axial":
         raise MachineError(
-            "--programme combined holds one coordinate while another moves: it is a programme "
-            "of several coordinates (add --axes 3)"
+            f"--axis names one axis; --axes {args.axes} measures all of them (drop --axis)"
         )
-    model = get_model(args.model, axis=args.axis, dt=1.0 / args.rate)
-    items = programme_items(args, model.dt)
+    forms = PROGRAMMES[args.programme]
+    if args.axes not in forms:
+        raise MachineError(
+            f"--programme {args.programme} has no {args.axes}-axis form (add --axes "
+            f"{' or '.join(map(str, forms))}); with --axes {args.axes} choose {_forms(args.axes)}"
+        )
+    dt = 1.0 / args.rate
+    items = programme_items(
+        args.programme, args.axes, dt, args.seed, args.n, args.duration,
+        args.step_mm * 1e-3, args.hold,
+    )  # fmt: skip
     paths = [out / f"{item.name}.csv" for item in items]
     existing = [str(p) for p in paths if p.exists()]
     if existing and not args.force:
@@ -120,13 +121,15 @@ def cli_run(args: argparse.Namespace) -> int:
             f"{len(existing)} record file(s) already exist, e.g. {existing[0]}; refusing to "
             "overwrite (pass --force to replace them)"
         )
+    model, source = _model(args, dt)
+    where = f"({args.axis})" if model.n_coords == 1 else f"({', '.join(model.coords)})"
     progress(
-        f"{args.programme} programme, {len(items)} item(s), model {model.name} ({args.axis}), "
+        f"{args.programme} programme, {len(items)} item(s), model {model.name} {where}, "
         f"{1 / model.dt:g} Hz"
     )
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", MachineWarning)
-        records = run_programme(model, items, progress=progress)
+        records = run_programme(source, items, progress=progress)
     for w in caught:
         print(f"bushenv measure: warning: {w.message}", file=sys.stderr)
     out.mkdir(parents=True, exist_ok=True)
@@ -136,11 +139,10 @@ def cli_run(args: argparse.Namespace) -> int:
                 f"{record.name}: the model's force is not finite (diverged); nothing written "
                 f"for it or later items ({k - 1} of {len(records)} written)"
             )
-        save_csv(record, path, overwrite=args.force)
-        progress(
-            f"[{k}/{len(records)}] {path}: {len(record)} samples, "
-            f"max |F| = {record.info['max_abs_force_n']:.4g} N"
-        )
+        save_record(record, path, overwrite=args.force)
+        peaks = np.abs(record.f).max(axis=0)
+        shown = ", ".join(f"{p:.4g} {u}" for p, u in zip(peaks, model.force_units, strict=True))
+        progress(f"[{k}/{len(records)}] {path}: {len(record)} samples, max |F| = {shown}")
         print(path)
     write_json(out / "measure.json", _manifest(args, model, records, paths))
     return 0
@@ -148,7 +150,7 @@ def cli_run(args: argparse.Namespace) -> int:
 
 def _manifest(args, model, records, paths) -> dict:
     """What made the records: the model (spec, class, file and parameter hashes), the
-    programme and its settings, and each record's file, length and peak force."""
+    programme and its settings, and each record's file, length and peak force per coordinate."""
     from bushenv.models import file_hash, model_file, params_sha
 
     path = model_file(args.model, args.axis)
@@ -158,13 +160,19 @@ def _manifest(args, model, records, paths) -> dict:
             "class": type(model).__name__,
             "file_sha256": file_hash(path) if path is not None and path.is_file() else None,
             "params_sha256": params_sha(model),
-            "axis": args.axis,
+            "axis": args.axis if model.n_coords == 1 else None,
+            "coords": list(model.coords),
         },
         "sample_rate_hz": 1.0 / model.dt,
         "programme": args.programme,
         "seed": args.seed,
         "records": [
-            {"file": p.name, "samples": len(r), "max_abs_force_n": r.info["max_abs_force_n"]}
+            {
+                "file": p.name,
+                "samples": len(r),
+                "max_abs_force_n": r.info["max_abs_force_n"],
+                "max_abs_force": np.abs(r.f).max(axis=0).tolist(),
+            }
             for r, p in zip(records, paths, strict=True)
         ],
     }

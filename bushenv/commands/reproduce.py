@@ -6,15 +6,15 @@ import argparse
 from pathlib import Path
 
 from bushenv.models import AXES
+from bushenv.programmes import IDENTIFICATIONS
 from bushenv.progress import Progress
-from bushenv.reproduce import format_tables, reproduce
+from bushenv.reproduce import coupled_table, reproduce
+from bushenv.reproduce_report import format_coupled, format_tables
 
 EXAMPLE = "bushenv reproduce --out runs/reproduce"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    from bushenv.planar.machine import IDENTIFICATIONS
-
     p.add_argument("--out", required=True, help="output folder (refused if it holds a report)")
     p.add_argument("--axes", default="axial,radial", help="comma list of axes")
     p.add_argument("--seed", type=int, default=0, help="seed for records and training")
@@ -83,9 +83,8 @@ def run(args: argparse.Namespace) -> int:
 def _planar(out: Path, args: argparse.Namespace, progress: Progress) -> None:
     from bushenv.models.base import PAPER_DT
     from bushenv.persist import json_text, write_text
-    from bushenv.planar.reproduce3 import format_planar, planar_table
 
-    report = planar_table(
+    report = coupled_table(
         args.seed,
         args.identification_s,
         args.verification_s,
@@ -93,7 +92,7 @@ def _planar(out: Path, args: argparse.Namespace, progress: Progress) -> None:
         progress,
         identification=args.planar_identification,
     )
-    text = format_planar(report)
+    text = format_coupled(report)
     write_text(out / "planar.json", json_text(report, indent=2))
     write_text(out / "planar.md", "# The 3-axis table\n\n```\n" + text + "\n```\n")
     print(("\n" if args.planar == "add" else "") + text)

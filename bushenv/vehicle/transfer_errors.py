@@ -18,7 +18,7 @@ coordinate i (axial, radial, rotation) by a factor (1 + a):
 **Size**: the component-level error is the RMS force error ratio (``bushenv.metrics.rms_ratio``,
 in %) on the erring coordinate's own force, the error term's law against the reference's, both
 driven open loop by the bench's random motion at amplitude index n = 1 (independent random on
-all three coordinates, ``bushenv.planar.programme.random_independent``, 2 mm, 2 mm, 0.05 rad
+all three coordinates, ``bushenv.motions.random_independent``, 2 mm, 2 mm, 0.05 rad
 peak, ``BENCH_S`` long, seed ``BENCH_SEED``): what a bushing test rig shows of the error. A
 signed size s > 0 overstates the effect (a > 0), s < 0 understates it (a < 0); ``calibrate``
 finds a by bisection for each kind and coordinate, so every kind errs by the same |s|.
@@ -104,7 +104,7 @@ def scaled_rubber(base: Any, kind: str, coord: str, factor: float) -> Any:
 @lru_cache(maxsize=4)
 def bench_motion(dt_s: float) -> np.ndarray:
     """(T, 3) the bench's random motion at n = 1 (module docstring), read-only."""
-    from bushenv.planar.programme import random_independent
+    from bushenv.motions import random_independent
 
     q = random_independent(1.0, BENCH_S, dt_s, BENCH_SEED)
     q.setflags(write=False)

@@ -33,7 +33,7 @@ from scipy.signal import fftconvolve
 from bushenv.diagnose.fit import diagnose
 from bushenv.excitation import chirp
 from bushenv.models.base import velocity_of
-from bushenv.planar.programme import PEAK_AT_N1, random_independent
+from bushenv.motions import PEAK_AT_N1, random_independent
 from bushenv.planar.records import PlanarRecord
 
 HERE = Path(__file__).parent

@@ -78,10 +78,10 @@ def compact_table(report: dict) -> str:
 
 def reference_deflections(seed: int = 0) -> dict:
     """Per manoeuvre: the reference car's largest pivot deflection over the four pivots, per
-    coordinate, over the n = 1 identification peaks (``planar.programme.PEAK_AT_N1``)."""
+    coordinate, over the n = 1 identification peaks (``bushenv.motions.PEAK_AT_N1``)."""
     import numpy as np
 
-    from bushenv.planar.programme import PEAK_AT_N1
+    from bushenv.motions import PEAK_AT_N1
     from bushenv.rigs.halfcar_params import ENV_ID
     from bushenv.rigs.specs import spec_kwargs
     from bushenv.vehicle.compare import run_car

@@ -212,9 +212,9 @@ def planar_attack_run(out: Path) -> dict[str, Any]:
 
 def planar_certificate_run(out: Path) -> dict[str, Any]:
     """A three-axis network's holds over its range and the linear fit's passivity matrix."""
+    from bushenv.certify.passivity import passivity
+    from bushenv.certify.range_holds import range_holds
     from bushenv.models import load_model
-    from bushenv.planar.passivity import passivity
-    from bushenv.planar.range_holds import range_holds
 
     planar_fit_run(out)
     nn = load_model(out / "nn3.npz")
@@ -229,9 +229,9 @@ def planar_certificate_run(out: Path) -> dict[str, Any]:
 def planar_reproduce_run(out: Path) -> dict[str, Any]:
     """``bushenv reproduce --planar only``'s table, the linear model on short records."""
     from bushenv.models.base import PAPER_DT
-    from bushenv.planar.reproduce3 import planar_table
+    from bushenv.reproduce import coupled_table
 
-    return strip(planar_table(0, 6.0, 6.0, PAPER_DT, models=("linear",)))
+    return strip(coupled_table(0, 6.0, 6.0, PAPER_DT, models=("linear",)))
 
 
 RUNS = {

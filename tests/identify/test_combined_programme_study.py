@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bushenv.planar.programme import random_independent
+from bushenv.motions import random_independent
 
 
 @pytest.fixture(scope="module")

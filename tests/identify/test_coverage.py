@@ -14,7 +14,7 @@ from bushenv.identify.coverage import (
     not_shown,
 )
 from bushenv.models.planar_base import COORDS
-from bushenv.planar.programme import held_sweeps, random_independent
+from bushenv.motions import held_sweeps, random_independent
 
 DT = 1 / 204.8
 SPAN = np.array([2e-3, 2e-3, 0.05])

@@ -12,7 +12,7 @@ import pytest
 from bushenv.cli import main
 from bushenv.models.base import velocity_of
 from bushenv.models.planar_linear import PlanarLinear, fit_linear
-from bushenv.planar.reproduce3 import identification_records
+from bushenv.reproduce import identification_records
 from bushenv.rigs.halfcar_params import ENV_ID
 from bushenv.rigs.specs import spec_kwargs
 from bushenv.vehicle.checks import VehicleInputError

@@ -1,16 +1,18 @@
-"""The 3-axis programme: amplitude index per axis, correlation, preload sets, machine limits."""
+"""Motions of several coordinates: amplitude index per coordinate, correlation, preload sets,
+machine limits; the machine's programmes over C."""
 
 import numpy as np
 import pytest
 
 from bushenv.excitation import MAX_DISPLACEMENT_M, MAX_VELOCITY_M_PER_S
-from bushenv.planar.programme import (
+from bushenv.motions import (
     PEAK_AT_N1,
     preload_sweep,
-    programme,
     random_correlated,
     random_independent,
+    verification_motions,
 )
+from bushenv.programmes import PROGRAMMES, ProgrammeError, programme_items
 from bushenv.reference.planar import MAX_ROTATION_RAD
 
 DT = 1 / 204.8
@@ -47,7 +49,7 @@ def test_preload_sweep_holds_one_coordinate_and_sweeps_the_other():
 
 
 def test_every_record_is_within_the_machine_limits():
-    for q in programme(DT, seed=0).values():
+    for q in verification_motions(DT, seed=0).values():
         assert np.abs(q[:, :2]).max() <= MAX_DISPLACEMENT_M
         assert np.abs(np.diff(q[:, :2], axis=0)).max() / DT <= MAX_VELOCITY_M_PER_S
         assert np.abs(q[:, 2]).max() <= MAX_ROTATION_RAD
@@ -57,7 +59,7 @@ def test_benchmark_table_reports_ratio_and_axes_at_rest_in_newtons():
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).parents[2] / "scripts" / "planar_benchmark.py"
+    path = Path(__file__).parents[1] / "scripts" / "planar_benchmark.py"
     spec = importlib.util.spec_from_file_location("planar_benchmark", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
@@ -75,3 +77,41 @@ def test_benchmark_table_reports_ratio_and_axes_at_rest_in_newtons():
         row[k]["rotation"] = cell(1.0, rest=True)
     assert "rotation at rest: max error | 7 N m" in mod.table({0: {"set": row}})
     assert lines[3].endswith("| 2.00 |")  # nn-axis 8 % over nn 4 %
+
+
+def test_the_motions_take_their_number_of_coordinates_from_the_peaks():
+    peaks = np.array([1e-3, 2e-3])
+    for make in (random_independent, random_correlated):
+        q = make(1.0, 4.0, DT, 0, peaks)
+        assert q.shape == (int(round(4.0 / DT)), 2)
+        np.testing.assert_allclose(np.abs(q).max(axis=0), peaks, rtol=1e-12)
+    assert preload_sweep(0, 1e-3, 1e-3, 4.0, DT, n_coords=2).shape[1] == 2
+
+
+@pytest.mark.parametrize("n_coords", [1, 3])
+def test_every_programme_gives_items_of_the_bushings_coordinates_within_the_limits(n_coords):
+    for kind, forms in PROGRAMMES.items():
+        if n_coords not in forms:
+            with pytest.raises(ProgrammeError, match=f"no form for {n_coords} coordinate"):
+                programme_items(kind, n_coords, DT)
+            continue
+        items = programme_items(kind, n_coords, DT, duration_s=2.0 if kind != "papers" else None)
+        assert items and len({i.name for i in items}) == len(items), kind
+        for item in items:
+            q = item.x.reshape(len(item.x), -1)
+            assert q.shape[1] == n_coords, (kind, item.name)
+            moved = q[:, : min(2, n_coords)]
+            assert np.abs(moved).max() <= MAX_DISPLACEMENT_M + 1e-12, item.name
+
+
+def test_the_three_axis_programmes_keep_their_names_and_order():
+    names = [i.name for i in programme_items("papers", 3, DT, seed=4)]
+    assert names[:4] == [
+        "random_independent_n1_40s_seed4",
+        "random_correlated_n1_40s_seed4",
+        "random_independent_n1.5_20s_seed5",
+        "random_correlated_n1.5_20s_seed5",
+    ]
+    assert names[-2:] == ["axial_preload_3mm_radial_sweep", "axial_preload_2mm_radial_sweep"]
+    combined = programme_items("combined", 3, DT, duration_s=2.0)
+    assert len(combined) == 12 and combined[0].name == "axial_held_+_radial_sweep"
