@@ -74,6 +74,10 @@ class HalfCarBatch:
         self._stiff = np.repeat(np.stack([x.stiff for x in tables]), n, axis=0).T.copy()
         self._damp = np.repeat(np.stack([x.damp for x in tables]), n, axis=0).T.copy()
         self._split = np.repeat(np.stack([x.split for x in tables]), n, axis=0)  # (cols, 4, 2, 3)
+        self._hold_rows = t.bushing_rows.reshape(-1)  # each pivot's axial, radial, rotary spring
+        self._hold_base = np.array([LONG_ARM_M, LONG_ARM_M, 0.0])
+        self._hold_sign = np.stack([-np.ones(len(POSITIONS)), -np.ones(len(POSITIONS)),
+                                    t.pivot_sign], axis=1)  # fmt: skip
         self._state0 = np.repeat(t.state[:, :, None], cols, axis=2)
         self.state = self._state0.copy()
         self.rest = self._rest0.copy()
@@ -221,14 +225,11 @@ class HalfCarBatch:
             ok = (np.abs(forces) <= limits).all(axis=(1, 2))  # False where NaN
         k_in, c_in = self._split[:, :, 0], self._split[:, :, 1]
         held = forces - (k_in * q + c_in * v)
-        t = self._table
-        sign = t.pivot_sign
-        for i in range(len(POSITIONS)):
-            for c in range(2):
-                e = t.bushing_rows[i, c]
-                self.rest[e, ok] = LONG_ARM_M - held[ok, i, c] / k_in[ok, i, c]
-            e = t.bushing_rows[i, 2]  # the rotary spring is unmirrored: chipmunk's own angle
-            self.rest[e, ok] = sign[i] * held[ok, i, 2] / k_in[ok, i, 2]
+        # the springs' rest lengths LONG_ARM_M - H / k_in, the rotary's rest angle s H / k_in
+        # (chipmunk's own angle: the right side unmirrored), where the forces can be applied
+        rest = (self._hold_base + self._hold_sign * held / k_in).reshape(len(ok), -1).T
+        rows = self._hold_rows
+        self.rest[rows] = np.where(ok, rest, self.rest[rows])
         return forces, ~ok
 
     # ----- whole manoeuvres -------------------------------------------------------------------
