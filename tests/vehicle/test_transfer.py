@@ -159,3 +159,30 @@ def test_the_command_writes_its_report_and_refuses_a_bad_size(tmp_path, capsys):
     assert report["findings"]["size_pct"] == 10.0
     assert main(["vehicle-transfer", "--out", str(out), "--size-pct", "40"]) == 2
     assert "--size-pct must be in (0, 15] %, got 40.0" in capsys.readouterr().err
+    assert main(["vehicle-transfer", "--out", str(out), "--held=0"]) == 2
+    assert "--held 0.0: non-zero" in capsys.readouterr().err
+    assert main(["vehicle-transfer", "--out", str(out), "--combinations", "-1"]) == 2
+    assert "--combinations must be >= 0, got -1" in capsys.readouterr().err
+
+
+def test_findings_name_the_errors_below_a_tenth_and_above_the_size():
+    from bushenv.vehicle.transfer_report import findings
+
+    comps = [["lower_left", "radial", "damping"], ["upper_left", "rotation", "stiffness"],
+             ["lower_right", "axial", "hysteresis"]]  # fmt: skip
+    pct = np.array([[[0.5, 0.9]], [[12.0, np.nan]], [[3.0, 9.0]]])  # (J, M, O): 1 manoeuvre
+    report = {
+        "settings": {"size_pct": 10.0}, "components": comps, "map_pct": pct,
+        "map_rms": pct / 100, "manoeuvres": [{"name": "bump"}],
+        "outputs": [{"name": "roll", "unit": "rad"}, {"name": "camber", "unit": "rad"}],
+        "in_car_component_pct": [[5.0], [10.0], [np.nan]],
+        "checks": {"singles": {"-1": {"influence": {"overall": 0.95}}}, "combinations": [],
+                   "combined": {"median_relative_error": 0.25, "cells": 3}},
+    }  # fmt: skip
+    found = findings(report)
+    assert [r["component"] for r in found["never_reach"]] == [comps[0]]
+    assert [r["component"] for r in found["amplified"]] == [comps[1]]
+    assert found["amplified"][0]["where"] == ("bump", "roll")
+    assert found["amplified"][0]["change"] == "0.12 rad"
+    assert found["predictor"]["meets_rank"] and not found["predictor"]["meets_median"]
+    assert found["in_car_component_by_kind"]["hysteresis"] is None
