@@ -1,34 +1,19 @@
-"""Every fixed point of a NARX network in a hold, its stability, and the folds between holds.
+"""Every fixed point of a NARX network at held deflection vectors, its stability, and the folds
+between holds, for a network over any number of coordinates C.
 
-**Why the search below finds every fixed point.** At a hold x the fixed points are the roots
-of phi(y) = N(xs, .., y, .., y) - y (``network.diagonal``). Every hidden unit is a tanh in
-[-1, 1], so N lies in I = [b_out - sum |w_out|, b_out + sum |w_out|] whatever its input; a
-root y* = N(.., y*, ..) therefore lies in I, and phi > 0 just below I, phi < 0 just above it,
-so at least one root exists. I (slightly widened) is cut into cells; with M bounding |phi''|
-(``network.derivative_bounds``) a cell [a, b] of width w, sigma = sign(phi(a)), is
+At a hold q the fixed points are the roots of phi(y) = N(qs, .., y, .., y) - y (``network``).
+They are found exhaustively: by cells for C = 1 (``cells``: a bound on phi'' decides every cell,
+double roots at a fold included), by boxes for C > 1 (``boxes``: interval enclosures and
+Krawczyk's uniqueness test; boxes left at the depth limit are counted, ``unresolved``).
 
-- *empty* when phi(a), phi(b) share the sign sigma and sigma phi(a) + sigma phi'(a) w/2 - M w^2/8
-  and sigma phi(b) - sigma phi'(b) w/2 - M w^2/8 are both > 0: by Taylor's theorem sigma phi is
-  bounded below on each half by a concave quadratic whose minimum over the half is at its
-  ends, and those ends are the numbers just checked, so phi has no root in the cell;
-- *monotone* when phi'(a), phi'(b) share a sign and |phi'(a)| + |phi'(b)| > M w: phi' is
-  M-Lipschitz, so it cannot reach 0 inside, phi is strictly monotone and has exactly one root
-  in [a, b) if phi(a) = 0 or phi(a) phi(b) < 0, none otherwise.
-
-Any other cell is halved, up to ``MAX_DEPTH`` times. Every root lies in a cell that is never
-declared empty, so each root ends in a monotone cell (found, then refined by bisection to
-machine precision) or in a cell left unresolved at the depth limit, which is narrower than
-``2**-MAX_DEPTH`` of the initial cell and can only hold a (near-)double root: a hold sitting
-on a fold to within that width. Unresolved cells are counted per hold (``unresolved``) and
-each run of touching ones gives one root (phi vanishes there to machine precision; a tangent
-root need not change sign), so nothing is dropped silently: whether a hold placed exactly on a
-fold shows its double root no longer depends on how the platform rounds tanh.
-
-**Stability.** Linearised about y*, the held recurrence is dy_t = sum_j a_j dy_{t-j}
-(``network.lag_gradients``); the fixed point is asymptotically stable when the spectral
-radius of its companion matrix is below 1. Since phi'(y*) = sum a_j - 1, a root where phi'
-vanishes (a double root) has the eigenvalue 1: that is where, as x moves, a stable and an
-unstable fixed point meet and vanish (a fold, :func:`folds`).
+**Stability.** Linearised about y*, the held recurrence is dy_t = sum_l A_l dy_{t-l}
+(``NarxNet.lag_matrices``, C x C each); the fixed point is asymptotically stable when the
+spectral radius of its block companion matrix is below 1 (C = 1: the scalar companion matrix
+of the a_j). Since phi's Jacobian is sum_l A_l - I, a singular root has the eigenvalue 1: that
+is where, as q moves, a stable and an unstable fixed point meet and vanish (a fold). Over a grid
+of holds the folds are points (C = 1) or surfaces: :func:`fold_crossings` finds where they cut
+the grid's edges, :func:`folds` the same for one coordinate's sorted holds, located to a
+nanometre.
 """
 
 from __future__ import annotations
@@ -37,28 +22,30 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bushenv.certify.network import NarxNet, derivative_bounds, diagonal, lag_gradients
+from bushenv.certify.boxes import roots_by_boxes
+from bushenv.certify.cells import INITIAL_CELLS, roots_by_cells
+from bushenv.certify.network import CertifyError, NarxNet, narx_net
 
-INITIAL_CELLS = 256  # per hold; the bounds decide the rest
-MAX_DEPTH = 40  # halvings of a cell: 2^-40 of a 1/256 cell, far below float64 use
-BISECTION_STEPS = 60
-FOLD_TOLERANCE_M = 1e-9  # folds are located to a nanometre of displacement
+FOLD_TOLERANCE_M = 1e-9  # one-coordinate folds are located to a nanometre of displacement
+FOLD_TOLERANCE = 1e-4  # fold crossings on a grid's edges: to this fraction of the edge
+DUPLICATE = 1e-9  # two roots of one hold closer than this (scaled output) are one
 
 
 @dataclass(frozen=True, eq=False)
 class FixedPoints:
-    """The fixed points at M holds, flattened to P points sorted by (hold, y).
+    """The fixed points at M holds, flattened to P points sorted by hold (then y).
 
-    ``x_m`` (M,) holds, m; ``hold`` (P,) index into ``x_m``; ``y`` (P,) scaled network
-    output; ``force_n`` (P,) static force (k x + f_offset + f_scale y), N; ``spectral_radius``
-    (P,); ``lag_gradient`` (P, n_past_f) the a_j; ``unresolved`` (M,) cells left at the depth
-    limit (0 unless a hold sits on a fold to within machine precision).
+    ``q`` (M, C) holds (m, or rad for a rotation); ``hold`` (P,) index into ``q``; ``y`` (P, C)
+    scaled network outputs; ``force`` (P, C) static force (K q + f_offset + f_scale y: N, or
+    N m); ``spectral_radius`` (P,); ``lag_gradient`` (P, n_past_f, C, C) the lag matrices A_l;
+    ``unresolved`` (M,) cells or boxes left at the depth limit (0 unless a hold sits on a fold).
+    A one-coordinate network's holds read as scalars too: ``x_m``, ``point_x_m``, ``force_n``.
     """
 
-    x_m: np.ndarray
+    q: np.ndarray
     hold: np.ndarray
     y: np.ndarray
-    force_n: np.ndarray
+    force: np.ndarray
     spectral_radius: np.ndarray
     lag_gradient: np.ndarray
     unresolved: np.ndarray
@@ -68,199 +55,214 @@ class FixedPoints:
         return self.spectral_radius < 1.0
 
     @property
-    def point_x_m(self) -> np.ndarray:
-        """(P,) the hold of each fixed point, m."""
-        return self.x_m[self.hold]
-
-    @property
     def count(self) -> np.ndarray:
         """(M,) number of fixed points per hold."""
-        return np.bincount(self.hold, minlength=self.x_m.size)
+        return np.bincount(self.hold, minlength=len(self.q))
+
+    @property
+    def stable_count(self) -> np.ndarray:
+        """(M,) stable fixed points per hold."""
+        return np.bincount(self.hold[self.stable], minlength=len(self.q))
 
     def of_hold(self, i: int) -> np.ndarray:
-        """Indices (into the flat arrays) of hold ``i``'s fixed points, by increasing y."""
+        """Indices (into the flat arrays) of hold ``i``'s fixed points, in order."""
         return np.flatnonzero(self.hold == i)
+
+    @property
+    def x_m(self) -> np.ndarray:
+        """(M,) the holds of a one-coordinate network, m."""
+        return self.q[:, 0]
+
+    @property
+    def point_x_m(self) -> np.ndarray:
+        """(P,) the hold of each fixed point of a one-coordinate network, m."""
+        return self.q[self.hold, 0]
+
+    @property
+    def force_n(self) -> np.ndarray:
+        """(P,) the static force of a one-coordinate network's fixed points, N."""
+        return self.force[:, 0]
 
 
 def spectral_radius(a: np.ndarray) -> np.ndarray:
-    """(P,) spectral radius of the companion matrices of dy_t = sum_j a[:, j-1] dy_{t-j}."""
-    a = np.atleast_2d(a)
-    P, n = a.shape
-    comp = np.zeros((P, n, n))
-    comp[:, 0, :] = a
-    comp[:, np.arange(1, n), np.arange(n - 1)] = 1.0
-    return np.abs(np.linalg.eigvals(comp)).max(axis=-1) if P else np.zeros(0)
+    """(P,) spectral radius of the block companion matrices of dy_t = sum_l a[:, l-1] dy_{t-l};
+    ``a`` (P, L, C, C), or (P, L) for one coordinate."""
+    a = np.asarray(a, dtype=np.float64)
+    if a.ndim <= 2:
+        a = np.atleast_2d(a)[:, :, None, None]
+    n, lags, dim = a.shape[0], a.shape[1], a.shape[2]
+    comp = np.zeros((n, dim * lags, dim * lags))
+    comp[:, :dim, :] = a.transpose(0, 2, 1, 3).reshape(n, dim, dim * lags)
+    comp[:, dim:, :-dim] = np.eye(dim * (lags - 1))
+    return np.abs(np.linalg.eigvals(comp)).max(axis=-1) if n else np.zeros(0)
 
 
-def _cells(net: NarxNet, c: np.ndarray, n_cells: int):
-    lo, hi = net.y_range
-    pad = 1e-9 * (hi - lo) + 1e-12
-    edges = np.linspace(lo - pad, hi + pad, n_cells + 1)
-    phi, dphi = diagonal(net, c[:, None, :], edges[None, :])
-    m = c.shape[0]
-    hold = np.repeat(np.arange(m), n_cells)
-    a = np.tile(edges[:-1], m)
-    b = np.tile(edges[1:], m)
-    return (
-        hold,
-        a,
-        b,
-        phi[:, :-1].ravel(),
-        phi[:, 1:].ravel(),
-        dphi[:, :-1].ravel(),
-        dphi[:, 1:].ravel(),
-    )
-
-
-def _isolate(net: NarxNet, c: np.ndarray, n_cells: int):
-    """Cells [a, b) holding exactly one root, and the unresolved ones (see the module doc)."""
-    _, curv = derivative_bounds(net)
-    hold, a, b, pa, pb, da, db = _cells(net, c, n_cells)
-    found, unresolved = [], []
-    for depth in range(MAX_DEPTH + 1):
-        w = b - a
-        sig = np.sign(pa)
-        q = curv * w * w / 8.0
-        empty = (
-            (pa * pb > 0) & (sig * (pa + da * w / 2) - q > 0) & (sig * (pb - db * w / 2) - q > 0)
+def _holds(net: NarxNet, q) -> np.ndarray:
+    """(M, C) holds from ``q``: (M, C), or (M,) for one coordinate."""
+    q = np.asarray(q, dtype=np.float64)
+    q = q.reshape(-1, 1) if net.n_coords == 1 and q.ndim <= 1 else np.atleast_2d(q)
+    if q.ndim != 2 or q.shape[1] != net.n_coords or not np.all(np.isfinite(q)):
+        raise CertifyError(
+            f"holds must be finite (M, {net.n_coords}) ({', '.join(net.units)}), got {q.shape}"
         )
-        mono = (da * db > 0) & (np.abs(da) + np.abs(db) > curv * w)
-        has_root = (pa == 0) | (pa * pb < 0)
-        pick = ~empty & mono & has_root
-        found.append((hold[pick], a[pick], b[pick], pa[pick]))
-        rest = ~empty & ~mono
-        hold, a, b, pa, pb, da, db = (v[rest] for v in (hold, a, b, pa, pb, da, db))
-        if hold.size == 0:
-            break
-        if depth == MAX_DEPTH:
-            unresolved.append(hold)
-            # phi vanishes on such a cell to machine precision: a (near-)double root, kept
-            # whether or not phi changes sign across it (a tangent root at a fold does not,
-            # or does by rounding alone), one per run of adjacent cells; pa = 0 marks it exact
-            keep = _one_per_run(hold, a, b, np.abs(pa) + np.abs(pb))
-            sign_change = (pa == 0) | (pa * pb < 0)
-            found.append((hold[keep], a[keep], b[keep], np.where(sign_change, pa, 0.0)[keep]))
-            break
-        mid = 0.5 * (a + b)
-        pm, dm = diagonal(net, c[hold], mid)
-        hold = np.concatenate([hold, hold])
-        a, b = np.concatenate([a, mid]), np.concatenate([mid, b])
-        pa, pb = np.concatenate([pa, pm]), np.concatenate([pm, pb])
-        da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
-    cat = [np.concatenate(parts) for parts in zip(*found, strict=True)]
-    bad = np.concatenate(unresolved) if unresolved else np.zeros(0, dtype=np.int64)
-    return (*cat, np.bincount(bad, minlength=c.shape[0]))
+    return q
 
 
-def _one_per_run(hold: np.ndarray, a: np.ndarray, b: np.ndarray, size: np.ndarray) -> np.ndarray:
-    """Indices of one cell (the smallest ``size``) per run of touching cells of one hold."""
-    order = np.lexsort((a, hold))
-    keep, best = [], None
-    for k, i in enumerate(order):
-        j = order[k - 1] if k else None
-        touching = j is not None and hold[i] == hold[j] and a[i] <= b[j]
-        if not touching:
-            if best is not None:
-                keep.append(best)
-            best = i
-        elif size[i] < size[best]:
-            best = i
-    if best is not None:
-        keep.append(best)
-    return np.array(keep, dtype=np.int64)
-
-
-def _bisect(net: NarxNet, c: np.ndarray, a: np.ndarray, b: np.ndarray, pa: np.ndarray):
-    """Roots of phi in [a, b) given a sign change (or phi(a) = 0), vectorised."""
-    exact = pa == 0
-    sa = np.sign(pa)
-    a, b = a.copy(), b.copy()
-    for _ in range(BISECTION_STEPS):
-        mid = 0.5 * (a + b)
-        pm, _ = diagonal(net, c, mid)
-        left = np.sign(pm) == sa
-        a = np.where(left, mid, a)
-        b = np.where(left, b, mid)
-        if np.all(b - a <= 4 * np.finfo(float).eps * np.maximum(1.0, np.abs(a))):
-            break
-    return np.where(exact, a, 0.5 * (a + b))
-
-
-def fixed_points(net: NarxNet, x_m: np.ndarray, n_cells: int = INITIAL_CELLS) -> FixedPoints:
-    """Every fixed point of ``net`` held at each displacement of ``x_m`` (M,), m."""
-    x_m = np.atleast_1d(np.asarray(x_m, dtype=np.float64))
-    c = net.held_preactivation(x_m)
-    hold, a, b, pa, unresolved = _isolate(net, c, n_cells)
-    y = _bisect(net, c[hold], a, b, pa)
-    order = np.lexsort((y, hold))
+def fixed_points(net_or_model, q, n_cells: int = INITIAL_CELLS) -> FixedPoints:
+    """Every fixed point of a network (a ``NarxNet`` or a NARX model) held at each row of ``q``
+    (M, C); one coordinate: ``q`` may be (M,). ``n_cells``: the one-coordinate search's first
+    cells per hold."""
+    net = net_or_model if isinstance(net_or_model, NarxNet) else narx_net(net_or_model)
+    q = _holds(net, q)
+    c = net.held(q)
+    if net.n_coords == 1:
+        hold, y, unresolved = roots_by_cells(net, c, n_cells)
+    else:
+        hold, y, unresolved = roots_by_boxes(net, c)
+    order = np.lexsort((*y.T[::-1], hold))
     hold, y = hold[order], y[order]
-    grad, _ = lag_gradients(net, c[hold], y)
+    if net.n_coords > 1:  # a root on the face two unique boxes share is found twice: keep one
+        dup = np.zeros(len(y), dtype=bool)
+        dup[1:] = (hold[1:] == hold[:-1]) & np.all(np.abs(y[1:] - y[:-1]) < DUPLICATE, axis=1)
+        hold, y = hold[~dup], y[~dup]
+    a, _ = net.lag_matrices(c[hold], y)
     return FixedPoints(
-        x_m=x_m,
+        q=q,
         hold=hold,
         y=y,
-        force_n=net.force_n(x_m[hold], y),
-        spectral_radius=spectral_radius(grad),
-        lag_gradient=grad,
+        force=net.force(q[hold], y),
+        spectral_radius=spectral_radius(a),
+        lag_gradient=a,
         unresolved=unresolved,
     )
 
 
+def grid(*axes) -> np.ndarray:
+    """(N_1 ... N_C, C) the held vectors of a grid over the given per-coordinate values, the
+    first coordinate slowest."""
+    mesh = np.meshgrid(*[np.atleast_1d(np.asarray(a, dtype=np.float64)) for a in axes],
+                       indexing="ij")  # fmt: skip
+    return np.stack([m.ravel() for m in mesh], axis=1)
+
+
 @dataclass(frozen=True)
 class Fold:
-    """A fold between two holds: a pair of fixed points exists on one side of ``x_m`` only.
+    """Where the number of fixed points changes between two holds: a fold (surface, C > 1)
+    cuts the edge from ``q_from`` to ``q_to`` at ``q``, from ``count_from`` to ``count_to``
+    fixed points; ``force`` where the pair meets, ``radii`` the spectral radii of the pair on
+    the side it exists (one is >= 1 at a fold)."""
 
-    ``exists_above``: the pair exists for x > x_m (else for x < x_m). ``force_n``: where the
-    pair meets. ``radii``: spectral radii of the pair just on its side (one is >= 1 at a
-    fold). ``gained``: fixed points gained crossing it upwards in x (-2 or +2 normally).
-    """
+    q: tuple[float, ...]
+    q_from: tuple[float, ...]
+    q_to: tuple[float, ...]
+    count_from: int
+    count_to: int
+    force: tuple[float, ...] = ()
+    radii: tuple[float, float] = (float("nan"), float("nan"))
 
-    x_m: float
-    force_n: float
-    exists_above: bool
-    radii: tuple[float, float]
-    gained: int
+    @property
+    def exists_above(self) -> bool:
+        """Whether the pair exists past the crossing (towards ``q_to``)."""
+        return self.count_to > self.count_from
+
+    @property
+    def gained(self) -> int:
+        """Fixed points gained crossing from ``q_from`` to ``q_to`` (-2 or +2 normally)."""
+        return self.count_to - self.count_from
+
+    @property
+    def x_m(self) -> float:
+        """Where a one-coordinate fold lies, m."""
+        return self.q[0]
+
+    @property
+    def force_n(self) -> float:
+        """Where a one-coordinate fold's pair meets, N."""
+        return self.force[0] if self.force else float("nan")
 
 
 def _pair_at(fp: FixedPoints, i: int) -> tuple[int, int]:
-    """The two adjacent fixed points of hold ``i`` closest in y (the pair about to merge)."""
+    """The two fixed points of hold ``i`` closest in y (the pair about to merge)."""
     idx = fp.of_hold(i)
-    k = int(np.argmin(np.diff(fp.y[idx])))
-    return int(idx[k]), int(idx[k + 1])
+    y = fp.y[idx]
+    gap = np.linalg.norm(y[:, None, :] - y[None, :, :], axis=-1) + np.diag(np.full(len(y), np.inf))
+    j, k = np.unravel_index(np.argmin(gap), gap.shape)
+    return int(idx[min(j, k)]), int(idx[max(j, k)])
 
 
-def folds(net: NarxNet, fp: FixedPoints, tol_m: float = FOLD_TOLERANCE_M) -> list[Fold]:
-    """Folds between consecutive holds of ``fp`` (x sorted ascending), refined by bisection.
-
-    Where the number of fixed points changes between x_i and x_{i+1}, the interval is halved
-    (all such intervals at once) until it is narrower than ``tol_m``. Two folds within one
-    interval of the hold grid are seen as one change (or none when they cancel): the grid
-    must be finer than the folds' spacing.
-    """
-    n = fp.count
-    change = np.flatnonzero(n[1:] != n[:-1])
-    if change.size == 0:
-        return []
-    lo, hi = fp.x_m[change].copy(), fp.x_m[change + 1].copy()
-    n_lo = n[change].copy()
-    while np.max(hi - lo) > tol_m:
-        mid = 0.5 * (lo + hi)
-        same = fixed_points(net, mid).count == n_lo
-        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
-    result = []
+def _locate(net: NarxNet, a, b, n_a, tol: np.ndarray, refine: bool) -> list[Fold]:
+    """Bisect each edge a -> b (rows) until its bracket is narrower than ``tol`` (per edge,
+    as a fraction of it); the pair at the end where it exists gives force and radii."""
+    s_lo, s_hi = np.zeros(len(a)), np.ones(len(a))
+    if not refine:
+        s_lo = s_hi = np.full(len(a), 0.5)
+    while np.any(s_hi - s_lo > tol):
+        s = 0.5 * (s_lo + s_hi)
+        same = fixed_points(net, a + s[:, None] * (b - a)).count == n_a
+        s_lo, s_hi = np.where(same, s, s_lo), np.where(same, s_hi, s)
+    lo, hi = a + s_lo[:, None] * (b - a), a + s_hi[:, None] * (b - a)
     ends = fixed_points(net, np.concatenate([lo, hi]))
-    k = lo.size
+    k, out = len(a), []
     for j in range(k):
-        c_lo, c_hi = ends.count[j], ends.count[k + j]
+        c_lo, c_hi = int(ends.count[j]), int(ends.count[k + j])
         side = k + j if c_hi > c_lo else j
-        p, q = _pair_at(ends, side) if ends.count[side] >= 2 else (0, 0)
-        result.append(
+        p, r = _pair_at(ends, side) if ends.count[side] >= 2 else (None, None)
+        nan2 = (float("nan"), float("nan"))
+        out.append(
             Fold(
-                x_m=float(0.5 * (lo[j] + hi[j])),
-                force_n=float(0.5 * (ends.force_n[p] + ends.force_n[q])),
-                exists_above=bool(c_hi > c_lo),
-                radii=(float(ends.spectral_radius[p]), float(ends.spectral_radius[q])),
-                gained=int(c_hi - c_lo),
+                q=tuple(float(v) for v in 0.5 * (lo[j] + hi[j])),
+                q_from=tuple(float(v) for v in a[j]),
+                q_to=tuple(float(v) for v in b[j]),
+                count_from=c_lo,
+                count_to=c_hi,
+                force=()
+                if p is None
+                else tuple(float(v) for v in 0.5 * (ends.force[p] + ends.force[r])),
+                radii=nan2
+                if p is None
+                else (float(ends.spectral_radius[p]), float(ends.spectral_radius[r])),
             )
         )
-    return result
+    return out
+
+
+def folds(
+    net_or_model,
+    fp: FixedPoints | None = None,
+    axes: list | None = None,
+    refine: bool = True,
+    tol_m: float = FOLD_TOLERANCE_M,
+) -> list[Fold]:
+    """Folds crossing the edges of the grid ``grid(*axes)`` (``fp``: its fixed points, if
+    already computed; ``axes`` None: ``fp``'s holds of one coordinate, sorted), each located by
+    bisection along its edge to ``tol_m`` of translation (a nanometre) or ``FOLD_TOLERANCE`` of
+    the edge, whichever is finer (``refine=False``: placed at the edge's middle; over several
+    coordinates the bisection costs ~14 or more certificates of every crossing edge). Two folds
+    on one edge show as one change (or none when they cancel): the grid must be finer than
+    their spacing."""
+    net = net_or_model if isinstance(net_or_model, NarxNet) else narx_net(net_or_model)
+    if axes is None:
+        if fp is None:
+            raise CertifyError("folds: give the grid's axes or its fixed points")
+        axes = [fp.q[:, 0]]
+    axes = [np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in axes]
+    q = grid(*axes)
+    fp = fp if fp is not None else fixed_points(net, q)
+    n = fp.count.reshape([len(v) for v in axes])
+    idx = np.arange(q.shape[0]).reshape(n.shape)
+    lo_i, hi_i = [], []
+    for ax in range(len(axes)):
+        sl0, sl1 = [slice(None)] * len(axes), [slice(None)] * len(axes)
+        sl0[ax], sl1[ax] = slice(0, -1), slice(1, None)
+        change = n[tuple(sl0)] != n[tuple(sl1)]
+        lo_i.append(idx[tuple(sl0)][change])
+        hi_i.append(idx[tuple(sl1)][change])
+    lo_i, hi_i = np.concatenate(lo_i), np.concatenate(hi_i)
+    if lo_i.size == 0:
+        return []
+    a, b = q[lo_i], q[hi_i]
+    metres = np.array([u == "m" for u in net.units])
+    length_m = np.max(np.abs(b - a) * metres, axis=1)
+    with np.errstate(divide="ignore"):
+        tol = np.minimum(FOLD_TOLERANCE, np.where(length_m > 0, tol_m / length_m, np.inf))
+    return _locate(net, a, b, fp.count[lo_i], tol, refine)

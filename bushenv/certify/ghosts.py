@@ -48,12 +48,17 @@ def _tau(net: NarxNet, c: np.ndarray, y: np.ndarray) -> np.ndarray:
 def ghosts(net: NarxNet, x_m: np.ndarray, min_passage_s: float = MIN_PASSAGE_S) -> Ghosts:
     """Extrema of phi at each hold of ``x_m`` (M,) where |phi| has a non-zero local minimum
     and the free run would take at least ``min_passage_s`` to pass (see the module doc).
+    The slow flow along the diagonal is one coordinate's: over several coordinates (``x_m``
+    (M, C)) none are computed.
 
     Extrema are located where phi' changes sign on a ``GHOST_CELLS`` grid and refined by
     bisection; two extrema closer than one grid cell are not separated (ghosts that matter
     are broad: their passage time grows as the extremum flattens).
     """
-    x_m = np.atleast_1d(np.asarray(x_m, dtype=np.float64))
+    if net.n_coords > 1:
+        empty = np.zeros(0)
+        return Ghosts(hold=np.zeros(0, dtype=np.int64), y=empty, phi=empty, passage_s=empty)
+    x_m = np.asarray(x_m, dtype=np.float64).reshape(-1)
     c = net.held_preactivation(x_m)
     lo, hi = net.y_range
     grid = np.linspace(lo, hi, GHOST_CELLS + 1)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bushenv import excitation as ex
 from bushenv.certify.fixed_points import FixedPoints
 from bushenv.certify.ghosts import Ghosts, slow_flow_time
 from bushenv.certify.network import NarxNet, diagonal
@@ -37,41 +38,70 @@ REACH_TOL = 0.01  # of f_scale: the last second stays this close to a fixed poin
 ACCELERATION = 3.0  # leaving: the fastest sample after the plateau vs its mean speed on it
 
 
-def step_profiles(x_m: np.ndarray, hold_s: float, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """(T, M) step-and-hold profiles (shorter ones padded with their hold) and (M,) indices
-    of the first sample at the held value."""
+def _rise_s(q: np.ndarray, units: tuple[str, ...], dt: float) -> float | None:
+    """The machine's rise to the hold ``q`` (C,): None for one coordinate (``step_item``'s own
+    rule); over several, the shortest half-cosine rise that keeps every translation within the
+    machine's velocity, so that all coordinates arrive together."""
+    if len(q) == 1:
+        return None
+    rise = 0.0
+    for x, u in zip(q, units, strict=True):
+        if u == "m" and abs(x) / dt > ex.MAX_VELOCITY_M_PER_S:
+            rise = max(rise, 0.5 * np.pi * abs(x) / ex.MAX_VELOCITY_M_PER_S * (1 + 1e-6))
+    return rise
+
+
+def step_profiles(
+    q: np.ndarray, hold_s: float, dt: float, units: tuple[str, ...] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Step-and-hold profiles to each hold (shorter ones padded with their hold) and (M,)
+    indices of the first sample at the held value: ``q`` (M,) one coordinate -> (T, M);
+    ``q`` (M, C) -> (T, M, C) (``units`` of the coordinates, default m)."""
+    q = np.asarray(q, dtype=np.float64)
+    one = q.ndim <= 1
+    q = q.reshape(-1, 1) if one else q
+    units = units or ("m",) * q.shape[1]
     # the machine's step with a short hold, then the rest of the hold: the same samples as
     # step_item(x, hold_s, ...) without building a whole profile per hold
     short = min(0.1, hold_s)
-    heads = [step_item(float(x), short, dt, pre_s=STEP_PRE_S).x for x in np.atleast_1d(x_m)]
-    T = max(h.size for h in heads) + int(round((hold_s - short) / dt))
-    prof = np.empty((T, len(heads)))
-    for i, (h, x) in enumerate(zip(heads, np.atleast_1d(x_m), strict=True)):
-        prof[: h.size, i] = h
-        prof[h.size :, i] = x
-    start = np.argmax(prof == prof[-1], axis=0)
-    return prof, start
+    heads = []
+    for row in q:
+        rise = _rise_s(row, units, dt)
+        heads.append(
+            np.stack(
+                [step_item(float(x), short, dt, pre_s=STEP_PRE_S, rise_s=rise).x for x in row], -1
+            )
+        )
+    T = max(len(h) for h in heads) + int(round((hold_s - short) / dt))
+    prof = np.empty((T, len(heads), q.shape[1]))
+    for i, (h, row) in enumerate(zip(heads, q, strict=True)):
+        prof[: len(h), i] = h
+        prof[len(h) :, i] = row
+    start = np.argmax(np.all(prof == prof[-1], axis=-1), axis=0)
+    return (prof[..., 0], start) if one else (prof, start)
 
 
 def reference_static_force(
-    reference, x_m: np.ndarray, hold_s: float = HOLD_S, average_s: float = AVERAGE_S
+    reference, q: np.ndarray, hold_s: float = HOLD_S, average_s: float = AVERAGE_S
 ) -> np.ndarray:
-    """(M,) the reference's settled force, N: mean of its last ``average_s`` of a ``hold_s``
-    hold after the machine's step from rest (the same profile the model runs)."""
-    prof, _ = step_profiles(x_m, hold_s, reference.dt)
+    """The reference's settled force at each hold, N (N m for a rotation): mean of its last
+    ``average_s`` of a ``hold_s`` hold after the machine's step from rest (the same profile
+    the model runs). ``q`` (M,) one coordinate -> (M,); (M, C) -> (M, C)."""
+    prof, _ = step_profiles(q, hold_s, reference.dt, tuple(reference.units))
     f = reference.copy().simulate(prof)
     n = max(1, int(round(average_s / reference.dt)))
     return f[-n:].mean(axis=0)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class HoldRun:
-    """The free run at one hold. ``reached``: index among that hold's fixed points (by
-    increasing y) where the run ends, or the one it will reach after a
+    """The free run at one hold. ``reached``: index among that hold's fixed points (in the
+    order of ``FixedPoints.of_hold``) where the run ends, or the one it will reach after a
     predicted departure; None when it oscillates or no fixed point is in its way.
     ``departure_s`` counts from the step; ``observed`` False means predicted.
     ``departs_from``: "ghost", "unstable fixed point" or None (not explained).
-    ``linger_force_n``: where a departing run sat before it left (else None), N."""
+    ``final_force`` (C,) the force at the end of the hold; ``linger_force`` (C,) where a
+    departing run sat before it left (else None), N or N m."""
 
     reached: int | None
     departs: bool
@@ -79,8 +109,13 @@ class HoldRun:
     observed: bool
     departs_from: str | None
     oscillates: bool
-    final_force_n: float
-    linger_force_n: float | None = None
+    final_force: np.ndarray
+    linger_force: np.ndarray | None = None
+
+    @property
+    def linger_force_n(self) -> float | None:
+        """``linger_force`` of a one-coordinate run, N."""
+        return None if self.linger_force is None else float(self.linger_force[0])
 
 
 def _windows(y: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
@@ -94,21 +129,23 @@ def _windows(y: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
     return rng[half : y.shape[0] - w + 1 + half], (c[w:] - c[:-w]) / w
 
 
-def _explain(level: float, ys: np.ndarray, stable: np.ndarray, ghost_y: np.ndarray) -> str | None:
-    near = JUMP
-    if ghost_y.size and np.min(np.abs(ghost_y - level)) < near:
+def _explain(level: np.ndarray, ys: np.ndarray, stable: np.ndarray, ghost_y: np.ndarray):
+    """What a run lingered at, ``level`` (C,): a ghost or an unstable fixed point (each (k, C))
+    within ``JUMP`` in every coordinate, or None."""
+    if ghost_y.size and np.min(np.max(np.abs(ghost_y - level), axis=-1)) < JUMP:
         return "ghost"
     unstable = ys[~stable]
-    if unstable.size and np.min(np.abs(unstable - level)) < near:
+    if unstable.size and np.min(np.max(np.abs(unstable - level), axis=-1)) < JUMP:
         return "unstable fixed point"
     return None
 
 
 def _observed_departure(
     y: np.ndarray, r: np.ndarray, level_all: np.ndarray, w: int
-) -> tuple[int, float] | None:
-    """(sample of departure, plateau level) of the last lingering that was left, or None.
-    ``r``, ``level_all``: range and mean of the windows of ``y`` (``_windows``)."""
+) -> tuple[int, int] | None:
+    """(sample of departure, first sample of the plateau) of the last lingering that was left
+    by the one-coordinate trace ``y``, or None. ``r``, ``level_all``: range and mean of the
+    windows of ``y`` (``_windows``)."""
     if y.size <= 2 * w:
         return None
     calm = np.flatnonzero((r < PLATEAU_RANGE) & (np.abs(level_all - y[-1]) > JUMP))
@@ -124,7 +161,15 @@ def _observed_departure(
     speed_after = np.max(np.abs(np.diff(y[start + w - 1 : leave + 1])))
     if speed_after < ACCELERATION * speed_on:
         return None
-    return leave, level
+    return leave, start
+
+
+def _departure(y, windows, w) -> tuple[int, int] | None:
+    """The earliest observed departure over the coordinates of ``y`` (T, C)."""
+    found = [_observed_departure(y[:, j], windows[0][:, j], windows[1][:, j], w)
+             for j in range(y.shape[1])]  # fmt: skip
+    found = [d for d in found if d is not None]
+    return min(found) if found else None
 
 
 def hold_run(
@@ -136,44 +181,49 @@ def hold_run(
     step: int,
     windows: tuple[np.ndarray, np.ndarray],
 ) -> HoldRun:
-    """Classify hold ``i``'s free-run trace ``y`` (T,) (scaled output; the step at ``step``;
-    ``windows``: its ``_windows`` of ``LINGER_S``)."""
+    """Classify hold ``i``'s free-run trace ``y`` (T, C) (scaled output; the step at ``step``;
+    ``windows``: its ``_windows`` of ``LINGER_S``, each (T', C)). A run still moving at the end,
+    away from every fixed point, gets a predicted departure from the slow flow along the
+    diagonal (``ghosts``: one coordinate); over several coordinates it is left unsettled."""
     idx = fp.of_hold(i)
     ys, stable = fp.y[idx], fp.stable[idx]
-    ghost_y = gh.y[gh.hold == i]
-    dt, x = net.dt_s, float(fp.x_m[i])
+    ghost_y = gh.y[gh.hold == i][:, None] if fp.q.shape[1] == 1 else np.zeros((0, fp.q.shape[1]))
+    dt, q = net.dt_s, fp.q[i]
     w = max(2, int(round(LINGER_S / dt)))
     tail = y[-max(2, int(round(1.0 / dt))) :]
-    final = float(net.force_n(x, y[-1]))
-    dist = np.max(np.abs(tail[:, None] - ys[None, :]), axis=0)
+    final = net.force(q, y[-1])
+    dist = np.max(np.abs(tail[:, None, :] - ys[None, :, :]), axis=(0, 2))
     # an unstable fixed point is "reached" only by a run that sits exactly on it (from rest)
     at = np.flatnonzero(dist < REACH_TOL)
     if at.size:
         reached = int(at[np.argmin(dist[at] + 1e3 * ~stable[at])])
-        dep = _observed_departure(y[step:], windows[0][step:], windows[1][step:], w)
+        dep = _departure(y[step:], (windows[0][step:], windows[1][step:]), w)
         if dep is None:
             return HoldRun(reached, False, None, True, None, False, final)
-        leave, level = dep
+        leave, start = dep
+        level = windows[1][step + start]
         why = _explain(level, ys, stable, ghost_y)
-        linger = float(net.force_n(x, level))
-        return HoldRun(reached, True, leave * dt, True, why, False, final, linger)
+        return HoldRun(reached, True, leave * dt, True, why, False, final, net.force(q, level))
     last = tail[-w:]
-    reversals = np.count_nonzero(np.diff(np.sign(np.diff(last))) != 0)
-    if np.ptp(last) >= PLATEAU_RANGE and reversals > 2:
+    reversals = np.count_nonzero(np.diff(np.sign(np.diff(last, axis=0)), axis=0) != 0, axis=0)
+    if np.any((np.ptp(last, axis=0) >= PLATEAU_RANGE) & (reversals > 2)):
         return HoldRun(None, False, None, True, None, True, final)
+    if fp.q.shape[1] > 1:
+        return HoldRun(None, False, None, False, None, False, final)
     # still on its way, away from every fixed point: predict when it leaves and where to
-    remaining, moves = slow_flow_time(net, x, float(y[-1]), JUMP)
+    x, y1 = float(q[0]), y[:, 0]
+    remaining, moves = slow_flow_time(net, x, float(y1[-1]), JUMP)
     if not moves:
         return HoldRun(None, False, None, False, None, False, final)
-    direction = np.sign(_phi(net, x, float(y[-1])))
-    ahead = np.flatnonzero((ys - y[-1]) * direction > JUMP)
+    direction = np.sign(_phi(net, x, float(y1[-1])))
+    ahead = np.flatnonzero((ys[:, 0] - y1[-1]) * direction > JUMP)
     reached = None
     if ahead.size:
         reached = int(ahead[0] if direction > 0 else ahead[-1])
-    level = float(np.mean(y[-w:]))
+    level = np.mean(y[-w:], axis=0)
     why = _explain(level, ys, stable, ghost_y)
-    departure = (y.size - 1 - step) * dt + remaining
-    return HoldRun(reached, True, departure, False, why, False, final, float(net.force_n(x, level)))
+    departure = (y1.size - 1 - step) * dt + remaining
+    return HoldRun(reached, True, departure, False, why, False, final, net.force(q, level))
 
 
 def _phi(net: NarxNet, x: float, y: float) -> float:
@@ -184,15 +234,18 @@ def _phi(net: NarxNet, x: float, y: float) -> float:
 def free_runs(
     model, net: NarxNet, fp: FixedPoints, gh: Ghosts, hold_s: float = HOLD_S
 ) -> tuple[list[HoldRun], np.ndarray, np.ndarray]:
-    """Every hold of ``fp`` run free after the machine's step: (runs, profiles (T, M),
-    forces (T, M)). The model is copied (its state is not touched)."""
-    prof, start = step_profiles(fp.x_m, hold_s, net.dt_s)
-    f = model.copy().simulate(prof)
-    y = net.output_of_force(prof, f)  # v = 0 in a hold, so the backbone is k x alone
+    """Every hold of ``fp`` run free after the machine's step: (runs, profiles, forces), each
+    (T, M, C). The model is copied (its state is not touched)."""
+    prof, start = step_profiles(fp.q, hold_s, net.dt_s, net.units)
+    run_in = prof[..., 0] if net.n_coords == 1 else prof
+    f = model.copy().simulate(run_in).reshape(prof.shape)
+    # v = 0 in a hold, so the backbone is K q alone
+    y = (f - np.sum(prof[..., None, :] * net.k, axis=-1) - net.f_offset) / net.f_scale
+    T, M, C = y.shape
     w = max(2, int(round(LINGER_S / net.dt_s)))
-    rng, mean = _windows(y, w)
+    rng, mean = _windows(y.reshape(T, M * C), w)
+    rng, mean = rng.reshape(-1, M, C), mean.reshape(-1, M, C)
     runs = [
-        hold_run(net, fp, gh, i, y[:, i], int(start[i]), (rng[:, i], mean[:, i]))
-        for i in range(fp.x_m.size)
+        hold_run(net, fp, gh, i, y[:, i], int(start[i]), (rng[:, i], mean[:, i])) for i in range(M)
     ]
     return runs, prof, f

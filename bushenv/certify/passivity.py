@@ -1,69 +1,52 @@
-"""Small-signal passivity: the dynamic stiffness of a NARX model about a hold, and where it
-gives energy back.
+"""Small-signal passivity as a matrix test on the dynamic stiffness K(jw) (C x C,
+``stiffness``); for one coordinate the test is Im K >= 0.
 
-Linearised about a fixed point (x0, y*) of the held recurrence (``fixed_points``), with
-a_j = dN/dy_{t-j} and b_j = dN/dxs_{t-j} (``network.lag_gradients``), a small displacement
-x = x0 + dx gives dy_t = sum_j b_j dx_{t-j} / x_scale + sum_j a_j dy_{t-j}, hence, with
-z = exp(j w T) and T the sample time,
+**Derivation.** About a held deflection q0 let the model's small-signal response to
+q = q0 + Re(X e^{jwt}) (X in C^C) be f = f0 + Re(K X e^{jwt}). The mean power flowing into the
+element is the mean of f^T dq/dt; for phasors, mean(Re(a e^{jwt}) Re(b e^{jwt})) = Re(a^H b) / 2
+elementwise, so
 
-    K(z) = F / x = (f_scale / x_scale) B(z) / A(z) + k + c V(z)
-    B(z) = sum_{j=0}^{n_past_x} b_j z^-j,     A(z) = 1 - sum_{j=1}^{n_past_f} a_j z^-j
+    P = Re((jw X)^H K X) / 2 = (w / 2) Re(-j X^H K X) = (w / 2) Im(X^H K X).
 
-(k = c = 0 for the pure NN). V(z) is the velocity the model is fed, per unit displacement:
-``"central"``, (z - 1/z) / (2T), is what ``simulate`` uses (``base.velocity_of``,
-``np.gradient``; the machine and the search evaluators); ``"backward"``, (1 - 1/z) / T, is the
-rigs' (x_k - x_{k-1}) / dt. Both have Im V = sin(w T) / T, so the convention changes Re K only:
-the passivity verdict is the same.
+Split K = H_R + j H_I with the two Hermitian matrices H_R = (K + K^H) / 2 and
+H_I = (K - K^H) / (2j); then X^H K X = X^H H_R X + j X^H H_I X with both quadratic forms real,
+so the work done on the element over one cycle is
 
-Over one cycle of x = x0 + A sin(w t) the work done on the model is pi A^2 Im K (for sampled
-motion judged with the trapezoidal rule of ``divergence.cumulative_work``: that times
-sinc(w T), same sign). Frequencies where Im K < 0 are where the model generates energy. The
-steady state exists only about a stable fixed point.
+    W = 2 pi P / w = pi X^H H_I X.
+
+The element takes energy from every small motion at w (passive) iff H_I(w) is positive
+semidefinite; where an eigenvalue of H_I is negative, the motion along its eigenvector (an
+elliptic orbit when the eigenvector is complex) *gives* energy back each cycle: the model
+generates energy. For one coordinate H_I = Im K and W = pi A^2 Im K (for sampled motion judged
+with the trapezoidal rule of ``divergence.cumulative_work``: that times sinc(w T), same sign).
+For K = K0 + jw C with real K0, C: H_I = w (C + C^T) / 2 - j (K0 - K0^T) / 2, so a linear element
+is passive iff the symmetric part of C is PSD and K0 is symmetric (a circulatory, non-symmetric
+stiffness does net work on a closed orbit).
+
+Units and scaling. q may mix m and rad, so the eigenvalues of H_I depend on units (their signs,
+by Sylvester's law of inertia, do not). Reported are the eigenvalues of D H_I D with
+D = diag(amplitudes), by default the papers' n = 1 peaks (2 mm per translation, 0.05 rad per
+rotation, ``AMPLITUDES``): lambda is the work per cycle / pi, in J, on the worst unit-norm
+combination of those amplitudes. A sampled model fed the central difference has
+Im V = sin(wT) / T for w.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
-from bushenv.certify.network import CertifyError, NarxNet, lag_gradients
-from bushenv.machine import STEP_PRE_S, step_item
+from bushenv.certify.network import CertifyError, narx_net
+from bushenv.certify.stiffness import dynamic_stiffness, linear_stiffness, sine_stiffness
 
-VELOCITY_CONVENTIONS = ("central", "backward")
-SETTLE_S = 5.0  # hold before a sine: 1000+ samples, the stable fixed points' transients are gone
-SINE_S = 6.0  # sine length; its first half is left out of the fit: the start-up transient
-SKIP_S = 3.0  # decays as rho^n, 0.984^614 = 5e-5 for the slowest shipped model (rho = 0.984)
+AMPLITUDES = {"m": 2e-3, "rad": 0.05}  # D: the papers' n = 1 peaks, per unit of a coordinate
+SINE_FRACTION = 0.02  # sines measuring K: this fraction of the amplitudes, small signal
 
 
-def dynamic_stiffness(
-    net: NarxNet,
-    x_m: np.ndarray,
-    y: np.ndarray,
-    freq_hz: np.ndarray,
-    velocity: str = "central",
-) -> np.ndarray:
-    """(P, F) complex K, N/m, of ``net`` linearised about the P fixed points (x_m, y).
-
-    ``x_m``, ``y``: (P,) holds and scaled outputs; ``freq_hz`` (F,).
-    """
-    if velocity not in VELOCITY_CONVENTIONS:
-        raise CertifyError(f"velocity must be one of {VELOCITY_CONVENTIONS}, got {velocity!r}")
-    x_m, y = np.atleast_1d(x_m), np.atleast_1d(y)
-    a, b = lag_gradients(net, net.held_preactivation(x_m), y)
-    w_t = 2.0 * np.pi * np.asarray(freq_hz, dtype=np.float64) * net.dt_s
-    zinv = np.exp(-1j * w_t)
-    # B and A term by term (a handful of lags): a (P, lags) @ (lags, F) product goes through
-    # multi-threaded BLAS, which on a loaded machine is 20-50 times slower than this loop
-    num = np.zeros((x_m.size, w_t.size), dtype=complex)
-    for j in range(b.shape[1]):
-        num += b[:, j : j + 1] * zinv**j
-    den = np.ones((x_m.size, w_t.size), dtype=complex)
-    for j in range(a.shape[1]):
-        den -= a[:, j : j + 1] * zinv ** (j + 1)
-    if velocity == "central":
-        v = (1.0 / zinv - zinv) / (2.0 * net.dt_s)
-    else:
-        v = (1.0 - zinv) / net.dt_s
-    return net.f_scale_n / net.x_scale_m * num / den + net.k_n_per_m + net.c_ns_per_m * v
+def amplitudes(units: tuple[str, ...]) -> np.ndarray:
+    """(C,) the scaling amplitudes D of coordinates in ``units``."""
+    return np.array([AMPLITUDES[u] for u in units])
 
 
 def negative_bands(freq_hz: np.ndarray, values: np.ndarray) -> list[tuple[float, float]]:
@@ -81,55 +64,84 @@ def negative_bands(freq_hz: np.ndarray, values: np.ndarray) -> list[tuple[float,
     return bands
 
 
-def _sine_profiles(x0_m: float, freq_hz: np.ndarray, amplitude_m: float, dt: float):
-    """(T, F) step to x0, ``SETTLE_S`` hold, then x0 + A sin(2 pi f t); index of the sine."""
-    head = step_item(x0_m, SETTLE_S, dt, pre_s=STEP_PRE_S).x
-    t = np.arange(int(round(SINE_S / dt))) * dt
-    sines = x0_m + amplitude_m * np.sin(2.0 * np.pi * np.outer(t, freq_hz))
-    return np.concatenate(
-        [np.broadcast_to(head[:, None], (head.size, freq_hz.size)), sines]
-    ), head.size
+def loss_matrix(k: np.ndarray) -> np.ndarray:
+    """H_I = (K - K^H) / (2j) of complex K (..., C, C): Hermitian; work per cycle pi X^H H_I X."""
+    k = np.asarray(k, dtype=complex)
+    return (k - np.conj(np.swapaxes(k, -1, -2))) / 2j
 
 
-def sine_stiffness(
-    model, x0_m: float, freq_hz: np.ndarray, amplitude_m: float, velocity: str = "central"
-) -> np.ndarray:
-    """(F,) complex K, N/m, measured on ``model`` (any bushing model) by sines about a hold.
+def loss_eigenvalues(k: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """(..., C) ascending eigenvalues of D H_I D, J (work per cycle / pi), D = diag(scale)."""
+    d = np.asarray(scale, dtype=np.float64)
+    return np.linalg.eigvalsh(loss_matrix(k) * d[:, None] * d[None, :])
 
-    The model steps from rest to ``x0_m`` (the machine's step), holds ``SETTLE_S``, then
-    follows x0 + A sin(w t) for ``SINE_S``. Fitted by least squares on the sine after its
-    first ``SKIP_S`` (the last sample, where the central-difference velocity is one-sided, is
-    left out): F ~ p sin(w t) + q cos(w t) + r + s t, K = (p + j q) / A. The trend term s t
-    absorbs a slow relaxation still going on (the reference rubber's 3 s branch).
-    ``velocity``: what the model is fed, as in :func:`dynamic_stiffness`.
+
+@dataclass
+class PassivityReport:
+    """Per hold (and per stable fixed point for networks) the loss eigenvalues over frequency.
+
+    ``q`` (P, C) the hold of each row; ``eig`` (P, F, C) eigenvalues of D H_I D, J;
+    ``freq_hz`` (F,); ``method``: "analytic", "linearised" or "sines"; ``no_stable``: holds
+    (M, C) where a network has no stable fixed point (no steady state to judge).
     """
-    if velocity not in VELOCITY_CONVENTIONS:
-        raise CertifyError(f"velocity must be one of {VELOCITY_CONVENTIONS}, got {velocity!r}")
+
+    model: str
+    method: str
+    freq_hz: np.ndarray
+    q: np.ndarray
+    eig: np.ndarray
+    no_stable: np.ndarray = field(default_factory=lambda: np.zeros((0, 1)))
+
+    @property
+    def min_eig(self) -> float:
+        """The least eigenvalue over every frequency and hold, J."""
+        return float(self.eig[..., 0].min()) if self.eig.size else float("nan")
+
+    def active_bands(self) -> list[tuple[int, list[tuple[float, float]]]]:
+        """(row, bands in Hz) of every row where the least eigenvalue goes below zero."""
+        out = []
+        for p in range(len(self.q)):
+            bands = negative_bands(self.freq_hz, self.eig[p, :, 0])
+            if bands:
+                out.append((p, bands))
+        return out
+
+    @property
+    def passive(self) -> bool:
+        return not self.active_bands()
+
+
+def passivity(model, q0, freq_hz: np.ndarray, velocity: str = "central") -> PassivityReport:
+    """The passivity report of ``model`` (any bushing model of C coordinates) at the holds
+    ``q0`` (M, C) over ``freq_hz`` (F,): analytic for a linear model, linearised about every
+    stable fixed point for a NARX network, by sines (``SINE_FRACTION`` of the amplitudes) for
+    any other."""
+    from bushenv.certify.fixed_points import fixed_points
+    from bushenv.models.linear import LinearBushing
+    from bushenv.models.planar_linear import PlanarLinear
+
+    dim = model.n_coords
+    q0 = np.asarray(q0, dtype=np.float64).reshape(-1, dim)
     freq_hz = np.atleast_1d(np.asarray(freq_hz, dtype=np.float64))
-    x, k0 = _sine_profiles(x0_m, freq_hz, amplitude_m, model.dt)
-    x = np.ascontiguousarray(x)
-    v = None
-    if velocity == "backward":
-        v = np.zeros_like(x)
-        v[1:] = np.diff(x, axis=0) / model.dt
-    f = model.copy().simulate(x, v)
-    skip = int(round(SKIP_S / model.dt))
-    t = np.arange(x.shape[0] - k0) * model.dt
-    sel = slice(skip, t.size - 1)
-    ts, fs = t[sel], f[k0:][sel]  # (N,), (N, F)
-    w = 2.0 * np.pi * freq_hz
-    ph = np.outer(ts, w)
-    basis = np.stack(  # (N, F, 4)
-        [
-            np.sin(ph),
-            np.cos(ph),
-            np.ones_like(ph),
-            np.broadcast_to((ts - ts.mean())[:, None], ph.shape),
-        ],
-        axis=-1,
+    if np.any(freq_hz <= 0) or np.any(freq_hz >= 0.5 / model.dt):
+        raise CertifyError(f"frequencies must lie in (0, {0.5 / model.dt:g}) Hz (Nyquist)")
+    d = amplitudes(tuple(model.units))
+    if isinstance(model, LinearBushing | PlanarLinear):
+        k = np.broadcast_to(linear_stiffness(model, freq_hz), (len(q0), freq_hz.size, dim, dim))
+        return PassivityReport(model.name, "analytic", freq_hz, q0, loss_eigenvalues(k, d))
+    try:
+        net = narx_net(model)
+    except CertifyError:
+        k = sine_stiffness(model, q0, freq_hz, SINE_FRACTION * d, velocity)
+        return PassivityReport(model.name, "sines", freq_hz, q0, loss_eigenvalues(k, d))
+    fp = fixed_points(net, q0)
+    keep = fp.stable
+    k = dynamic_stiffness(net, fp.q[fp.hold[keep]], fp.y[keep], freq_hz, velocity)
+    return PassivityReport(
+        model.name,
+        "linearised",
+        freq_hz,
+        fp.q[fp.hold[keep]],
+        loss_eigenvalues(k, d),
+        q0[fp.stable_count == 0],
     )
-    # normal equations per frequency, all at once (well conditioned: near-orthogonal columns)
-    gram = np.einsum("nfi,nfj->fij", basis, basis)
-    rhs = np.einsum("nfi,nf->fi", basis, fs)
-    coef = np.linalg.solve(gram, rhs[..., None])[..., 0]
-    return (coef[:, 0] + 1j * coef[:, 1]) / amplitude_m

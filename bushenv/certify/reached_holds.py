@@ -225,9 +225,10 @@ def hold_entries(
 ) -> list[dict]:
     """The certificate's ``holds`` entries (fixed points, free runs, static force) over a
     uniform grid of ``holds`` over -stroke..+stroke, without the passivity and the energy scan;
-    ``reference`` None: wrong sign against the deflection (:func:`wrong_sign`). Raises
+    ``reference`` None: wrong sign against the deflection (``certificate.wrong_sign``). Raises
     ``CertifyError`` for a model that is not a NARX network."""
-    from bushenv.certify.certificate import _hold_entry
+    from bushenv.certify.certificate import wrong_sign
+    from bushenv.certify.document import hold_entry
 
     net = narx_net(model)
     x = np.linspace(-stroke_m, stroke_m, holds)
@@ -235,7 +236,9 @@ def hold_entries(
     gh = ghosts(net, x)
     runs, _, _ = free_runs(model, net, fp, gh, hold_s)
     ref = np.full(x.size, np.nan) if reference is None else reference_static_force(reference, x)
-    return [_hold_entry(net, fp, gh, r, i, ref, []) for i, r in enumerate(runs)]
+    return [
+        hold_entry(net, fp, gh, r, i, ref[i : i + 1], [], wrong_sign) for i, r in enumerate(runs)
+    ]
 
 
 def failing_holds(entries: list[dict]) -> list[dict]:

@@ -1,12 +1,13 @@
-"""``bushenv certify``: hold-stability and passivity certificates of a NARX model, of one
-coordinate or of several (``bushenv.planar.certificate``: holds on a grid of deflection vectors).
+"""``bushenv certify``: hold-stability and passivity certificates of a NARX model of any
+number of coordinates (``bushenv.certify``: holds on a grid of deflection vectors).
 
-Writes DIR/certificate.json and three plots (static force, spectral radius, Im K); prints a
-summary on stdout and progress on stderr. Exits as a test runner does: 0 when the certificate
-passes (holds and passivity), 1 when it fails, 2 on bad input. The reference and the stroke
-come from the one judging setup (``bushenv.judge``): the stroke is the model card's (1.5 x its
-records'), the papers' +-12.5 mm only for the shipped models, ``--stroke-mm`` on top; without a
-reference only the reference-free parts run, and the summary says what needs one.
+Writes DIR/certificate.json and the plots that apply (static force, spectral radius, its map
+over each pair of coordinates, the least loss eigenvalue); prints a summary on stdout and
+progress on stderr. Exits as a test runner does: 0 when the certificate passes (holds and
+passivity), 1 when it fails, 2 on bad input. The span of the holds is the model card's (1.5 x
+its records' per coordinate), the papers' +-12.5 mm only for the shipped models,
+``--stroke-mm`` / ``--rotation-mrad`` on top; without a reference only the reference-free parts
+run, and the summary says what needs one.
 """
 
 from __future__ import annotations
@@ -16,9 +17,9 @@ from pathlib import Path
 
 from bushenv.certify.certificate import CertifyOptions, certify
 from bushenv.certify.network import CertifyError, narx_net
-from bushenv.certify.plots import passivity_plot, spectral_radius_plot, static_force_plot
-from bushenv.judge import ScaleFlags, build_judge
-from bushenv.models import MODELS, get_model
+from bushenv.certify.plots import certificate_plots
+from bushenv.commands.certify_setup import Setup, setup
+from bushenv.models import get_model
 from bushenv.persist import write_json
 from bushenv.progress import Progress
 
@@ -48,14 +49,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "model",
         metavar="MODEL",
-        help="nn, hybrid or a NARX model file (.npz) of one or three coordinates",
+        help="nn, hybrid or a NARX model file (.npz) of any number of coordinates",
     )
     parser.add_argument(
         "--reference",
         default=None,
-        help="registered name, model file or 'none': what the static force and Im K are "
-        "compared with (default: rubber for a registered model; none for a model file, then "
-        "the static comparison is not made)",
+        help="registered name, model file or 'none': what the static force and the loss "
+        "eigenvalues are compared with, of the model's coordinates (default: rubber for a "
+        "registered model; none for a model file, then the static comparison is not made)",
     )
     parser.add_argument(
         "--trust-reference",
@@ -67,27 +68,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--holds",
         type=int,
         default=DEFAULTS.holds,
-        help=f"held displacements over the stroke, >= 3 (default: {DEFAULTS.holds})",
+        help="held deflections in all, >= 3; over C coordinates about holds^(1/C) per "
+        f"coordinate, odd (default: {DEFAULTS.holds})",
     )
     parser.add_argument(
         "--stroke-mm",
         type=float,
         default=None,
-        help="holds span -S..+S mm (default: the model card's stroke, 1.5 x its records'; "
-        f"{DEFAULTS.stroke_m * 1e3:g}, the machine's, for the shipped models)",
+        help="holds span -S..+S mm in every translation (default: the model card's stroke, 1.5 x "
+        f"its records'; {DEFAULTS.stroke_m * 1e3:g}, the machine's, for the shipped models)",
     )
     parser.add_argument(
         "--rotation-mrad",
         type=float,
         default=None,
-        help="three-axis models: holds span -R..+R mrad in rotation (default: 1.5 x the "
-        "card's training range)",
+        help="holds span -R..+R mrad in every rotation (default: 1.5 x the card's training range)",
     )
     parser.add_argument(
         "--at-mm",
         type=_mm_list,
         default=(),
-        help="held displacements to certify besides the grid, mm, e.g. 0.53,4 (default: none)",
+        help="one coordinate: held displacements to certify besides the grid, mm, e.g. 0.53,4 "
+        "(default: none)",
     )
     parser.add_argument(
         "--hold-s",
@@ -106,21 +108,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--passivity-mm",
         type=_mm_list,
         default=DEFAULTS.passivity_holds_m,
-        help="holds about which K is computed, mm "
-        f"(default: {_fmt_mm(DEFAULTS.passivity_holds_m)})",
+        help="one coordinate: holds about which K is computed, mm (over several: rest and "
+        f"+-half the span along each) (default: {_fmt_mm(DEFAULTS.passivity_holds_m)})",
     )
     parser.add_argument(
         "--sine-mm",
         type=float,
         default=DEFAULTS.reference_amplitude_m * 1e3,
-        help="amplitude of the sines that measure the reference's K, mm "
+        help="amplitude of the sines that measure the reference's K, mm (rotations: the same "
+        "fraction of 0.05 rad as of 2 mm) "
         f"(default: {DEFAULTS.reference_amplitude_m * 1e3:g})",
     )
     parser.add_argument(
         "--energy-mm",
         type=_mm_list,
         default=DEFAULTS.energy_amplitudes_m,
-        help="amplitudes of the sines judged for the energy criterion, mm "
+        help="one coordinate: amplitudes of the sines judged for the energy criterion, mm "
         f"(default: {_fmt_mm(DEFAULTS.energy_amplitudes_m)})",
     )
     parser.add_argument("--out", required=True, metavar="DIR", help="folder for the results")
@@ -148,31 +151,15 @@ def run(args: argparse.Namespace) -> int:
     if target.exists() and not args.force:
         raise CertifyError(f"{target} exists; pass --force to replace it")
     model = get_model(args.model, axis=args.axis, coords=None)
-    if model.n_coords > 1:
-        return _run_vector(args, model, out, target)
     try:
         narx_net(model)
     except CertifyError as exc:
         raise CertifyError(f"{args.model}: {exc}") from None
-    judge = build_judge(
-        args.model,
-        args.reference,
-        axis=args.axis,
-        dt=model.dt,
-        flags=ScaleFlags(stroke_mm=args.stroke_mm),
-        trust_reference=args.trust_reference,
-        model_object=model,
-    )
-    reference = judge.reference
-    if args.stroke_mm is None and args.model not in MODELS and "card" not in judge.scales.source:
-        raise CertifyError(
-            f"{args.model}: no model card to take the stroke from (and the papers' +-12.5 mm "
-            "is the shipped models' only); give --stroke-mm S, the stroke the model is for"
-        )
+    how = setup(args, model)
     opts = CertifyOptions(
         holds=args.holds,
         extra_holds_m=args.at_mm,
-        stroke_m=judge.scales.stroke_m,
+        span=how.span,
         hold_s=args.hold_s,
         velocity=args.velocity,
         passivity_holds_m=args.passivity_mm,
@@ -180,104 +167,26 @@ def run(args: argparse.Namespace) -> int:
         energy_amplitudes_m=args.energy_mm,
     )
     report = _progress(args.quiet)
-    cert = certify(model, reference, opts, progress=report)
+    cert = certify(model, how.reference, opts, progress=report)
     doc = cert.document
     doc["model"]["source"] = str(args.model)
     doc["model"]["axis"] = args.axis
+    doc["settings"]["span_source"] = how.span_source
     doc["reference"] = {
-        "source": judge.reference_spec,
-        "class": None if reference is None else type(reference).__name__,
+        "source": how.reference_spec,
+        "class": None if how.reference is None else type(how.reference).__name__,
     }
-    doc["judge"] = judge.describe()
+    doc["judge"] = how.judge
     report("plots", 0.99)
     out.mkdir(parents=True, exist_ok=True)
-    name = f"{Path(args.model).name} ({args.axis})"
-    paths = [
-        static_force_plot(cert, out / "static_force.png", f"{name}: static force in a hold"),
-        spectral_radius_plot(cert, out / "spectral_radius.png", f"{name}: hold stability"),
-        passivity_plot(cert, out / "passivity.png", f"{name}: small-signal Im K"),
-    ]
+    paths = certificate_plots(cert, out, how.title)
     write_json(target, doc)
-    _summary(doc, [target, *paths], judge)
+    _summary(doc, [target, *paths], how)
     s = doc["summary"]
     return 0 if s["passes_holds"] and s["passes_passivity"] else 1
 
 
-def _vector_span(args: argparse.Namespace, model) -> tuple[tuple[float, ...], str]:
-    """The holds' half-width per coordinate: 1.5 x the card's training range (the one-axis
-    stroke rule), else --stroke-mm for translations and --rotation-mrad for rotations."""
-    from bushenv.identify.card import card_paths
-
-    given = {"m": args.stroke_mm, "rad": args.rotation_mrad}
-    if all(given[u] is not None for u in model.units):
-        return tuple(given[u] * 1e-3 for u in model.units), "--stroke-mm/--rotation-mrad"
-    card = card_paths(args.model)[0]
-    if Path(args.model).suffix == ".npz" and card.is_file():
-        import json
-
-        span = json.loads(card.read_text()).get("training_range")
-        if span:
-            out = [
-                1.5 * span[c] if given[u] is None else given[u] * 1e-3
-                for c, u in zip(model.coords, model.units, strict=True)
-            ]
-            return tuple(out), f"1.5 x the training range of {card.name}"
-    missing = " and ".join(
-        f for f, u in (("--stroke-mm", "m"), ("--rotation-mrad", "rad")) if given[u] is None
-    )
-    raise CertifyError(
-        f"{args.model}: no model card with a training range beside it to take the holds' span "
-        f"from; give {missing} (the deflections the bushing is used at)"
-    )
-
-
-def _run_vector(args: argparse.Namespace, model, out: Path, target: Path) -> int:
-    """The certificate over C > 1 coordinates (``bushenv.planar.certificate``): holds on a grid of
-    deflection vectors, wrong sign without a reference, passivity as a matrix test."""
-    from bushenv.planar.certificate import (
-        VectorOptions,
-        certify_vector,
-        per_coordinate,
-        radius_plot,
-    )
-
-    if args.reference not in (None, "none"):
-        raise CertifyError(
-            f"--reference {args.reference}: a three-axis certificate compares with no reference "
-            "yet (wrong sign is judged against the deflection, q . f >= 0); drop --reference"
-        )
-    span, source = _vector_span(args, model)
-    opts = VectorOptions(span, per_coordinate(args.holds, model.n_coords))
-    doc, grid = certify_vector(model, opts, progress=_progress(args.quiet))
-    doc["model"] = {"source": str(args.model), "name": model.name, "dt_s": model.dt}
-    doc["settings"]["span_source"] = source
-    out.mkdir(parents=True, exist_ok=True)
-    plot = radius_plot(doc, grid, out / "spectral_radius.png", f"{Path(args.model).name}: holds")
-    write_json(target, doc)
-    s = doc["summary"]
-    units = ["mrad" if u == "rad" else "mm" for u in model.units]
-    shown = ", ".join(
-        f"{c} +-{v * 1e3:.4g} {u}" for c, v, u in zip(model.coords, span, units, strict=True)
-    )
-    print(f"holds over {shown} ({source}); no reference: wrong sign is q . f < 0")
-    print(
-        f"holds: {s['holds']} ({opts.per_coordinate} per coordinate), settling stably "
-        f"{s['holds_settling_stably']}, more than one fixed point {s['holds_with_more_than_one']}, "
-        f"no stable one {s['holds_without_a_stable_one']}, fold crossings {s['fold_crossings']}, "
-        f"wrong sign {s['wrong_sign_holds']}"
-    )
-    print(
-        f"passivity: {s['non_passive_holds']} of {s['passivity_holds']} holds non-passive "
-        f"(least loss eigenvalue {s['least_loss_eigenvalue_j']:.3g} J); hold certificate "
-        f"{'passes' if s['passes_holds'] else 'FAILS'}, passivity "
-        f"{'passes' if s['passes_passivity'] else 'FAILS'}"
-    )
-    print(target)
-    print(plot)
-    return 0 if s["passes_holds"] and s["passes_passivity"] else 1
-
-
-def _mm_ranges(ranges: list[list[float]]) -> str:
+def _ranges(ranges: list[list[float]]) -> str:
     return "[" + ", ".join(f"{a * 1e3:+.3g}..{b * 1e3:+.3g} mm" for a, b in ranges) + "]"
 
 
@@ -285,28 +194,36 @@ def _hz_bands(bands: list[list[float]]) -> str:
     return "[" + ", ".join(f"{a:.1f}-{b:.1f} Hz" for a, b in bands) + "]"
 
 
-def _summary(doc: dict, paths: list[Path], judge) -> None:
+def _where(s: dict, key: str) -> str:
+    """The holds of a summary entry: ranges over one coordinate, a count over several."""
+    ranges = s.get(f"{key}_ranges_m")
+    return "" if ranges is None else " " + _ranges(ranges)
+
+
+def _summary(doc: dict, paths: list[Path], how: Setup) -> None:
     s = doc["summary"]
-    print(
-        f"stroke +-{judge.scales.stroke_m * 1e3:.4g} mm ({judge.scales.source}); reference: "
-        f"{judge.reference_spec or 'none'}"
-        + ("" if judge.vetting is None else f", vetting {judge.vetting.headline()}")
-    )
-    if judge.reference is None:
+    print(f"holds over {how.span_text} ({how.span_source}); reference: {how.reference_line}")
+    if how.reference is None:
         print(
             "no reference: wrong sign is judged against the deflection (a passive bushing's "
-            "static force has the sign of x); the static force's size (off the reference's) "
-            "needs one and was not compared; pass --reference NAME|FILE"
+            "static force points away from rest: q . f >= 0, F x >= 0 for one coordinate); "
+            "the static force's size (off the reference's) needs one and was not compared; "
+            "pass --reference NAME|FILE"
         )
     print(
-        f"holds: {s['holds']}, settling stably {s['holds_settling_stably']}, departing "
-        f"{s['departing_holds']}, oscillating {s['oscillating_holds']}, folds {s['folds']}; "
-        f"wrong sign {s['wrong_sign_holds']} {_mm_ranges(s['wrong_sign_ranges_m'])}, static "
-        f"force off {s['static_off_holds']} {_mm_ranges(s['static_off_ranges_m'])}"
+        f"holds: {s['holds']} ({doc['settings']['per_coordinate']} per coordinate), settling "
+        f"stably {s['holds_settling_stably']}, more than one fixed point "
+        f"{s['holds_with_more_than_one']}, no stable one {s['holds_without_a_stable_one']}, "
+        f"departing {s['departing_holds']}, oscillating {s['oscillating_holds']}, folds "
+        f"{s['folds']}; wrong sign {s['wrong_sign_holds']}{_where(s, 'wrong_sign')}, static "
+        f"force off {s['static_off_holds']}{_where(s, 'static_off')}"
     )
+    least = s["least_loss_eigenvalue_j"]
     print(
-        f"non-passive at rest: {_hz_bands(s['non_passive_bands_hz_at_rest'])}; "
-        f"hold certificate {'passes' if s['passes_holds'] else 'FAILS'}, passivity "
+        f"passivity: {s['non_passive_holds']} of {s['passivity_holds']} holds non-passive "
+        f"(least loss eigenvalue {'n/a' if least is None else f'{least:.3g} J'}); non-passive "
+        f"at rest: {_hz_bands(s['non_passive_bands_hz_at_rest'])}; hold certificate "
+        f"{'passes' if s['passes_holds'] else 'FAILS'}, passivity "
         f"{'passes' if s['passes_passivity'] else 'FAILS'}"
     )
     for p in paths:

@@ -90,21 +90,53 @@ class Carried:
         return out
 
 
-def _merge(cells: list[tuple[float, float, set[str]]]) -> list[Flagged]:
-    cells = sorted(cells, key=lambda c: c[0])
-    out: list[list] = []
-    for lo, hi, why in cells:
-        if out and lo <= out[-1][1] + 1e-12:
-            out[-1][1] = max(out[-1][1], hi)
-            out[-1][2] |= why
-        else:
-            out.append([lo, hi, set(why)])
-    order = ("oscillates", "departs", "unstable", "unsettled", "wrong sign", "fold")
-    return [Flagged((lo,), (hi,), ", ".join(k for k in order if k in why)) for lo, hi, why in out]
+_ORDER = ("oscillates", "departs", "unstable", "unsettled", "several fixed points",
+          "unresolved", "wrong sign", "fold")  # fmt: skip
+
+
+def _merge(boxes: list[tuple[np.ndarray, np.ndarray, set[str]]]) -> list[Flagged]:
+    """Boxes merged where two touch along one coordinate and agree in every other (one
+    coordinate: touching ranges), until none do."""
+    out = [[lo.copy(), hi.copy(), set(why)] for lo, hi, why in boxes]
+    merged = True
+    while merged:
+        merged = False
+        out.sort(key=lambda b: tuple(b[0]))
+        for a in range(len(out)):
+            for b in range(a + 1, len(out)):
+                la, ha, _ = out[a]
+                lb, hb, _ = out[b]
+                same = np.isclose(la, lb, rtol=0, atol=1e-12) & np.isclose(
+                    ha, hb, rtol=0, atol=1e-12
+                )
+                if np.sum(~same) == 1:
+                    j = int(np.flatnonzero(~same)[0])
+                    if lb[j] <= ha[j] + 1e-12 and la[j] <= hb[j] + 1e-12:
+                        la[j], ha[j] = min(la[j], lb[j]), max(ha[j], hb[j])
+                        out[a][2] |= out[b][2]
+                        del out[b]
+                        merged = True
+                        break
+                elif same.all():
+                    out[a][2] |= out[b][2]
+                    del out[b]
+                    merged = True
+                    break
+            if merged:
+                break
+    return [
+        Flagged(tuple(lo.tolist()), tuple(hi.tolist()), ", ".join(k for k in _ORDER if k in why))
+        for lo, hi, why in out
+    ]
+
+
+def _q(h: dict) -> list[float]:
+    """A hold's deflection vector (certificates of one coordinate before the one layout: x_m)."""
+    return h["q"] if "q" in h else [h["x_m"]]
 
 
 def _hold_why(h: dict) -> set[str]:
-    """How a hold of a one-coordinate certificate fails (empty: it passes)."""
+    """How a hold of a certificate fails (empty: it passes)."""
     why = set()
     if h["oscillates"]:
         why.add("oscillates")
@@ -116,32 +148,57 @@ def _hold_why(h: dict) -> set[str]:
             why.add("unsettled")
         elif not h["fixed_points"][r]["stable"]:
             why.add("unstable")
+    if "q" in h:  # the one layout's verdict: one fixed point per hold, every root found
+        if len(h["fixed_points"]) > 1:
+            why.add("several fixed points")
+        if h.get("unresolved_cells"):
+            why.add("unresolved")
     if h["wrong_sign"]:
         why.add("wrong sign")
     return why
 
 
+def _cell_edges(values: np.ndarray) -> np.ndarray:
+    """(N + 1,) edges half-way between sorted grid values, the ends as far out as the nearest."""
+    x = np.unique(values)
+    if x.size == 1:
+        return np.r_[x, x]
+    mid = 0.5 * (x[1:] + x[:-1])
+    return np.r_[x[0] - 0.5 * (x[1] - x[0]), mid, x[-1] + 0.5 * (x[-1] - x[-2])]
+
+
 def flagged_of_holds(doc: dict) -> list[Flagged]:
-    """The flagged ranges of a one-coordinate certificate document (``certify``)."""
+    """The flagged boxes of a certificate document (``certify``): each failing hold stands for
+    its cell of the grid (per coordinate from half-way to the value below to half-way to the
+    value above), each fold for the box between the two holds that bracket it; touching boxes
+    merged."""
     holds = doc["holds"]
-    x = np.array([h["x_m"] for h in holds], dtype=float)
-    if x.size == 0:
+    if not holds:
         return []
-    edges = np.r_[x[0] - 0.5 * (x[1] - x[0]) if x.size > 1 else x[0], 0.5 * (x[1:] + x[:-1])]
-    edges = np.r_[edges, x[-1] + 0.5 * (x[-1] - x[-2]) if x.size > 1 else x[-1]]
-    cells = []
-    for i, h in enumerate(holds):
+    q = np.array([_q(h) for h in holds], dtype=float)
+    axes = [np.unique(q[:, j]) for j in range(q.shape[1])]
+    edges = [_cell_edges(a) for a in axes]
+    boxes = []
+    for h, row in zip(holds, q, strict=True):
         why = _hold_why(h)
         if why:
-            cells.append((float(edges[i]), float(edges[i + 1]), why))
+            k = [int(np.searchsorted(a, v)) for a, v in zip(axes, row, strict=True)]
+            lo = np.array([e[i] for e, i in zip(edges, k, strict=True)])
+            hi = np.array([e[i + 1] for e, i in zip(edges, k, strict=True)])
+            boxes.append((lo, hi, why))
     for f in doc.get("folds", []):
-        k = int(np.searchsorted(x, f["x_m"]))
-        lo, hi = x[max(k - 1, 0)], x[min(k, x.size - 1)]
-        cells.append((float(lo), float(hi), {"fold"}))
-    return _merge(cells)
+        if "q_from" in f:
+            a, b = np.array(f["q_from"]), np.array(f["q_to"])
+        else:  # one coordinate: the holds that bracket the fold
+            x = axes[0]
+            k = int(np.searchsorted(x, f["x_m"]))
+            a, b = x[[max(k - 1, 0)]], x[[min(k, x.size - 1)]]
+        boxes.append((np.minimum(a, b), np.maximum(a, b), {"fold"}))
+    return _merge(boxes)
 
 
-def _failing_one(summary: dict, doc: dict) -> str:
+def _failing(summary: dict, doc: dict) -> str:
+    """The failing checks of a certificate, one line."""
     unstable = sum(
         1
         for h in doc["holds"]
@@ -153,8 +210,10 @@ def _failing_one(summary: dict, doc: dict) -> str:
         (summary.get("oscillating_holds", 0), "oscillating holds"),
         (summary.get("departing_holds", 0), "departing holds"),
         (unstable, "holds not settling on a stable fixed point"),
+        (summary.get("holds_with_more_than_one", 0), "holds with more than one fixed point"),
         (summary.get("wrong_sign_holds", 0), "wrong-sign holds"),
         (summary.get("folds", 0), "folds"),
+        (summary.get("unresolved_cells", 0) if "q" in doc["holds"][0] else 0, "unresolved cells"),
     ]
     text = ", ".join(f"{n} {what}" for n, what in parts if n)
     failing = [h for h in doc["holds"] if _hold_why(h)]
@@ -162,39 +221,6 @@ def _failing_one(summary: dict, doc: dict) -> str:
     if text and rho is not None and rho >= 1.0:
         text += f" (spectral radius up to {rho:.5g})"
     return text
-
-
-def flagged_of_vector(doc: dict) -> list[Flagged]:
-    """The flagged boxes of a certificate over several coordinates (``certify_vector``): one
-    box of +- half the grid's spacing about each hold vector that fails."""
-    span = np.array(doc["settings"]["span"], dtype=float)
-    half = span / (int(doc["settings"]["per_coordinate"]) - 1)  # half of 2 span / (n - 1)
-    wrong = {tuple(q) for q in doc.get("wrong_sign_at", [])}
-    out = []
-    for h in doc["holds"]:
-        q = np.array(h["q"], dtype=float)
-        why = []
-        if h["fixed_points"] != 1:
-            why.append(f"{h['fixed_points']} fixed points")
-        if h["stable"] == 0:
-            why.append("no stable fixed point")
-        elif h["stable"] != h["fixed_points"]:
-            why.append("unstable fixed points")
-        if tuple(h["q"]) in wrong:
-            why.append("wrong sign")
-        out.append(Flagged(tuple((q - half).tolist()), tuple((q + half).tolist()), ", ".join(why)))
-    return out
-
-
-def _failing_vector(summary: dict) -> str:
-    parts = [
-        (summary["holds"] - summary["holds_settling_stably"], "holds not settling on one stable "
-         "fixed point"),
-        (summary["fold_crossings"], "fold crossings"),
-        (summary["wrong_sign_holds"], "wrong-sign holds"),
-        (summary["unresolved_boxes"], "unresolved boxes"),
-    ]  # fmt: skip
-    return ", ".join(f"{n} {what}" for n, what in parts if n)
 
 
 def read_document(path: str | os.PathLike) -> dict:
@@ -213,42 +239,40 @@ def read_document(path: str | os.PathLike) -> dict:
     return doc
 
 
+def _forces(h: dict) -> np.ndarray:
+    """(P, C) the static forces of a hold's fixed points, sorted by the first coordinate."""
+    f = np.array([p["force"] if "force" in p else [p["force_n"]] for p in h["fixed_points"]])
+    return f[np.argsort(f[:, 0], kind="stable")] if f.size else f.reshape(0, 1)
+
+
 def check_belongs(doc: dict, model: BushingModel, path: str | os.PathLike) -> None:
     """Refuse a certificate of another model: its recorded parameters, then the fixed points
     of a few of its holds recomputed on ``model`` (so a retrained network of the same shape
     is told apart), naming what differs."""
+    from bushenv.certify.fixed_points import fixed_points
+    from bushenv.certify.network import describe, narx_net
+
+    net = narx_net(model)
     mine = doc["model"]
-    if model.n_coords == 1:
-        from bushenv.certify.fixed_points import fixed_points
-        from bushenv.certify.network import describe, narx_net
-
-        net = narx_net(model)
-        _same_params(path, mine, describe(net))
-        holds = doc["holds"]
-        spread = np.linspace(0, len(holds) - 1, min(CHECKED_HOLDS, len(holds)))
-        pick = sorted({int(i) for i in spread})
-        fp = fixed_points(net, np.array([holds[i]["x_m"] for i in pick], dtype=float))
-        for row, i in enumerate(pick):
-            got = np.sort(fp.force_n[fp.hold == row])
-            had = np.sort([p["force_n"] for p in holds[i]["fixed_points"]])
-            _same_forces(path, holds[i]["x_m"] * 1e3, "mm", had, got)
-        return
-    from bushenv.planar.fixed_points import fixed_points as planar_fixed_points
-
-    want = {"name": model.name, "dt_s": model.dt}
-    _same_params(path, mine, want)
-    if doc.get("coords") != list(model.coords):
+    want = describe(net)
+    _same_params(path, mine, {k: v for k, v in want.items() if k in mine or k in ("name", "dt_s")})
+    if doc.get("coords", list(model.coords) if model.n_coords == 1 else None) != list(model.coords):
         raise ModelError(
             f"{path}: a certificate over {doc.get('coords')}, not this model's "
             f"{list(model.coords)}; certify this model (bushenv certify) or drop --certificate"
         )
-    listed = doc["holds"][:CHECKED_HOLDS]
-    if listed:
-        fp = planar_fixed_points(model, np.array([h["q"] for h in listed], dtype=float))
-        for row, h in enumerate(listed):
-            got = np.sort(fp.force[fp.hold == row][:, 0])
-            had = np.sort(np.array(h["forces"], dtype=float).reshape(-1, model.n_coords)[:, 0])
-            _same_forces(path, np.array(h["q"]) * 1e3, "mm/mrad", had, got)
+    holds = doc["holds"]
+    spread = np.linspace(0, len(holds) - 1, min(CHECKED_HOLDS, len(holds)))
+    pick = sorted({int(i) for i in spread})
+    if not pick:
+        return
+    fp = fixed_points(net, np.array([_q(holds[i]) for i in pick], dtype=float))
+    units = "mm" if model.n_coords == 1 else "mm/mrad"
+    for row, i in enumerate(pick):
+        got = fp.force[fp.hold == row]
+        got = got[np.argsort(got[:, 0], kind="stable")]
+        at = np.array(_q(holds[i])) * 1e3
+        _same_forces(path, at[0] if model.n_coords == 1 else at, units, _forces(holds[i]), got)
 
 
 def _same_params(path, mine: dict, want: dict) -> None:
@@ -268,8 +292,9 @@ def _same_params(path, mine: dict, want: dict) -> None:
 
 
 def _same_forces(path, at, unit: str, had: np.ndarray, got: np.ndarray) -> None:
-    tol = FORCE_MATCH_REL * np.maximum(1.0, np.abs(had)) if had.size == got.size else None
+    tol = FORCE_MATCH_REL * np.maximum(1.0, np.abs(had)) if had.shape == got.shape else None
     if tol is None or np.any(np.abs(had - got) > tol):
+        had, got = had[:, 0], got[:, 0]
         raise ModelError(
             f"{path}: this certificate is of another model: its fixed points at {at} {unit} "
             f"({np.round(had, 3).tolist()} N) are not this model's ({np.round(got, 3).tolist()} "
@@ -279,16 +304,13 @@ def _same_forces(path, at, unit: str, had: np.ndarray, got: np.ndarray) -> None:
 
 
 def is_narx(model: BushingModel) -> bool:
-    """Whether ``model`` has a NARX recurrence to certify (nn, hybrid; over three axes nn,
-    nn-axis, hybrid). The classes' own modules: the certificate's are not imported for a kind
+    """Whether ``model`` has a NARX recurrence to certify (nn, hybrid; over several coordinates
+    also nn-axis). The classes' own modules: the certificate's are not imported for a kind
     without one (they cost a linear model's export half a second)."""
-    if model.n_coords == 1:
-        from bushenv.models.narx import NarxBushing
-
-        return isinstance(model, NarxBushing)
+    from bushenv.models.narx import NarxBushing
     from bushenv.models.planar_narx import PlanarNarx
 
-    return isinstance(model, PlanarNarx)
+    return isinstance(model, NarxBushing | PlanarNarx)
 
 
 def carried_certificate(
@@ -303,9 +325,9 @@ def carried_certificate(
 ) -> Carried:
     """The certificate the FMU of ``model`` carries. ``path``: a ``certificate.json`` to read
     (checked to be ``model``'s); else run as ``bushenv certify`` runs it, against
-    ``reference`` (None: none, wrong sign judged against the deflection) over the stroke
-    ``bushenv certify`` takes (the card's, the machine's; ``stroke_m`` on top). Several
-    coordinates: ``certify_vector`` over ``spans``. A kind without a recurrence (linear,
+    ``reference`` (None: none, wrong sign judged against the deflection) over the span
+    ``bushenv certify`` takes (one coordinate: the card's stroke, the machine's; ``stroke_m``
+    on top; several: ``spans``, the test machine's). A kind without a recurrence (linear,
     Bouc-Wen) has none: a ``Carried`` that says so (a ``path`` given for one is refused)."""
     units = tuple(getattr(model, "units", ("m",)))
     if not is_narx(model):
@@ -333,33 +355,23 @@ def carried_certificate(
         doc = read_document(path)
         check_belongs(doc, model, path)
         source = f"{Path(path).name}, given"
-    elif model.n_coords == 1:
-        doc, source = _run_one(model, spec, axis, reference, stroke_m)
     else:
-        if reference is not None:
-            raise ModelError(
-                f"--reference {reference}: a three-axis certificate compares with no reference "
-                "yet (wrong sign is judged against the deflection); drop --reference"
-            )
-        doc, source = _run_vector(model, spans)
+        doc, source = _run(model, spec, axis, reference, stroke_m, spans)
     s = doc["summary"]
-    if model.n_coords == 1:
-        flagged, failing = flagged_of_holds(doc), _failing_one(s, doc)
-    else:
-        flagged, failing = flagged_of_vector(doc), _failing_vector(s)
     return Carried(
         source,
         bool(s["passes_holds"]),
         bool(s["passes_passivity"]),
-        tuple(flagged),
-        failing,
+        tuple(flagged_of_holds(doc)),
+        _failing(s, doc),
         units,
         doc,
     )
 
 
-def _run_one(model, spec, axis, reference, stroke_m) -> tuple[dict, str]:
-    from bushenv.certify.certificate import CertifyOptions, certify
+def _judged(model, spec, axis, reference, stroke_m) -> tuple[Any, float, str, str]:
+    """One coordinate: (reference, stroke, where the stroke comes from, the reference's
+    description) from the judging setup (``bushenv.judge``, one coordinate's)."""
     from bushenv.judge import NO_REFERENCE, ScaleFlags, build_judge
 
     judge = build_judge(
@@ -370,29 +382,33 @@ def _run_one(model, spec, axis, reference, stroke_m) -> tuple[dict, str]:
         flags=ScaleFlags(stroke_mm=None if stroke_m is None else stroke_m * 1e3),
         model_object=model,
     )
-    opts = CertifyOptions(stroke_m=judge.scales.stroke_m)
-    doc = certify(model, judge.reference, opts).document
+    return judge.reference, judge.scales.stroke_m, judge.scales.source, judge.reference_spec
+
+
+def _run(model, spec, axis, reference, stroke_m, spans) -> tuple[dict, str]:
+    from bushenv.certify.certificate import CertifyOptions, certify, per_coordinate
+    from bushenv.models import get_model
+
+    if model.n_coords == 1:
+        ref, stroke, span_source, ref_spec = _judged(model, spec, axis, reference, stroke_m)
+        span = (stroke,)
+    else:
+        span, span_source, ref_spec = tuple(spans), "the three-axis test machine's", reference
+        ref = None
+        if reference is not None:
+            ref = get_model(reference, axis=axis, dt=model.dt, coords=model.n_coords,
+                            wanted_by="bushenv export --reference")  # fmt: skip
+    opts = CertifyOptions(span=span)
+    doc = certify(model, ref, opts).document
     against = (
-        "no reference (wrong sign judged against the deflection)"
-        if judge.reference is None
-        else f"reference {judge.reference_spec}"
+        "no reference (wrong sign judged against the deflection: q . f < 0)"
+        if ref is None
+        else f"reference {ref_spec}"
     )
-    return doc, (
-        f"certified at export, {opts.holds} holds over +-{opts.stroke_m * 1e3:.4g} mm "
-        f"({judge.scales.source}), {against}"
-    )
-
-
-def _run_vector(model, spans: tuple[float, ...]) -> tuple[dict, str]:
-    from bushenv.planar.certificate import VectorOptions, certify_vector, per_coordinate
-
-    opts = VectorOptions(tuple(spans), per_coordinate(201, model.n_coords))
-    doc, _ = certify_vector(model, opts)
     shown = ", ".join(
         f"{c} +-{s * 1e3:.4g} {'mrad' if u == 'rad' else 'mm'}"
-        for c, u, s in zip(model.coords, model.units, spans, strict=True)
+        for c, u, s in zip(model.coords, model.units, span, strict=True)
     )
-    return doc, (
-        f"certified at export, {opts.per_coordinate}^{model.n_coords} hold vectors over {shown} "
-        "(the three-axis test machine's), no reference (wrong sign: q . f < 0)"
-    )
+    n = per_coordinate(opts.holds, model.n_coords)
+    grid = f"{n} holds" if model.n_coords == 1 else f"{n}^{model.n_coords} hold vectors"
+    return doc, f"certified at export, {grid} over {shown} ({span_source}), {against}"

@@ -4,13 +4,14 @@ certificate's holds.
 
 Over a ``GRID_POINTS``^3 grid of held vectors within the searched limits (+- the stroke per
 coordinate), every fixed point of the network's recurrence and its stability
-(``planar.fixed_points``). A hold is listed when the free run can settle to more than one
-force (``several_fixed_points``), to none stably (``no_stable_fixed_point``), or holds a
-stable force that pushes into the deflection (``pushes_into_the_deflection``: q . f below
-minus the floors' work, at a vector beyond ``vetting.SIGN_FRACTION`` of the stroke, the
-planar vetting's rule). For each listed hold a profile ramps every coordinate from rest to it
-within its rate and holds ``campaign_holds.HOLD_PROFILE_S``; the judge confirms (a divergence)
-or refutes it, and confirmed holds join the failures (rechecked, shrunk, kept).
+(``certify.range_holds.suspect_holds``, any number of coordinates). A hold is listed when the
+free run can settle to more than one force (``several_fixed_points``), to none stably
+(``no_stable_fixed_point``), or holds a stable force that pushes into the deflection
+(``pushes_into_the_deflection``: q . f below minus the floors' work, at a vector beyond
+``vetting.SIGN_FRACTION`` of the stroke, the planar vetting's rule). For each listed hold a
+profile ramps every coordinate from rest to it within its rate and holds
+``campaign_holds.HOLD_PROFILE_S``; the judge confirms (a divergence) or refutes it, and
+confirmed holds join the failures (rechecked, shrunk, kept).
 
 A model that is not a planar network (no recurrence to hold) skips the stage; its budget is
 the number of listed holds (at most ``campaign_holds.MAX_HOLDS``, spread over the grid).
@@ -34,25 +35,12 @@ __all__ = ["NAME", "PlanarHolds", "listed_holds3", "step_and_hold3"]
 def listed_holds3(model, limits: Rig3Limits, floors: np.ndarray) -> list[dict] | None:
     """The suspect holds of the module doc: [{"q": (3,) m, m, rad, "kinds"}]; None for a
     model that is not a planar network."""
-    from bushenv.models.planar_base import PlanarModelError
-    from bushenv.planar.fixed_points import fixed_points, grid
+    from bushenv.certify.range_holds import suspect_holds
     from bushenv.vetting import SIGN_FRACTION
 
-    stroke = np.asarray(limits.stroke, dtype=np.float64)
-    try:
-        fp = fixed_points(model, grid(*[np.linspace(-s, s, GRID_POINTS) for s in stroke]))
-    except PlanarModelError:
+    out = suspect_holds(model, limits.stroke, floors, SIGN_FRACTION, GRID_POINTS)
+    if out is None:
         return None
-    q = fp.q[fp.hold]
-    work = np.einsum("pi,pi->p", q, fp.force)
-    far = np.max(np.abs(q) / stroke, axis=1) >= SIGN_FRACTION
-    pushes = fp.stable & far & (work < -(np.abs(q) @ np.asarray(floors, dtype=np.float64)))
-    pushing = np.bincount(fp.hold[pushes], minlength=len(fp.q)) > 0
-    flags = np.stack([fp.count > 1, fp.stable_count == 0, pushing], axis=1)
-    out = [
-        {"q": fp.q[h].tolist(), "kinds": [k for k, f in zip(KINDS, flags[h], strict=True) if f]}
-        for h in np.flatnonzero(flags.any(axis=1))
-    ]
     if len(out) > MAX_HOLDS:
         keep = np.unique(np.linspace(0, len(out) - 1, MAX_HOLDS).round().astype(int))
         out = [out[i] for i in keep]

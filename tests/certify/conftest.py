@@ -179,3 +179,41 @@ def ringing_hybrid(g=1.004, beta=0.25, x_ring_m=-1.25e-3, f_scale_n=3000.0) -> H
         n_past_x=1,
         n_past_f=1,
     )
+
+
+# ----- networks over three coordinates ------------------------------------------------------
+SCALE3 = np.array([2e-3, 2e-3, 0.05])
+
+
+def bistable(gain_q=0.5, out=2.0):
+    """Three single-axis networks, each y = out tanh(2 y + gain_q qs); out = 2: three roots per
+    axis at rest (+-1.998651 stable, 0 unstable), one beyond a fold."""
+    from bushenv.models.planar_narx import N_IN, PlanarNarxPerAxis
+
+    h = 27
+    w1, w_out = np.zeros((h, N_IN)), np.zeros((3, h))
+    for ax in range(3):
+        u = 9 * ax
+        w1[u, 18 + ax :: 3] = 0.4  # own output, lags 1..5: sum 2
+        w1[u, ax] = gain_q  # own coordinate, lag 0
+        w_out[ax, u] = out
+    return PlanarNarxPerAxis(
+        q_offset=np.zeros(3), q_scale=SCALE3, f_offset=np.zeros(3),
+        f_scale=np.array([100.0, 100.0, 10.0]), w1=w1, b1=np.zeros(h), w_out=w_out,
+        b_out=np.zeros(3),
+    )  # fmt: skip
+
+
+def scalar_roots(c):
+    """Roots of 2 tanh(2 y + c) - y by a fine scan and bisection (independent of the boxes)."""
+    g = lambda y: 2 * np.tanh(2 * y + c) - y  # noqa: E731
+    ys = np.linspace(-2.5, 2.5, 200_000)  # even: no grid point on a root at 0
+    v = g(ys)
+    roots = []
+    for i in np.flatnonzero(np.sign(v[:-1]) != np.sign(v[1:])):
+        a, b = ys[i], ys[i + 1]
+        for _ in range(80):
+            m = 0.5 * (a + b)
+            a, b = (m, b) if np.sign(g(m)) == np.sign(g(a)) else (a, m)
+        roots.append(0.5 * (a + b))
+    return np.array(roots)

@@ -89,7 +89,10 @@ def test_the_document_is_plain_json_with_the_issues_fields(tmp_path):
         "wrong_sign",
     ):
         assert key in h
-    assert set(h["fixed_points"][0]) == {"force_n", "spectral_radius", "stable"}
+    # one layout for every C (vectors), and the scalar forms of one coordinate
+    assert set(h["fixed_points"][0]) == {"force", "force_n", "spectral_radius", "stable"}
+    assert h["q"] == [h["x_m"]] and h["static_force"] == [h["static_force_n"]]
+    assert doc["format"] == "bushenv-certificate" and doc["coords"] == ["deflection"]
     assert {"x_m", "force_n", "pair_exists", "spectral_radii"} <= set(doc["folds"][0])
     p = doc["passivity"]["holds"][0]
     assert len(p["frequency_hz"]) == len(p["im_k_n_per_m"][0])

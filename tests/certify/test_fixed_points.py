@@ -1,10 +1,21 @@
 import numpy as np
 import pytest
 
-from bushenv.certify.fixed_points import fixed_points, folds, spectral_radius
-from bushenv.certify.network import diagonal, narx_net
+from bushenv.certify.fixed_points import fixed_points, folds, grid, spectral_radius
+from bushenv.certify.network import CertifyError, diagonal, narx_net
+from bushenv.models import MODELS
+from bushenv.models.planar_narx import PlanarNarx
 
-from .conftest import X_SCALE_M, fold_nn, fold_roots, fold_u, random_narx
+from .conftest import (
+    SCALE3,
+    X_SCALE_M,
+    bistable,
+    fold_nn,
+    fold_roots,
+    fold_u,
+    random_narx,
+    scalar_roots,
+)
 
 
 @pytest.mark.parametrize("g", [1.5, 2.0, 4.0])
@@ -14,7 +25,7 @@ def test_fixed_points_of_the_fold_network_match_the_closed_form(g):
     fp = fixed_points(net, u * X_SCALE_M)
     for i, ui in enumerate(u):
         want = fold_roots(g, ui)
-        got = fp.y[fp.of_hold(i)]
+        got = fp.y[fp.of_hold(i), 0]
         assert got.size == want.size, (ui, got, want)
         np.testing.assert_allclose(got, want, atol=1e-6)
     assert fp.unresolved.sum() == 0
@@ -27,7 +38,7 @@ def test_both_roots_of_a_nearly_merged_pair_are_found_just_inside_a_fold(eps):
     fp = fixed_points(narx_net(fold_nn(g=g)), np.array([u * X_SCALE_M]))
     want = fold_roots(g, u)
     assert fp.y.size == want.size == 3
-    np.testing.assert_allclose(fp.y, want, atol=1e-6)
+    np.testing.assert_allclose(fp.y[:, 0], want, atol=1e-6)
     assert fp.unresolved.sum() == 0
 
 
@@ -51,7 +62,7 @@ def test_single_lag_spectral_radius_is_g_sech2():
     net = narx_net(fold_nn(g=g, y_weights=(1.0,), x_weights=(1.0, 0.0)))
     fp = fixed_points(net, np.array([0.0, 0.2e-3, -0.5e-3]))
     u = fp.x_m[fp.hold] / X_SCALE_M
-    want = g / np.cosh(g * fp.y + u) ** 2
+    want = g / np.cosh(g * fp.y[:, 0] + u) ** 2
     np.testing.assert_allclose(fp.spectral_radius, want, rtol=1e-10)
     assert list(fp.stable) == list(want < 1)
 
@@ -83,7 +94,7 @@ def test_every_root_of_a_dense_brute_force_search_is_found_on_random_networks(
         for i in range(x.size):
             neg = phi[i] < 0
             k = np.flatnonzero(neg[:-1] != neg[1:])
-            got = fp.y[fp.of_hold(i)]
+            got = fp.y[fp.of_hold(i), 0]
             for yk in y[k]:  # every bracketed root has a match
                 assert np.min(np.abs(got - yk)) <= (hi - lo) / 20_000 + 1e-9
             assert got.size >= k.size
@@ -109,13 +120,82 @@ def test_stable_fixed_points_attract_and_unstable_ones_repel_in_the_model_kernel
             model.reset(1)
             xs = (x - net.x_offset_m) / net.x_scale_m
             model.state[1 : 1 + 3] = xs
-            model.state[1 + 3 :, 0] = fp.y[p] + 1e-7 * rng.normal(size=4)
+            model.state[1 + 3 :, 0] = fp.y[p, 0] + 1e-7 * rng.normal(size=4)
             out = np.array([model.step(x, 0.0) for _ in range(1500)])  # step keeps the state
             y = (out - net.f_offset_n) / net.f_scale_n
-            moved = np.max(np.abs(y[-50:] - fp.y[p]))
+            moved = np.max(np.abs(y[-50:] - fp.y[p, 0]))
             if fp.stable[p]:
                 assert moved < 1e-6
             else:
                 assert moved > 1e-4
             checked[bool(fp.stable[p])] += 1
     assert checked[True] > 5 and checked[False] > 2
+
+
+# ----- over three coordinates: boxes ---------------------------------------------------------
+def test_bistable_axes_give_the_product_of_their_roots_and_the_stable_ones():
+    fp = fixed_points(bistable(), np.zeros((1, 3)))
+    r = scalar_roots(0.0)
+    assert len(r) == 3 and fp.count[0] == 27 and fp.unresolved[0] == 0
+    assert fp.stable_count[0] == 8  # the stable root on every axis: 2 x 2 x 2
+    for ax in range(3):
+        assert np.abs(fp.y[:, ax][:, None] - r[None, :]).min(axis=1).max() < 1e-12
+    outer = np.all(np.abs(fp.y) > 1.0, axis=1)
+    np.testing.assert_array_equal(fp.stable, outer)
+
+
+def test_fold_surface_crossing_is_where_the_pair_of_roots_meets():
+    # fold of y = 2 tanh(2y + c): 4 sech^2 = 1 -> u = atanh(sqrt(3)/2), y = sqrt(3), c = u - 2y
+    c_fold = np.arctanh(np.sqrt(3) / 2) - 2 * np.sqrt(3)
+    q_fold = abs(c_fold) / 0.5 * SCALE3[0]  # c = 0.5 qs, qs = q / 2 mm
+    axial = np.linspace(-0.012, 0.012, 5)
+    found = folds(bistable(), axes=[axial, [0.0], [0.0]])
+    assert len(found) == 2
+    # located to a nanometre along the 6 mm edge (finer than FOLD_TOLERANCE of it)
+    assert sorted(abs(f.q[0]) for f in found) == pytest.approx([q_fold, q_fold], abs=2e-9)
+    assert {(f.count_from, f.count_to) for f in found} == {(9, 27), (27, 9)}
+    for f in found:  # at the fold the merging pair has the eigenvalue 1
+        assert min(f.radii) == pytest.approx(1.0, abs=1e-3)
+
+
+def test_mimo_fixed_points_are_roots_and_a_held_run_ends_on_a_stable_one():
+    model = PlanarNarx.untrained(seed=0)
+    q0 = np.array([0.0, 0.0, 0.0])
+    fp = fixed_points(model, q0[None])
+    net = narx_net(model)
+    phi, _ = net.phi(net.held(q0[None])[[0] * fp.count[0]], fp.y)
+    assert np.abs(phi).max() < 1e-12
+    assert fp.stable_count[0] >= 1
+    f = model.simulate(np.zeros((3000, 3)))
+    gap = np.abs(fp.force[fp.stable] - f[-1]).max(axis=1)
+    assert gap.min() < 1e-6 * np.abs(f[-1]).max()
+
+
+def test_spectral_radius_decides_what_a_perturbed_hold_does():
+    model = bistable()
+    fp = fixed_points(model, np.zeros((1, 3)))
+    assert fp.spectral_radius[fp.stable].max() < 1 < fp.spectral_radius[~fp.stable].min()
+
+
+def test_block_companion_of_one_coordinate_is_the_scalar_companion():
+    rng = np.random.default_rng(4)
+    a = rng.normal(0, 0.6, (20, 5))
+    np.testing.assert_allclose(spectral_radius(a[:, :, None, None]), spectral_radius(a))
+
+
+def test_grid_orders_the_last_coordinate_fastest():
+    g = grid([0.0, 1.0], [0.0], [0.0, 0.1])
+    np.testing.assert_array_equal(g, [[0, 0, 0], [0, 0, 0.1], [1, 0, 0], [1, 0, 0.1]])
+
+
+@pytest.mark.parametrize("coords", [1, 3])
+def test_a_model_that_is_not_a_network_is_refused_by_name(coords):
+    with pytest.raises(CertifyError, match="linear"):
+        fixed_points(MODELS["linear"].model_class(coords).preset(), np.zeros((1, coords)))
+
+
+@pytest.mark.parametrize("coords", [1, 3])
+def test_holds_of_the_wrong_width_are_refused(coords):
+    model = fold_nn() if coords == 1 else bistable()
+    with pytest.raises(CertifyError, match=f"finite \\(M, {coords}\\)"):
+        fixed_points(model, np.zeros((2, coords + 1)))

@@ -99,7 +99,7 @@ def test_a_hybrid_held_past_its_fold_jumps_to_k_x_plus_the_far_residual():
     assert not runs[0].departs and runs[1].departs and runs[1].departs_from == "ghost"
     far = fp.force_n[fp.of_hold(1)[runs[1].reached]]
     assert far == pytest.approx(
-        model.k_n_per_m * x[1] + model.f_scale_n * (fp.y[fp.of_hold(1)][0] + 0.9)
+        model.k_n_per_m * x[1] + model.f_scale_n * (fp.y[fp.of_hold(1)][0, 0] + 0.9)
     )
     _, _, f = _long_run(model, x, 30.0)
     assert f[-1, 1] == pytest.approx(far, abs=1e-6)

@@ -1,18 +1,20 @@
-"""``bushenv certify`` of a three-axis network: holds on a grid of deflection vectors, wrong sign
-judged against the deflection (q . f >= 0 for a passive bushing), passivity as a matrix test."""
+"""``bushenv certify`` of a three-axis network: the one certificate over held deflection vectors
+(fixed points, folds, free runs), wrong sign against the deflection (q . f >= 0 for a passive
+bushing) or against a reference, passivity as a matrix test."""
 
 import json
 
 import numpy as np
 import pytest
 
+from bushenv.certify import CertifyOptions, certify, per_coordinate
 from bushenv.certify.network import CertifyError
 from bushenv.cli import main
 from bushenv.models.planar_linear import PlanarLinear
 from bushenv.models.planar_narx import N_IN, PlanarNarx
-from bushenv.planar.certificate import VectorOptions, certify_vector, per_coordinate, wrong_sign
 
 SPAN = (3e-3, 3e-3, 0.075)
+SMALL = dict(hold_s=4.0, reference_freq_hz=(10.0, 50.0))
 
 
 def network(w1_scale=0.05, feedback=0.0, b_out=(0.0, 0.0, 0.0), seed=0):
@@ -30,36 +32,56 @@ def network(w1_scale=0.05, feedback=0.0, b_out=(0.0, 0.0, 0.0), seed=0):
     )  # fmt: skip
 
 
-def test_the_one_axis_rule_is_the_case_c_equals_1():
-    units = ("m",)
-    assert wrong_sign(np.array([[1e-3]]), np.array([[-11.0]]), units)[0]
-    assert not wrong_sign(np.array([[1e-3]]), np.array([[-9.0]]), units)[0]
-    assert not wrong_sign(np.array([[-1e-3]]), np.array([[-50.0]]), units)[0]
+def test_holds_per_coordinate_are_odd_and_the_one_axis_grid_is_the_holds_themselves():
     assert per_coordinate(201, 1) == 201 and per_coordinate(201, 3) == 7
+    assert per_coordinate(27, 3) == 3 and per_coordinate(3, 2) == 3
 
 
 def test_a_quiet_network_settles_everywhere_and_a_constant_pull_is_wrong_sign():
-    doc, grid = certify_vector(network(), VectorOptions(SPAN, 5))
-    s = doc["summary"]
-    assert s["holds"] == 125 and s["holds_settling_stably"] == 125 and s["fold_crossings"] == 0
-    assert np.array(grid["radius"]).shape == (5, 5, 5)
+    cert = certify(network(), None, CertifyOptions(holds=125, span=SPAN, **SMALL))
+    s = cert.document["summary"]
+    assert s["holds"] == 125 and s["holds_settling_stably"] == 125 and s["folds"] == 0
+    assert cert.document["coords"] == ["axial", "radial", "rotation"]
+    h = cert.document["holds"][0]
+    assert len(h["q"]) == 3 and len(h["static_force"]) == 3 and "x_m" not in h
     pulling = network(w1_scale=0.0, b_out=(-1.0, 0.0, 0.0))  # -500 N axial at every hold
-    doc, _ = certify_vector(pulling, VectorOptions(SPAN, 5))
-    bad = np.array(doc["wrong_sign_at"])
+    doc = certify(pulling, None, CertifyOptions(holds=125, span=SPAN, **SMALL)).document
+    bad = np.array(doc["summary"]["wrong_sign_at"])
     assert doc["summary"]["wrong_sign_holds"] > 0 and not doc["summary"]["passes_holds"]
     assert np.all(bad[:, 0] > 0)  # a constant -500 N axial pulls outward only where axial > 0
 
 
+def test_a_reference_judges_the_static_force_coordinate_by_coordinate():
+    ref = PlanarLinear(np.diag([2.5e5, 1.0e6, 3.0e3]), np.zeros((3, 3)))
+    pulling = network(w1_scale=0.0, b_out=(-1.0, 0.0, 0.0))
+    doc = certify(pulling, ref, CertifyOptions(holds=27, span=SPAN, **SMALL)).document
+    at = [h for h in doc["holds"] if h["q"][0] > 0 and h["q"][1] == 0 and h["q"][2] == 0][0]
+    assert at["reference_static_force"] == pytest.approx([2.5e5 * 3e-3, 0.0, 0.0], abs=1e-6)
+    assert at["wrong_sign"] and at["static_off"]  # -500 N against +750 N
+    assert "reference" in doc["settings"]["wrong_sign_against"]
+    p = doc["passivity"]["holds"][0]
+    assert np.array(p["reference_loss_eigenvalues_j"]).shape == (2, 3)
+    # a spring has no loss: its eigenvalues vanish to rounding
+    assert np.abs(p["reference_loss_eigenvalues_j"]).max() < 1e-6
+
+
 def test_a_network_that_cannot_settle_fails_its_holds():
-    doc, _ = certify_vector(network(feedback=4.0), VectorOptions(SPAN, 3))
-    s = doc["summary"]
+    doc = certify(network(feedback=4.0), None, CertifyOptions(holds=27, span=SPAN, **SMALL))
+    s = doc.document["summary"]
     assert not s["passes_holds"]
     assert s["holds_with_more_than_one"] + s["holds_without_a_stable_one"] > 0
 
 
 def test_a_linear_model_has_nothing_to_certify_and_says_so():
-    with pytest.raises(CertifyError, match="no recurrence to certify"):
-        certify_vector(PlanarLinear.preset(), VectorOptions(SPAN, 3))
+    with pytest.raises(CertifyError, match="holds by construction"):
+        certify(PlanarLinear.preset(), None, CertifyOptions(span=SPAN))
+
+
+def test_a_reference_of_another_number_of_coordinates_is_refused():
+    from bushenv.models.linear import LinearBushing
+
+    with pytest.raises(CertifyError, match="reference has 1 coordinate"):
+        certify(network(), LinearBushing(1e6, 0.0), CertifyOptions(holds=27, span=SPAN))
 
 
 def test_the_command_takes_a_three_axis_file_with_a_span_and_exits_as_a_test_runner(
@@ -69,15 +91,34 @@ def test_the_command_takes_a_three_axis_file_with_a_span_and_exits_as_a_test_run
     assert main(["certify", path, "--out", str(tmp_path / "c"), "--quiet"]) == 2
     assert "give --stroke-mm and --rotation-mrad" in capsys.readouterr().err
     code = main(["certify", path, "--stroke-mm", "3", "--rotation-mrad", "75", "--holds", "27",
-                 "--out", str(tmp_path / "c"), "--quiet"])  # fmt: skip
+                 "--hold-s", "4", "--out", str(tmp_path / "c"), "--quiet"])  # fmt: skip
     doc = json.loads((tmp_path / "c" / "certificate.json").read_text())
     assert code == (
         0 if doc["summary"]["passes_holds"] and doc["summary"]["passes_passivity"] else 1
     )
     assert doc["coords"] == ["axial", "radial", "rotation"] and doc["summary"]["holds"] == 27
-    assert (tmp_path / "c" / "spectral_radius.png").stat().st_size > 0
+    for png in ("spectral_radius", "spectral_radius_map", "static_force", "passivity"):
+        assert (tmp_path / "c" / f"{png}.png").stat().st_size > 0
     out = capsys.readouterr().out
-    assert "rotation +-75 mrad" in out and "wrong sign is q . f < 0" in out
-    assert main(["certify", path, "--reference", "rubber", "--stroke-mm", "3",
-                 "--rotation-mrad", "75", "--out", str(tmp_path / "d")]) == 2  # fmt: skip
-    assert "compares with no reference yet" in capsys.readouterr().err
+    assert "rotation +-75 mrad" in out and "q . f >= 0" in out
+
+
+def test_the_command_certifies_against_a_three_axis_reference(tmp_path, capsys):
+    path = str(network().save(tmp_path / "nn3.npz"))
+    ref = str(PlanarLinear.preset().save(tmp_path / "lin3.npz"))
+    code = main(["certify", path, "--reference", ref, "--stroke-mm", "3", "--rotation-mrad",
+                 "75", "--holds", "27", "--hold-s", "4", "--out", str(tmp_path / "d"),
+                 "--quiet"])  # fmt: skip
+    assert code in (0, 1)
+    doc = json.loads((tmp_path / "d" / "certificate.json").read_text())
+    assert doc["reference"]["source"] == ref and doc["reference"]["class"] == "PlanarLinear"
+    assert all(h["reference_static_force"] is not None for h in doc["holds"])
+    assert "reference: " + ref in capsys.readouterr().out
+    one_axis = str(tmp_path / "lin1.npz")
+    from bushenv.models.linear import LinearBushing
+
+    LinearBushing(1e6, 0.0).save(one_axis)
+    argv = ["certify", path, "--reference", one_axis, "--stroke-mm", "3", "--rotation-mrad",
+            "75", "--out", str(tmp_path / "e"), "--quiet"]  # fmt: skip
+    assert main(argv) == 2
+    assert "is a one-axis model" in capsys.readouterr().err

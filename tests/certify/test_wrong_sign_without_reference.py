@@ -63,4 +63,21 @@ def test_certify_without_reference_reports_the_wrong_sign_and_exits_1(tmp_path, 
 def test_the_sign_rule_without_a_reference(x_m, static_n, want):
     from bushenv.certify.certificate import wrong_sign
 
-    assert wrong_sign(x_m, static_n) is want
+    assert bool(wrong_sign([[x_m]], [[static_n]])[0]) is want
+
+
+def test_the_vector_rule_weighs_a_moment_by_the_lever_and_is_the_scalar_rule_for_c_1():
+    from bushenv.certify.certificate import wrong_sign
+
+    units = ("m",)
+    assert wrong_sign(np.array([[1e-3]]), np.array([[-11.0]]), units)[0]
+    assert not wrong_sign(np.array([[1e-3]]), np.array([[-9.0]]), units)[0]
+    assert not wrong_sign(np.array([[-1e-3]]), np.array([[-50.0]]), units)[0]
+    three = ("m", "m", "rad")
+    q = np.array([[0.0, 0.0, 0.05]])  # 0.05 rad: the floor is 10 N x 0.04 m/rad x 0.05 rad
+    assert wrong_sign(q, np.array([[0.0, 0.0, -0.5]]), three)[0]  # -0.025 J < -0.02 J
+    assert not wrong_sign(q, np.array([[0.0, 0.0, -0.3]]), three)[0]
+    # against a reference: a coordinate where the two oppose, both beyond the floor
+    ref = np.array([[0.0, 0.0, 1.0]])
+    assert wrong_sign(q, np.array([[0.0, 0.0, -0.5]]), three, ref)[0]
+    assert not wrong_sign(q, np.array([[0.0, 0.0, -0.3]]), three, ref)[0]
