@@ -153,6 +153,11 @@ def run(args: argparse.Namespace) -> int:
 
     torch.set_num_threads(1)
     progress = Progress(quiet=args.quiet)
+    command = getattr(TARGETS[args.env], "command", "")
+    if command:  # a target with its own command (the half car: four bushings, not one)
+        from bushenv.cli import CliError
+
+        raise CliError(f"--env {args.env} is searched by `{command}`, not by bushenv attack")
     if args.rotation_mrad is not None and not TARGETS[args.env].coords:
         from bushenv.cli import CliError
 

@@ -28,7 +28,7 @@ from bushenv.persist import write_json, write_text
 from bushenv.progress import Progress, format_seconds
 
 EXAMPLE = "bushenv vehicle --out runs/vehicle"
-SEARCH_BUDGET = 48  # car runs per searcher and kind: about 2 min for three kinds on 2 cores
+SEARCH_BUDGET = 96  # car runs per searcher and kind: about 2 min for three kinds on 2 cores
 
 
 def _names(text: str) -> list[str]:
@@ -197,7 +197,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _search(args: argparse.Namespace, bushings: dict, out: Path, progress, t0: float) -> int:
     """``--search``: the adversary, its report, figures and cases."""
-    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.common import resolve_model
     from bushenv.rigs.halfcar_params import ENV_ID
     from bushenv.vehicle.adversary import REFERENCE, AdversaryConfig, run_adversary
     from bushenv.vehicle.adversary_cases import save_cases
@@ -208,8 +208,8 @@ def _search(args: argparse.Namespace, bushings: dict, out: Path, progress, t0: f
     models = {k: b.model for k, b in bushings.items()}
     report, kept = run_adversary(models, config, progress)
     report["bushings"] = {k: _shown(b.describe(), out) for k, b in bushings.items()}
-    reference = resolve_planar(REFERENCE, next(iter(models.values())).dt, "reference",
-                               env_id=ENV_ID)  # fmt: skip
+    dt = next(iter(models.values())).dt
+    reference = resolve_model(REFERENCE, dt=dt, coords=3, what="reference", env_id=ENV_ID)
     dirs = [out / "cases"] + ([Path(args.corpus)] if args.corpus else [])
     report["cases"] = save_cases(kept, bushings, reference, args.seed, dirs)
     figures = []

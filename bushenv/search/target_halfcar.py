@@ -4,8 +4,10 @@ four arm pivots beside its twin with the reference bushings, judged on the wheel
 A profile is a (T, 3) array of HalfCar-v0's inputs (road left m, road right m, lateral
 acceleration m/s^2); its families are the standard manoeuvres with their parameters free within
 the standards' bounds (``bushenv/vehicle/adversary_space.py``, registered here as ``car_*``).
-Each profile is replayed by ``bushenv.vehicle.compare.run_car``, as ``bushenv vehicle`` runs
-the standard manoeuvres, so a searched manoeuvre and a standard one are judged alike.
+A batch of profiles is driven at once by ``HalfCarBatch`` (HalfCar-v0's car as arrays: within
+1 % of each output's peak of the pymunk env, docs/envs.md); the adversary judges the standard
+manoeuvres on the same path, so a searched manoeuvre and a standard one are judged alike, and
+re-measures its find in the pymunk env (``bushenv/vehicle/adversary_blame.py``).
 
 The judge (``judge_car``): the objective is the peak difference of the dynamic wheel loads (both
 wheels) between the model car and its twin, in % of the twin's own peak -- the vehicle study's
@@ -13,16 +15,15 @@ wheels) between the model car and its twin, in % of the twin's own peak -- the v
 what the road sees (grip), it exists under every manoeuvre, roads and steering alike, and the
 study judged seed 000's finding on it among others. A profile fails on two criteria:
 
-- ``terminated``: HalfCar-v0 ended the model car (it left its bounds, the twin did not);
+- ``terminated``: the model car left its bounds (HalfCar-v0's), its twin did not;
   robustness min((tol - D) / tol, -fraction of the manoeuvre not run), D over the steps run;
 - ``differs``: the car ran to the end and D > ``tolerance_pct`` (default the study's 5 %
   "almost identical"); robustness (tol - D) / tol.
 
 Robustness is negative exactly when a profile fails; the searchers minimise it, so they look
-for the largest wheel-load difference. Where the twin itself leaves its bounds (too rough a
-road), or would have after the model car ended (the reference car is then run alone through
-the whole manoeuvre), the verdict is the reference's, not the model's:
-``reference_unusable``, robustness 1.
+for the largest wheel-load difference. Where the twin itself leaves its bounds at any time in
+the manoeuvre (too rough a road), also after the model car ended, the verdict is the
+reference's, not the model's: ``reference_unusable``, robustness 1.
 The (T, B, 2) forces a batch keeps are the two cars' dynamic wheel loads (N), each held at its
 last value after its run ended.
 """
@@ -34,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bushenv.divergence import Verdict
+from bushenv.rigs.halfcar_params import POSITIONS
 from bushenv.scales import MACHINE
 from bushenv.search.base import SearchError
 from bushenv.search.families import FAMILIES, Family
@@ -129,6 +131,54 @@ def judge_car(runs: list, samples: list[int], tolerance_pct: float) -> CarVerdic
     )
 
 
+@dataclass
+class BatchRun:
+    """One column of a ``HalfCarBatch`` run as ``judge_run`` reads a ``compare.CarRun``."""
+
+    model: dict[str, np.ndarray]
+    reference: dict[str, np.ndarray]
+    dt_s: float
+    steps: int
+    end: dict
+
+
+def car_runs(model, reference, x: np.ndarray, lengths: np.ndarray, dt: float) -> list[BatchRun]:
+    """(T, B, 3) profiles driven by ``HalfCarBatch`` (the model car beside its twin, all B at
+    once); each column cut where its manoeuvre ends or its model car left its bounds."""
+    from bushenv.rigs.halfcar_batch import HalfCarBatch
+    from bushenv.vehicle.compare import OUTPUTS
+
+    B = x.shape[1]
+    keys = [k for o in OUTPUTS for k in o.keys]
+    pivots = [f"deflection_{k}_{c}_m" for k in POSITIONS for c in ("axial", "radial")]
+    cars = HalfCarBatch(B, model=model, reference=reference,
+                        max_lateral_accel_step_m_per_s2=space.AY_STEP_M_PER_S2)  # fmt: skip
+    p = cars.params
+    out = cars.simulate(x[:, :, 0], x[:, :, 1], x[:, :, 2],
+                        keys=[*keys, *("reference_" + k for k in keys), *pivots])  # fmt: skip
+    runs = []
+    for b in range(B):
+        n, first = int(lengths[b]), int(out["divergence_step"][b])
+        ended = bool(out["diverged"][b]) and 0 <= first < n
+        steps = first if ended else n
+        end = {"reason": "", "reference_left_bounds": False}
+        if bool(out["physical_limit"][b]):
+            end.update(reason="the reference car left its bounds", reference_left_bounds=True)
+        elif ended:
+            defl = max(abs(float(out[k][first, b])) for k in pivots)
+            why = (f"bushing deflection {1e3 * defl:.4g} mm exceeds {1e3 * p.max_deflection:.4g} "
+                   "mm" if defl > p.max_deflection else "the model car left its bounds (a "
+                   "force, travel, roll or displacement limit)")  # fmt: skip
+            end.update(reason=why, time_s=(first + 1) * dt)
+        runs.append(BatchRun(
+            {o.name: np.stack([out[k][:steps, b] for k in o.keys], axis=1)
+             - (p.tyre_static_n if o.name == "wheel_load" else 0.0) for o in OUTPUTS},
+            {o.name: np.stack([out["reference_" + k][:steps, b] for k in o.keys], axis=1)
+             - (p.tyre_static_n if o.name == "wheel_load" else 0.0) for o in OUTPUTS},
+            dt, steps, end))  # fmt: skip
+    return runs
+
+
 def _held(a: np.ndarray, n: int) -> np.ndarray:
     """(n, 2) of ``a`` (k, 2), each column held at its last value past k (zeros if k = 0)."""
     out = np.zeros((n, 2))
@@ -176,25 +226,10 @@ class HalfCarTarget(Target):
     def responses(
         self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
     ) -> Responses:
-        from bushenv.vehicle.compare import run_car
-
         if x.ndim != 3 or x.shape[2] != 3:
             raise SearchError(f"the halfcar target takes (T, B, 3) profiles, got {x.shape}")
-        kwargs = {"max_lateral_accel_step_m_per_s2": space.AY_STEP_M_PER_S2}
-        runs, samples = [], []
-        for b in range(x.shape[1]):
-            n = int(lengths[b])
-            m = space.as_manoeuvre(x[:n, b], dt)
-            run = run_car(m, model, reference.model, "model", kwargs)
-            if run.end.get("reason") and not run.end.get("reference_left_bounds"):
-                # the model car ended: the manoeuvre is the model's fault only if the reference
-                # car takes all of it (on too rough a road it would have left its bounds later)
-                alone = run_car(m, reference.model, reference.model, "reference", kwargs)
-                if alone.end.get("reason"):
-                    run.end.update(reference_left_bounds=True, reason="the reference car "
-                                   f"leaves its bounds later: {alone.end['reason']}")  # fmt: skip
-            runs.append(run)
-            samples.append(n)
+        runs = car_runs(model, reference.model, x, lengths, dt)
+        samples = [int(n) for n in lengths]
         verdict = judge_car(runs, samples, self.tolerance_pct)
         T = x.shape[0]
         fm = np.stack([_held(r.model[OBJECTIVE], T) for r in runs], axis=1)

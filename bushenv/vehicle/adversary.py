@@ -30,6 +30,7 @@ from bushenv.vehicle.manoeuvres import Manoeuvre, standard_manoeuvres
 from bushenv.vehicle.study import IDENTICAL_PCT
 
 REFERENCE = "rubber"  # the judge: the coupled rubber, as in ``bushenv vehicle``
+ROAD_FAMILIES = ("car_road", "car_bump", "car_pothole")
 
 
 @dataclass(frozen=True)
@@ -115,18 +116,32 @@ def largest(entries: list[dict]) -> dict | None:
     return max(done, key=lambda e: e["d_pct"]) if done else None
 
 
+def peak_input(e: dict) -> float:
+    """A profile's size: its largest |road| (mm) on a road, its largest |a_y| (m/s^2) else."""
+    x = e["profile"]
+    road = float(np.abs(x[:, :2]).max())
+    return 1e3 * road if road > 0 else float(np.abs(x[:, 2]).max())
+
+
 def terminations(entries: list[dict], result_coverage: dict[str, list[float]]) -> dict:
-    """Per family: how many searched profiles ended the model car, of how many tried, and the
-    earliest end (s) with its manoeuvre's parameters."""
+    """Per family: how many searched profiles ended the model car, of how many tried; the
+    earliest end (s) with its manoeuvre's parameters; the smallest input that ended it and the
+    largest kept input that ran to the end (road mm, a_y m/s^2: ``peak_input``). Profiles that
+    ran to the end within the tolerance are not kept by a search, so the bracket is of the
+    kept ones."""
     out: dict[str, Any] = {}
     for fam, cov in sorted(result_coverage.items()):
-        ended = [e for e in entries if e["params"].get("family") == fam
-                 and e["criterion"] == "terminated"]  # fmt: skip
+        mine = [e for e in entries if e["params"].get("family") == fam]
+        ended = [e for e in mine if e["criterion"] == "terminated"]
+        ran = [peak_input(e) for e in mine if completed(e)]
         first = min(ended, key=lambda e: e["time_s"]) if ended else None
         out[fam] = {"tried": int(cov[0]), "ended": len(ended),
                     "earliest_s": first["time_s"] if first else None,
                     "earliest_params": _plain_params(first["params"]) if first else None,
-                    "earliest_reason": first["end"] if first else None}  # fmt: skip
+                    "earliest_reason": first["end"] if first else None,
+                    "smallest_input_ended": min(map(peak_input, ended)) if ended else None,
+                    "largest_input_ran": max(ran) if ran else None,
+                    "input_unit": "mm" if fam in ROAD_FAMILIES else "m/s^2"}  # fmt: skip
     return out
 
 
@@ -193,14 +208,14 @@ def run_adversary(
     bushings: dict[str, Any], config: AdversaryConfig, progress: Progress | None = None
 ) -> tuple[dict, dict]:
     """Search for every kind in ``bushings`` (label -> three-axis model); (report, kept)."""
-    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.common import resolve_model
     from bushenv.rigs.halfcar_params import ENV_ID
 
     config = config.checked()
     progress = progress or Progress(quiet=True)
     dt = next(iter(bushings.values())).dt
     manoeuvres = standard_manoeuvres(dt, config.seed)
-    reference = resolve_planar(REFERENCE, dt, "reference", env_id=ENV_ID)
+    reference = resolve_model(REFERENCE, dt=dt, coords=3, what="reference", env_id=ENV_ID)
     progress.total = len(bushings) * len(config.searchers) * config.budget
     progress.say(f"adversary: {len(bushings)} kinds x {', '.join(config.searchers)} x "
                  f"{config.budget} car runs, seed {config.seed}")  # fmt: skip

@@ -52,6 +52,9 @@ def kind_lines(k: dict[str, Any]) -> list[str]:
     b = k.get("blame")
     if b:
         c = b["carried_by"]
+        lines.append(
+            f"- re-measured in the pymunk env (HalfCar-v0 itself): {_f(b['d_pct_all_four'])} %"
+        )
         lines.append(f"- carried by the **{c['pivot']}** pivot (the reference bushing there "
                      f"takes D from {_f(b['d_pct_all_four'])} % to "
                      f"{_f(b['swap'][c['pivot']]['d_pct_reference_here'])} %), largest in-car "
@@ -60,7 +63,9 @@ def kind_lines(k: dict[str, Any]) -> list[str]:
     for n, t in ended.items():
         lines.append(f"- {n}: {t['ended']} of {t['tried']} searched profiles ended the model car; "
                      f"earliest at {_f(t['earliest_s'], 2)} s ({t['earliest_reason']}; "
-                     f"{_params(t['earliest_params'])})")  # fmt: skip
+                     f"{_params(t['earliest_params'])}); smallest input that ended it "
+                     f"{_f(t['smallest_input_ended'], 2)} {t['input_unit']}, largest that ran "
+                     f"to the end {_f(t['largest_input_ran'], 2)} {t['input_unit']}")  # fmt: skip
     return lines
 
 
@@ -128,7 +133,7 @@ def plot_search(report: dict[str, Any], kept: dict[str, Any], path: str | Path) 
                     if pts:
                         a.plot([offset + e["evaluation"] for e in pts],
                                [e["d_pct"] for e in pts], "x" if ended else "o", ms=4,
-                               color=colours[fam], label=None if ended else fam)  # fmt: skip
+                               color=colours[fam], label=fam)  # fmt: skip
             a.axvline(offset + r.evaluations + 0.5, color="0.6", lw=0.8)
             a.text(offset + 1, 0, r.searcher, fontsize=7, va="bottom")
             offset += r.evaluations
@@ -140,7 +145,9 @@ def plot_search(report: dict[str, Any], kept: dict[str, Any], path: str | Path) 
                     fontsize=9)  # fmt: skip
         a.grid(alpha=0.3)
         handles, labels = a.get_legend_handles_labels()
-        uniq = dict(zip(labels, handles, strict=True))
+        uniq: dict = {}
+        for label, handle in zip(labels, handles, strict=True):
+            uniq.setdefault(label, handle)  # a family's dots before its crosses
         a.legend(uniq.values(), uniq.keys(), fontsize=6, loc="upper right", ncol=2)
     ax[-1, 0].set_xlabel("evaluation (searchers one after another)")
     fig.tight_layout()

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from bushenv.cli import main
-from bushenv.rigs.bushrig3 import resolve_planar
+from bushenv.rigs.common import resolve_model
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.families import FAMILIES
 from bushenv.search.targets import TARGETS
@@ -26,7 +26,7 @@ BUSHINGS = (
 
 @pytest.fixture(scope="module")
 def rubber():
-    return resolve_planar("rubber", DT, "reference", env_id="HalfCar-v0")
+    return resolve_model("rubber", dt=DT, coords=3, what="reference", env_id="HalfCar-v0")
 
 
 def _corners(dim):
@@ -161,3 +161,5 @@ def test_search_options_without_search_and_unknown_searchers_are_refused(tmp_pat
     code = main(["vehicle", "--search", "--out", str(tmp_path), "--searchers", "ppo",
                  "--kinds", "linear", "--linear", str(BUSHINGS / "linear.npz")])  # fmt: skip
     assert code == 2 and "the half car takes random and cma" in capsys.readouterr().err
+    assert main(["attack", "--env", "halfcar", "--budget", "2", "--quiet"]) == 2
+    assert "searched by `bushenv vehicle --search`" in capsys.readouterr().err
