@@ -40,10 +40,10 @@ def _table(model, reference: Any, model_at: set[str]) -> dict[str, Any]:
 def force_table(run, model, reference: Any) -> dict[str, dict[str, dict[str, float]]]:
     """Per pivot and coordinate: in-car and open-loop force difference, RMS (N or N m) and %
     of the twin's (in car) or the reference law's (open loop) RMS."""
-    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.common import resolve_model
     from bushenv.rigs.halfcar_params import ENV_ID
 
-    ref_law = resolve_planar(reference, run.dt_s, "reference", env_id=ENV_ID)
+    ref_law = resolve_model(reference, dt=run.dt_s, coords=3, what="reference", env_id=ENV_ID)
     out: dict[str, dict[str, dict[str, float]]] = {}
     for i, pivot in enumerate(POSITIONS):
         q = np.ascontiguousarray(run.deflection[:, i, :])
