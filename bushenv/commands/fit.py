@@ -1,8 +1,10 @@
 """``bushenv fit``: identify a model from measured records; write it, its card and figures.
 
-The model choices are the registered models with an identification (``MODELS``), and each
-model's own flags are built from its options dataclass (``ModelEntry.options``): one flag per
-field, its help and default from the field. A flag several models share (``--time-budget-s``)
+The records say how many coordinates C the bushing has (one: ``time,displacement,force``;
+three: axial, radial, rotation); ``--model`` is a kind in ``MODELS`` and the identification is
+the one that kind has over C (``bushenv.identify.fit``). Each kind's flags are built from its
+options dataclass (``ModelEntry.options``, one per C it is identified over): one flag per
+field, its help and default from the field. A flag several models share (``--time-limit-s``)
 is declared once and shows each model's default.
 """
 
@@ -18,34 +20,37 @@ from typing import Any
 from bushenv.commands.options import add_resample_option
 from bushenv.identify import fittable_models, options_class
 from bushenv.identify.options import describe, flag_of, option_fields
-from bushenv.record_rates import one_rate
 
 EXAMPLE = "bushenv fit train1.csv train2.csv --model hybrid --validate held.csv --out my_hybrid.npz"
 DEST = "option_"  # argparse dest prefix of the model options
 
 
-def model_options() -> dict[str, list[tuple[str, Any]]]:
-    """Option name -> [(model, dataclass field)] for every model with an identification; the
-    planar (3-axis) models' owners read "NAME (3-axis)"."""
-    from bushenv.commands.fit_planar import PLANAR_LABEL
-    from bushenv.models import MODELS, names_for
+def coordinate_counts() -> list[int]:
+    """Every number of coordinates some registered kind is identified over."""
+    from bushenv.models import MODELS
 
+    return sorted({c for e in MODELS.values() for c in e.coordinate_counts() if e.fits(c)})
+
+
+def owner(name: str, coords: int) -> str:
+    """How ``--help`` and the errors name a kind's form: ``nn``, ``nn (3-axis)``."""
+    return name if coords == 1 else f"{name} ({coords}-axis)"
+
+
+def model_options() -> dict[str, list[tuple[str, Any]]]:
+    """Option name -> [(owner, dataclass field)] for every kind's identification over every
+    number of coordinates (owners as ``owner`` names them)."""
     table: dict[str, list[tuple[str, Any]]] = defaultdict(list)
-    for name in fittable_models():
-        for f in option_fields(options_class(name)):
-            table[f.name].append((name, f))
-    for name in names_for(3, fittable=True):
-        for f in option_fields(MODELS[name].options_class(3)):
-            table[f.name].append((name + PLANAR_LABEL, f))
+    for c in coordinate_counts():
+        for name in fittable_models(c):
+            for f in option_fields(options_class(name, c)):
+                table[f.name].append((owner(name, c), f))
     return dict(table)
 
 
 def model_choices() -> list[str]:
-    """``--model``: the one-axis fittable models, then the planar ones not named alike."""
-    from bushenv.models import names_for
-
-    one = fittable_models()
-    return one + [n for n in names_for(3, fittable=True) if n not in one]
+    """``--model``: every kind identified over some number of coordinates."""
+    return list(dict.fromkeys(n for c in coordinate_counts() for n in fittable_models(c)))
 
 
 def _option_help(owners: list[tuple[str, Any]]) -> str:
@@ -75,7 +80,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--model",
         required=True,
         choices=model_choices(),
-        help="model to identify (required); on 3-axis records a planar model (PLANAR_MODELS)",
+        help="model to identify (required): a kind whose form over the records' coordinates "
+        "has an identification",
     )
     p.add_argument("--out", required=True, metavar="MODEL.npz", help="model file to write")
     p.add_argument(
@@ -106,18 +112,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         )
 
 
-def chosen_options(args: argparse.Namespace) -> dict[str, str]:
-    """The model options given on the command line (name -> text); refuses another model's."""
+def chosen_options(args: argparse.Namespace, coords: int = 1) -> dict[str, str]:
+    """The model options given on the command line (name -> text); refuses another model's,
+    or one the kind does not take over ``coords`` coordinates."""
     from bushenv.cli import CliError
 
     table = model_options()
+    mine = owner(args.model, coords)
+    what = "model" if coords == 1 else f"the {coords}-axis model"
     given = {k[len(DEST) :]: v for k, v in vars(args).items() if k.startswith(DEST)}
     for name in given:
         models = [m for m, _ in table[name]]
-        if args.model not in models:
-            own = [flag_of(n) for n, o in table.items() if args.model in (m for m, _ in o)]
+        if mine not in models:
+            own = [flag_of(n) for n, o in table.items() if mine in (m for m, _ in o)]
             raise CliError(
-                f"{flag_of(name)} is not an option of model {args.model} (it is one of "
+                f"{flag_of(name)} is not an option of {what} {args.model} (it is one of "
                 f"{', '.join(models)}); {args.model} takes: {', '.join(own) or 'no options'}"
             )
     return given
@@ -145,49 +154,48 @@ def _check_paths(args: argparse.Namespace) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bushenv.cli import CliError
-    from bushenv.commands.fit_planar import planar_records, run_planar
     from bushenv.identify import fit
     from bushenv.identify.card import save_fit
-    from bushenv.identify.data import check_model_rate, check_same_rate
-    from bushenv.planar.records import HEADER_TEXT
-    from bushenv.records import load_csv
+    from bushenv.identify.data import check_model_rate, check_same_coordinates, check_same_rate
+    from bushenv.record_files import load_record
+    from bushenv.record_notes import start_notes
+    from bushenv.record_rates import one_rate
 
     out = _check_paths(args)
-    if planar_records(args):
-        given = {k[len(DEST) :]: v for k, v in vars(args).items() if k.startswith(DEST)}
-        return run_planar(args, out, given)
-    if args.model not in fittable_models():
-        raise CliError(
-            f"model {args.model} is a 3-axis model: its records have the header "
-            f"'{HEADER_TEXT}'; for one-axis records choose one of {', '.join(fittable_models())}"
-        )
-    given = chosen_options(args)
-    train = [load_csv(p) for p in args.train]
-    held = [load_csv(p) for p in args.validate or []]
+    train = [load_record(p) for p in args.train]
+    held = [load_record(p) for p in args.validate or []]
+    coords = len(check_same_coordinates(train + held, what="training and held-out records"))
+    options_class(args.model, coords)  # the kind has an identification over these records
+    given = chosen_options(args, coords)
     train, held = one_rate([train, held], args.resample, "fit")
     dt = check_same_rate(train, what="training records")
     for i, rec in enumerate(held):
         check_model_rate(rec, dt, i)
+    notes = [n for rec in train + held for n in start_notes(rec)]
+    for note in notes:
+        print(f"note: {note}", file=sys.stderr, flush=True)
     say = None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True))
     if say:
         seconds = sum(r.duration_s for r in train)
-        say(f"fit {args.model} on {len(train)} record(s), {seconds:.1f} s at {1 / dt:.6g} Hz")
+        say(f"fit {owner(args.model, coords)} on {len(train)} record(s), {seconds:.1f} s at "
+            f"{1 / dt:.6g} Hz")  # fmt: skip
     result = fit(train, args.model, given, seed=args.seed, progress=say or False)
-    card = save_fit(result, out, held, plots=not args.no_plots)
+    card = save_fit(result, out, held, plots=not args.no_plots, notes=notes)
     print(summary(card, out))
     return 0
 
 
 def summary(card: dict[str, Any], out: Path) -> str:
-    """What ``bushenv fit`` prints on stdout: files written and held-out metrics."""
+    """What ``bushenv fit`` prints on stdout: files written, what the card says of the
+    identification, and the metrics of every record (per coordinate where the card has them)."""
     from bushenv.identify.card import card_paths
+    from bushenv.identify.card_text import coordinates, per_coordinate
 
     src = card["source"]
     json_path, md_path = card_paths(out)
     lines = [
         f"model {card['model']} -> {out} (card {json_path.name}, {md_path.name}; "
-        f"{len(card['plots'])} figures)",
+        f"{len(card.get('plots') or [])} figures)",
         f"identified in {src['wall_time_s']:.1f} s, seed {src['seed']}",
     ]
     if src.get("time_limited"):
@@ -201,19 +209,43 @@ def summary(card: dict[str, Any], out: Path) -> str:
         lines.append(
             "parameters: " + ", ".join(f"{k} = {p['value']:.6g} {p['unit']}" for k, p in params)
         )
+    lines += _card_lines(card)
+    lines += [f"{k}: {v}" for k, v in (src.get("info") or {}).items()]
+    if card.get("notes"):
+        lines.append(f"{len(card['notes'])} note(s) on the records, in the card (shown above)")
     # full names, the column as wide as the longest (the card's paths, relative to it)
     names = [str(out.parent / r["file"]) if r["file"] else r["name"] for r in card["records"]]
     names = [os.path.normpath(n) for n in names]
     width = max(30, *(len(n) for n in names))
-    lines += [
-        "",
-        f"{'record':{width}s} {'role':9s} {'RMS ratio %':>12s} {'ESR %':>8s} {'max err N':>10s} "
-        f"{'NRMSE %':>8s}",
-    ]
+    coords = coordinates(card)
+    lines += ["", f"{'record':{width}s} {'role':9s} {'coordinate':10s} {'RMS ratio %':>12s} "
+              f"{'ESR %':>8s} {'max err':>10s} {'MAX %':>7s} {'NRMSE %':>8s}"]  # fmt: skip
     for name, r in zip(names, card["records"], strict=True):
-        m = r["metrics"]
-        lines.append(
-            f"{name:{width}s} {r['role']:9s} {100 * m['rms_ratio']:12.2f} "
-            f"{100 * m['esr']:8.3f} {m['max_error']:10.1f} {100 * m['nrmse']:8.2f}"
-        )
+        for coord, m in per_coordinate(r["metrics"], coords).items():
+            err = m.get("max_error")
+            cells = [_pct(m.get("rms_ratio")), _pct(m.get("esr")),
+                     "-" if err is None else f"{err:.1f}", _pct(m.get("max_error_ratio")),
+                     _pct(m.get("nrmse"))]  # fmt: skip
+            lines.append(
+                f"{name:{width}s} {r['role']:9s} {coord:10s} {cells[0]:>12s} {cells[1]:>8s} "
+                f"{cells[2]:>10s} {cells[3]:>7s} {cells[4]:>8s}"
+            )
     return "\n".join(lines)
+
+
+def _pct(v: float | None) -> str:
+    return "-" if v is None else f"{100 * v:.2f}"
+
+
+def _card_lines(card: dict[str, Any]) -> list[str]:
+    """The card's findings on the model's range: holds, backbone alone, coverage."""
+    from bushenv.certify.range_holds import describe
+    from bushenv.identify.card_text import backbone_lines, coordinates, coverage_lines
+    from bushenv.models import MODELS
+
+    lines = []
+    if card.get("holds"):
+        units = MODELS[card["model"]].model_class(len(coordinates(card))).units
+        lines += describe(card["holds"], units)
+    lines += backbone_lines(card) if card.get("backbone") else []
+    return lines + coverage_lines(card)

@@ -7,8 +7,8 @@ import argparse
 from pathlib import Path
 
 from bushenv.execution import get_backend
+from bushenv.identify.mimo_options import HYBRID_TRAININGS
 from bushenv.models.planar_narx import STRUCTURES
-from bushenv.planar.train_options import HYBRID_TRAININGS
 from bushenv.progress import Progress
 from bushenv.search.matrix import parse_seeds
 from bushenv.zoo.planar_study import PlanarZooConfig, refuse_other_kind, run_planar_study
@@ -48,14 +48,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         choices=("off", "on"),
         default="off",
         help="train every model with the certified-holds loss term (bushenv fit --certified on; "
-        "rig3: the planar term, planar/certified.py)",
+        "rig3: the planar term, identify/mimo_certified.py)",
     )
     p.add_argument(
         "--structure",
         choices=STRUCTURES,
         default="free",
         help="rig3: the planar network's weights tied by construction (bushenv fit --structure; "
-        "mirror: odd in each coordinate, planar/structure.py)",
+        "mirror: odd in each coordinate, identify/mimo_structure.py)",
     )
     p.add_argument(
         "--training",

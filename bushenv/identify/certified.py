@@ -58,7 +58,6 @@ from bushenv.identify.narx_data import NarxProblem
 from bushenv.identify.narx_torch import TorchNarx
 from bushenv.identify.static_estimate import StaticEstimate, static_estimate
 
-FLOOR_FRACTION = 0.01  # of the records' RMS force: below it a held force has no sign
 SETTLE_HOLD_S = 1.0  # hold after the step whose second half must sit on a fixed point
 SETTLE_TOLERANCE = 0.01  # of f_scale: the certificate's "reached" tolerance (holds.REACH_TOL)
 SEARCH_CELLS = 32  # initial cells of the fixed-point search per hold (it refines itself)
@@ -90,7 +89,9 @@ class CertifiedHolds:
         """The records' static estimate (their training parts), computed once per problem."""
         if self._estimate is None or self._estimate[0] != id(problem):
             lengths = [hi - lo for lo, hi in problem.train]
-            est = static_estimate(problem.data.segments, lengths, problem.dt)
+            segs = problem.data.segments
+            parts = [(s.x[:n], s.f[:n]) for s, n in zip(segs, lengths, strict=True)]
+            est = static_estimate(parts, problem.dt)
             self._estimate = (id(problem), est)
         return self._estimate[1]
 
@@ -119,22 +120,19 @@ class CertifiedHolds:
         est = self.estimate(problem)
         cnet = narx_net_of(net, problem)
         fp = fixed_points(cnet, x_m, n_cells=SEARCH_CELLS)
-        y = held_output(net, problem, x_m[fp.hold], fp.y)
+        y0 = fp.y[:, 0]  # one coordinate: the scaled outputs as scalars
+        y = held_output(net, problem, x_m[fp.hold], y0)
         force = problem.k * torch.from_numpy(x_m[fp.hold]) + problem.f_off + problem.f_sc * y
-        f_s = est.force_n(x_m[fp.hold])
-        floor = FLOOR_FRACTION * est.force_rms_n
-        sign = torch.from_numpy(np.where(f_s >= 0.0, 1.0, -1.0))
-        size = torch.from_numpy(np.abs(f_s))
-        along = sign * force
-        outside = torch.relu(self.low * size - floor - along) + torch.relu(
-            along - self.high * size - floor
+        sign, lo, hi, scale = (
+            torch.from_numpy(a) for a in est.band(x_m[fp.hold], self.low, self.high)
         )
-        static = outside / torch.clamp(size, min=floor)
+        along = sign * force
+        static = (torch.relu(lo - along) + torch.relu(along - hi)) / scale
         rho = spectral_radius_of(net, problem, x_m[fp.hold], y)
         excess = torch.relu(rho - self.radius) / (1.0 - self.radius)
         late = step_run(net, problem, x_m)
         with torch.no_grad():  # the fixed point of its own hold each run ends nearest to
-            gap = np.abs(late[fp.hold, -1].numpy() - fp.y)
+            gap = np.abs(late[fp.hold, -1].numpy() - y0)
         nearest = np.array([fp.of_hold(i)[np.argmin(gap[fp.hold == i])] for i in range(x_m.size)])
         off = torch.relu(torch.abs(late - y[nearest][:, None]) - SETTLE_TOLERANCE)
         return {
@@ -200,22 +198,22 @@ def step_run(
 
 def narx_net_of(net: TorchNarx, problem: NarxProblem) -> NarxNet:
     """The certificate's view of the network being trained (its current weights)."""
-    a = net.arrays()
+    a, one = net.arrays(), np.ones(1)
     return NarxNet(
         n_past_x=problem.n_past_x,
         n_past_f=problem.n_past_f,
-        x_offset_m=problem.x_off,
-        x_scale_m=problem.x_sc,
-        f_offset_n=problem.f_off,
-        f_scale_n=problem.f_sc,
+        q_offset=problem.x_off * one,
+        q_scale=problem.x_sc * one,
+        f_offset=problem.f_off * one,
+        f_scale=problem.f_sc * one,
         w1=a["w1"],
         b1=a["b1"],
         w2=a["w2"],
         b2=a["b2"],
-        w_out=a["w_out"],
-        b_out=float(a["b_out"]),
-        k_n_per_m=problem.k,
-        c_ns_per_m=problem.c,
+        w_out=a["w_out"].reshape(1, -1),
+        b_out=float(a["b_out"]) * one,
+        k=np.array([[problem.k]]),
+        c=np.array([[problem.c]]),
         dt_s=problem.dt,
         model_name=problem.kind,
     )

@@ -1,27 +1,40 @@
-"""Linear (Kelvin-Voigt) identification: least squares of F on [x, v] (seed 000 §4.1)."""
+"""Linear (Kelvin-Voigt) identification: least squares of F on [x, v] (seed 000 §4.1), for a
+bushing of any number of coordinates: k and c for one, the C x C matrices K and C for several
+(each force row its own least squares on every coordinate's displacement and velocity)."""
 
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.identify.data import IdentificationError, TrainingSet, check_record
 from bushenv.identify.options import NoOptions
-from bushenv.models.base import velocity_of
+from bushenv.models.base import BushingModel, velocity_of
 from bushenv.models.linear import LinearBushing
+from bushenv.models.registry import MODELS
 from bushenv.progress import ProgressSpec
 from bushenv.scales import BushingScales
 
 __all__ = ["IdentificationError", "check_record", "fit_linear", "least_squares_kc"]
 
 
-def least_squares_kc(x: np.ndarray, f: np.ndarray, v: np.ndarray) -> tuple[float, float]:
-    """(k N/m, c N s/m) minimising sum (f - k x - c v)^2 (``np.linalg.lstsq``)."""
-    a = np.column_stack([x, v])
-    (k, c), *_ = np.linalg.lstsq(a, f, rcond=None)
-    return float(k), float(c)
+def least_squares_kc(x: np.ndarray, f: np.ndarray, v: np.ndarray) -> tuple[Any, Any]:
+    """(k N/m, c N s/m) minimising sum (f - k x - c v)^2 (``np.linalg.lstsq``) for (N,)
+    arrays; for (N, C) arrays the (C, C) matrices K, C minimising |f - K x - C v|^2 row by row,
+    each column scaled to its largest value first (millimetres and radians differ by orders)."""
+    if np.ndim(x) == 1:
+        a = np.column_stack([x, v])
+        (k, c), *_ = np.linalg.lstsq(a, f, rcond=None)
+        return float(k), float(c)
+    a = np.hstack([x, v])
+    scale = np.maximum(np.abs(a).max(axis=0), 1e-300)
+    coef, *_ = np.linalg.lstsq(a / scale, f, rcond=None)
+    coef = (coef / scale[:, None]).T  # (C, 2 C): force row i = [K_i, C_i]
+    n = x.shape[1]
+    return coef[:, :n], coef[:, n:]
 
 
 def fit_linear(
@@ -29,18 +42,25 @@ def fit_linear(
     options: NoOptions | None = None,
     seed: int = 0,
     progress: ProgressSpec = False,
-) -> LinearBushing:
+) -> BushingModel:
     """Least-squares Kelvin-Voigt model of every sample of ``data`` (exact: no seed, no
-    options); each record's velocity is its own central difference."""
+    options); each record's velocity is its own central difference. One coordinate: a
+    ``LinearBushing``; the three in-plane ones: a ``PlanarLinear`` (3x3 K and C)."""
     x, f, v = data.concatenated()
     k, c = least_squares_kc(x, f, v)
-    line = f"linear: k = {k:.6g} N/m, c = {c:.6g} N s/m"
+    if data.n_coords == 1:
+        line = f"linear: k = {k:.6g} N/m, c = {c:.6g} N s/m"
+        model = LinearBushing(k_n_per_m=k, c_ns_per_m=c, dt=data.dt)
+        model.training = {"k_n_per_m": k, "c_ns_per_m": c, "seconds": 0.0}
+    else:
+        cls = MODELS["linear"].model_class(data.n_coords)
+        model = cls(k, c, dt=data.dt)
+        diag = ", ".join(f"{n} {kk:.6g}" for n, kk in zip(model.coords, np.diag(k), strict=True))
+        line = f"linear: K diagonal {diag} (SI)"
     if callable(progress):
         progress(line)
     elif progress:
         print(line, file=sys.stderr, flush=True)
-    model = LinearBushing(k_n_per_m=k, c_ns_per_m=c, dt=data.dt)
-    model.training = {"k_n_per_m": k, "c_ns_per_m": c, "seconds": 0.0}
     return model
 
 

@@ -194,5 +194,5 @@ class PlanarHybrid(PlanarNarx):
         return PlanarLinear(self.k_matrix, self.c_matrix, dt=self.dt)
 
 
-# the network kinds ``train.fit_planar_network`` trains, by file name; here, without torch
+# the network kinds ``train.fit_mimo`` trains, by file name; here, without torch
 KINDS = {"nn": PlanarNarx, "nn-axis": PlanarNarxPerAxis, "hybrid": PlanarHybrid}

@@ -22,9 +22,9 @@ from bushenv.registry import Registry, load_entry_point
 
 @dataclass(frozen=True)
 class Form:
-    """One kind of model over C > 1 coordinates: its class, identification and options
-    (identification ``fit(histories, dt, options, seed, say) -> (model, info)``, histories a
-    list of (q (T, C), f (T, C)) pairs)."""
+    """One kind of model over C > 1 coordinates: its class, identification and options (the
+    identification as ``ModelEntry.fit``, its ``data`` of (T, C) records; what the card shows
+    of it, ``model.training["info"]``)."""
 
     entry_point: str | type
     fit: Any = None
@@ -134,9 +134,8 @@ def names_for(coords: int = 1, fittable: bool = False) -> tuple[str, ...]:
 
 MODELS: Registry[ModelEntry] = Registry("model", ModelError)
 M = "bushenv.models."  # the three-coordinate forms
-T = "bushenv.planar."  # their training options, until they join the one-axis kin
-FITS = "bushenv.planar.fitting:"
-OPTS = "bushenv.identify.options:"
+FITS = "bushenv.identify.mimo:"  # the MIMO networks' identifications
+T = "bushenv.identify.mimo_options:"  # and their options
 MODELS.add(
     "linear",
     ModelEntry(
@@ -144,7 +143,13 @@ MODELS.add(
         "Kelvin-Voigt spring and dashpot, F = k x + c v (seed 000 eqs 1-3)",
         fit="bushenv.identify.linear:fit_linear",
         options="bushenv.identify.options:NoOptions",
-        wider={3: Form(M + "planar_linear:PlanarLinear", FITS + "fit_linear", OPTS + "NoOptions")},
+        wider={
+            3: Form(
+                M + "planar_linear:PlanarLinear",
+                "bushenv.identify.linear:fit_linear",
+                "bushenv.identify.options:NoOptions",
+            )
+        },  # fmt: skip
     ),
 )
 MODELS.add(
@@ -159,7 +164,7 @@ MODELS.add(
             3: Form(
                 M + "planar_narx:PlanarNarx",
                 FITS + "fit_nn",
-                T + "train_options:PlanarNetworkOptions",
+                T + "MimoOptions",
             )
         },  # fmt: skip
     ),
@@ -173,7 +178,7 @@ MODELS.add(
             3: Form(
                 M + "planar_narx:PlanarNarxPerAxis",
                 FITS + "fit_nn_axis",
-                T + "train_options:PlanarNetworkOptions",
+                T + "MimoOptions",
             )
         },  # fmt: skip
     ),
@@ -190,7 +195,7 @@ MODELS.add(
             3: Form(
                 M + "planar_narx:PlanarHybrid",
                 FITS + "fit_hybrid",
-                T + "train_options:PlanarHybridOptions",
+                T + "MimoHybridOptions",
             )
         },  # fmt: skip
     ),
@@ -228,8 +233,8 @@ MODELS.add(
         wider={
             3: Form(
                 M + "boucwen.planar:PlanarBoucWen",
-                FITS + "fit_boucwen",
-                T + "boucwen_fit:PlanarBoucWenOptions",
+                "bushenv.identify.vector_boucwen:fit_boucwen",
+                "bushenv.identify.boucwen_options:VectorBoucWenOptions",
             )
         },  # fmt: skip
     ),
@@ -243,7 +248,7 @@ MODELS.add(
             3: Form(
                 M + "planar_hybrid_bw:PlanarBoucWenHybrid",
                 FITS + "fit_hybrid_bw",
-                FITS + "PlanarHybridBWOptions",
+                FITS + "HybridBWOptions",
             )
         },  # fmt: skip
     ),

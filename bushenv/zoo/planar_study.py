@@ -16,8 +16,8 @@ from itertools import product
 from pathlib import Path
 from typing import Any
 
+from bushenv.identify.mimo_options import MimoHybridOptions
 from bushenv.models.planar_narx import KINDS
-from bushenv.planar.train_options import PlanarHybridOptions
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
 from bushenv.search.campaign_planar import HELD_TO
@@ -59,7 +59,7 @@ class PlanarZooConfig:
                 )
         if self.budget < 1:
             raise ZooError(f"--budget must be >= 1 evaluation, got {self.budget}")
-        unknown = sorted(set(self.train_options) - set(PlanarHybridOptions.__dataclass_fields__))
+        unknown = sorted(set(self.train_options) - set(MimoHybridOptions.__dataclass_fields__))
         if unknown:
             raise ZooError(f"planar training options: unknown {unknown}")
         if "training" in self.train_options and set(self.models) != {"hybrid"}:

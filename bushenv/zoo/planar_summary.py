@@ -2,7 +2,7 @@
 check and how many of those the attack across axes breaks, with Wilson 95 % intervals
 (``summary.rate``); the MIMO networks pooled against the target of 90 %.
 
-Members trained with ``--certified on`` (``planar/certified.py``) are grouped apart
+Members trained with ``--certified on`` (``identify/mimo_certified.py``) are grouped apart
 (``free-run +certified / hybrid``) and kept out of the pool: the pool is the plain MIMO networks
 the target is about. The certified hybrids get their own rates (``certified_hybrids``): passing
 the single-axis check, broken across axes among those passing (any coordinate, and in a moving

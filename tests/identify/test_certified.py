@@ -48,16 +48,16 @@ def test_term_is_zero_where_the_static_force_is_inside_the_band(problems):
     # times the records' static estimate, inside the 0.8-1.9 band; every a_j is 0 (rho = 0)
     p = problems["hybrid"]
     term = CertifiedHolds(weight=1.0)
-    ratio = p.k / term.estimate(p).k_n_per_m
+    ratio = p.k / term.estimate(p).k[0]
     assert 1.0 < ratio < 1.3
-    net = _silent(p, term.estimate(p).f0_n)
+    net = _silent(p, term.estimate(p).f0[0])
     loss = term(net, p)
     loss.backward()
     assert loss.item() == 0.0
     assert all(float(torch.sum(q.grad**2)) == 0.0 for q in net.parameters() if q.grad is not None)
     assert term.admits(net, p)
     # the same network off by a constant force: wrong sign near rest, positive loss
-    shifted = _silent(p, term.estimate(p).f0_n + 0.2 * term.estimate(p).force_rms_n)
+    shifted = _silent(p, term.estimate(p).f0[0] + 0.2 * term.estimate(p).force_rms[0])
     assert term(shifted, p).item() > 0.0
     assert not term.admits(shifted, p)
 
@@ -69,8 +69,8 @@ def test_band_edges_are_where_the_term_starts(problems):
     term = CertifiedHolds(weight=1.0)
     est = term.estimate(p)
     for factor, inside in ((0.7, False), (0.85, True), (1.85, True), (2.0, False)):
-        q = type(p)(**{**p.__dict__, "k": factor * est.k_n_per_m})
-        net = _silent(q, est.f0_n)
+        q = type(p)(**{**p.__dict__, "k": factor * est.k[0]})
+        net = _silent(q, est.f0[0])
         assert (term(net, q).item() == 0.0) is inside, factor
 
 

@@ -1,5 +1,5 @@
-"""The relaxation (Prony series) on the deflection vector: its law, its passivity, its files and
-its identification inside the vector Bouc-Wen."""
+"""The relaxation (Prony series) on the deflection vector: its law, its passivity and its files
+(its identification inside the vector Bouc-Wen: tests/identify/test_vector_boucwen.py)."""
 
 import numpy as np
 import pytest
@@ -8,8 +8,7 @@ from bushenv.models import load_model
 from bushenv.models.base import PAPER_DT
 from bushenv.models.boucwen.planar import PlanarBoucWen
 from bushenv.models.planar_base import PlanarModelError
-from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
-from bushenv.planar.programme import random_independent
+from bushenv.motions import random_independent
 
 K = np.diag([4.0e5, 1.5e6, 3.0e3])
 C = np.diag([4.0e2, 1.0e3, 2.0])
@@ -64,124 +63,8 @@ def test_a_file_from_before_the_relaxation_loads_without_it(tmp_path):
     assert np.array_equal(again.simulate(q), new.simulate(q))
 
 
-def test_identification_recovers_a_relaxing_vector_boucwen():
-    gain = np.stack([np.diag([1.5e5, 4e5, 800.0]), np.zeros((3, 3))])
-    truth = relaxing([0.02, 0.2], gain)
-    q = random_independent(1.0, 8.0, PAPER_DT, 0)
-    f = truth.simulate(q)
-    opts = PlanarBoucWenOptions(
-        evaluations=40,
-        time_limit_s=0.0,
-        relaxation_times="0.02,0.2",
-        relaxation_selection="extrapolation",
-    )
-    model, _ = fit_planar_boucwen([(q, f)], PAPER_DT, opts)
-    plain, _ = fit_planar_boucwen(
-        [(q, f)], PAPER_DT, PlanarBoucWenOptions(evaluations=40, time_limit_s=0.0)
-    )
-    q_new = random_independent(1.3, 6.0, PAPER_DT, 7)
-    f_new = truth.simulate(q_new)
-
-    def err(m):
-        return np.sqrt(np.mean((m.simulate(q_new) - f_new) ** 2, axis=0) / np.mean(f_new**2, 0))
-
-    assert np.all(err(model) < 0.01), err(model)
-    assert np.max(err(plain)) > 3 * np.max(err(model))  # the relaxation is what it adds
-    assert np.all(np.linalg.eigvalsh(model.relax_gain) >= -1e-9)  # kept passive
-    assert np.all(model.relax_gain[:, ~np.eye(3, dtype=bool)] == 0)  # each axis on its own
-    assert model.relax_gain[0, 2, 2] == pytest.approx(800.0, rel=0.1)
-    assert 0.02 in model.relax_tau  # the selection keeps the short branch the truth has
-
-
-def test_the_selection_drops_short_branches_that_do_not_carry_beyond_the_training_amplitude():
-    """bushenv's reference slips in small steps (Iwan friction) whose loops the 3-30 ms
-    branches imitate at the training amplitude: kept, they under-predict the radial force at
-    1.5x that amplitude; the selection, judging on the training records' largest deflections,
-    drops them."""
-    from bushenv.planar.programme import random_correlated
-    from bushenv.reference.planar import PlanarRubber
-
-    ref = PlanarRubber.preset(seed=0)
-    train = [(q, ref.simulate(q)) for q in (random_independent(1.0, 5.0, PAPER_DT, 0),
-                                            random_correlated(1.0, 5.0, PAPER_DT, 0))]  # fmt: skip
-    q_new = random_correlated(1.5, 10.0, PAPER_DT, 1)
-    f_new = ref.simulate(q_new)
-    fits = {
-        selection: fit_planar_boucwen(
-            train,
-            PAPER_DT,
-            PlanarBoucWenOptions(20, time_limit_s=0.0, relaxation_selection=selection),
-        )
-        for selection in ("extrapolation", "all")
-    }
-    (chosen, info), (every, every_info) = fits["extrapolation"], fits["all"]
-    longest = np.sort(every.relax_tau)[-len(chosen.relax_tau) :]
-    assert 0 < len(chosen.relax_tau) < len(every.relax_tau)
-    assert np.array_equal(np.sort(chosen.relax_tau), longest)  # the shortest dropped
-    assert info["relaxation"].startswith("kept " + ", ".join(f"{t:g}" for t in longest))
-    assert every_info["relaxation"] == "every branch (no selection)"
-
-    def radial_max(m):
-        return np.abs(m.simulate(q_new) - f_new)[:, 1].max() / np.abs(f_new[:, 1]).max()
-
-    assert radial_max(chosen) < 0.7 * radial_max(every), (radial_max(chosen), radial_max(every))
-
-
-def test_records_too_short_to_test_extrapolation_keep_every_branch():
-    q = random_independent(1.0, 0.5, PAPER_DT, 0)
-    truth = relaxing([0.05], np.diag([1e5, 2e5, 300.0])[None])
-    opts = PlanarBoucWenOptions(10, time_limit_s=0.0, relaxation_selection="extrapolation")
-    model, info = fit_planar_boucwen([(q, truth.simulate(q))], PAPER_DT, opts)
-    assert len(model.relax_tau) == len(PlanarBoucWenOptions().taus())
-    assert "too few samples" in info["relaxation"]
-
-
-@pytest.mark.parametrize("text", ["0.1,abc", "0,1", "-0.1", "0.1,0.1", "nan"])
-def test_bad_relaxation_times_are_refused_by_name(text):
-    with pytest.raises(PlanarModelError, match="relaxation_times"):
-        PlanarBoucWenOptions(relaxation_times=text).check()
-
-
 def test_a_bad_relaxation_array_is_refused_by_name():
     with pytest.raises(PlanarModelError, match="relax_gain"):
         relaxing([0.1], np.zeros((2, 3, 3)))
     with pytest.raises(PlanarModelError, match="relax_tau"):
         relaxing([0.0], np.zeros((1, 3, 3)))
-
-
-def test_branches_slower_than_the_records_are_warned_of_and_a_hold_separates_them():
-    """The programme's random drives have no motion below 1 Hz: a 1 s branch moves with the
-    deflection and its gain cannot be told from the static stiffness. A held preload (the
-    sweep holds radial and swings rotation) separates it on those two coordinates only."""
-    from bushenv.models.base import velocity_of
-    from bushenv.models.boucwen import relaxation
-    from bushenv.planar.programme import preload_sweep, random_correlated
-
-    taus = PlanarBoucWenOptions().taus()
-
-    def lost(records):
-        q = np.vstack(records)
-        v = np.vstack([velocity_of(r, PAPER_DT) for r in records])
-        p = np.vstack([relaxation.branch_deflections(r, PAPER_DT, taus) for r in records])
-        return relaxation.inseparable(q, v, p, taus)
-
-    rand = [random_independent(1.0, 10.0, PAPER_DT, 0), random_correlated(1.0, 10.0, PAPER_DT, 0)]
-    assert all(1.0 in each for each in lost(rand))
-    axial, radial, rotation = lost([*rand, preload_sweep(1, 2e-3, 0.05, 10.0, PAPER_DT)])
-    assert 1.0 in axial and radial == [] and rotation == []  # the axial coordinate stays at rest
-
-    truth = relaxing([0.05], np.diag([1e5, 2e5, 300.0])[None])
-    _, info = fit_planar_boucwen([(q, truth.simulate(q)) for q in rand], PAPER_DT,
-                                 PlanarBoucWenOptions(5, time_limit_s=0.0))  # fmt: skip
-    warning = info["relaxation warning"]
-    assert "axial" in warning and "1 s" in warning and "not identified" in warning
-    sep = [
-        *rand,
-        preload_sweep(1, 2e-3, 0.05, 10.0, PAPER_DT),
-        preload_sweep(2, 0.03, 2e-3, 10.0, PAPER_DT),
-    ]
-    axial_sweep = np.zeros_like(sep[0])
-    axial_sweep[:, 0] = preload_sweep(1, 2e-3, 0.05, 10.0, PAPER_DT)[:, 1]
-    _, info = fit_planar_boucwen([(q, truth.simulate(q)) for q in [*sep, axial_sweep]],
-                                 PAPER_DT, PlanarBoucWenOptions(5, time_limit_s=0.0))  # fmt: skip
-    assert "relaxation warning" not in info, info

@@ -1,6 +1,6 @@
-"""The planar networks' training options, one list: the flags of ``bushenv fit`` on 3-axis
-records (``fitting.PLANAR_FITS``) and what ``train.fit_planar_network`` takes
-(``train.TrainOptions`` is ``PlanarNetworkOptions``). No torch here: the command line reads them.
+"""The MIMO networks' training options, one list: the flags of ``bushenv fit`` on 3-axis
+records (``MODELS``' three-coordinate forms name them) and what ``mimo_train.fit_mimo`` takes.
+No torch here: the command line reads them.
 """
 
 from __future__ import annotations
@@ -28,9 +28,9 @@ def record_problem(samples: int, val_fraction: float) -> str | None:
 
 
 @dataclass(frozen=True)
-class PlanarNetworkOptions:
-    """Options of the planar network training: the flags of ``bushenv fit`` and what
-    ``train.fit_planar_network`` takes (``train.TrainOptions`` is this class)."""
+class MimoOptions:
+    """Options of the MIMO network training: the flags of ``bushenv fit`` and what
+    ``mimo_train.fit_mimo`` takes."""
 
     hidden: int = option(27, "hidden tanh units (the per-axis kind: a third per axis)")
     teacher_steps: int = option(400, "Adam steps one step ahead")
@@ -52,7 +52,7 @@ class PlanarNetworkOptions:
         "on: a loss term holding every fixed point of the held network, over the rig3 box "
         "(single coordinates, pairs, all three), within a band of the records' static force per "
         "coordinate and below a spectral radius, and every held run after a step settled "
-        "(planar/certified.py; studies/2026-11-planar-certified)",
+        "(identify/mimo_certified.py; studies/2026-11-planar-certified)",
         choices=SWITCH,
     )
     # the same as the one-axis network's term (``identify.narx_options``)
@@ -69,7 +69,7 @@ class PlanarNetworkOptions:
         "free",
         "weights tied by construction (nn, hybrid): mirror (odd in each coordinate, diagonal "
         "backbone), rate (displacement as increments: one held fixed point), mirror-rate "
-        "(planar/structure.py; studies/2026-11-planar-certified)",
+        "(identify/mimo_structure.py; studies/2026-11-planar-certified)",
         choices=STRUCTURES,
     )
 
@@ -79,12 +79,12 @@ class PlanarNetworkOptions:
         self._check_certified()
         if small or self.free_run_steps < 0 or not 0 < self.val_fraction < 0.9:
             raise PlanarModelError(
-                f"planar network options: {small or 'free_run_steps / val_fraction'} out of "
+                f"MIMO network options: {small or 'free_run_steps / val_fraction'} out of "
                 "range (counts >= 1, free_run_steps >= 0, 0 < val_fraction < 0.9)"
             )
         if self.teacher_batch < 0 or not 0 <= self.feedback_noise < 10:
             raise PlanarModelError(
-                f"planar network options: teacher_batch {self.teacher_batch} and feedback_noise "
+                f"MIMO network options: teacher_batch {self.teacher_batch} and feedback_noise "
                 f"{self.feedback_noise} out of range (teacher_batch >= 0, 0 <= feedback_noise < 10)"
             )
         if self.hidden % 3:
@@ -103,21 +103,19 @@ class PlanarNetworkOptions:
         if self.certified_weight < 0 or self.certified_holds < 1:
             bad.append("certified_weight >= 0 and certified_holds >= 1")
         if bad:
-            raise PlanarModelError(f"planar network options: {'; '.join(bad)}")
+            raise PlanarModelError(f"MIMO network options: {'; '.join(bad)}")
 
-    def train_options(self) -> PlanarNetworkOptions:
+    def train_options(self) -> MimoOptions:
         """The training's options alone (a subclass's other fields dropped)."""
-        return PlanarNetworkOptions(
-            **{k: getattr(self, k) for k in PlanarNetworkOptions.__dataclass_fields__}
-        )
+        return MimoOptions(**{k: getattr(self, k) for k in MimoOptions.__dataclass_fields__})
 
     def certified_term(self):
         """The certified-hold term the options ask for, or None."""
         if self.certified != "on":
             return None
-        from bushenv.planar.certified import PlanarCertifiedHolds
+        from bushenv.identify.mimo_certified import MimoCertifiedHolds
 
-        return PlanarCertifiedHolds(
+        return MimoCertifiedHolds(
             weight=self.certified_weight,
             low=self.certified_low,
             high=self.certified_high,
@@ -144,7 +142,7 @@ NETWORK_KEPT = ("if-better", "always")
 
 
 @dataclass(frozen=True)
-class PlanarHybridOptions(PlanarNetworkOptions):
+class MimoHybridOptions(MimoOptions):
     """The matrix-backbone hybrid's network: the plain recipe, or the accurate one."""
 
     training: str = option(
@@ -171,6 +169,6 @@ class PlanarHybridOptions(PlanarNetworkOptions):
         return given
 
 
-def default_options(kind: str) -> PlanarNetworkOptions:
+def default_options(kind: str) -> MimoOptions:
     """The training options a network ``kind`` gets when none are given: the same for all."""
-    return PlanarNetworkOptions()
+    return MimoOptions()

@@ -1,23 +1,27 @@
-"""Training the planar networks in torch: teacher forcing, then short free-run fine-tuning.
+"""Training the MIMO networks in torch: teacher forcing, then short free-run fine-tuning.
 
-The recipe of ``bushenv.identify``'s NARX training, in three coordinates: inputs and outputs
+The network of C outputs the three-axis bushing needs (``bushenv.models.planar_narx``: every
+coordinate's displacement and force lags in, every force out) trains here; the one-axis network
+(C = 1, ``narx_train.py``) trains by its own longer recipe (a chosen size, staged window
+lengths, a difference basis, a compiled unroll), which this one does not share. The recipe
+of ``bushenv.identify``'s NARX training, in C coordinates: inputs and outputs
 scaled to [-1, 1] over the training records (seed 000 §4.2), full-batch Adam one step ahead on
 measured force lags, then Adam on free-run windows (the network fed with its own outputs from a
 measured start), keeping the weights with the lowest free-run error on a held-out tail. Torch
-only trains; the arrays go to ``narx.PlanarNarx`` whose numpy loop does every run in use.
+only trains; the arrays go to ``planar_narx.PlanarNarx`` whose numpy loop does every run in use.
 
-The hybrid's accurate recipe (``train_options.NOISY_FEEDBACK_TRAINING``, ``--training
+The hybrid's accurate recipe (``mimo_options.NOISY_FEEDBACK_TRAINING``, ``--training
 noisy-feedback``, studies/2026-11-planar-fit-unseen) trains differently one step ahead: mini-batches
 instead of the full batch (many more, cheaper Adam steps), Gaussian noise on the fed-back past
 outputs, so the network leans on the displacement inputs rather than on its own last output,
 and 54 units, 6000 steps at a lower rate. It is 3x as accurate on unseen records and has more
 than one fixed point at some holds of its training range, so it is not the default.
 
-``certified="on"`` adds the certified-hold term (``certified.py``) to both stages' loss, and the
-weights kept are the best admitted ones (``PlanarCertifiedHolds.admits`` on its fixed grid,
+``certified="on"`` adds the certified-hold term (``mimo_certified.py``) to both stages' loss,
+and the weights kept are the best admitted ones (``MimoCertifiedHolds.admits`` on its fixed grid,
 checked at every validation), or the best of all when none was admitted; the returned model's
 ``training`` attribute says which, with the check of the weights kept. ``structure`` other than
-"free" trains a network whose weights are tied by construction (``structure.py``: mirror-
+"free" trains a network whose weights are tied by construction (``mimo_structure.py``: mirror-
 symmetric, displacement increments, or both).
 """
 
@@ -28,20 +32,19 @@ from collections.abc import Sequence
 import numpy as np
 import torch
 
-from bushenv.models.base import velocity_of
-from bushenv.models.planar_base import PlanarModelError
-from bushenv.models.planar_linear import fit_linear
-from bushenv.models.planar_narx import KINDS, N_PAST_F, N_PAST_Q, PlanarNarx, axis_masks
-from bushenv.planar.structure import (
+from bushenv.identify.mimo_options import MimoOptions, default_options, record_problem
+from bushenv.identify.mimo_structure import (
     StructuredNet,
     fit_diagonal_linear,
     increment_gain,
     is_mirror,
     symmetric_scale,
 )
-from bushenv.planar.train_options import PlanarNetworkOptions as TrainOptions
-from bushenv.planar.train_options import default_options, record_problem
-from bushenv.progress import Progress
+from bushenv.models.base import velocity_of
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.models.planar_linear import fit_linear
+from bushenv.models.planar_narx import KINDS, N_PAST_F, N_PAST_Q, PlanarNarx, axis_masks
+from bushenv.progress import Progress, ProgressSpec
 
 TEACHER_CHECK_EVERY = 50  # certified: teacher steps between two checks (they pick hard holds)
 
@@ -97,17 +100,17 @@ def _scale(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (hi + lo), np.maximum(0.5 * (hi - lo), 1e-12)
 
 
-def fit_planar_network(
+def fit_mimo(
     q: np.ndarray | Sequence[np.ndarray],
     f: np.ndarray | Sequence[np.ndarray],
     dt: float,
     kind: str = "nn",
-    options: TrainOptions | None = None,
+    options: MimoOptions | None = None,
     seed: int = 0,
-    quiet: bool = True,
+    progress: ProgressSpec = False,
     may_drop: bool = False,
 ) -> PlanarNarx:
-    """Identify a planar network from a record ``q`` (T, 3) m/rad, ``f`` (T, 3) N/N m, or from
+    """Identify a MIMO network from a record ``q`` (T, 3) m/rad, ``f`` (T, 3) N/N m, or from
     several: equal-length lists of such arrays.
 
     ``kind``: "nn" (MIMO), "nn-axis" (three single-axis networks) or "hybrid" (3x3 linear
@@ -124,7 +127,7 @@ def fit_planar_network(
     threads = torch.get_num_threads()
     torch.set_num_threads(1)  # these nets are tiny: threads only add contention (15 s vs 0.2 s)
     try:
-        return _fit(_records(q, f), dt, kind, options, seed, quiet, may_drop)
+        return _fit(_records(q, f), dt, kind, options, seed, progress, may_drop)
     finally:
         torch.set_num_threads(threads)
 
@@ -135,7 +138,7 @@ def _records(q, f) -> list[tuple[np.ndarray, np.ndarray]]:
     qs, fs = ([q], [f]) if single else (list(q), list(f))
     if len(qs) != len(fs) or not qs:
         raise PlanarModelError(
-            f"fit_planar_network: give one (q, f) pair of arrays or two lists of equal length, "
+            f"fit_mimo: give one (q, f) pair of arrays or two lists of equal length, "
             f"got {len(qs)} and {len(fs)} records"
         )
     return [(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
@@ -150,12 +153,12 @@ def _split(records, opt) -> list[int]:
         label = "the record" if len(records) == 1 else f"record {k + 1}"
         if q.shape != f.shape or q.ndim != 2 or q.shape[1] != 3:
             raise PlanarModelError(
-                f"fit_planar_network: {label}: q and f must be equal (T, 3) arrays, got "
+                f"fit_mimo: {label}: q and f must be equal (T, 3) arrays, got "
                 f"{q.shape} and {f.shape}"
             )
         problem = record_problem(q.shape[0], opt.val_fraction)
         if problem:
-            raise PlanarModelError(f"fit_planar_network: {label}: {problem}: give a longer record")
+            raise PlanarModelError(f"fit_mimo: {label}: {problem}: give a longer record")
         n_val = int(opt.val_fraction * q.shape[0])
         tails.append(n_val)
     total = sum(q.shape[0] for q, _ in records)
@@ -163,7 +166,7 @@ def _split(records, opt) -> list[int]:
         q.shape[0] - n - t0 > opt.window for (q, _), n in zip(records, tails, strict=True)
     ):
         raise PlanarModelError(
-            f"fit_planar_network: {total} samples in {len(records)} record(s); training needs "
+            f"fit_mimo: {total} samples in {len(records)} record(s); training needs "
             f"T >= {20 * opt.window} in all and one training part longer than the free-run "
             f"window ({opt.window} samples)"
         )
@@ -192,9 +195,9 @@ def _window_starts(lengths: list[int], window: int) -> np.ndarray:
     ).astype(np.int64)
 
 
-def _fit(records, dt, kind, options, seed, quiet, may_drop=False) -> PlanarNarx:
+def _fit(records, dt, kind, options, seed, progress, may_drop=False) -> PlanarNarx:
     if kind not in KINDS:
-        raise PlanarModelError(f"unknown planar network kind {kind!r}; known: {list(KINDS)}")
+        raise PlanarModelError(f"unknown MIMO network kind {kind!r}; known: {list(KINDS)}")
     opt = options or default_options(kind)
     if opt.structure != "free" and kind == "nn-axis":
         raise PlanarModelError(
@@ -230,20 +233,23 @@ def _fit(records, dt, kind, options, seed, quiet, may_drop=False) -> PlanarNarx:
         net = StructuredNet(opt.structure, opt.hidden, gen, increment_gain((q - q_off) / q_sc))
     term = opt.certified_term()
     if term is not None:
-        from bushenv.planar.certified import PlanarProblem
-        from bushenv.planar.static_estimate import planar_static_estimate
+        from bushenv.identify.mimo_certified import MimoProblem
+        from bushenv.identify.static_estimate import static_estimate
+        from bushenv.models.planar_base import COORDS
 
         fitted = [(r[0][: len(r[0]) - n], r[1][: len(r[1]) - n])
                   for r, n in zip(records, tails, strict=True)]  # fmt: skip
-        estimate = planar_static_estimate(fitted, dt)  # the training parts, total force
+        estimate = static_estimate(fitted, dt, COORDS)  # the training parts, total force
         k = extra.get("k_matrix", np.zeros((3, 3)))
-        problem = PlanarProblem(q_off, q_sc, f_off, f_sc, k, dt, estimate)
+        problem = MimoProblem(q_off, q_sc, f_off, f_sc, k, dt, estimate)
 
     def extra_loss(stage: str) -> torch.Tensor | float:
         return term(net, problem) if term is not None and stage in term.stages else 0.0
 
     rng = np.random.default_rng(seed)
-    progress = Progress(opt.teacher_steps + opt.free_run_steps, quiet=quiet, label=f"planar {kind}")
+    progress = Progress.of(
+        progress, total=opt.teacher_steps + opt.free_run_steps, label=f"{len(q[0])}-axis {kind}"
+    )
 
     z = torch.tensor(np.hstack([qz_tr, yl_tr]))
     n_q = qz_tr.shape[1]  # z's displacement columns; the fed-back outputs follow

@@ -1,10 +1,11 @@
-"""Structured planar networks: the MIMO NARX network with weights tied so that its holds are
+"""Structured MIMO networks: the MIMO NARX network with weights tied so that its holds are
 right by construction, not by a loss term.
 
-Every structure is still the seeds' NARX network (``narx.py``: 33 inputs, displacement lags
-0..5 and own-output lags 1..5, one tanh hidden layer, linear output; the hybrid adds its linear
-backbone), so a trained one is a plain ``PlanarNarx``/``PlanarHybrid`` array set: the kernel,
-the files, ``fixed_points`` and the hold check (``certified.check``) see no difference. Only
+Every structure is still the seeds' NARX network (``bushenv.models.planar_narx``: 33 inputs,
+displacement lags 0..5 and own-output lags 1..5, one tanh hidden layer, linear output; the
+hybrid adds its linear backbone), so a trained one is a plain ``PlanarNarx``/``PlanarHybrid``
+array set: the kernel, the files, ``fixed_points`` and the hold check
+(``mimo_certified.check``) see no difference. Only
 the training parametrises the arrays (``structured_net``):
 
 - ``mirror``: the network is equivariant under the mirror of each coordinate, N(M_s z) = M_s
@@ -75,7 +76,7 @@ def fit_diagonal_linear(q: np.ndarray, f: np.ndarray, dt: float) -> PlanarLinear
 
 
 class StructuredNet(torch.nn.Module):
-    """The training's network (``train._Net``'s interface: ``forward``, ``unroll``, ``arrays``
+    """The training's network (``mimo_train._Net``'s interface: ``forward``, ``unroll``, ``arrays``
     and the attributes ``w1``, ``m1``, ``b1``, ``w_out``, ``mo``, ``b_out`` the certified term
     reads) with the arrays built from free parameters by ``structure``. ``gain`` multiplies the
     increment weights of ``rate`` (the scaled increments are small; without it Adam's steps are

@@ -1,10 +1,10 @@
-"""Certified planar training: a loss term that asks a planar network to hold like the records say.
+"""Certified MIMO training: a loss term that asks a MIMO network to hold like the records say.
 
 The one-axis term (``bushenv.identify.certified``) in three coordinates. Held at a deflection
 vector q, the network's own-output recurrence has fixed points y* (3,) (``fixed_points.py``);
 the model holds the static force F* = K q + f_offset + f_scale (.) y* (K the hybrid's backbone,
 0 for the pure network), stable when the block companion matrix of dy_t = sum_l A_l dy_{t-l}
-has spectral radius rho < 1. ``PlanarCertifiedHolds`` penalises, over holds spread across the
+has spectral radius rho < 1. ``MimoCertifiedHolds`` penalises, over holds spread across the
 rig3 box (single coordinates, pairs and all three, ``holds_q``), every fixed point whose
 
 - static force leaves, in any coordinate, the band of the records' static estimate
@@ -39,9 +39,10 @@ from typing import Any, ClassVar
 import numpy as np
 import torch
 
+from bushenv.certify.fixed_points import fixed_points, grid
+from bushenv.certify.network import NarxNet, narx_net
+from bushenv.identify.static_estimate import COUPLING, StaticEstimate
 from bushenv.models.planar_narx import N_PAST_F, N_PAST_Q, PlanarNarx
-from bushenv.planar.fixed_points import HeldNetwork, fixed_points, grid
-from bushenv.planar.static_estimate import COUPLING, PlanarStaticEstimate
 
 STROKE = (12.5e-3, 12.5e-3, 0.15)  # BushRig3-v0's stroke (m, m, rad): the box the search drives
 RAMP_S = 0.02  # the step's rise, within the rig's rates (0.63 m/s, 7.5 rad/s at full stroke)
@@ -58,7 +59,7 @@ R3 = 1.0 / _PHI3 ** np.arange(1, 4)
 
 
 @dataclass(frozen=True)
-class PlanarProblem:
+class MimoProblem:
     """What the term needs of a training: the scaling, the backbone, the sample time and the
     records' static estimate."""
 
@@ -68,10 +69,10 @@ class PlanarProblem:
     f_scale: np.ndarray
     k: np.ndarray  # (3, 3) backbone stiffness, zeros for a pure network
     dt: float
-    estimate: PlanarStaticEstimate
+    estimate: StaticEstimate
 
     def model(self, arrays: dict[str, np.ndarray]) -> PlanarNarx:
-        """The planar network of ``arrays`` (its fixed points do not depend on the backbone)."""
+        """The MIMO network of ``arrays`` (its fixed points do not depend on the backbone)."""
         return PlanarNarx(
             q_offset=self.q_offset,
             q_scale=self.q_scale,
@@ -96,8 +97,8 @@ def late_samples(hold_s: float, dt: float) -> int:
 
 
 @dataclass
-class PlanarCertifiedHolds:
-    """The certified-hold loss term of the planar networks (module docstring)."""
+class MimoCertifiedHolds:
+    """The certified-hold loss term of the MIMO networks (module docstring)."""
 
     weight: float
     low: float = 0.8
@@ -125,7 +126,7 @@ class PlanarCertifiedHolds:
         s = np.asarray(self.stroke)
         return grid(*(s[i] * u * np.abs(u) for i in range(3)))
 
-    def __call__(self, net: Any, problem: PlanarProblem) -> torch.Tensor:
+    def __call__(self, net: Any, problem: MimoProblem) -> torch.Tensor:
         q = np.vstack([self.holds_q(self.calls), self.hard])
         self.calls += 1
         parts = self.penalties(net, problem, q)
@@ -136,13 +137,13 @@ class PlanarCertifiedHolds:
             + (torch.mean(settle**2) if settle.numel() else settle.sum())
         )
 
-    def penalties(self, net: Any, problem: PlanarProblem, q: np.ndarray) -> dict[str, Any]:
+    def penalties(self, net: Any, problem: MimoProblem, q: np.ndarray) -> dict[str, Any]:
         """At the holds ``q`` (M, 3): per fixed point the static force (P, 3), its relative
         distance outside the band (P, 3) and the spectral radius's excess (P,) (differentiable,
         >= 0), the spectral radius; per hold the settle hinge (M', L, 3)."""
         with torch.no_grad():
             arrays = net.arrays()
-        held = HeldNetwork.of(problem.model(arrays))
+        held = narx_net(problem.model(arrays))
         fp = fixed_points(problem.model(arrays), q)
         c_np = held.held(q)[fp.hold]
         w = _weights(net)
@@ -179,7 +180,7 @@ class PlanarCertifiedHolds:
             "fixed_points": fp,
         }
 
-    def check(self, model: PlanarNarx, estimate: PlanarStaticEstimate) -> dict[str, Any]:
+    def check(self, model: PlanarNarx, estimate: StaticEstimate) -> dict[str, Any]:
         """``check`` with this term's band, radius and stroke; the holds that fail it (the
         worst ``HARD_HOLDS``) join every later training step, so the grid's own failures are
         trained on until a check passes them."""
@@ -188,7 +189,7 @@ class PlanarCertifiedHolds:
         self.hard = q[np.array(out["failing_holds"][:HARD_HOLDS], dtype=np.int64)]
         return out
 
-    def admits(self, model: PlanarNarx, estimate: PlanarStaticEstimate) -> bool:
+    def admits(self, model: PlanarNarx, estimate: StaticEstimate) -> bool:
         return self.check(model, estimate)["admitted"]
 
 
@@ -208,7 +209,7 @@ def _weights(net: Any) -> dict[str, torch.Tensor]:
     }
 
 
-def newton_step(w, c: torch.Tensor, c_np: np.ndarray, held: HeldNetwork, y0: np.ndarray):
+def newton_step(w, c: torch.Tensor, c_np: np.ndarray, held: NarxNet, y0: np.ndarray):
     """(P, 3) the fixed points ``y0`` as functions of the weights: y0 - J0^-1 phi(y0; w)."""
     y0_t = torch.from_numpy(y0)
     phi = torch.tanh(c + y0_t @ w["s"].T) @ w["w_out"].T + w["b_out"] - y0_t
@@ -248,7 +249,7 @@ def spectral_radius_of(w, c: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
     return torch.sqrt(torch.clamp(re * re + im * im, min=1e-300))
 
 
-def step_run(net: Any, problem: PlanarProblem, q: np.ndarray) -> torch.Tensor:
+def step_run(net: Any, problem: MimoProblem, q: np.ndarray) -> torch.Tensor:
     """(M, L, 3) the network's scaled output over the last half of the hold after
     ``step_profile`` to each hold, run free from rest (differentiable)."""
     prof = step_profile(q, problem.dt)  # (T, M, 3)
@@ -264,14 +265,14 @@ def step_run(net: Any, problem: PlanarProblem, q: np.ndarray) -> torch.Tensor:
 
 def check(
     model: PlanarNarx,
-    estimate: PlanarStaticEstimate,
+    estimate: StaticEstimate,
     q: np.ndarray,
     low: float = 0.8,
     high: float = 1.9,
     radius: float = 0.98,
     coupling: float = COUPLING,
 ) -> dict[str, Any]:
-    """A planar network's holds judged at ``q`` (M, 3) (numpy, the model's own kernel): its
+    """A MIMO network's holds judged at ``q`` (M, 3) (numpy, the model's own kernel): its
     fixed points (``fixed_points``), their static force against the band, their spectral
     radius, the free run after the step settling; admitted when every fixed point is within
     ``ADMIT_TOLERANCE`` of the band, rho below halfway from ``radius`` to 1, every hold settled

@@ -1,4 +1,7 @@
-"""Identifying the vector Bouc-Wen bushing (``boucwen.py``) from 3-axis records.
+"""Identifying the vector Bouc-Wen bushing (``bushenv.models.boucwen.planar``) from 3-axis
+records: the ``boucwen`` kind's identification over three coordinates (``fit_boucwen``), and
+the ``hybrid-bw`` kind's backbone (``mimo.fit_hybrid_bw``). The one-axis Bouc-Wen (seed 002's
+16 parameters) is identified by a global search instead (``global_search.py``).
 
 The force is linear in K, C and h once the hysteretic shape (d, beta, eta) is fixed, so the
 search runs over those five numbers only (variable projection): for each trial shape, z is
@@ -24,84 +27,25 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from bushenv.identify.options import option
+from bushenv.identify.boucwen_options import VectorBoucWenOptions
+from bushenv.identify.data import IdentificationError, TrainingSet
 from bushenv.models.base import velocity_of
 from bushenv.models.boucwen import relaxation
 from bushenv.models.boucwen.planar import PlanarBoucWen
 from bushenv.models.planar_base import COORDS, PlanarModelError
+from bushenv.progress import Progress, ProgressSpec
 
 SEARCH_ETA = (1.0, 6.0)
 SEARCH_BETA = (0.5, 3.0)
 SEARCH_D_SHARE = (0.01, 2.0)  # yield deflection searched, share of each axis's peak
 START_D_SHARE = (0.05, 0.1, 0.2, 0.4)  # start yield deflections, share of each axis's peak
-# two per decade over the band a vehicle bushing is driven in (corners 0.16 Hz to 50 Hz): fixed,
-# not fitted, so the force stays linear in every gain
-RELAXATION_TIMES = "0.003,0.01,0.03,0.1,0.3,1"
 EXTRAPOLATION_SHARE = 0.1  # the largest deflections held out to choose the relaxation branches
 SELECTION_TIE = 0.01  # scores closer than this (relative) are a tie: the fuller grid kept
-
-
-@dataclass(frozen=True)
-class PlanarBoucWenOptions:
-    """Options of the vector Bouc-Wen identification; each is a flag of ``bushenv fit``."""
-
-    evaluations: int = option(200, "shape evaluations of the bounded Powell search (after 8)")
-    yield_surface: str = option(
-        "vector",
-        "vector: one yield surface on the deflection vector; axis: each coordinate its own",
-        choices=("vector", "axis"),
-    )
-    time_limit_s: float = option(
-        0.0,
-        "wall-time limit of the search, s (0: none, the default: the evaluations decide, so "
-        "the same records give the same parameters on every machine; a second search after a "
-        "relaxation selection has its own); a stop by the clock is reported on the card",
-    )
-
-    relaxation_times: str = option(
-        RELAXATION_TIMES,
-        "time constants of the relaxation branches (Prony series, one per coordinate each, "
-        "gains >= 0), s, comma-separated; '' for none",
-    )
-
-    relaxation_selection: str = option(
-        "all",
-        "all: keep every relaxation branch; extrapolation: drop the shortest ones when that "
-        "predicts the training records' largest tenth of deflections clearly better from the "
-        "rest (measured to help on one bushing and hurt on another: "
-        "studies/2026-11-planar-fit-unseen)",
-        choices=("all", "extrapolation"),
-    )
-
-    def taus(self) -> np.ndarray:
-        """(M,) the relaxation time constants, s."""
-        text = self.relaxation_times.strip()
-        try:
-            taus = np.array([float(x) for x in text.split(",")]) if text else np.zeros(0)
-        except ValueError:
-            raise PlanarModelError(
-                f"relaxation_times: {self.relaxation_times!r} is not a comma-separated list of "
-                "seconds (e.g. 0.01,0.1,1)"
-            ) from None
-        if np.any(~np.isfinite(taus)) or np.any(taus <= 0) or len(set(taus)) != len(taus):
-            raise PlanarModelError(
-                f"relaxation_times: {self.relaxation_times!r}: each must be a distinct time "
-                "constant > 0 s"
-            )
-        return taus
-
-    def check(self) -> None:
-        self.taus()
-        if self.evaluations < 1 or self.time_limit_s < 0:
-            raise PlanarModelError(
-                f"evaluations must be >= 1 and time_limit_s >= 0, got {self.evaluations}, "
-                f"{self.time_limit_s}"
-            )
+MIN_SAMPLES = 20  # per record
 
 
 class _OutOfTime(Exception):
@@ -173,10 +117,37 @@ class _Problem:
         return rows if rows.any() and (~rows).sum() >= 20 * columns else None
 
 
-def fit_planar_boucwen(
+def say_of(progress: ProgressSpec) -> Callable[[str], None] | None:
+    """Progress lines as the searches here write them: to a callable given, on stderr (True),
+    or none (False)."""
+    if callable(progress):
+        return progress
+    return Progress(label="").say if progress else None
+
+
+def fit_boucwen(
+    data: TrainingSet,
+    options: VectorBoucWenOptions,
+    seed: int = 0,
+    progress: ProgressSpec = True,
+) -> PlanarBoucWen:
+    """The ``boucwen`` identification of ``data``'s (T, 3) records (``fit_vector_boucwen``;
+    deterministic, ``seed`` unused); its summary is ``model.training["info"]``."""
+    for s in data.segments:
+        if len(s) < MIN_SAMPLES:
+            raise IdentificationError(
+                f"{s.label}: {len(s)} samples; the boucwen identification needs at least "
+                f"{MIN_SAMPLES} per record: give longer records"
+            )
+    model, info = fit_vector_boucwen(data.histories(), data.dt, options, say=say_of(progress))
+    model.training = {"info": info}
+    return model
+
+
+def fit_vector_boucwen(
     histories: Sequence[tuple[np.ndarray, np.ndarray]],
     dt: float,
-    options: PlanarBoucWenOptions | None = None,
+    options: VectorBoucWenOptions | None = None,
     say: Callable[[str], None] | None = None,
 ) -> tuple[PlanarBoucWen, dict[str, Any]]:
     """Identify from records ``[(q (T, 3), f (T, 3)), ...]`` (each run from rest).
@@ -184,13 +155,13 @@ def fit_planar_boucwen(
     Returns the model and a summary: evaluations, score (sum of the three RMS ratios on the
     training records), whether the clock stopped the search, the relaxation branches kept.
     """
-    opt = options or PlanarBoucWenOptions()
+    opt = options or VectorBoucWenOptions()
     qs = [np.asarray(q, dtype=np.float64) for q, _ in histories]
     fs = [np.asarray(f, dtype=np.float64) for _, f in histories]
     for q, f in zip(qs, fs, strict=True):
-        if q.ndim != 2 or q.shape[1] != 3 or f.shape != q.shape or q.shape[0] < 20:
+        if q.ndim != 2 or q.shape[1] != 3 or f.shape != q.shape or q.shape[0] < MIN_SAMPLES:
             raise PlanarModelError(
-                f"fit_planar_boucwen: records must be (T, 3) q and f with T >= 20, got "
+                f"fit_vector_boucwen: records must be (T, 3) q and f with T >= {MIN_SAMPLES}, got "
                 f"{q.shape} and {f.shape}"
             )
     taus = opt.taus()
