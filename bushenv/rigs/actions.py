@@ -90,20 +90,43 @@ def unit_action(action: Any, env_id: str = "env") -> float:
     return a
 
 
-def unit_actions(actions: Any, n: int, env_id: str = "vector env") -> np.ndarray:
-    """(N, 1) or (N,) normalised actions as float64 (N,), cleaned like ``unit_action``; any
-    other shape or a non-numeric action is refused with a ``RigError`` naming (N, 1)."""
+def unit_vector(action: Any, c: int, env_id: str = "env") -> list[float]:
+    """A normalised action of ``c`` coordinates as ``c`` floats in [-1, 1], each cleaned like
+    ``unit_action`` (one coordinate: ``unit_action`` itself, with its fast path); anything but
+    real numbers of shape (c,) is refused with a ``RigError`` naming the shape."""
+    if c == 1:
+        return [unit_action(action, env_id)]
+    if action.__class__ is np.ndarray and action.dtype is _F32 and action.shape == (c,):
+        arr = action  # what agents send: no conversion to check
+    else:
+        arr = _array(action)
+    if arr is None or arr.shape != (c,):
+        raise RigError(
+            f"{env_id}: action {describe(action)} does not fit the action space "
+            f"Box(-1.0, 1.0, ({c},), float32): expected real numbers in an array of shape ({c},)"
+        )
+    out = []
+    for a in arr.tolist():
+        a = float(a)
+        out.append(0.0 if a != a else (1.0 if a > 1.0 else (-1.0 if a < -1.0 else a)))
+    return out
+
+
+def unit_actions(actions: Any, n: int, env_id: str = "vector env", c: int = 1) -> np.ndarray:
+    """(N, c) normalised actions as float64, cleaned like ``unit_action``: (N, c) or, for one
+    coordinate, also (N,) taken, and (N,) returned; any other shape or a non-numeric action is
+    refused with a ``RigError`` naming (N, c)."""
     if actions.__class__ is np.ndarray and actions.dtype.kind in REAL_KINDS:
         arr = actions
     else:
         arr = _array(actions)
-    if arr is None or arr.shape not in ((n, 1), (n,)):
+    if arr is None or arr.shape not in (((n, 1), (n,)) if c == 1 else ((n, c),)):
         raise RigError(
             f"{env_id}: actions {describe(actions)} do not fit the action space "
-            f"Box(-1.0, 1.0, ({n}, 1), float32): expected real numbers in an array of shape "
-            f"({n}, 1)"
+            f"Box(-1.0, 1.0, ({n}, {c}), float32): expected real numbers in an array of shape "
+            f"({n}, {c})"
         )
-    a = arr.astype(np.float64).reshape(n)
+    a = arr.astype(np.float64).reshape((n,) if c == 1 else (n, c))
     a[np.isnan(a)] = 0.0
     np.clip(a, -1.0, 1.0, out=a)
     return a

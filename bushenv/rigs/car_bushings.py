@@ -87,12 +87,12 @@ def arm_models(p, kwargs: dict[str, Any]) -> None:
     """Set ``p.models``, ``p.references`` ({"arm": model over ``ARM_COORDS``}), their labels
     and ``p.rotation_in`` (role -> rotation split) from ``arm_bushing`` and
     ``arm_bushing_reference``."""
-    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.common import resolve_model
 
-    arm = resolve_planar(p.arm_bushing, p.dt, "arm_bushing", env_id=CAR.name)
-    twin = resolve_planar(
-        kwargs.get("arm_bushing_reference", "reference"), p.dt, "arm_bushing_reference",
-        env_id=CAR.name,
+    arm = resolve_model(p.arm_bushing, dt=p.dt, coords=3, what="arm_bushing", env_id=CAR.name)
+    twin = resolve_model(
+        kwargs.get("arm_bushing_reference", "reference"), dt=p.dt, coords=3,
+        what="arm_bushing_reference", env_id=CAR.name,
     )  # fmt: skip
     p.models, p.references = {"arm": arm}, {"arm": twin}
     p.rotation_in = {"model": rotation_split(arm), "reference": rotation_split(twin)}

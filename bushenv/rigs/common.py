@@ -21,7 +21,8 @@ from typing import Any
 import numpy as np
 
 from bushenv.errors import DIVERGENCE_RAISES
-from bushenv.models import MODELS, BushingModel, get_model
+from bushenv.models import MODELS, BushingModel, ModelError, get_model, names_for
+from bushenv.models.base import DT_TOLERANCE, PAPER_DT
 from bushenv.rigs.errors import RigError
 
 # What a model's step may raise that ends its episode as a divergence: its own state ran away
@@ -61,10 +62,50 @@ def per_axis(name: str, value: Any, axis: str) -> float:
 
 
 # ----- models --------------------------------------------------------------------------------
-def resolve_model(spec: Any, axis: str, dt: float) -> BushingModel:
-    """The model under test: a registered name, a ``.npz`` path or a model object (copied, so
-    two environments never share one model's state)."""
-    model = get_model(spec, axis=axis, dt=dt)
+def resolve_model(
+    spec: Any,
+    axis: str = "axial",
+    dt: float = PAPER_DT,
+    coords: int = 1,
+    what: str = "model",
+    env_id: str = "BushRig-v0",
+    rate_setting: str = "",
+) -> BushingModel:
+    """The model under test over ``coords`` coordinates: a registered name, a ``.npz`` path or a
+    model object (copied, so two environments never share one model's state), at rest.
+
+    One coordinate: ``axis``'s model (``get_model``'s errors). Several: a name builds its form
+    over that many coordinates at its reference preset (without load-cell noise); errors name
+    ``env_id`` and the argument ``what``; a file at another rate names ``rate_setting`` (the
+    caller's argument that sets the step) with the value to give."""
+    if coords == 1:
+        model = get_model(spec, axis=axis, dt=dt)
+        model.reset(1)
+        return model
+    wanted = f"{env_id}'s {what}"
+    if isinstance(spec, BushingModel) or (isinstance(spec, str) and spec in MODELS):
+        options = MODELS[spec].reference_preset if isinstance(spec, str) else None
+        try:
+            model = get_model(spec, dt=dt, preset=options, coords=coords, wanted_by=wanted)
+        except ModelError as exc:
+            raise RigError(f"{env_id}: {what}: {exc}") from None
+    elif isinstance(spec, str | Path) and str(spec).endswith(".npz"):
+        try:
+            model = get_model(str(spec), coords=coords, wanted_by=wanted)
+        except ModelError as exc:
+            raise RigError(f"{env_id}: {what}: {exc}") from None
+        if abs(model.dt - dt) > DT_TOLERANCE * dt:  # a fit at its records' rate: say what to set
+            fix = f"pass {rate_setting}={model.dt:.6g}" if rate_setting else "give both one rate"
+            raise RigError(
+                f"{env_id}: {what} {spec}: model sampled at {1 / model.dt:.6g} Hz, "
+                f"expected {1 / dt:.6g} Hz (dt={dt:.6g} s): {fix}"
+            )
+    else:
+        kind = "three-axis" if coords == 3 else f"{coords}-coordinate"
+        raise RigError(
+            f"{env_id}: {what} {spec!r}: {MODELS.unknown_message(spec)} ({kind}: "
+            f"{', '.join(names_for(coords))}), or a {kind} .npz model file"
+        )
     model.reset(1)
     return model
 
@@ -164,25 +205,45 @@ def reset_columns(model: BushingModel, mask: np.ndarray, shared: np.ndarray | No
 class ForceDeviationReward:
     """The adversarial objective: how far the model's force is from the reference's.
 
-        r = min(|F_model - F_reference| / force_scale_n, cap);   r = cap if not finite
+        r = min(sum_i |e_i| / force_scale_i, cap);   r = cap if not finite
 
-    ``force_scale_n`` is the reference-sized force of the rig (spec ``force_scale_n``), so r is
-    a dimensionless deviation, 0 when the model is perfect. Works on a single env's info
-    (floats) and a vector env's (arrays). Reads ``info["error_n"]``.
+    over the errors e_i (model minus reference force, N or N m) the rig writes into ``info``
+    under ``keys`` (``"error_n"`` by default: one force), each over its ``force_scale`` (the
+    reference-sized force of that coordinate, spec ``force_scale_n``), so r is a dimensionless
+    deviation, 0 when the model is perfect. Works on a single env's info (floats) and a vector
+    env's (arrays).
     """
 
-    def __init__(self, force_scale_n: float, cap: float) -> None:
-        self.force_scale_n = positive("force_scale_n", force_scale_n)
+    def __init__(self, force_scale_n: Any, cap: float, keys: tuple[str, ...] = ("error_n",)):
+        scales = np.atleast_1d(np.asarray(force_scale_n, dtype=np.float64))
+        if scales.shape != (len(keys),):
+            raise RigError(f"force_scale_n: {len(keys)} scales for {keys}, got {scales.tolist()}")
+        self.force_scales = tuple(positive("force_scale_n", s) for s in scales)
+        self.keys = tuple(keys)
+        self._pairs = tuple(zip(self.keys, self.force_scales, strict=True))
         self.cap = positive("reward_cap", cap)
 
+    @property
+    def force_scale_n(self) -> float:
+        """The first (one-force rigs: the only) scale."""
+        return self.force_scales[0]
+
     def __call__(self, info: dict[str, Any]) -> Any:
-        e = info["error_n"]
-        if isinstance(e, np.ndarray):
-            r = np.abs(e) / self.force_scale_n
+        first = info[self.keys[0]]
+        if first.__class__ is float:  # a single env's step: plain floats
+            r = abs(first) / self.force_scales[0]
+            for key, scale in self._pairs[1:]:
+                r = r + abs(info[key]) / scale
+            return r if r <= self.cap else self.cap  # also catches NaN
+        r = None
+        for key, scale in self._pairs:
+            e = info[key]
+            term = (np.abs(e) if isinstance(e, np.ndarray) else abs(e)) / scale
+            r = term if r is None else r + term
+        if isinstance(r, np.ndarray):
             np.minimum(r, self.cap, out=r)
             r[~np.isfinite(r)] = self.cap
             return r
-        r = abs(e) / self.force_scale_n
         if not (r <= self.cap):  # also catches NaN
             return self.cap
         return r

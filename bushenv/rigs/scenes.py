@@ -15,31 +15,33 @@ RED, BLUE, GREEN, GREY = (200, 40, 40), (40, 70, 200), (60, 150, 60), (120, 120,
 
 # ----- BushRig-v0 --------------------------------------------------------------------------------
 def draw_bushrig(c: Canvas, p: Any, title: str, t_s: float, last, trace: Trace | None) -> None:
-    """The rig at displacement ``last[0]`` (m) with forces ``last[1:]`` (model, reference, N).
+    """The rig at displacement ``last[0]`` (m) with forces ``last[1:]`` (model, reference, N)
+    of its first coordinate (``p.axis``).
 
     ``p`` is the rig's ``RigParameters``; the stroke +-x_max spans +-60 px (the inner sleeve's
     motion is exaggerated)."""
     x, f_m, f_r = last
+    x_max, force_scale = float(p.max_x[0]), float(p.force_scale[0])
     c.clear()
     c.text(f"{title}  axis={p.axis}  model={p.model_name}  reference={p.reference_name}", (10, 8))
     c.text(f"t = {t_s:6.3f} s   x = {x * 1e3:+7.3f} mm", (10, 28), small=True)
     y, xc = 130.0, 150.0
-    _draw_rig_hardware(c, y, xc, xc + x * 60.0 / p.max_x)
+    _draw_rig_hardware(c, y, xc, xc + x * 60.0 / x_max)
     # force arrows on the load cell (the force the bushing puts on the ground)
-    scale = 50.0 / p.force_scale
+    scale = 50.0 / force_scale
     for f, col, dy in ((f_m, RED, -6), (f_r, BLUE, 6)):
         if math.isfinite(f):
             fx = max(-100.0, min(100.0, f * scale))
             c.arrow((56, y + dy), (56 + fx, y + dy), col, 3)
-    fs = 2 * p.force_scale  # bars and traces span +-2 force_scale_n
+    fs = 2 * force_scale  # bars and traces span +-2 force_scale_n
     c.force_bar(330, 70, 250, 16, f_m, fs, RED, f"F model (+-{fs / 1e3:.1f} kN)")
     c.force_bar(330, 110, 250, 16, f_r, fs, BLUE, "F reference")
-    c.force_bar(330, 150, 250, 16, x, p.max_x, GREEN, "displacement")
+    c.force_bar(330, 150, 250, 16, x, x_max, GREEN, "displacement")
     c.text(f"{f_m / 1e3:+8.3f} kN", (500, 52), RED, small=True)
     c.text(f"{f_r / 1e3:+8.3f} kN", (500, 92), BLUE, small=True)
     if trace is not None:
         colors, labels = (GREEN, RED, BLUE), ("x / x_max", "F model", "F reference")
-        plot_traces(c, (20, 230, 560, 150), trace, (p.max_x, fs, fs), colors, labels)
+        plot_traces(c, (20, 230, 560, 150), trace, (x_max, fs, fs), colors, labels)
 
 
 def _draw_rig_hardware(c: Canvas, y: float, xc: float, bushing_x: float) -> None:

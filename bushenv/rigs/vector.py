@@ -1,12 +1,13 @@
-"""BushRigVectorEnv: N bushing test rigs stepped as arrays (``vector_entry_point`` of BushRig-v0).
+"""BushRigVectorEnv: N bushing test rigs stepped as arrays (``vector_entry_point`` of BushRig-v0
+and BushRig3-v0).
 
-The rig's displacement is prescribed (see ``BushRigEnv``), so a rig needs no pymunk body to
-know its motion: N rigs are N columns of arrays, and the two models run through their batched
-``step`` on (N,) arrays -- the same compiled kernels the single env calls with B = 1. Every
-operation on a column is the single env's operation on its floats (IEEE double, same order:
-action clean-up, x + a * step, clip, (x - x0) / dt, F / limit, the reward, and the episode's end
-from ``divergence.force_termination``), so column i equals a ``BushRigEnv`` given the same
-actions, bit for bit (tests/rigs/test_vector.py). An auto-reset column of a model returns to
+The rig's motion is prescribed (see ``BushRigEnv``), so a rig needs no pymunk body to know its
+motion: N rigs of C coordinates are (N, C) arrays, and the two models run through their
+batched ``step`` -- the same compiled kernels the single env calls with B = 1. Every operation
+on a column is the single env's operation on its floats (IEEE double, same order: action
+clean-up, x + a * step, clip, (x - x0) / dt, F / limit, the reward, and the episode's end from
+``divergence.force_termination``), so column i equals a ``BushRigEnv`` given the same actions,
+bit for bit (tests/rigs/test_vector.py). An auto-reset column of a model returns to
 ``initial_state`` except rows shared by all columns (``common.shared_state_rows``).
 """
 
@@ -20,7 +21,8 @@ from gymnasium.vector.utils import batch_space
 
 from bushenv.divergence import force_termination
 from bushenv.rigs.actions import check_options, unit_actions
-from bushenv.rigs.bushrig import ENV_ID, BushRigEnv, RigParameters, check_excitation
+from bushenv.rigs.bushrig import BushRigEnv, over_reason
+from bushenv.rigs.bushrig_params import RigParameters, spec_id
 from bushenv.rigs.common import (
     MODEL_ERRORS,
     ForceDeviationReward,
@@ -35,15 +37,8 @@ from bushenv.rigs.common import (
 from bushenv.rigs.specs import spec_kwargs
 from bushenv.rigs.vector_base import ArrayVectorEnv
 
-# info keys and their values at rest (the reset info of one rig)
-REST_INFO = {
-    "time_s": 0.0,
-    "step": 0,
-    "displacement_m": 0.0,
-    "velocity_m_per_s": 0.0,
-    "force_model_n": 0.0,
-    "force_reference_n": 0.0,
-    "error_n": 0.0,
+# info keys beside the per-coordinate ones, and their values at rest
+REST_FLAGS = {
     "model_force_finite": True,
     "model_over_force_limit": False,
     "reference_over_force_limit": False,
@@ -84,78 +79,95 @@ class BushRigVectorEnv(ArrayVectorEnv):
         divergence_monitor=None,
         **spec_overrides: Any,
     ) -> None:
+        env_id = spec_id(spec_overrides)
         super().__init__(
-            ENV_ID, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode
+            env_id, num_envs, max_episode_steps, episode_steps, autoreset_mode, render_mode
         )
         n = self.num_envs
-        p = RigParameters(spec_kwargs(ENV_ID, spec_overrides))
+        p = RigParameters(spec_kwargs(env_id, spec_overrides), env_id)
         self.params = p
         self.metadata = p.metadata(self.metadata)
         self._overrides = dict(spec_overrides)
         self.render_mode = render_mode
         self.model, self.reference = p.model, p.reference
-        self._shared = (shared_state_rows(self.model), shared_state_rows(self.reference))
+        self._shared = tuple(
+            shared_state_rows(m) for m in (self.model, self.reference) if m is not None
+        )
         self.single_action_space, self.single_observation_space = p.spaces()
         self.action_space = batch_space(self.single_action_space, n)
         self.observation_space = batch_space(self.single_observation_space, n)
+        self.keys = p.info_keys()
         self.reward_fn = check_hook("reward_fn", reward_fn) or ForceDeviationReward(
-            p.force_scale, p.reward_cap
+            p.force_scale, p.reward_cap, self.keys["error"]
         )
         self.divergence_monitor = check_hook("divergence_monitor", divergence_monitor)
-        self._obs = np.zeros((n, 3, p.history), dtype=np.float32)
-        self._x = np.zeros(n)
-        self._replay: np.ndarray | None = None
+        c = p.n_coords
+        self._obs = np.zeros((n, 3, c, p.history), dtype=np.float32)
+        self._x = np.zeros((n, c))
+        self._rest = np.zeros((n, c))  # the reference's forces when there is none
+        self._replay: np.ndarray | None = None  # (T, N, C)
         self._columns = np.arange(n)
         self._render_env: BushRigEnv | None = None
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
-        p, n = self.params, self.num_envs
+        p, n, c = self.params, self.num_envs, self.params.n_coords
         self._replay = None
         self._end[:] = self.max_episode_steps
-        options = check_options(ENV_ID, options)
+        options = check_options(self.env_id, options)
         if options.get("excitation") is not None:
-            x = check_excitation(options["excitation"], p.max_x, p.max_step)
-            if x.ndim == 1:
-                x = np.repeat(x[:, None], n, axis=1)
+            x = p.check_excitation(options["excitation"], vector=True)
+            every = x.ndim == (1 if c == 1 else 2)  # one profile for every rig
+            x = x.reshape(x.shape[0], -1, c)
+            if every:
+                x = np.repeat(x, n, axis=1)
             if x.shape[1] != n:
                 raise RigError(f"excitation has {x.shape[1]} columns, expected num_envs={n}")
             self._replay = np.ascontiguousarray(x)
             self._end[:] = x.shape[0]
-        self.model.reset(n)
-        self.reference.reset(n)
+        for m in (self.model, self.reference):
+            if m is not None:
+                m.reset(n)
         call_reset(self.reward_fn)
         call_reset(self.divergence_monitor)
         self._obs[:] = 0.0
         self._x[:] = 0.0
         self._t[:] = 0
         self._prev_done[:] = False
-        zeros, no = np.zeros(n), np.zeros(n, dtype=bool)
+        zeros, no = np.zeros((n, c)), np.zeros(n, dtype=bool)
         reasons = np.full(n, "", dtype=object)
         info = self._info(zeros, zeros, zeros, zeros, ~no, no, no, no.copy(), reasons)
         return self._obs.reshape(n, -1).copy(), info
 
+    def _forces(self, model, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """(N, C) forces of ``model`` at (N, C) ``x``, ``v``: one coordinate as (N,) steps."""
+        n, c = x.shape
+        if c == 1:
+            return np.array(model.step(x[:, 0], v[:, 0]), dtype=np.float64).reshape(n, 1)
+        return np.array(model.step(x, v), dtype=np.float64)
+
     def _model_forces(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, str, str]:
-        """The model's (N,) forces, the reason if its batched step refused (a divergence), and
-        the model's own error if it raised otherwise (``common.MODEL_ERRORS``). A refusal
+        """The model's (N, C) forces, the reason if its batched step refused (a divergence),
+        and the model's own error if it raised otherwise (``common.MODEL_ERRORS``). A refusal
         refuses the whole batch; the histories that caused it show non-finite forces in what
         the kernel wrote (``last_force_n``); all columns are judged if none do."""
-        n = self.num_envs
+        n, c = x.shape
         try:
-            return np.array(self.model.step(x, v), dtype=np.float64), "", ""
+            return self._forces(self.model, x, v), "", ""
         except MODEL_ERRORS as exc:
             f_m = np.array(self.model.last_force_n, np.float64)
-            if f_m.shape != (n,) or np.isfinite(f_m).all():
-                f_m = np.full(n, np.nan)
-            return f_m, f"model raised {type(exc).__name__}: {exc}", ""
+            if f_m.size != n * c or np.isfinite(f_m).all():
+                f_m = np.full(n * c, np.nan)
+            return f_m.reshape(n, c), f"model raised {type(exc).__name__}: {exc}", ""
         except Exception as exc:  # the model's own bug: ends every episode, not a divergence
-            return np.full(n, np.nan), "", model_error_text(exc)
+            return np.full((n, c), np.nan), "", model_error_text(exc)
 
     def step(self, actions):
         p, n = self.params, self.num_envs
         x0 = self._x
         if self._replay is None:
-            x = x0 + unit_actions(actions, n, ENV_ID) * p.max_step
+            a = unit_actions(actions, n, self.env_id, p.n_coords).reshape(n, p.n_coords)
+            x = x0 + a * p.max_step
             np.clip(x, -p.max_x, p.max_x, out=x)
         else:
             x = self._replay[np.minimum(self._t, self._end - 1), self._columns]
@@ -163,21 +175,24 @@ class BushRigVectorEnv(ArrayVectorEnv):
         self._x = x
         self._t += 1
         f_m, raised, model_error = self._model_forces(x, v)
-        f_r = np.array(self.reference.step(x, v), dtype=np.float64)
+        f_r = self._rest if self.reference is None else self._forces(self.reference, x, v)
 
         obs = self._obs
-        obs[:, :, 1:] = obs[:, :, :-1]
-        obs[:, 0, 0] = x / p.max_x
-        obs[:, 1, 0] = force_observations(f_m, p.force_limit)
-        obs[:, 2, 0] = force_observations(f_r, p.force_limit)
+        obs[..., 1:] = obs[..., :-1]
+        obs[:, 0, :, 0] = x / p.max_x
+        obs[:, 1, :, 0] = force_observations(f_m, p.force_limit)
+        obs[:, 2, :, 0] = force_observations(f_r, p.force_limit)
 
-        non_finite, model_over, ref_over = force_termination(f_m, f_r, p.force_limit)
+        nf, mo, ro = force_termination(f_m, f_r, p.force_limit)
+        non_finite, ref_over = nf.any(axis=1), ro.any(axis=1)
+        model_over = mo.any(axis=1) & ~ref_over  # a reference beyond a limit: no verdict
         terminated = non_finite | model_over
         truncated = ref_over & ~non_finite
         reasons = np.full(n, "", dtype=object)
         reasons[non_finite] = raised or "model force is not finite"
         for i in np.flatnonzero(model_over):
-            reasons[i] = f"|F_model| = {abs(f_m[i]):.6g} N exceeds {p.force_limit:.6g} N"
+            j = int(np.argmax(mo[i]))
+            reasons[i] = over_reason(p, f_m[i, j], j)
         monitor = np.zeros(n, dtype=bool)
         info = self._info(x, v, f_m, f_r, ~non_finite, model_over, ref_over, monitor, reasons)
         if self.divergence_monitor is not None:
@@ -196,32 +211,45 @@ class BushRigVectorEnv(ArrayVectorEnv):
         return self._end_step(obs.reshape(n, -1).copy(), reward, terminated, truncated, info)
 
     def _reset_columns(self, mask: np.ndarray) -> None:
-        reset_columns(self.model, mask, self._shared[0])
-        reset_columns(self.reference, mask, self._shared[1])
+        models = [m for m in (self.model, self.reference) if m is not None]
+        for m, shared in zip(models, self._shared, strict=True):
+            reset_columns(m, mask, shared)
         self._obs[mask] = 0.0
         self._x[mask] = 0.0
 
     def _rest_info(self) -> dict[str, Any]:
-        return REST_INFO
+        rest: dict[str, Any] = {"time_s": 0.0, "step": 0}
+        for kind, names in self.keys.items():
+            if kind != "f_r" or self.reference is not None:
+                rest.update(dict.fromkeys(names, 0.0))
+        return {**rest, **REST_FLAGS}
 
     def _info(self, x, v, f_m, f_r, finite, model_over, ref_over, monitor, reasons):
-        info = {
-            "time_s": self._t * self.params.dt,
-            "step": self._t.copy(),
-            "displacement_m": x.copy(),
-            "velocity_m_per_s": v.copy(),
-            "force_model_n": f_m,
-            "force_reference_n": f_r,
-            "error_n": f_m - f_r,
-            "model_force_finite": finite.copy(),
-            "model_over_force_limit": model_over.copy(),
-            "reference_over_force_limit": ref_over.copy(),
-            "monitor_verdict": monitor,
-            "diverged": np.zeros(self.num_envs, dtype=bool),
-            "machine_limit": ref_over.copy(),
-            "divergence_reason": reasons,
-            "model_error": np.full(self.num_envs, "", dtype=object),
-        }
+        k, n = self.keys, self.num_envs
+        info: dict[str, Any] = {"time_s": self._t * self.params.dt, "step": self._t.copy()}
+        for i, name in enumerate(k["q"]):
+            info[name] = x[:, i].copy()
+        for i, name in enumerate(k["v"]):
+            info[name] = v[:, i].copy()
+        for i, name in enumerate(k["f_m"]):
+            info[name] = f_m[:, i]
+        if self.reference is not None:
+            for i, name in enumerate(k["f_r"]):
+                info[name] = f_r[:, i]
+        for i, name in enumerate(k["error"]):
+            info[name] = f_m[:, i] - f_r[:, i]
+        info.update(
+            {
+                "model_force_finite": finite.copy(),
+                "model_over_force_limit": model_over.copy(),
+                "reference_over_force_limit": ref_over.copy(),
+                "monitor_verdict": monitor,
+                "diverged": np.zeros(n, dtype=bool),
+                "machine_limit": ref_over.copy(),
+                "divergence_reason": reasons,
+                "model_error": np.full(n, "", dtype=object),
+            }
+        )
         return self._masks(info)
 
     def render(self):
@@ -234,10 +262,10 @@ class BushRigVectorEnv(ArrayVectorEnv):
         env = self._render_env
         env._t = int(self._t[0])
         p = self.params
-        env._last = (
-            float(self._x[0]),
-            float(self._obs[0, 1, 0]) * p.force_limit,
-            float(self._obs[0, 2, 0]) * p.force_limit,
+        env._last = (  # the first coordinate: the drawing's
+            float(self._x[0, 0]),
+            float(self._obs[0, 1, 0, 0]) * float(p.force_limit[0]),
+            float(self._obs[0, 2, 0, 0]) * float(p.force_limit[0]),
         )
         return (env.render(),)
 

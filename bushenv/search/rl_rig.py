@@ -159,8 +159,10 @@ class OscillatorActions(VecEnvWrapper):
         self.mode, self.reward = mode, reward
         self.lo_f, self.hi_f = np.log(OSC_F_HZ[0]), np.log(OSC_F_HZ[1])
         self.lo_a, self.hi_a = np.log(OSC_A_M[0]), np.log(OSC_A_M[1])
-        self.max_x, self.max_step, self.dt = params.max_x, params.max_step, params.dt
-        self.a_cap_factor = VELOCITY_MARGIN * params.max_v / (2.0 * np.pi)
+        # the rig's one coordinate (BushRig-v0's limits are (1,) arrays)
+        self.max_x, self.max_step = float(params.max_x[0]), float(params.max_step[0])
+        self.dt = params.dt
+        self.a_cap_factor = VELOCITY_MARGIN * float(params.max_v[0]) / (2.0 * np.pi)
         n_obs = venv.observation_space.shape[0] + 5
         obs = spaces.Box(-np.inf, np.inf, shape=(n_obs,), dtype=np.float32)
         act = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)

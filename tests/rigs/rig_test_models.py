@@ -48,6 +48,23 @@ class NanAfter(BushingModel):
         self.state[:, mask] = 0.0
 
 
+class NanAfter3(NanAfter):
+    """``NanAfter`` over three coordinates (axial, radial, rotation): k q per coordinate."""
+
+    name = "nan_after_3_test_double"
+    coords = ("axial", "radial", "rotation")
+    units = ("m", "m", "rad")
+    force_units = ("N", "N", "N m")
+
+    def _advance(self, x, v, out):
+        for t in range(x.shape[0]):
+            self.state[0] += 1
+            out[t] = np.where(self.state[0][:, None] > self.after, np.nan, self.k * x[t])
+
+    def copy(self):
+        return NanAfter3(self.after, self.k, self.dt)
+
+
 class RaisesAfter(NanAfter):
     name = "raises_after_test_double"
 

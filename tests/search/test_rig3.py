@@ -208,10 +208,12 @@ def test_a_coordinate_held_while_another_moves_is_not_in_a_hold():
 
 
 def test_the_floors_follow_the_judging_references_stiffness_and_the_builtin_keeps_the_papers():
-    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.common import resolve_model
     from bushenv.search.target_rig3 import MACHINE_FLOORS, reference_floors
 
-    builtin, why = reference_floors(resolve_planar("reference", DT, "reference"))
+    builtin, why = reference_floors(
+        resolve_model("reference", dt=DT, coords=3, what="reference", env_id="BushRig3-v0")
+    )
     assert np.array_equal(builtin, MACHINE_FLOORS) and "x1," in why
     lin = PlanarLinear.preset()
     stiff = PlanarLinear(lin.k_matrix * np.array([1.0, 3.0, 1.0])[:, None], lin.c_matrix, lin.dt)
