@@ -3,7 +3,7 @@ pivot x coordinate x kind of model error at one component-level size, under the 
 manoeuvres of ``bushenv vehicle``) and the predictor from component-level to vehicle-level
 errors, checked on cases it was not built from.
 
-    bushenv vehicle-transfer --out DIR [--size-pct 10] [--combinations 16] [--held -1]
+    bushenv vehicle-transfer --out DIR [--size-pct 10] [--combinations 16] [--held 2] [--order 2]
 
 Writes DIR/transfer.md (the findings first), DIR/transfer.json, DIR/transfer_map.csv (every
 component, manoeuvre and output), DIR/transfer_predictor.npz (the predictor:
@@ -58,8 +58,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=list(HELD_MULTIPLES),
         metavar="LIST",
         help="every single error also run at these multiples of --size-pct, held out of the "
-        "predictor (default: -1, the sign reversed; write a list with a minus first as "
-        "--held=-1,2)",
+        "predictor (default: 2; a list with a minus first is written --held=-0.5,2)",
+    )
+    p.add_argument(
+        "--order",
+        type=int,
+        choices=(1, 2),
+        default=2,
+        help="the predictor: 1, first-order superposition of the +size runs; 2, also the "
+        "-size runs (each error's own curvature; 48 more cars)",
     )
     p.add_argument(
         "--manoeuvres",
@@ -97,7 +104,8 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"--duration-s must be > 0.1 s, got {args.duration_s}")
     dt = float(spec_kwargs(ENV_ID, {})["dt_s"])
     config = TransferConfig(dt, args.size_pct, tuple(args.manoeuvres), args.duration_s,
-                            args.seed, args.combinations, tuple(args.held))  # fmt: skip
+                            args.seed, args.combinations, tuple(args.held),
+                            args.order)  # fmt: skip
     try:
         config.check()
     except TransferInputError as exc:

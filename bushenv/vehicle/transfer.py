@@ -37,6 +37,7 @@ from bushenv.vehicle.transfer_errors import (
 )
 from bushenv.vehicle.transfer_predict import (
     TransferPredictor,
+    basis,
     check_cells,
     gram_matrix,
     influence_rank,
@@ -65,7 +66,7 @@ MAP_OUTPUTS = (
     MapOutput("a_w_Wd", "lateral a_w (Wd)", "m/s^2", "lateral_accel", "Wd", AW_FLOOR_M_PER_S2),
 )
 COMPONENTS = tuple((p, c, k) for p in POSITIONS for c in COORDS for k in KINDS)
-HELD_MULTIPLES = (-1.0,)  # the single errors held out: these multiples of the map's size
+HELD_MULTIPLES = (2.0,)  # the single errors held out: these multiples of the map's size
 COMBINED_SIZE = (0.5, 1.5)  # a combination's terms: |size| drawn in these multiples of it
 # a relative error is judged where the measured change is at least this share of the
 # component size (below it the car barely moved: 0.5 % of an output's RMS at a 10 % error)
@@ -83,8 +84,11 @@ class TransferConfig:
     seed: int = 0
     combinations: int = 16
     held_multiples: tuple[float, ...] = HELD_MULTIPLES
+    order: int = 2  # the predictor: 1 from the +size runs, 2 also from the -size runs
 
     def check(self) -> None:
+        if self.order not in (1, 2):
+            raise TransferInputError(f"order must be 1 or 2, got {self.order!r}")
         if not (np.isfinite(self.size_pct) and 0 < self.size_pct <= 15):
             raise TransferInputError(
                 f"size_pct must be in (0, 15] %, got {self.size_pct!r} (an understated "
@@ -95,6 +99,8 @@ class TransferConfig:
         for k in self.held_multiples:
             if not (np.isfinite(k) and k != 0 and abs(k * self.size_pct) <= 30):
                 raise TransferInputError(f"held multiple {k!r}: non-zero, |k size| <= 30 %")
+            if k == 1 or (k == -1 and self.order == 2):
+                raise TransferInputError(f"held multiple {k!r}: the predictor is built on it")
 
 
 def difference_histories(run: SingleRun, base: SingleRun, dt_s: float) -> list[np.ndarray]:
@@ -214,66 +220,105 @@ class Campaign:
         return out
 
 
+def _predictor(camp: Campaign, plus: list, minus: list | None) -> TransferPredictor:
+    """The predictor from the single errors' histories ``plus`` (and ``minus``: second order),
+    each a list over manoeuvres of lists over outputs."""
+    M, O = len(camp.manoeuvres), len(MAP_OUTPUTS)
+    k = len(COMPONENTS) * (1 if minus is None else 2)
+    gram = np.empty((M, O, k, k))
+    for m in range(M):
+        for o in range(O):
+            down = None if minus is None else [d[m][o] for d in minus]
+            gram[m, o] = gram_matrix(basis([d[m][o] for d in plus], down))
+    return TransferPredictor(
+        tuple(x.name for x in camp.manoeuvres), tuple(o.name for o in MAP_OUTPUTS), COMPONENTS,
+        camp.config.size_pct, gram, camp.base_rms, camp.floors, 1 if minus is None else 2,
+    )  # fmt: skip
+
+
+def _predicted_history(a: np.ndarray, plus: list, minus: list | None, m: int, o: int):
+    """The predicted difference history of manoeuvre m, output o for weights ``a`` (J,)."""
+    out = 0.0
+    for j in np.flatnonzero(a):
+        if minus is None:
+            out = out + a[j] * plus[j][m][o]
+        else:
+            p, n = plus[j][m][o], minus[j][m][o]
+            out = out + a[j] * (p - n) / 2 + a[j] ** 2 * (p + n) / 2
+    return out
+
+
+def _checks(camp: Campaign, config: TransferConfig, predictors: dict, plus, minus) -> dict:
+    """The held-out runs and every predictor's figures on them (``predictors`` by name: the
+    first one is the campaign's)."""
+    s0, least = config.size_pct, LEAST_SHARE * config.size_pct
+    out: dict[str, Any] = {"singles": {}, "combinations": [], "predictors": list(predictors)}
+    for k in config.held_multiples:
+        meas = np.array([camp.pct(camp.measure([ErrorTerm(*c, k * s0)], f"held {k:+g}x "
+                                               f"{'/'.join(c)}")) for c in COMPONENTS])  # fmt: skip
+        entry: dict[str, Any] = {"multiple": k, "size_pct": k * s0, "measured_pct": meas}
+        for name, p in predictors.items():
+            pred = np.array([p.predict_pct([ErrorTerm(*c, k * s0)]) for c in COMPONENTS])
+            entry[name] = {"predicted_pct": pred, "cells": check_cells(meas, pred, least),
+                           "influence": influence_rank(meas, pred)}  # fmt: skip
+        out["singles"][f"{k:+g}"] = entry
+    main = next(iter(predictors))
+    for i, terms in enumerate(combinations(config.combinations, s0, config.seed)):
+        diffs = camp.measure(terms, f"combination {i + 1}/{config.combinations}")
+        a = predictors[main].weights(terms)
+        down = minus if predictors[main].order == 2 else None
+        resid = camp.pct([[d - _predicted_history(a, plus, down, m, o)
+                           for o, d in enumerate(dm)] for m, dm in enumerate(diffs)])  # fmt: skip
+        out["combinations"].append({
+            "terms": [t.__dict__ for t in terms], "measured_pct": camp.pct(diffs),
+            "history_error_pct": resid,
+            **{f"{n}_pct": p.predict_pct(terms) for n, p in predictors.items()},
+        })  # fmt: skip
+    if out["combinations"]:
+        meas = np.array([c["measured_pct"] for c in out["combinations"]])
+        resid = np.array([c["history_error_pct"] for c in out["combinations"]])
+        ok = np.isfinite(meas) & (meas >= least)
+        out["combined"] = {n: check_cells(meas, np.array([c[f"{n}_pct"] for c in
+                                                          out["combinations"]]), least)
+                           for n in predictors}  # fmt: skip
+        out["combined"][main]["median_history_error"] = (
+            float(np.median(resid[ok] / meas[ok])) if ok.any() else None
+        )
+    return out
+
+
 def run_transfer(
     config: TransferConfig, progress: Any = None
 ) -> tuple[dict[str, Any], TransferPredictor]:
     """The map, the predictor and its check (module docstring); ``progress`` a
-    ``bushenv.progress.Progress`` or None (its ``total`` set here to the car steps to run)."""
+    ``bushenv.progress.Progress`` or None (its ``total`` set here to the car steps to run).
+    Returns the report and the campaign's predictor (``config.order``)."""
     t0 = time.perf_counter()
-    s0 = config.size_pct
-    held = combinations(config.combinations, s0, config.seed)
-    n_runs = 1 + len(COMPONENTS) * (1 + len(config.held_multiples)) + len(held)
+    s0, J = config.size_pct, len(COMPONENTS)
+    n_runs = 1 + J * (config.order + len(config.held_multiples)) + config.combinations
     if progress is not None:
         names = config.manoeuvres
         progress.total = n_runs * sum(m.samples for m in standard_manoeuvres(
             config.dt_s, config.seed, names, config.duration_s))  # fmt: skip
-        progress.say(f"{len(COMPONENTS)} component errors at {s0:g} % x {len(names)} manoeuvres,"
-                     f" then {len(COMPONENTS) * len(config.held_multiples)} held-out singles and"
-                     f" {len(held)} combinations: {n_runs} cars")  # fmt: skip
+        signs = "+-" if config.order == 2 else "+"
+        progress.say(f"{J} component errors at {signs}{s0:g} % x {len(names)} manoeuvres, then "
+                     f"{J * len(config.held_multiples)} held-out singles and "
+                     f"{config.combinations} combinations: {n_runs} cars")  # fmt: skip
     camp = Campaign(config, progress)
-    singles = [camp.measure([ErrorTerm(*c, s0)], f"map {'/'.join(c)}") for c in COMPONENTS]
-    M, O = len(camp.manoeuvres), len(MAP_OUTPUTS)
-    gram = np.empty((M, O, len(COMPONENTS), len(COMPONENTS)))
-    for m in range(M):
-        for o in range(O):
-            gram[m, o] = gram_matrix([d[m][o] for d in singles])
-    predictor = TransferPredictor(
-        tuple(x.name for x in camp.manoeuvres), tuple(o.name for o in MAP_OUTPUTS), COMPONENTS,
-        s0, gram, camp.base_rms, camp.floors,
-    )  # fmt: skip
-    map_pct = np.array([camp.pct(d) for d in singles])  # (J, M, O)
-    in_car = [camp.in_car_component_pct(ErrorTerm(*c, s0)) for c in COMPONENTS]
-    least = LEAST_SHARE * s0
-    checks: dict[str, Any] = {"singles": {}, "combinations": []}
-    for k in config.held_multiples:
-        meas = np.array([camp.pct(camp.measure([ErrorTerm(*c, k * s0)], f"held {k:+g}x "
-                                               f"{'/'.join(c)}")) for c in COMPONENTS])  # fmt: skip
-        pred = np.array([predictor.predict_pct([ErrorTerm(*c, k * s0)]) for c in COMPONENTS])
-        checks["singles"][f"{k:+g}"] = {
-            "multiple": k, "size_pct": k * s0, "measured_pct": meas, "predicted_pct": pred,
-            "cells": check_cells(meas, pred, least), "influence": influence_rank(meas, pred),
-        }  # fmt: skip
-    for i, terms in enumerate(held):
-        diffs = camp.measure(terms, f"combination {i + 1}/{len(held)}")
-        meas, pred = camp.pct(diffs), predictor.predict_pct(terms)
-        w = predictor.weights(terms)
-        hist = [[sum(w[j] * singles[j][m][o] for j in np.flatnonzero(w))
-                 for o in range(O)] for m in range(M)]  # fmt: skip
-        resid = camp.pct([[d - h for d, h in zip(dm, hm, strict=True)]
-                          for dm, hm in zip(diffs, hist, strict=True)])  # fmt: skip
-        checks["combinations"].append({"terms": [t.__dict__ for t in terms],
-                                       "measured_pct": meas, "predicted_pct": pred,
-                                       "history_error_pct": resid})  # fmt: skip
-    combos = checks["combinations"]
-    if combos:
-        meas = np.array([c["measured_pct"] for c in combos])
-        pred = np.array([c["predicted_pct"] for c in combos])
-        resid = np.array([c["history_error_pct"] for c in combos])
-        checks["combined"] = check_cells(meas, pred, least)
-        ok = np.isfinite(meas) & (meas >= least)
-        checks["combined"]["median_history_error"] = (
-            float(np.median(resid[ok] / meas[ok])) if ok.any() else None
-        )
+    plus = [camp.measure([ErrorTerm(*c, s0)], f"map {'/'.join(c)}") for c in COMPONENTS]
+    minus = None
+    if config.order == 2:
+        minus = [camp.measure([ErrorTerm(*c, -s0)], f"map -{s0:g} % {'/'.join(c)}")
+                 for c in COMPONENTS]  # fmt: skip
+    first = _predictor(camp, plus, None)
+    predictors = {"second_order": _predictor(camp, plus, minus)} if minus is not None else {}
+    predictors["first_order"] = first
+    checks = _checks(camp, config, predictors, plus, minus)
+    if minus is not None:  # the first order's sign reversal, on the -s0 runs built in
+        meas = np.array([camp.pct(d) for d in minus])
+        pred = np.array([first.predict_pct([ErrorTerm(*c, -s0)]) for c in COMPONENTS])
+        checks["first_order_sign"] = {"cells": check_cells(meas, pred, LEAST_SHARE * s0),
+                                      "influence": influence_rank(meas, pred)}  # fmt: skip
     report = {
         "settings": {**config.__dict__, "manoeuvres": list(config.manoeuvres),
                      "held_multiples": list(config.held_multiples)},
@@ -282,9 +327,13 @@ def run_transfer(
         "components": [list(c) for c in COMPONENTS],
         "factors": {"/".join(c[1:]): calibrate(c[2], c[1], s0, config.dt_s)
                     for c in COMPONENTS[: len(COORDS) * len(KINDS)]},
-        "baseline_rms": camp.base_rms, "map_pct": map_pct, "in_car_component_pct": in_car,
-        "map_rms": np.sqrt(np.maximum(np.einsum("mojj->jmo", gram), 0.0)),
+        "baseline_rms": camp.base_rms,
+        "map_pct": np.array([camp.pct(d) for d in plus]),  # (J, M, O)
+        "map_minus_pct": None if minus is None else np.array([camp.pct(d) for d in minus]),
+        "map_rms": np.sqrt(np.maximum(np.einsum("mojj->jmo", first.gram), 0.0)),
+        "in_car_component_pct": [camp.in_car_component_pct(ErrorTerm(*c, s0))
+                                 for c in COMPONENTS],
         "checks": checks, "ended": camp.ended, "cars": n_runs,
         "car_steps": camp.done, "run_seconds": time.perf_counter() - t0,
     }  # fmt: skip
-    return report, predictor
+    return report, next(iter(predictors.values()))

@@ -1,11 +1,17 @@
 """The predictor from component-level bushing errors to vehicle-level changes, and its check.
 
-First-order superposition of measured responses: each component error j (pivot, coordinate,
-kind) was run alone at the campaign's size s_0, giving the difference history d_j(t) of every
-vehicle output against the reference car. For errors of sizes s_j at once the predicted
-difference is sum_j (s_j / s_0) d_j(t), so its RMS over a manoeuvre is
+Superposition of measured responses: each component error j (pivot, coordinate, kind) was run
+alone at the campaign's size +s_0 (and, for the second order, at -s_0), giving the difference
+histories d_j+(t), d_j-(t) of every vehicle output against the reference car. For errors of
+sizes s_j at once, a_j = s_j / s_0, the predicted difference is
 
-    RMS(d_hat) = sqrt(w^T G w),   w_j = s_j / s_0,   G_jk = mean_t sum_cols d_j(t) d_k(t)
+    first order:   sum_j a_j d_j+(t)
+    second order:  sum_j a_j (d_j+ - d_j-)(t) / 2 + a_j^2 (d_j+ + d_j-)(t) / 2
+
+(each component's own curvature, from the two signs; no interaction terms). Either is a sum of
+basis histories e_k(t) with weights w_k (a_j, then a_j^2), so its RMS over a manoeuvre is
+
+    RMS(d_hat) = sqrt(w^T G w),   G_kl = mean_t sum_cols e_k(t) e_l(t)
 
 (the cross terms keep two errors that cancel from adding up). ``TransferPredictor`` holds G per
 manoeuvre and output, and the reference car's RMS of each output, so it predicts without a car;
@@ -33,7 +39,8 @@ class TransferPredictor:
     """``gram`` (M, O, J, J) per manoeuvre and output; ``baseline_rms`` (M, O) the reference
     car's RMS (SI; weighted a_w for the comfort outputs); ``components`` J (pivot, coord, kind);
     ``size_pct`` s_0; ``floors`` (O,) the RMS below which an output's relative change is not
-    stated."""
+    stated; ``order`` 1 (basis d_j+, K = J) or 2 (basis (d_j+ - d_j-)/2, then (d_j+ + d_j-)/2,
+    K = 2 J)."""
 
     manoeuvres: tuple[str, ...]
     outputs: tuple[str, ...]
@@ -42,6 +49,7 @@ class TransferPredictor:
     gram: np.ndarray
     baseline_rms: np.ndarray
     floors: np.ndarray
+    order: int = 1
 
     def weights(self, terms: list[ErrorTerm]) -> np.ndarray:
         """(J,) s_j / s_0 of ``terms`` (each component at most once)."""
@@ -57,7 +65,8 @@ class TransferPredictor:
 
     def predict_rms(self, terms: list[ErrorTerm]) -> np.ndarray:
         """(M, O) predicted RMS change of each output in each manoeuvre, SI units."""
-        w = self.weights(terms)
+        a = self.weights(terms)
+        w = a if self.order == 1 else np.concatenate([a, a * a])
         power = np.einsum("j,mojk,k->mo", w, self.gram, w)
         return np.sqrt(np.maximum(power, 0.0))
 
@@ -68,7 +77,7 @@ class TransferPredictor:
     def save(self, path: str | Path) -> None:
         header = {"format": FORMAT, "manoeuvres": list(self.manoeuvres),
                   "outputs": list(self.outputs), "components": [list(c) for c in self.components],
-                  "size_pct": self.size_pct}  # fmt: skip
+                  "size_pct": self.size_pct, "order": self.order}  # fmt: skip
         atomic_write(path, lambda fh: np.savez(
             fh, header=np.array(json.dumps(header)), gram=self.gram,
             baseline_rms=self.baseline_rms, floors=self.floors))  # fmt: skip
@@ -85,7 +94,7 @@ class TransferPredictor:
             raise TransferInputError(f"{path}: format {header.get('format')!r}, not {FORMAT}")
         return cls(tuple(header["manoeuvres"]), tuple(header["outputs"]),
                    tuple(tuple(c) for c in header["components"]), float(header["size_pct"]),
-                   **arrays)  # fmt: skip
+                   order=int(header.get("order", 1)), **arrays)  # fmt: skip
 
 
 def relative_pct(rms: np.ndarray, baseline: np.ndarray, floors: np.ndarray) -> np.ndarray:
@@ -94,6 +103,15 @@ def relative_pct(rms: np.ndarray, baseline: np.ndarray, floors: np.ndarray) -> n
     with np.errstate(divide="ignore", invalid="ignore"):
         pct = 100.0 * rms / baseline
     return np.where(baseline >= floors, pct, np.nan)
+
+
+def basis(plus: list[np.ndarray], minus: list[np.ndarray] | None) -> list[np.ndarray]:
+    """The basis histories of one manoeuvre and output: ``plus`` (first order) or the odd and
+    even parts of ``plus`` and ``minus`` (second order), each (n, k)."""
+    if minus is None:
+        return list(plus)
+    odd = [(p - m) / 2 for p, m in zip(plus, minus, strict=True)]
+    return odd + [(p + m) / 2 for p, m in zip(plus, minus, strict=True)]
 
 
 def gram_matrix(histories: list[np.ndarray]) -> np.ndarray:

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.persist import write_figure
+from bushenv.vehicle.transfer import LEAST_SHARE
 
 # a component error does not reach the car when every change it makes is below this share of
 # its own size (1 % of an output's RMS at a 10 % error): a tenth of what went in
@@ -74,20 +75,28 @@ def findings(report: dict[str, Any]) -> dict[str, Any]:
             [float(np.percentile(v, q)) for q in (10, 50, 90)] if v.size else None
         )
     checks = report["checks"]
-    combined = checks.get("combined", {})
-    ranks = {k: v["influence"]["overall"] for k, v in checks["singles"].items()}
-    med = combined.get("median_relative_error")
+    names = checks["predictors"]
+    summaries = {n: _predictor_summary(checks, n) for n in names}
     return {
         "size_pct": s0, "components": rows, "never_reach": never, "amplified": amplified,
         "median_of_largest_by": groups, "in_car_component_by_kind": in_car_by_kind,
-        "predictor": {
-            "median_relative_error": med, "combinations": len(checks["combinations"]),
-            "cells": combined.get("cells"), "spearman_cells": combined.get("spearman"),
-            "influence_rank": ranks,
-            "meets_median": med is not None and med <= TARGET_MEDIAN,
-            "meets_rank": bool(ranks)
-            and all(r is not None and r >= TARGET_RANK for r in ranks.values()),
-        },
+        "predictor": summaries[names[0]], "predictors": summaries,
+    }  # fmt: skip
+
+
+def _predictor_summary(checks: dict[str, Any], name: str) -> dict[str, Any]:
+    """A predictor's figures on the held-out cases, against the targets."""
+    combined = checks.get("combined", {}).get(name, {})
+    ranks = {k: v[name]["influence"]["overall"] for k, v in checks["singles"].items()}
+    med = combined.get("median_relative_error")
+    return {
+        "name": name, "median_relative_error": med, "p90_relative_error":
+        combined.get("p90_relative_error"), "combinations": len(checks["combinations"]),
+        "cells": combined.get("cells"), "spearman_cells": combined.get("spearman"),
+        "influence_rank": ranks,
+        "meets_median": med is not None and med <= TARGET_MEDIAN,
+        "meets_rank": bool(ranks)
+        and all(r is not None and r >= TARGET_RANK for r in ranks.values()),
     }  # fmt: skip
 
 
@@ -137,22 +146,34 @@ def markdown(report: dict[str, Any], found: dict[str, Any], figures: list[str]) 
         + ", ".join(f"{k} {'/'.join(_f(x, 2) for x in v)} %" if v else f"{k} n/a"
                     for k, v in found["in_car_component_by_kind"].items()) + "."
     )  # fmt: skip
-    ranks = ", ".join(f"{_f(v)} at {float(k) * s0:+g} %" for k, v in p["influence_rank"].items())
-    med = p["median_relative_error"]
-    med_text = "n/a" if med is None else _f(100 * med)
-    lines += [
-        f"- **Predictor** (first-order superposition of the single errors' difference "
-        f"histories): median relative error **{med_text} %** "
-        f"on {p['combinations']} held-out combinations ({p['cells']} manoeuvre-output cells; "
-        f"target <= {100 * TARGET_MEDIAN:g} %: {'met' if p['meets_median'] else 'NOT met'}); "
-        f"rank correlation of the components' influence **{ranks}** (target >= "
-        f"{TARGET_RANK:g}: {'met' if p['meets_rank'] else 'NOT met'}); Spearman of predicted "
-        f"and measured changes over the combinations' cells {_f(p['spearman_cells'])}.",
-        "",
-    ]  # fmt: skip
+    for p in found["predictors"].values():
+        lines.append(_predictor_line(p, s0))
+    lines.append("")
     lines += [f"![{Path(f).stem}]({Path(f).name})" for f in figures] + [""]
     lines += _map_tables(report) + _check_tables(report) + _run_lines(report)
     return "\n".join(lines) + "\n"
+
+
+WHAT = {
+    "second_order": "second-order superposition: each error's odd and even parts from its +- runs",
+    "first_order": "first-order superposition of the +size runs",
+}
+
+
+def _predictor_line(p: dict[str, Any], s0: float) -> str:
+    med, p90 = p["median_relative_error"], p["p90_relative_error"]
+    ranks = ", ".join(f"{_f(v)} at {float(k) * s0:+g} %" for k, v in p["influence_rank"].items())
+    pct = "n/a" if med is None else _f(100 * med)
+    tail = "n/a" if p90 is None else _f(100 * p90)
+    return (
+        f"- **Predictor, {p['name'].replace('_', ' ')}** ({WHAT.get(p['name'], p['name'])}): "
+        f"median relative error **{pct} %** (90th percentile {tail} %) on {p['combinations']} "
+        f"held-out combinations ({p['cells']} manoeuvre-output cells; target <= "
+        f"{100 * TARGET_MEDIAN:g} %: {'met' if p['meets_median'] else 'NOT met'}); rank "
+        f"correlation of the components' influence **{ranks or 'n/a'}** (target >= "
+        f"{TARGET_RANK:g}: {'met' if p['meets_rank'] else 'NOT met'}); Spearman of predicted "
+        f"and measured changes over the combinations' cells {_f(p['spearman_cells'])}."
+    )
 
 
 def _map_tables(report: dict[str, Any]) -> list[str]:
@@ -193,21 +214,27 @@ def _map_tables(report: dict[str, Any]) -> list[str]:
 def _check_tables(report: dict[str, Any]) -> list[str]:
     checks = report["checks"]
     lines = ["## The predictor's check on cases it was not built from", ""]
-    for k, s in checks["singles"].items():
-        c = s["cells"]
+    held = [(f"{s['size_pct']:+g} % ({k}x)", s[n]["cells"], s[n]["influence"], n)
+            for k, s in checks["singles"].items() for n in checks["predictors"]]  # fmt: skip
+    if "first_order_sign" in checks:  # the -size runs, held out of the first order only
+        s = checks["first_order_sign"]
+        held.append(("-size (built into the second order)", s["cells"], s["influence"],
+                     "first_order"))  # fmt: skip
+    for label, c, influence, name in held:
         med, p90 = c["median_relative_error"], c["p90_relative_error"]
-        rank = s["influence"]["overall"]
         lines.append(
-            f"- every single error at {s['size_pct']:+g} % ({k}x): median relative error "
+            f"- every single error at {label}, {name.replace('_', ' ')}: median relative error "
             f"{_f(None if med is None else 100 * med)} %, 90th percentile "
             f"{_f(None if p90 is None else 100 * p90)} % over {c['cells']} cells; rank "
-            f"correlation of the components' influence {_f(rank)}"
+            f"correlation of the components' influence {_f(influence['overall'])}"
         )
+    main = checks["predictors"][0]
+    lines += ["", f"Per combination, the {main.replace('_', ' ')} predictor:"]
     lines += ["", "| combination | cells | median relative error % | worst cell: measured / "
               "predicted % |", "|---|---|---|---|"]  # fmt: skip
-    least = report["checks"].get("combined", {}).get("least_pct", 0.0)
+    least = LEAST_SHARE * report["settings"]["size_pct"]
     for c in checks["combinations"]:
-        m, p = np.asarray(c["measured_pct"], float), np.asarray(c["predicted_pct"], float)
+        m, p = np.asarray(c["measured_pct"], float), np.asarray(c[f"{main}_pct"], float)
         ok = np.isfinite(m) & (m >= least)
         terms = ", ".join(f"{PIVOT_SHORT[t['pivot']]} {t['coord']} {t['kind']} {t['size_pct']:+g}"
                           for t in c["terms"])  # fmt: skip
@@ -315,13 +342,14 @@ def plot_check(report: dict[str, Any], path: str | Path) -> Path:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.5, 6))
-    least = report["checks"].get("combined", {}).get("least_pct", 0.0)
-    sets = [(f"single errors at {s['size_pct']:+g} %", s["measured_pct"], s["predicted_pct"])
+    least = LEAST_SHARE * report["settings"]["size_pct"]
+    main = report["checks"]["predictors"][0]
+    sets = [(f"single errors at {s['size_pct']:+g} %", s["measured_pct"], s[main]["predicted_pct"])
             for s in report["checks"]["singles"].values()]  # fmt: skip
     combos = report["checks"]["combinations"]
     if combos:
         sets.append(("combinations", [c["measured_pct"] for c in combos],
-                     [c["predicted_pct"] for c in combos]))  # fmt: skip
+                     [c[f"{main}_pct"] for c in combos]))  # fmt: skip
     for label, m, p in sets:
         m, p = np.ravel(np.asarray(m, float)), np.ravel(np.asarray(p, float))
         ok = np.isfinite(m) & np.isfinite(p) & (m > 0) & (p > 0)
@@ -333,7 +361,10 @@ def plot_check(report: dict[str, Any], path: str | Path) -> Path:
     ax.axvline(least, color="0.5", ls=":", lw=0.8, label=f"judged from {least:g} %")
     ax.set_xlabel("measured RMS change, % of the reference car's RMS")
     ax.set_ylabel("predicted RMS change, %")
-    ax.set_title("Predictor vs measured on held-out cases\n(every manoeuvre and output)")
+    ax.set_title(
+        f"{main.replace('_', ' ')} predictor vs measured on held-out cases\n"
+        "(every manoeuvre and output)"
+    )
     ax.legend(fontsize=8)
     fig.tight_layout()
     return write_figure(fig, path)

@@ -93,16 +93,23 @@ def test_the_gram_form_is_the_rms_of_the_superposed_histories():
 
 @pytest.fixture(scope="module")
 def campaign():
-    config = TransferConfig(DT, 10.0, ("pothole",), 0.6, 0, 2, (-1.0,))
+    config = TransferConfig(DT, 10.0, ("pothole",), 0.6, 0, 2, (2.0,))
     return config, run_transfer(config)
 
 
 def test_the_predictor_gives_back_its_own_singles_and_superposes_the_others(campaign, tmp_path):
     config, (report, pred) = campaign
-    pct = np.asarray(report["map_pct"])
+    pct, minus = np.asarray(report["map_pct"]), np.asarray(report["map_minus_pct"])
+    g = pred.gram  # basis: odd parts, then even parts; a + run is their sum
+    plus_gram = g[:, :, :48, :48] + g[:, :, 48:, 48:] + g[:, :, :48, 48:] + g[:, :, 48:, :48]
+    first = TransferPredictor(pred.manoeuvres, pred.outputs, pred.components, 10.0, plus_gram,
+                              pred.baseline_rms, pred.floors)  # fmt: skip
+    assert pred.order == 2 and g.shape[2:] == (96, 96)
     for j, c in enumerate(COMPONENTS):
-        np.testing.assert_allclose(pred.predict_pct([ErrorTerm(*c, 10.0)]), pct[j], rtol=1e-9)
-        np.testing.assert_allclose(pred.predict_pct([ErrorTerm(*c, -20.0)]), 2 * pct[j],
+        for size, want in ((10.0, pct[j]), (-10.0, minus[j])):  # exact at the built sizes
+            np.testing.assert_allclose(pred.predict_pct([ErrorTerm(*c, size)]), want,
+                                       rtol=1e-9, atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(first.predict_pct([ErrorTerm(*c, -20.0)]), 2 * pct[j],
                                    rtol=1e-9)  # fmt: skip
     assert np.all(pred.predict_rms([]) == 0)
     path = tmp_path / "p.npz"
@@ -121,7 +128,7 @@ def test_a_campaign_repeats_to_the_last_bit_and_its_cars_ran_to_the_end(campaign
     for a, b in zip(report["checks"]["combinations"], again["checks"]["combinations"],
                     strict=True):  # fmt: skip
         np.testing.assert_array_equal(a["measured_pct"], b["measured_pct"])
-    assert report["ended"] == [] and report["cars"] == 1 + 2 * len(COMPONENTS) + 2
+    assert report["ended"] == [] and report["cars"] == 1 + 3 * len(COMPONENTS) + 2
 
 
 def test_a_symmetric_error_on_a_symmetric_bump_rolls_nothing_and_a_one_sided_one_does():
@@ -146,10 +153,11 @@ def test_combinations_are_drawn_from_the_seed_within_the_stated_sizes():
 def test_the_command_writes_its_report_and_refuses_a_bad_size(tmp_path, capsys):
     out = tmp_path / "t"
     args = ["vehicle-transfer", "--out", str(out), "--manoeuvres", "pothole",
-            "--duration-s", "0.8", "--combinations", "1", "--held", "-1", "--quiet"]  # fmt: skip
+            "--duration-s", "0.8", "--combinations", "1", "--quiet"]  # fmt: skip
     assert main(args) == 0
     text = capsys.readouterr().out
-    assert "**Predictor**" in text and ("Never reach" in text or "Every component" in text)
+    assert "**Predictor, second order**" in text
+    assert "Never reach" in text or "Every component" in text
     for name in ("transfer.md", "transfer.json", "transfer_map.csv", "transfer_predictor.npz",
                  "transfer_map.png", "transfer_check.png"):  # fmt: skip
         assert (out / name).stat().st_size > 0
@@ -161,6 +169,8 @@ def test_the_command_writes_its_report_and_refuses_a_bad_size(tmp_path, capsys):
     assert "--size-pct must be in (0, 15] %, got 40.0" in capsys.readouterr().err
     assert main(["vehicle-transfer", "--out", str(out), "--held=0"]) == 2
     assert "--held 0.0: non-zero" in capsys.readouterr().err
+    assert main(["vehicle-transfer", "--out", str(out), "--held=-1"]) == 2
+    assert "--held -1.0: the predictor is built on it" in capsys.readouterr().err
     assert main(["vehicle-transfer", "--out", str(out), "--combinations", "-1"]) == 2
     assert "--combinations must be >= 0, got -1" in capsys.readouterr().err
 
@@ -176,8 +186,10 @@ def test_findings_name_the_errors_below_a_tenth_and_above_the_size():
         "map_rms": pct / 100, "manoeuvres": [{"name": "bump"}],
         "outputs": [{"name": "roll", "unit": "rad"}, {"name": "camber", "unit": "rad"}],
         "in_car_component_pct": [[5.0], [10.0], [np.nan]],
-        "checks": {"singles": {"-1": {"influence": {"overall": 0.95}}}, "combinations": [],
-                   "combined": {"median_relative_error": 0.25, "cells": 3}},
+        "checks": {"predictors": ["second_order"],
+                   "singles": {"+2": {"second_order": {"influence": {"overall": 0.95}}}},
+                   "combinations": [],
+                   "combined": {"second_order": {"median_relative_error": 0.25, "cells": 3}}},
     }  # fmt: skip
     found = findings(report)
     assert [r["component"] for r in found["never_reach"]] == [comps[0]]
