@@ -4,12 +4,14 @@ its check on error combinations it was not built from.
 
 ``run_transfer(config, progress)`` runs the reference car once per manoeuvre, then one car per
 component error (4 pivots x 3 coordinates x 4 kinds, ``transfer_errors``) at the size
-``config.size_pct``, then the held-out cases (every single error at other sizes, and
-combinations of several errors at random sizes); it returns the report (plain values) and the
-``TransferPredictor``. Vehicle outputs are the comparison's (``compare.OUTPUTS``): dynamic wheel
-loads, roll, camber, track change, and the ISO 2631-1 weighted accelerations of the body
-(vertical Wk, lateral Wd); a change is the RMS of the difference history over the reference
-car's RMS (%), not stated where that RMS is below the output's floor.
+``config.size_pct`` (the map) and, for the second-order predictor, at minus that size, then the
+held-out cases (every single error at other sizes, and combinations of several errors at
+random sizes); it returns the report (plain values) and the ``TransferPredictor``
+(``config.order``; the first order is judged beside it on the same runs). Vehicle outputs are
+the comparison's (``compare.OUTPUTS``): dynamic wheel loads, roll, camber, track change, and
+the ISO 2631-1 weighted accelerations of the body (vertical Wk, lateral Wd); a change is the
+RMS of the difference history over the reference car's RMS (%), not stated where that RMS is
+below the output's floor.
 """
 
 from __future__ import annotations
