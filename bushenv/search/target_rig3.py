@@ -30,7 +30,7 @@ import numpy as np
 
 from bushenv.divergence import Verdict, judge
 from bushenv.errors import DIVERGENCE_RAISES, ModelRaised
-from bushenv.planar.static_estimate import static_stiffness3
+from bushenv.identify.static_estimate import coordinate_stiffness
 from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
 from bushenv.search.base import (
     Recorder,
@@ -99,9 +99,11 @@ ROTATION_LEVER_M = 0.04
 
 @lru_cache(maxsize=8)
 def _builtin_stiffness(dt: float) -> np.ndarray:
-    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.common import resolve_model
 
-    return static_stiffness3(resolve_planar("reference", dt, "reference"))
+    return coordinate_stiffness(
+        resolve_model("reference", dt=dt, coords=3, what="reference", env_id="BushRig3-v0")
+    )
 
 
 def reference_floors(reference) -> tuple[np.ndarray, str]:
@@ -109,7 +111,7 @@ def reference_floors(reference) -> tuple[np.ndarray, str]:
     static stiffness over the built-in reference's, per coordinate. A coordinate whose
     stiffness is not a positive number keeps the machine's floor (the vetting's holds then
     say why the reference cannot judge)."""
-    k, k0 = static_stiffness3(reference), _builtin_stiffness(reference.dt)
+    k, k0 = coordinate_stiffness(reference), _builtin_stiffness(reference.dt)
     ratio = np.where(np.isfinite(k) & (k > 0), k / k0, 1.0)
     floors = MACHINE_FLOORS * ratio
     text = ", ".join(f"{c} x{r:.3g}" for c, r in zip(COORDS, ratio, strict=True))
