@@ -1,4 +1,4 @@
-"""Certified planar training: the band holds the reference, the term is zero where a network
+"""Certified MIMO training: the band holds the reference, the term is zero where a network
 holds right and positive where it does not, its gradients are the implicit function theorem's,
 and a certified training leaves no out-of-band or unstable fixed point where the plain one did."""
 
@@ -6,18 +6,19 @@ import numpy as np
 import pytest
 import torch
 
-from bushenv.models.base import PAPER_DT
-from bushenv.models.planar_base import PlanarModelError
-from bushenv.planar.certified import (
-    PlanarCertifiedHolds,
-    PlanarProblem,
+from bushenv.identify import fit
+from bushenv.identify.mimo_certified import (
+    MimoCertifiedHolds,
+    MimoProblem,
     check,
     step_profile,
 )
-from bushenv.planar.fitting import PlanarNetworkOptions, fit_planar
-from bushenv.planar.programme import random_independent
-from bushenv.planar.static_estimate import planar_static_estimate
-from bushenv.planar.train import _Net
+from bushenv.identify.mimo_options import MimoOptions
+from bushenv.identify.mimo_train import _Net
+from bushenv.identify.static_estimate import static_estimate
+from bushenv.models.base import PAPER_DT
+from bushenv.models.planar_base import PlanarModelError
+from bushenv.motions import random_independent
 from bushenv.reference.planar import PlanarRubber
 
 
@@ -29,7 +30,7 @@ def record():
 
 @pytest.fixture(scope="module")
 def estimate(record):
-    return planar_static_estimate([record], PAPER_DT)
+    return static_estimate([record], PAPER_DT)
 
 
 def test_the_estimate_finds_each_coordinates_slow_stiffness(estimate):
@@ -41,7 +42,7 @@ def test_the_estimate_finds_each_coordinates_slow_stiffness(estimate):
 
 
 def test_the_reference_holds_inside_the_band_everywhere_on_the_box(estimate):
-    term = PlanarCertifiedHolds(1.0)
+    term = MimoCertifiedHolds(1.0)
     q = term.check_holds_q()
     f = PlanarRubber.preset(seed=0).simulate(step_profile(q, PAPER_DT, hold_s=1.0))[-1]
     sign, lo, hi, scale = estimate.band(q, term.low, term.high)
@@ -58,7 +59,7 @@ def test_the_reference_holds_inside_the_band_everywhere_on_the_box(estimate):
 
 
 def _problem(estimate, k=None):
-    return PlanarProblem(
+    return MimoProblem(
         q_offset=np.zeros(3),
         q_scale=np.array([2e-3, 2e-3, 0.05]),
         f_offset=np.array([10.0, -20.0, 3.0]),
@@ -81,7 +82,7 @@ def _quiet_net(problem, shift=0.0, hidden=6, seed=0):
 
 def test_the_term_is_zero_for_a_network_that_holds_right_and_positive_otherwise(estimate):
     problem = _problem(estimate)
-    term = PlanarCertifiedHolds(1.0)
+    term = MimoCertifiedHolds(1.0)
     good = _quiet_net(problem)
     assert term(good, problem).item() == 0.0
     assert term.check(_model(good, problem), estimate)["admitted"]
@@ -126,7 +127,7 @@ def _lively_net(problem, seed=3):
 def test_fixed_points_and_spectral_radius_match_the_certificate(estimate):
     problem = _problem(estimate)
     net = _lively_net(problem)
-    term = PlanarCertifiedHolds(1.0)
+    term = MimoCertifiedHolds(1.0)
     q = term.holds_q(0)
     parts = term.penalties(net, problem, q)
     fp = parts["fixed_points"]
@@ -142,7 +143,7 @@ def test_fixed_points_and_spectral_radius_match_the_certificate(estimate):
 def test_gradients_match_finite_differences_of_re_solved_fixed_points(estimate):
     problem = _problem(estimate)
     net = _lively_net(problem)
-    term = PlanarCertifiedHolds(1.0)
+    term = MimoCertifiedHolds(1.0)
     q = term.holds_q(0)[:8]
     rng = np.random.default_rng(0)
     r_force = torch.from_numpy(rng.normal(size=(8, 3)) / problem.f_scale)
@@ -173,7 +174,7 @@ def test_gradients_match_finite_differences_of_re_solved_fixed_points(estimate):
 def test_the_whole_term_has_the_gradient_of_its_value(estimate):
     problem = _problem(estimate)
     net = _lively_net(problem, seed=5)
-    term = PlanarCertifiedHolds(1.0, holds=7)
+    term = MimoCertifiedHolds(1.0, holds=7)
 
     def value():
         term.calls = 0
@@ -196,7 +197,7 @@ def test_the_whole_term_has_the_gradient_of_its_value(estimate):
 
 
 def test_the_holds_cover_single_coordinates_pairs_and_the_box():
-    term = PlanarCertifiedHolds(1.0)
+    term = MimoCertifiedHolds(1.0)
     q = np.vstack([term.holds_q(c) for c in range(20)])
     moved = q != 0
     for pattern in ((1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (0, 1, 1), (1, 1, 1)):
@@ -207,13 +208,13 @@ def test_the_holds_cover_single_coordinates_pairs_and_the_box():
 
 
 def test_options_refuse_a_band_without_one_and_the_bouc_wen_hybrid():
+    from bushenv.identify.mimo import HybridBWOptions
     from bushenv.identify.options import options_of
-    from bushenv.planar.fitting import PlanarHybridBWOptions
 
     with pytest.raises(PlanarModelError, match="certified_low"):
-        options_of(PlanarNetworkOptions, {"certified_low": "1.2"}, "hybrid")
+        options_of(MimoOptions, {"certified_low": "1.2"}, "hybrid")
     with pytest.raises(PlanarModelError, match="hybrid-bw"):
-        options_of(PlanarHybridBWOptions, {"certified": "on"}, "hybrid-bw")
+        options_of(HybridBWOptions, {"certified": "on"}, "hybrid-bw")
 
 
 DEFAULT = {}  # the default budgets: about a minute certified on the shared machine
@@ -223,10 +224,10 @@ DEFAULT = {}  # the default budgets: about a minute certified on the shared mach
 def test_a_certified_training_holds_where_the_plain_one_does_not(record, estimate):
     q, f = record
     n = q.shape[0] - int(0.2 * q.shape[0])
-    est = planar_static_estimate([(q[:n], f[:n])], PAPER_DT)
-    plain = fit_planar([record], "hybrid", DEFAULT, dt=PAPER_DT, seed=0).model
-    cert = fit_planar([record], "hybrid", {**DEFAULT, "certified": "on"}, dt=PAPER_DT, seed=0)
-    grid = PlanarCertifiedHolds(1.0).check_holds_q()
+    est = static_estimate([(q[:n], f[:n])], PAPER_DT)
+    plain = fit([record], "hybrid", DEFAULT, 0, progress=False, dt=PAPER_DT).model
+    cert = fit([record], "hybrid", {**DEFAULT, "certified": "on"}, 0, progress=False, dt=PAPER_DT)
+    grid = MimoCertifiedHolds(1.0).check_holds_q()
     before, after = check(plain, est, grid), check(cert.model, est, grid)
     assert before["out_of_band"] > 0
     assert after["out_of_band"] == 0 and after["unstable"] == 0

@@ -1,15 +1,17 @@
-"""The hybrid's one-step-ahead training: mini-batches and noise on the fed-back outputs."""
+"""The three-axis hybrid's one-step-ahead training: mini-batches and noise on the fed-back
+outputs."""
 
 import numpy as np
 import pytest
 
 from bushenv.excitation import random_rpc
+from bushenv.identify import options_class
+from bushenv.identify.mimo_options import NOISY_FEEDBACK_TRAINING, default_options
+from bushenv.identify.mimo_options import MimoOptions as TrainOptions
+from bushenv.identify.mimo_train import fit_mimo
 from bushenv.identify.options import options_of
 from bushenv.metrics import rms_ratio
 from bushenv.models.planar_base import PlanarModelError
-from bushenv.planar.fitting import options_class
-from bushenv.planar.train import TrainOptions, fit_planar_network
-from bushenv.planar.train_options import NOISY_FEEDBACK_TRAINING, default_options
 
 DT = 1 / 250
 PEAKS = np.array([3e-3, 3e-3, 0.1])
@@ -46,7 +48,7 @@ def _unseen_error(noise, steps=2000):
     opt = TrainOptions(
         teacher_steps=steps, teacher_batch=512, feedback_noise=noise, free_run_steps=0
     )
-    model = fit_planar_network(q, _bushing(q), DT, "hybrid", opt, seed=0)
+    model = fit_mimo(q, _bushing(q), DT, "hybrid", opt, seed=0)
     ft, pred = _bushing(qt), model.simulate(qt)
     return max(rms_ratio(ft[:, i], pred[:, i]) for i in range(3))
 
@@ -60,19 +62,19 @@ def test_noisy_feedback_halves_the_free_run_error_on_an_unseen_record():
 def test_every_network_gets_the_plain_training_unless_the_hybrid_asks_for_noisy_feedback():
     for kind in ("nn", "nn-axis", "hybrid"):
         assert default_options(kind) == TrainOptions()
-        assert options_class(kind)().train_options() == TrainOptions()
-    assert options_class("hybrid-bw")().train_options() == TrainOptions()
-    noisy = options_of(options_class("hybrid"), {"training": "noisy-feedback"}, "hybrid")
+        assert options_class(kind, 3)().train_options() == TrainOptions()
+    assert options_class("hybrid-bw", 3)().train_options() == TrainOptions()
+    noisy = options_of(options_class("hybrid", 3), {"training": "noisy-feedback"}, "hybrid")
     assert noisy.train_options() == TrainOptions(**NOISY_FEEDBACK_TRAINING)
     assert NOISY_FEEDBACK_TRAINING["hidden"] == 54 and NOISY_FEEDBACK_TRAINING["feedback_noise"]
 
 
 def test_a_flag_given_beside_the_training_wins():
     given = {"training": "noisy-feedback", "hidden": 81, "certified": "on"}
-    opts = options_of(options_class("hybrid"), given, "hybrid")
+    opts = options_of(options_class("hybrid", 3), given, "hybrid")
     assert opts.hidden == 81 and opts.teacher_batch == 2048 and opts.certified == "on"
     with pytest.raises(Exception, match="training"):
-        options_of(options_class("hybrid"), {"training": "fast"}, "hybrid")
+        options_of(options_class("hybrid", 3), {"training": "fast"}, "hybrid")
 
 
 def test_mini_batch_training_is_deterministic_given_the_seed():
@@ -80,9 +82,9 @@ def test_mini_batch_training_is_deterministic_given_the_seed():
     f = _bushing(q)
     opt = TrainOptions(hidden=6, teacher_steps=30, teacher_batch=64, feedback_noise=0.1,
                        free_run_steps=2, window=16, windows=4, eval_every=1)  # fmt: skip
-    a = fit_planar_network(q, f, DT, "hybrid", opt, seed=2)
-    b = fit_planar_network(q, f, DT, "hybrid", opt, seed=2)
-    c = fit_planar_network(q, f, DT, "hybrid", opt, seed=3)
+    a = fit_mimo(q, f, DT, "hybrid", opt, seed=2)
+    b = fit_mimo(q, f, DT, "hybrid", opt, seed=2)
+    c = fit_mimo(q, f, DT, "hybrid", opt, seed=3)
     np.testing.assert_array_equal(a.w1, b.w1)
     assert not np.array_equal(a.w1, c.w1)
 
@@ -92,4 +94,4 @@ def test_mini_batch_training_is_deterministic_given_the_seed():
 )
 def test_bad_batch_or_noise_is_refused_naming_it(given):
     with pytest.raises(PlanarModelError, match="teacher_batch .* feedback_noise"):
-        options_of(options_class("hybrid"), given, "hybrid")
+        options_of(options_class("hybrid", 3), given, "hybrid")

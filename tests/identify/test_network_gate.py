@@ -4,11 +4,12 @@ tails of the training records (``--network if-better``, the default)."""
 import numpy as np
 import pytest
 
+from bushenv.identify import fit
+from bushenv.identify.mimo_options import MimoOptions as TrainOptions
+from bushenv.identify.mimo_train import fit_mimo
 from bushenv.models.base import PAPER_DT
 from bushenv.models.planar_linear import PlanarLinear
-from bushenv.planar.fitting import fit_planar
-from bushenv.planar.programme import random_correlated
-from bushenv.planar.train import TrainOptions, fit_planar_network
+from bushenv.motions import random_correlated
 from bushenv.reference.planar import PlanarRubber
 
 OPT = TrainOptions(hidden=9, teacher_steps=100, free_run_steps=25, windows=8, window=32)
@@ -29,20 +30,20 @@ def _misleading(q):
 
 def test_a_network_worse_than_its_backbone_on_the_tails_is_dropped(q):
     f = _misleading(q)
-    gated = fit_planar_network(q, f, PAPER_DT, "hybrid", OPT, seed=1, may_drop=True)
+    gated = fit_mimo(q, f, PAPER_DT, "hybrid", OPT, seed=1, may_drop=True)
     gate = gated.training["network"]
     assert gate["dropped"] and gate["backbone_alone"] < gate["with_network"]
     # the model is then its backbone alone, to round-off
     alone = gated.backbone_alone().simulate(q)
     np.testing.assert_allclose(gated.simulate(q), alone, rtol=0, atol=1e-9)
-    kept = fit_planar_network(q, f, PAPER_DT, "hybrid", OPT, seed=1)  # no gate: kept as trained
+    kept = fit_mimo(q, f, PAPER_DT, "hybrid", OPT, seed=1)  # no gate: kept as trained
     assert "network" not in getattr(kept, "training", {})
     assert np.abs(kept.simulate(q) - alone).max() > 10.0
 
 
 def test_a_network_that_helps_is_kept(q):
     f = PlanarRubber.preset(seed=3).simulate(q)
-    model = fit_planar_network(q, f, PAPER_DT, "hybrid", OPT, seed=1, may_drop=True)
+    model = fit_mimo(q, f, PAPER_DT, "hybrid", OPT, seed=1, may_drop=True)
     gate = model.training["network"]
     assert not gate["dropped"] and gate["with_network"] < 0.9 * gate["backbone_alone"]
 
@@ -50,20 +51,20 @@ def test_a_network_that_helps_is_kept(q):
 @pytest.mark.parametrize("given, dropped", [({}, True), ({"network": "always"}, False)])
 def test_the_fit_says_which_and_always_keeps_it(q, given, dropped):
     opts = {"hidden": 9, "teacher_steps": 100, "free_run_steps": 25, "windows": 8, "window": 32}
-    fit = fit_planar([(q, _misleading(q))], "hybrid", {**opts, **given}, PAPER_DT, seed=1)
+    result = fit([(q, _misleading(q))], "hybrid", {**opts, **given}, 1, False, dt=PAPER_DT)
     if dropped:
-        assert fit.info["network"].startswith("DROPPED (the backbone alone is the model)")
+        assert result.info["network"].startswith("DROPPED (the backbone alone is the model)")
     else:
-        assert "network" not in fit.info
+        assert "network" not in result.info
 
 
 def test_hybrid_bw_drops_a_network_that_does_not_help(q):
     f = _misleading(q)
     opts = {"hidden": 9, "teacher_steps": 100, "free_run_steps": 25, "windows": 8, "window": 32,
             "evaluations": 4, "time_limit_s": 0.0}  # fmt: skip
-    fit = fit_planar([(q, f)], "hybrid-bw", opts, PAPER_DT, seed=1)
-    assert fit.info["network"].startswith("DROPPED")
-    model = fit.model
+    result = fit([(q, f)], "hybrid-bw", opts, 1, False, dt=PAPER_DT)
+    assert result.info["network"].startswith("DROPPED")
+    model = result.model
     np.testing.assert_allclose(
         model.simulate(q), model.backbone_alone().simulate(q), rtol=0, atol=1e-9
     )

@@ -1,14 +1,16 @@
-"""Planar networks: per-axis independence, step = simulate, files, hybrid bound, training."""
+"""The MIMO networks (three axes): per-axis independence, step = simulate, files, hybrid
+bound, training."""
 
 import numpy as np
 import pytest
 
 from bushenv.excitation import random_rpc
+from bushenv.identify.mimo_options import MimoOptions as TrainOptions
+from bushenv.identify.mimo_train import fit_mimo
 from bushenv.metrics import rms_ratio
 from bushenv.models import load_model
 from bushenv.models.planar_base import PlanarModelError
 from bushenv.models.planar_narx import N_IN, PlanarHybrid, PlanarNarx, PlanarNarxPerAxis, axis_masks
-from bushenv.planar.train import TrainOptions, fit_planar_network
 from bushenv.reference.planar import THETA_N1_RAD, PlanarRubber
 
 DT = 1 / 204.8
@@ -97,8 +99,8 @@ def test_tiny_training_learns_the_record_and_is_deterministic():
     opt = TrainOptions(
         hidden=9, teacher_steps=150, free_run_steps=4, windows=8, window=32, eval_every=2
     )
-    a = fit_planar_network(q, f, DT, kind="nn", options=opt, seed=1)
-    b = fit_planar_network(q, f, DT, kind="nn", options=opt, seed=1)
+    a = fit_mimo(q, f, DT, kind="nn", options=opt, seed=1)
+    b = fit_mimo(q, f, DT, kind="nn", options=opt, seed=1)
     np.testing.assert_array_equal(a.w1, b.w1)
     pred = a.simulate(q)
     assert max(rms_ratio(f[:, i], pred[:, i]) for i in range(3)) < 0.5
@@ -106,22 +108,22 @@ def test_tiny_training_learns_the_record_and_is_deterministic():
 
 def test_training_rejects_short_or_misshapen_records():
     with pytest.raises(PlanarModelError, match="100 samples in 1 record"):
-        fit_planar_network(np.zeros((100, 3)), np.zeros((100, 3)), DT)
+        fit_mimo(np.zeros((100, 3)), np.zeros((100, 3)), DT)
     with pytest.raises(PlanarModelError, match=r"\(T, 3\)"):
-        fit_planar_network(np.zeros((4000, 2)), np.zeros((4000, 2)), DT)
+        fit_mimo(np.zeros((4000, 2)), np.zeros((4000, 2)), DT)
     with pytest.raises(PlanarModelError, match="record 2: 30 samples cannot be split"):
         records = [np.zeros((4000, 3)), np.zeros((30, 3))]
-        fit_planar_network(records, records, DT)
+        fit_mimo(records, records, DT)
     with pytest.raises(PlanarModelError, match="two lists of equal length"):
-        fit_planar_network([np.zeros((4000, 3))] * 2, [np.zeros((4000, 3))], DT)
+        fit_mimo([np.zeros((4000, 3))] * 2, [np.zeros((4000, 3))], DT)
 
 
 def test_a_list_of_one_record_is_the_record_and_two_records_keep_their_own_tails():
     q, f = _record()
     opt = TrainOptions(hidden=9, teacher_steps=40, free_run_steps=4, windows=8, window=32,
                        eval_every=2)  # fmt: skip
-    one = fit_planar_network(q, f, DT, kind="nn", options=opt, seed=1)
-    listed = fit_planar_network([q], [f], DT, kind="nn", options=opt, seed=1)
+    one = fit_mimo(q, f, DT, kind="nn", options=opt, seed=1)
+    listed = fit_mimo([q], [f], DT, kind="nn", options=opt, seed=1)
     np.testing.assert_array_equal(one.w1, listed.w1)
 
 
@@ -136,9 +138,9 @@ def test_each_record_keeps_its_own_tail_out_of_training():
     def fit_with(k, rows):  # record k's force reversed in time over ``rows``: same range
         g = [a.copy() for a in fs]
         g[k][rows] = fs[k][rows][::-1]
-        return fit_planar_network(qs, g, DT, "nn", opt, seed=1).w1
+        return fit_mimo(qs, g, DT, "nn", opt, seed=1).w1
 
-    plain = fit_planar_network(qs, fs, DT, "nn", opt, seed=1).w1
+    plain = fit_mimo(qs, fs, DT, "nn", opt, seed=1).w1
     # the first record's tail only validates (joined end to end it would have trained) ...
     np.testing.assert_array_equal(fit_with(0, slice(half - n, half)), plain)
     # ... and the second record's head trains (joined, the tail was all of it that counted)
@@ -146,7 +148,7 @@ def test_each_record_keeps_its_own_tail_out_of_training():
 
 
 def test_free_run_windows_never_reach_across_two_records():
-    from bushenv.planar.train import _window_starts
+    from bushenv.identify.mimo_train import _window_starts
 
     starts = _window_starts([100, 40, 70], 32)
     ends = np.array([100, 140, 210])
@@ -156,14 +158,14 @@ def test_free_run_windows_never_reach_across_two_records():
         assert s + 32 <= ends[record]  # its last row is inside the same record
     assert len(_window_starts([20, 100], 32)) == 100 - 32  # too short for a window: none
     with pytest.raises(PlanarModelError, match="known"):
-        fit_planar_network(np.zeros((4000, 3)), np.zeros((4000, 3)), DT, kind="lstm")
+        fit_mimo(np.zeros((4000, 3)), np.zeros((4000, 3)), DT, kind="lstm")
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("kind", ["nn", "nn-axis", "hybrid"])
 def test_default_training_reaches_15_percent_on_unseen_record(kind):
     q, f = _record(T=8192, seed=10)
-    m = fit_planar_network(q, f, DT, kind=kind, seed=0)
+    m = fit_mimo(q, f, DT, kind=kind, seed=0)
     qt, ft = _record(T=2048, seed=40)
     pred = m.simulate(qt)
     assert max(rms_ratio(ft[:, i], pred[:, i]) for i in range(3)) < 0.15
