@@ -28,7 +28,7 @@ from bushenv.persist import write_json, write_text
 from bushenv.progress import Progress, format_seconds
 
 EXAMPLE = "bushenv vehicle --out runs/vehicle"
-SEARCH_BUDGET = 96  # car runs per searcher and kind: about 2 min for three kinds on 2 cores
+SEARCH_BUDGET = 96  # runs per searcher and kind: 185 s of search for three kinds (load 12)
 
 
 def _names(text: str) -> list[str]:
@@ -136,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
     from bushenv.rigs.halfcar_params import ENV_ID
     from bushenv.rigs.specs import spec_kwargs
     from bushenv.vehicle.bushings import Recipe, check_kinds, vehicle_bushings
-    from bushenv.vehicle.manoeuvres import standard_manoeuvres
+    from bushenv.vehicle.manoeuvres import NAMES, standard_manoeuvres
     from bushenv.vehicle.report import markdown, plot_manoeuvre
     from bushenv.vehicle.study import REFERENCE_CAR, UPPER_ONLY, run_vehicle
 
@@ -148,6 +148,11 @@ def run(args: argparse.Namespace) -> int:
     kinds = check_kinds(args.kinds)
     if not args.search and (args.corpus is not None or args.budget is not None):
         raise CliError("--budget and --corpus are options of --search; add --search")
+    if args.search and (args.duration_s is not None or list(args.manoeuvres) != list(NAMES)):
+        raise CliError(
+            "--manoeuvres and --duration-s choose the comparison's manoeuvres; "
+            "--search judges its finds against all seven standard ones as they are"
+        )
     files = {k: getattr(args, f"file_{k.replace('-', '_')}") for k in names_for(3, fittable=True)}
     files = {k: f for k, f in files.items() if f is not None}
     unused = sorted(set(files) - set(kinds))

@@ -13,6 +13,7 @@ pivot and coordinate carry the found difference (``adversary_blame``).
 
 from __future__ import annotations
 
+import re
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -171,8 +172,8 @@ def attack_kind(kind: str, model, reference, config: AdversaryConfig, manoeuvres
             base = progress.done
 
             def said(line: str, base=base) -> None:
-                done = int(line.split()[1].split("/")[0]) if "/" in line else 0
-                progress.update(base + done, f"{kind}: {line}")
+                done = re.search(r"(\d+)/\d+ evals", line)  # the searchers' own count
+                progress.update(base + (int(done.group(1)) if done else 0), f"{kind}: {line}")
 
             r = SEARCHERS[name].make().run(ev, config.budget, seed=config.seed, progress=said)
             progress.update(base + config.budget, f"{kind}: {name} done", force=True)

@@ -163,3 +163,5 @@ def test_search_options_without_search_and_unknown_searchers_are_refused(tmp_pat
     assert code == 2 and "the half car takes random and cma" in capsys.readouterr().err
     assert main(["attack", "--env", "halfcar", "--budget", "2", "--quiet"]) == 2
     assert "searched by `bushenv vehicle --search`" in capsys.readouterr().err
+    assert main(["vehicle", "--search", "--out", str(tmp_path), "--manoeuvres", "bump"]) == 2
+    assert "--search judges its finds against all seven" in capsys.readouterr().err
