@@ -11,8 +11,8 @@ the same searchers and the same budget per search:
   coordinate at a time, the others at rest; random search draws the coordinate, CMA-ES searches
   it). A member passes when no profile fails in the coordinate it drives, on any axis: that is
   all a single-axis rig measures. A failure in a coordinate at rest is counted apart;
-- its hold check (``planar.certified.check``, certified or not): fixed points over a 7^3 grid
-  of the rig3 box, out of the records' static band, unstable, or not settling after a step;
+- its hold check (``identify.mimo_certified.check``, certified or not): fixed points over a
+  7^3 grid of the rig3 box, out of the records' static band, unstable, or not settling after a step;
 - the attack across axes: each searcher over the planar families (``campaign_planar``'s search);
   its failures in a coordinate the profile moves are counted apart too (a member whose only
   failures are force in a coordinate held at rest has wrong coupling, not a runaway).
@@ -29,9 +29,9 @@ from typing import Any
 import numpy as np
 
 from bushenv import metrics
+from bushenv.identify import fit as fit_model
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.fitting import fit_planar
-from bushenv.planar.programme import random_correlated, random_independent
+from bushenv.motions import random_correlated, random_independent
 from bushenv.reference.planar import PlanarRubber
 from bushenv.search.campaign_planar import DEFAULT_REFERENCE, planar_search, tally
 from bushenv.search.families_planar import COORDS
@@ -39,8 +39,8 @@ from bushenv.search.planar_models import resolve_planar_spec
 from bushenv.zoo.summary import shown_options
 
 TRAIN_S, UNSEEN_S = 60.0, 20.0
-# The planar training's two stages (``planar.train``): one step ahead only, or then free-run
-# windows too (the default training); the recipes' names are the one-axis zoo's.
+# The MIMO training's two stages (``identify.mimo_train``): one step ahead only, or then
+# free-run windows too (the default training); the recipes' names are the one-axis zoo's.
 PLANAR_RECIPES = {"teacher-forcing": {"free_run_steps": 0}, "free-run": {}}
 
 
@@ -50,16 +50,16 @@ def planar_cell_name(cell: dict[str, Any]) -> str:
 
 
 def _certificate(model, train) -> dict[str, Any]:
-    """The planar hold check (``planar.certified.check``: fixed points over the 7^3 grid of the
-    rig3 box, their static force against the training record's estimate, their spectral
+    """The MIMO hold check (``identify.mimo_certified.check``: fixed points over the 7^3 grid of
+    the rig3 box, their static force against the training record's estimate, their spectral
     radius, the run after a step) of any member, certified or not."""
-    from bushenv.planar.certified import PlanarCertifiedHolds
-    from bushenv.planar.static_estimate import planar_static_estimate
+    from bushenv.identify.mimo_certified import MimoCertifiedHolds
+    from bushenv.identify.static_estimate import static_estimate
 
     q, f = train
     n = q.shape[0] - int(0.2 * q.shape[0])  # the training part (the default val_fraction)
-    estimate = planar_static_estimate([(q[:n], f[:n])], PAPER_DT)
-    out = PlanarCertifiedHolds(1.0).check(model, estimate)
+    estimate = static_estimate([(q[:n], f[:n])], PAPER_DT, COORDS)
+    out = MimoCertifiedHolds(1.0).check(model, estimate)
     out["failing_holds"] = len(out["failing_holds"])
     return out
 
@@ -155,7 +155,7 @@ def run_planar_cell(cell: dict[str, Any]) -> dict[str, Any]:
     options = {**PLANAR_RECIPES[cell["recipe"]], **cell.get("train_options", {})}
     if cell["model"] == "hybrid":  # a member is a network under study: never the backbone alone
         options.setdefault("network", "always")
-    fit = fit_planar([train], cell["model"], options, dt=PAPER_DT, seed=seed)
+    fit = fit_model([train], cell["model"], options, seed, progress=False, dt=PAPER_DT)
     model = fit.model
     path = model.save(Path(cell["out"]) / "models" / f"{planar_cell_name(cell)}.npz")
     reference = resolve_planar_spec(DEFAULT_REFERENCE, model.dt, "--reference")
