@@ -353,7 +353,7 @@ def test_any_mix_of_numbers_and_separators_loads_as_the_line_by_line_parser_does
 
 
 def test_one_record_type_reads_either_header_and_writes_it_back(tmp_path):
-    from bushenv.planar.records import HEADER_TEXT
+    from bushenv.record_columns import THREE_AXES
     from bushenv.record_files import load_record, save_record
 
     one = Record.from_arrays(np.sin(np.arange(50) * 0.1) * 1e-3, np.arange(50.0), 0.01)
@@ -365,7 +365,7 @@ def test_one_record_type_reads_either_header_and_writes_it_back(tmp_path):
     with pytest.raises(RecordError, match="write it with bushenv.record_files.save_record"):
         save_csv(three, tmp_path / "three.csv")
     save_record(three, tmp_path / "three.csv")
-    assert (tmp_path / "three.csv").read_text().splitlines()[0] == HEADER_TEXT
+    assert (tmp_path / "three.csv").read_text().splitlines()[0] == THREE_AXES.header_text
     a, b = load_record(tmp_path / "one.csv"), load_record(tmp_path / "three.csv")
     assert a.n_coords == 1 and a.q.shape == (50, 1) and a.source == str(tmp_path / "one.csv")
     assert b.n_coords == 3 and b.q.shape == (50, 3)

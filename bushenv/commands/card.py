@@ -18,24 +18,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _metric_text(m: dict | None) -> str:
-    """RMS ratio of a record: one figure, or per axis on a planar card."""
-    if not m:
+def _metric_text(m: dict | None, coords: list[str]) -> str:
+    """RMS ratio of a record: one figure for one coordinate, else one per coordinate."""
+    from bushenv.identify.card_text import per_coordinate
+
+    by = per_coordinate(m, coords)
+    if not by:
         return ""
-    if "rms_ratio" in m:
-        return f"RMS ratio {100 * m['rms_ratio']:.2f} %"
     cells = [
-        f"{c} {100 * m[c]['rms_ratio']:.2f} %" if m[c]["rms_ratio"] is not None else f"{c} -"
-        for c in m
+        f"{100 * v['rms_ratio']:.2f} %" if v["rms_ratio"] is not None else "-" for v in by.values()
     ]
-    return "RMS ratio " + ", ".join(cells)
+    if len(cells) == 1:
+        return f"RMS ratio {cells[0]}"
+    return "RMS ratio " + ", ".join(f"{c} {x}" for c, x in zip(by, cells, strict=True))
 
 
 def run(args: argparse.Namespace) -> int:
-    from bushenv.identify.card import CARD_FORMAT, load_card
-    from bushenv.planar.card import CARD_FORMAT as PLANAR_FORMAT
+    from bushenv.identify.card import load_card
+    from bushenv.identify.card_text import coordinates, coverage_lines
 
-    card = load_card(args.card, records=args.records, formats=(CARD_FORMAT, PLANAR_FORMAT))
+    card = load_card(args.card, records=args.records)
     d = card.data
     src = d["source"]
     print(
@@ -43,18 +45,15 @@ def run(args: argparse.Namespace) -> int:
         f"{d['sample_rate_hz']:.6g} Hz, made by {src['kind']} with bushenv {d['bushenv_version']}"
     )
     for r in card.records:
-        score = _metric_text(r.get("metrics"))
+        score = _metric_text(r.get("metrics"), coordinates(d))
         checked = (
             " (checked)" if (r["file"] or r["name"]).endswith(tuple(card.checked_records)) else ""
         )
         print(
             f"  {r['role']:9s} {r['file'] or r['name']}  {r['duration_s']:.1f} s  {score}{checked}"
         )
-    if d.get("format") == PLANAR_FORMAT:  # held-out records that judged extrapolation
-        from bushenv.planar.card import coverage_lines
-
-        for line in coverage_lines(d):
-            print(f"  {line}")
+    for line in coverage_lines(d):  # what the training records did not show
+        print(f"  {line}")
     if args.records:
         print(f"{len(args.records)} record file(s) match the card")
     return 0

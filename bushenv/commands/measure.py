@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from bushenv.machine import MachineError, MachineWarning, reference_for, run_programme
-from bushenv.models.base import PAPER_DT
+from bushenv.models.base import DT_TOLERANCE, PAPER_DT
 from bushenv.persist import write_json
 from bushenv.programmes import (
     IDENTIFICATION_N,
@@ -81,10 +81,17 @@ def _model(args: argparse.Namespace, dt: float):
     from bushenv.models import MODELS, get_model
 
     wanted_by = "bushenv measure" + (f" --axes {args.axes}" if args.axes != 1 else "")
-    model = get_model(args.model, axis=args.axis, dt=dt, coords=args.axes, wanted_by=wanted_by)
-    name = args.model
-    if name in MODELS and "seed" in inspect.signature(type(model).preset).parameters:
-        return model, reference_for(name, args.axes, args.seed, dt, args.axis)
+    named = args.model in MODELS  # a preset is built at the rate; a file runs at its own
+    model = get_model(
+        args.model, axis=args.axis, dt=dt if named else None, coords=args.axes, wanted_by=wanted_by
+    )
+    if abs(model.dt - dt) > DT_TOLERANCE * dt:  # a fitted model runs only at its own rate
+        raise MachineError(
+            f"{args.model}: model sampled at {1 / model.dt:.6g} Hz, --rate is {1 / dt:.6g} Hz: "
+            f"pass --rate {1 / model.dt:.6g}"
+        )
+    if named and "seed" in inspect.signature(type(model).preset).parameters:
+        return model, reference_for(args.model, args.axes, args.seed, dt, args.axis)
     return model, model
 
 

@@ -110,18 +110,18 @@ def three_axis_files(paths: tuple[str, ...]) -> bool:
     three = [p for p, k in kinds.items() if k]
     one = [p for p, k in kinds.items() if not k]
     if three and one:
-        from bushenv.planar.records import HEADER_TEXT
+        from bushenv.record_columns import THREE_AXES
 
         raise DiagnoseError(
             f"{three[0]} is a three-axis record but {one[0]} is a one-axis record ({len(three)} "
             f"three-axis, {len(one)} one-axis): one diagnosis takes records of one kind; "
-            f"three-axis records have the header '{HEADER_TEXT}'"
+            f"three-axis records have the header '{THREE_AXES.header_text}'"
         )
     return bool(three)
 
 
 def _load_three_axis(config: DiagnoseConfig, say: Say) -> tuple[list, list]:
-    from bushenv.planar.records import load_planar_csv
+    from bushenv.record_files import load_record
 
     if config.max_displacement_m is not None or config.max_force_n is not None:
         raise DiagnoseError(
@@ -139,7 +139,7 @@ def _load_three_axis(config: DiagnoseConfig, say: Say) -> tuple[list, list]:
         recs = []
         for p in paths:
             say(f"loading {p} (three-axis)")
-            recs.append(load_planar_csv(p))
+            recs.append(load_record(p, coords=3))
         out.append(recs)
     return out[0], out[1]
 

@@ -1,20 +1,34 @@
-"""Model cards: what a model file was made from, with what, and how well it does on held-out data.
+"""Model cards: what a model file was made from, with what, and how well it does on held-out data,
+for a bushing of any number of coordinates C.
 
 ``MODEL.npz`` gets ``MODEL.card.json`` and ``MODEL.card.md`` beside it. The JSON holds:
 
-- ``format`` ("bushenv-model-card"), ``version``, ``bushenv_version``, ``created`` (UTC);
-- ``model`` (registry name), ``model_file`` (file name), ``model_sha256``, ``dt_s``;
+- ``format`` ("bushenv-model-card"; cards of three-axis fits written before the one card carry
+  "bushenv-planar-model-card" and read the same), ``version``, ``bushenv_version``,
+  ``created`` (UTC);
+- ``model`` (registry name), ``coords`` (the coordinates, in array order), ``model_file``,
+  ``model_sha256``, ``dt_s``;
 - ``source``: how it was made (``"fit"`` with ``seed``, ``wall_time_s``, ``options`` -- every
-  option with its value --, ``training`` summary; or ``"torch-import"`` with the torch file and
-  the stated scaling);
-- ``parameters``: the physical parameters of a physical model, by name, with their units
-  (linear and the hybrid's backbone: k and c; Bouc-Wen: its sixteen); null for the NN;
-- ``records``: each source record with ``role`` ("train" or "held-out"), ``file`` (relative
-  to the card's folder; cards before that hold absolute paths, read the same), ``sha256``
-  (of the file's bytes, or null for records made in memory), ``data_sha256`` (of the time,
-  displacement and force values as float64), ``samples``, ``sample_rate_hz``, ``duration_s``,
-  and ``metrics`` of the model's free run from rest on it (``bushenv.metrics.all_metrics``:
-  RMS ratio and ESR of seed 000 eqs 8-9, max error, NRMSE, ...; fractions and N);
+  option with its value --, ``training`` summary and ``info``, the identification's own notes;
+  or ``"torch-import"`` with the torch file and the stated scaling);
+- ``parameters``: the physical parameters of a physical model, by name, with their units; null
+  for a network;
+- ``records``: each source record (``card_records.record_entry``) with ``role`` ("train" or
+  "held-out"), ``file`` (relative to the card's folder; older cards hold absolute paths, read
+  the same), ``sha256`` (of the file's bytes, or null for records made in memory),
+  ``data_sha256``, ``samples``, ``sample_rate_hz``, ``duration_s``, its range, and ``metrics``
+  of the model's free run from rest on it (``bushenv.metrics.all_metrics``: RMS ratio and ESR
+  of seed 000 eqs 8-9, max error, NRMSE, ...; per coordinate over several, where a coordinate
+  held at rest with only noise measured has null ratios);
+- ``notes``: what the records hold that the models cannot follow (``record_notes.start_notes``);
+- ``training_range``: the training records' largest |deflection| per coordinate; held-out
+  records beyond it by more than ``BEYOND`` are named (``card_text.coverage_lines``);
+- ``coverage``: which held combinations of coordinates the training records showed
+  (``bushenv.identify.coverage``; none exist for C = 1) and each held-out record's
+  ``not_shown`` ones;
+- ``holds`` (networks): their fixed points over the training range (``certify.range_holds``);
+- ``backbone`` (a hybrid with held-out records): its backbone alone on each, so the card says
+  what the network adds;
 - ``plots``: file names of the figures beside the card.
 
 ``load_card(path, records=...)`` reads a card and checks it: the model file beside it still has
@@ -24,21 +38,25 @@ the recorded hash, and each given record file matches the card's record of the s
 from __future__ import annotations
 
 import datetime
-import hashlib
 import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from bushenv.errors import BadInput
+from bushenv.identify.card_records import (
+    data_sha256,
+    free_run_metrics,
+    record_entry,
+    record_name,
+    sha256_file,
+)
 from bushenv.identify.parameters import physical_parameters
-from bushenv.metrics import all_metrics
 from bushenv.persist import plain, write_json, write_text
 
 CARD_FORMAT = "bushenv-model-card"
+LEGACY_FORMATS = ("bushenv-planar-model-card",)  # three-axis cards before the one card
 CARD_VERSION = 1
 
 
@@ -53,87 +71,6 @@ def card_paths(model_path: str | os.PathLike) -> tuple[Path, Path]:
     return p.with_name(stem + ".card.json"), p.with_name(stem + ".card.md")
 
 
-def sha256_file(path: str | os.PathLike) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
-def data_sha256(record: Any) -> str:
-    """sha256 of a record's time, displacement and force values (float64, little-endian)."""
-    h = hashlib.sha256()
-    for key in ("time", "displacement", "force"):
-        h.update(np.ascontiguousarray(getattr(record, key), dtype="<f8").tobytes())
-    return h.hexdigest()
-
-
-def record_entry(
-    record: Any, role: str, model: Any | None = None, card_dir: str | os.PathLike | None = None
-) -> dict[str, Any]:
-    """A card's description of ``record`` (and the model's metrics on it, if given); its file
-    relative to ``card_dir`` when given, so a card moved with its records still finds them."""
-    path = getattr(record, "path", None)
-    file = os.fspath(path) if path is not None else None
-    if path is not None and card_dir is not None:
-        try:
-            file = os.path.relpath(path, card_dir)
-        except ValueError:  # another drive (Windows): no relative path exists
-            file = os.path.abspath(path)
-    entry = {
-        "role": role,
-        "name": getattr(record, "name", "") or (Path(path).stem if path else ""),
-        "file": file,
-        "sha256": sha256_file(path) if path is not None else None,
-        "data_sha256": data_sha256(record),
-        "samples": len(record.force),
-        "sample_rate_hz": float(record.sample_rate_hz),
-        "duration_s": float(record.duration_s),
-        # the bushing's range on this record: attacks scale their search to it (bushenv.scales)
-        "max_abs_displacement_m": float(np.max(np.abs(record.displacement))),
-        "max_abs_velocity_m_per_s": float(
-            np.max(np.abs(np.diff(record.displacement))) * record.sample_rate_hz
-        ),
-        "max_abs_force_n": float(np.max(np.abs(record.force))),
-        # what the record says about the bushing's static behaviour (bushenv.scales)
-        "quasi_static_share": quasi_static_share(record.displacement, record.sample_rate_hz),
-        "longest_hold_s": longest_hold_s(record.displacement, record.sample_rate_hz),
-    }
-    if model is not None:
-        entry["metrics"] = free_run_metrics(model, record)
-    return entry
-
-
-def quasi_static_share(x: np.ndarray, rate_hz: float, below_hz: float = 1.0) -> float:
-    """Share of the displacement's power at or below ``below_hz`` (Welch estimate)."""
-    from scipy import signal
-
-    x = np.asarray(x, dtype=np.float64)
-    n = min(x.size, int(rate_hz * 16))
-    if n < 8:
-        return 0.0
-    f, p = signal.welch(x - x.mean(), fs=rate_hz, nperseg=n)
-    total = float(np.sum(p))
-    return float(np.sum(p[f <= below_hz]) / total) if total > 0 else 0.0
-
-
-def longest_hold_s(x: np.ndarray, rate_hz: float, tolerance_m: float = 1e-9) -> float:
-    """Longest run of samples at one displacement, s."""
-    moving = np.abs(np.diff(np.asarray(x, dtype=np.float64))) >= tolerance_m
-    longest = run = 0
-    for m in moving:
-        run = 0 if m else run + 1
-        longest = max(longest, run)
-    return longest / rate_hz
-
-
-def free_run_metrics(model: Any, record: Any) -> dict[str, float]:
-    """Every metric of ``bushenv.metrics`` for the model's free run from rest on ``record``."""
-    model.reset(1)
-    return all_metrics(record.force, model.simulate(record.displacement))
-
-
 def new_card(model: Any, model_path: str | os.PathLike, source: dict[str, Any]) -> dict[str, Any]:
     """The card of a model just written to ``model_path`` (records and plots added later)."""
     from bushenv import __version__
@@ -144,6 +81,7 @@ def new_card(model: Any, model_path: str | os.PathLike, source: dict[str, Any]) 
         "bushenv_version": __version__,
         "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
         "model": model.name,
+        "coords": list(model.coords),
         "model_file": Path(model_path).name,
         "model_sha256": sha256_file(model_path),
         "dt_s": model.dt,
@@ -151,87 +89,17 @@ def new_card(model: Any, model_path: str | os.PathLike, source: dict[str, Any]) 
         "source": source,
         "parameters": physical_parameters(model),
         "records": [],
-        "plots": [],
     }
 
 
 def write_card(card: dict[str, Any], model_path: str | os.PathLike) -> tuple[Path, Path]:
     """Write the card's JSON and markdown beside the model (atomically)."""
+    from bushenv.identify.card_text import card_markdown
+
     json_path, md_path = card_paths(model_path)
     write_json(json_path, plain(card), indent=1)
-    write_text(md_path, card_markdown(card))
+    write_text(md_path, card_markdown(plain(card)))
     return json_path, md_path
-
-
-def _pct(v: float) -> str:
-    return f"{100 * v:.2f}"
-
-
-def card_markdown(card: dict[str, Any]) -> str:
-    """The card for people: what, from which records, how well, with which options."""
-    src = card["source"]
-    lines = [
-        f"# Model card: {card['model_file']}",
-        "",
-        f"- model: **{card['model']}**, {card['sample_rate_hz']:.6g} Hz "
-        f"(dt = {card['dt_s']:.6g} s); sha256 `{card['model_sha256']}`",
-        f"- made by: {src['kind']} with bushenv {card['bushenv_version']} on {card['created']}",
-    ]
-    if src["kind"] == "fit":
-        lines.append(f"- seed {src['seed']}, wall time {src['wall_time_s']:.1f} s")
-        if src.get("stopped"):
-            early = "**stopped early** by the time limit: " if src.get("time_limited") else ""
-            lines.append(f"- training ended: {early}{src['stopped']}")
-        if src.get("budget_used"):
-            used = ", ".join(f"{k} {v}" for k, v in src["budget_used"].items())
-            lines.append(f"- budget used: {used}")
-        if src.get("choice"):
-            lines.append(f"- network chosen on validation: {src['choice']['summary']}")
-        if src.get("note"):
-            lines.append(f"- **note**: {src['note']}")
-    else:
-        lines.append(f"- torch file `{src['torch_file']}`, sha256 `{src['torch_sha256']}`")
-    if card.get("parameters"):
-        lines += ["", "## Parameters", "", "| parameter | value | unit |", "|---|---:|---|"]
-        params = card["parameters"].items()
-        lines += [f"| {k} | {p['value']:.6g} | {p['unit']} |" for k, p in params]
-    lines += _records_table(card["records"])
-    lines += ["", "## Options", "", "| option | value |", "|---|---|"]
-    for k, v in src.get("options", {}).items():
-        lines.append(f"| {k} | {v} |")
-    for name in card["plots"]:
-        lines += ["", f"![{name}]({name})"]
-    return "\n".join(lines) + "\n"
-
-
-def _records_table(records: list[dict[str, Any]]) -> list[str]:
-    if not records:
-        return ["", "No records: the model was not identified here."]
-    out = [
-        "",
-        "## Records",
-        "",
-        "Free run from rest on each record. RMS ratio and ESR: seed 000 eqs 8-9; NRMSE: RMS "
-        "error over the standard deviation of the measured force.",
-        "",
-        "| role | record | rate Hz | duration s | RMS ratio % | ESR % | max error N | "
-        "NRMSE % | sha256 |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---|",
-    ]
-    for r in records:
-        m = r.get("metrics") or {}
-        cells = [
-            _pct(m["rms_ratio"]) if m else "",
-            _pct(m["esr"]) if m else "",
-            f"{m['max_error']:.1f}" if m else "",
-            _pct(m["nrmse"]) if m else "",
-        ]
-        digest = (r["sha256"] or r["data_sha256"])[:16]
-        out.append(
-            f"| {r['role']} | {r['file'] or r['name']} | {r['sample_rate_hz']:.6g} | "
-            f"{r['duration_s']:.2f} | {' | '.join(cells)} | `{digest}` |"
-        )
-    return out
 
 
 @dataclass
@@ -306,14 +174,14 @@ def load_card(
     path: str | os.PathLike,
     records: list | None = None,
     check_model: bool = True,
-    formats: tuple[str, ...] = (CARD_FORMAT,),
+    formats: tuple[str, ...] = (CARD_FORMAT, *LEGACY_FORMATS),
 ) -> ModelCard:
     """Read the card of a model (``MODEL.card.json``, or ``MODEL.npz`` for the card beside it).
 
     Checks that the model file still has the card's hash (``check_model``) and that each of
     ``records`` (paths or ``Record`` objects) matches the card's record of the same file name;
     raises ``CardError`` naming the record or file that does not. ``formats``: the format
-    tags accepted (a planar card, ``bushenv.planar.card``, has the same model and record keys).
+    tags accepted (by default the card's and the three-axis cards' written before it).
     """
     p = Path(path)
     if p.suffix == ".npz":
@@ -340,20 +208,27 @@ def save_fit(
     model_path: str | os.PathLike,
     held_out: list | None = None,
     plots: bool = True,
+    notes: list[str] | None = None,
 ) -> dict[str, Any]:
-    """Write a ``FitResult``'s figures, model file and card (JSON + markdown), in that order
-    (a failure leaves no model file without its card).
+    """Write a fit's figures, model file and card (JSON + markdown), in that order (a failure
+    leaves no model file without its card); returns the card. The one card writer for a fit
+    of any number of coordinates (``bushenv fit`` calls it; C comes from the model).
 
+    ``result``: a ``bushenv.identify.FitResult`` (its ``model``, ``records`` -- the training
+    records, ``Record`` objects --, ``options``, ``seed``, ``seconds``, ``info``).
     ``held_out``: records never seen in training; the card gives the model's metrics on each
     and a figure pair per record (without held-out records, the first training record is
-    plotted, marked as seen in training). Returns the card.
+    plotted, marked as seen in training). ``notes``: what the user should know about the
+    records (``bushenv.record_notes.start_notes``).
     """
+    from bushenv.certify.range_holds import range_holds
+    from bushenv.identify.coverage import coverage, not_shown, spans
     from bushenv.identify.options import as_dict
 
     model_path = Path(model_path)
     model = result.model
-    held_out = list(held_out or [])
-    figures = _figures(model, model_path, result.records, held_out) if plots else []
+    train, held_out = list(result.records), list(held_out or [])
+    figures = _figures(model, model_path, train, held_out) if plots else []
     model.save(model_path)
     training = getattr(model, "training", {}) or {}
     source = {
@@ -367,14 +242,34 @@ def save_fit(
         "choice": training.get("choice"),
         "note": training.get("note"),
         "training": {k: training[k] for k in _TRAINING_SUMMARY if k in training},
+        "info": dict(getattr(result, "info", None) or {}),
     }
     card = new_card(model, model_path, source)
     here = model_path.parent
-    card["records"] = [record_entry(r, "train", model, here) for r in result.records]
+    card["records"] = [record_entry(r, "train", model, here) for r in train]
     card["records"] += [record_entry(r, "held-out", model, here) for r in held_out]
-    card["plots"] = figures
+    card["notes"] = list(notes or [])
+    span = spans([r.q for r in train])
+    card["training_range"] = {c: float(s) for c, s in zip(model.coords, span, strict=True)}
+    card["coverage"] = coverage([r.q for r in train], model.dt, model.coords)
+    for entry, r in zip(card["records"][len(train) :], held_out, strict=True):
+        entry["not_shown"] = not_shown(card["coverage"], r.q, r.dt)
+    holds = range_holds(model, span)
+    if holds is not None:
+        card["holds"] = holds
+    backbone = model.backbone_alone()
+    if backbone is not None and held_out:  # what the network adds where it was not trained
+        card["backbone"] = {
+            "model": backbone.name,
+            "records": [
+                {"name": record_name(r), "metrics": free_run_metrics(backbone.copy(), r)}
+                for r in held_out
+            ],
+        }
+    if plots:
+        card["plots"] = figures
     write_card(card, model_path)
-    return card
+    return plain(card)
 
 
 def _figures(model: Any, model_path: Path, train: list, held_out: list) -> list[str]:
@@ -387,7 +282,7 @@ def _figures(model: Any, model_path: Path, train: list, held_out: list) -> list[
     for i, (rec, role) in enumerate(shown):
         model.reset(1)
         f_model = model.simulate(rec.displacement)
-        prefix = model_path.with_name(f"{stem}.{i + 1}-{safe_name(rec.name or 'record')}")
+        prefix = model_path.with_name(f"{stem}.{i + 1}-{safe_name(record_name(rec) or 'record')}")
         names += [p.name for p in record_figures(rec, f_model, model.name, prefix, role)]
     return names
 

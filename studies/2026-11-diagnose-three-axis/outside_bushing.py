@@ -34,7 +34,7 @@ from bushenv.diagnose.fit import diagnose
 from bushenv.excitation import chirp
 from bushenv.models.base import velocity_of
 from bushenv.motions import PEAK_AT_N1, random_independent
-from bushenv.planar.records import PlanarRecord
+from bushenv.records import Record
 
 HERE = Path(__file__).parent
 DT = 1.0 / 512.0
@@ -106,7 +106,7 @@ def run(seeds: int) -> list[dict]:
         for case, (expected, coords) in CASES.items():
             motions = (random_independent(1.0, 20.0, DT, 50 + seed), test_motion(seed))
             recs = [
-                PlanarRecord(np.arange(len(q)) * DT, q, forces(q, case, seed, 10 * seed + k), n)
+                Record(np.arange(len(q)) * DT, q, forces(q, case, seed, 10 * seed + k), n)
                 for k, (n, q) in enumerate(zip(("train", "test"), motions, strict=True))
             ]
             r = diagnose(recs[0], [recs[1]])

@@ -21,7 +21,7 @@ from bushenv.diagnose.validation.three_axis_cases import (
     reference,
     score,
 )
-from bushenv.planar.records import PlanarRecord, save_planar_csv
+from bushenv.record_files import save_columns
 from bushenv.records import Record, save_csv
 
 
@@ -110,7 +110,7 @@ def test_a_coordinate_held_still_in_a_record_is_left_out_of_its_diagnosis_only()
     overrides, effects = reference(get_spec("friction@radial"), 0)
     q = preload_sweep(2, 0.075, 3e-3, 10.0, train.dt)  # rotation held, radial swept, axial at 0
     f = PlanarRubber.preset(effects=effects, seed=7, dt=train.dt, **overrides).simulate(q)
-    sweep = PlanarRecord(np.arange(len(q)) * train.dt, q, f.reshape(q.shape), "sweep")
+    sweep = Record(np.arange(len(q)) * train.dt, q, f.reshape(q.shape), "sweep")
     result = diagnose(train, [test, sweep])
     assert (result["coordinate"], result["effect"]) == ("radial", "friction")
     rows = {r["coordinate"]: r for r in result["coordinates"]}
@@ -128,7 +128,7 @@ def test_other_baselines_and_mixed_records_are_refused_by_the_library():
     one = Record.from_arrays(train.q[:, 0], train.f[:, 0], train.dt, name="one")
     with pytest.raises(DiagnoseError, match="TEST one has 1 coordinate"):
         diagnose(train, [one])
-    two = [PlanarRecord(r.time, r.q[:, :2], r.f[:, :2], n) for r, n in ((train, "a"), (test, "b"))]
+    two = [Record(r.time, r.q[:, :2], r.f[:, :2], n) for r, n in ((train, "a"), (test, "b"))]
     with pytest.raises(DiagnoseError, match="records of 2 coordinates: .* for 1, 3 coordinate"):
         diagnose(two[0], [two[1]])  # generic over C: refused only for want of a linear form
 
@@ -138,7 +138,7 @@ def files(tmp_path_factory):
     root = tmp_path_factory.mktemp("three_axis")
     train, test, _ = case("friction@radial")
     for name, rec in (("train3", train), ("test3", test)):
-        save_planar_csv(root / f"{name}.csv", rec.time, rec.q, rec.f)
+        save_columns(root / f"{name}.csv", rec.time, rec.q, rec.f)
     one = Record.from_arrays(train.q[:, 1], train.f[:, 1], train.dt, name="one")
     save_csv(one, root / "one_axis.csv")
     return root

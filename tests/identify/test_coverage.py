@@ -94,8 +94,8 @@ def test_combined_is_refused_for_one_axis_naming_the_fix(tmp_path, capsys):
 
 
 def test_a_record_made_in_memory_is_named_on_the_card_not_taken_for_a_file(tmp_path):
+    from bushenv.identify.card import record_entry
     from bushenv.models.planar_linear import PlanarLinear
-    from bushenv.planar.card import record_entry
     from bushenv.records import Record
 
     motion = dict(held_sweeps(1.0, DT, duration_s=2.0))["axial_held_+_radial_sweep"]

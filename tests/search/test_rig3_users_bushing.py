@@ -11,7 +11,7 @@ import pytest
 from bushenv.cli import main
 from bushenv.models.planar_linear import PlanarLinear, fit_linear
 from bushenv.persist import load_profiles
-from bushenv.planar.records import load_planar_csv
+from bushenv.record_files import load_record
 from bushenv.search.families import FAMILIES
 from bushenv.search.families_planar import COORDS, Rig3Limits, machine_limits
 from bushenv.search.targets import TARGETS
@@ -52,7 +52,7 @@ def attacked(bushing) -> dict:
 def test_a_users_reference_sets_stroke_and_rate_per_coordinate_from_its_cards_records(
     bushing, attacked
 ):
-    rec = load_planar_csv(bushing / "rec3" / TRAIN)
+    rec = load_record(bushing / "rec3" / TRAIN, coords=3)
     peak = np.max(np.abs(rec.q), axis=0)
     speed = np.max(np.abs(np.diff(rec.q, axis=0)), axis=0) / rec.dt
     lim = attacked["scales"]
@@ -85,7 +85,7 @@ def test_the_control_is_a_linear_fit_to_the_users_reference_and_named_as_such(bu
     control = attacked["control"]
     fitted = load_model(control["file"], coords=3)
     ref = load_model(bushing / "ref3.npz", coords=3)
-    q = load_planar_csv(bushing / "rec3" / TRAIN).q
+    q = load_record(bushing / "rec3" / TRAIN, coords=3).q
     v = np.gradient(q, ref.dt, axis=0)
     expected = fit_linear(q, v, ref.copy().simulate(q, v), dt=ref.dt)
     assert np.allclose(fitted.k_matrix, expected.k_matrix, rtol=1e-9)
@@ -181,7 +181,7 @@ def test_every_family_stays_within_small_limits_of_a_users_bushing(name):
 def test_the_covered_search_is_the_searchers_own_run():
     from bushenv.search.evaluate import BatchEvaluator
     from bushenv.search.searchers import SEARCHERS
-    from bushenv.search.target_rig3 import covered_search
+    from bushenv.search.target_base import covered_search
 
     ref = PlanarLinear.preset()
     model = PlanarLinear(ref.k_matrix, -0.3 * ref.c_matrix, ref.dt)
@@ -215,7 +215,7 @@ def test_the_hold_stage_steps_to_each_suspect_hold_within_the_limits_and_judges_
     from bushenv.models import load_model
     from bushenv.search.campaign_planar_holds import KINDS, PlanarHolds, listed_holds3
     from bushenv.search.evaluate import BatchEvaluator
-    from bushenv.search.target_rig3 import covered_search
+    from bushenv.search.target_base import covered_search
 
     model = load_model(network, coords=3)
     lim = Rig3Limits((3e-3, 3e-3, 0.075), (0.2, 0.2, 5.0))

@@ -31,7 +31,7 @@ import numpy as np
 from bushenv.models.base import PAPER_DT
 from bushenv.models.planar_base import COORDS
 from bushenv.motions import PEAK_AT_N1, random_correlated, random_independent
-from bushenv.planar.records import PlanarRecord
+from bushenv.records import Record
 from bushenv.reference.planar import PlanarRubber
 
 N_TRAIN, N_TEST = 1.0, 1.5
@@ -98,7 +98,7 @@ def reference(spec: Spec, seed: int, dt: float = PAPER_DT) -> tuple[dict[str, An
 
 def make_case(
     spec: Spec | str, seed: int, dt: float = PAPER_DT, duration_s: float = DURATION_S
-) -> tuple[PlanarRecord, PlanarRecord]:
+) -> tuple[Record, Record]:
     """(TRAIN, TEST) records of the case ``spec`` drawn from ``seed``."""
     spec = get_spec(spec) if isinstance(spec, str) else spec
     overrides, effects = reference(spec, seed, dt)
@@ -110,7 +110,7 @@ def make_case(
     for k, (name, q) in enumerate(motions):
         model = PlanarRubber.preset(effects=effects, seed=1000 * seed + k, dt=dt, **overrides)
         f = np.asarray(model.simulate(q), float).reshape(q.shape)
-        out.append(PlanarRecord(np.arange(q.shape[0]) * dt, q, f, name))
+        out.append(Record(np.arange(q.shape[0]) * dt, q, f, name))
     return out[0], out[1]
 
 

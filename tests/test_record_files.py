@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from bushenv.planar.records import HEADER_TEXT, RecordError, load_planar_csv, save_planar_csv
+from bushenv.record_columns import THREE_AXES
+from bushenv.record_files import load_record, save_columns
+from bushenv.records import RecordError
 
 DT = 1 / 204.8
 
@@ -17,12 +19,12 @@ def _data(T=20):
 
 def test_save_load_roundtrip_bit_for_bit(tmp_path):
     t, q, f = _data()
-    rec = load_planar_csv(save_planar_csv(tmp_path / "r.csv", t, q, f))
+    rec = load_record(save_columns(tmp_path / "r.csv", t, q, f), coords=3)
     np.testing.assert_array_equal(rec.q, q)
     np.testing.assert_array_equal(rec.f, f)
     assert rec.dt == pytest.approx(DT)
     with pytest.raises(RecordError, match="overwrite=True"):
-        save_planar_csv(tmp_path / "r.csv", t, q, f)
+        save_columns(tmp_path / "r.csv", t, q, f)
 
 
 def test_units_in_the_header_are_converted(tmp_path):
@@ -31,7 +33,7 @@ def test_units_in_the_header_are_converted(tmp_path):
         "time [ms],displacement_axial [mm],displacement_radial [mm],rotation [deg],"
         "force_axial [kN],force_radial [N],moment [N mm]\n0,1,2,90,1,5,1000\n5,0,0,0,0,0,0\n"
     )
-    rec = load_planar_csv(p)
+    rec = load_record(p, coords=3)
     np.testing.assert_allclose(rec.q[0], [1e-3, 2e-3, np.pi / 2])
     np.testing.assert_allclose(rec.f[0], [1000.0, 5.0, 1.0])
     np.testing.assert_allclose(rec.time, [0.0, 0.005])
@@ -44,16 +46,38 @@ def test_units_in_the_header_are_converted(tmp_path):
             "time,displacement,force\n0,0,0\n",
             r"line 1: header .* expected 'time,displacement_axial",
         ),
-        (HEADER_TEXT.replace("rotation", "rotation [grad]") + "\n", r"line 1: unknown unit 'grad'"),
-        (HEADER_TEXT + "\ns,m,m,rad,N,N,N m\n", r"line 2: time 's' is not a number \(units go"),
-        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0\n", r"line 3: 6 values, expected 7"),
-        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,0,0,nan,0,0,0\n", r"line 3: rotation is nan"),
-        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,0,0,45,0,0,0\n", r"line 3: rotation 45.0 .*\[deg\]"),
-        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,2,0,0,0,0,0\n", r"line 3: displacement_axial .*mm"),
-        (HEADER_TEXT + "\n0.1,0,0,0,0,0,0\n0.0,0,0,0,0,0,0\n", r"line 3: time goes backwards"),
-        (HEADER_TEXT + "\n0,0,0,0,0,0,0\n", r"1 sample\(s\)"),
         (
-            HEADER_TEXT + "\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0,0\n0.3,0,0,0,0,0,0\n0.4,0,0,0,0,0,0\n",
+            THREE_AXES.header_text.replace("rotation", "rotation [grad]") + "\n",
+            r"line 1: unknown unit 'grad'",
+        ),
+        (
+            THREE_AXES.header_text + "\ns,m,m,rad,N,N,N m\n",
+            r"line 2: time 's' is not a number \(units go",
+        ),
+        (
+            THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0\n",
+            r"line 3: 6 values, expected 7",
+        ),
+        (
+            THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n0.1,0,0,nan,0,0,0\n",
+            r"line 3: rotation is nan",
+        ),
+        (
+            THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n0.1,0,0,45,0,0,0\n",
+            r"line 3: rotation 45.0 .*\[deg\]",
+        ),
+        (
+            THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n0.1,2,0,0,0,0,0\n",
+            r"line 3: displacement_axial .*mm",
+        ),
+        (
+            THREE_AXES.header_text + "\n0.1,0,0,0,0,0,0\n0.0,0,0,0,0,0,0\n",
+            r"line 3: time goes backwards",
+        ),
+        (THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n", r"1 sample\(s\)"),
+        (
+            THREE_AXES.header_text
+            + "\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0,0\n0.3,0,0,0,0,0,0\n0.4,0,0,0,0,0,0\n",
             r"line 4: time step",
         ),
     ],
@@ -62,10 +86,10 @@ def test_bad_records_name_file_line_and_value(tmp_path, text, match):
     p = tmp_path / "bad.csv"
     p.write_text(text)
     with pytest.raises(RecordError, match=match) as err:
-        load_planar_csv(p)
+        load_record(p, coords=3)
     assert "bad.csv" in str(err.value)
 
 
 def test_missing_file_is_named(tmp_path):
     with pytest.raises(RecordError, match="no such record file"):
-        load_planar_csv(tmp_path / "none.csv")
+        load_record(tmp_path / "none.csv", coords=3)

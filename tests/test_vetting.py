@@ -1,4 +1,4 @@
-"""The planar reference is checked before it judges (``bushenv.planar.vetting``)."""
+"""A reference of several coordinates is checked before it judges (``bushenv.vetting``)."""
 
 import json
 
@@ -7,7 +7,8 @@ import numpy as np
 from bushenv.cli import main
 from bushenv.models import MODELS
 from bushenv.models.planar_linear import PlanarLinear
-from bushenv.planar.vetting import held_vectors, vet_planar_reference
+from bushenv.vetting import vet_coupled_reference
+from bushenv.vetting_holds import held_vectors
 
 STROKE = np.array([0.0125, 0.0125, 0.15])
 FLOORS = np.array([200.0, 200.0, 20.0])
@@ -25,7 +26,7 @@ def _linear(k_scale=(1.0, 1.0, 1.0), c_scale=(1.0, 1.0, 1.0), radial_into_axial=
 def test_the_coupled_reference_and_a_linear_bushing_pass_their_holds():
     ref = MODELS["reference"].model_class(3).preset(dt=PlanarLinear.preset().dt, measurement=False)
     for model in (ref, _linear()):
-        v = vet_planar_reference(model, "m", STROKE, FLOORS)
+        v = vet_coupled_reference(model, "m", STROKE, FLOORS)
         assert v.passed and v.checks[0].passed is True and v.checks[2].passed is True, v.lines()
 
 
@@ -38,13 +39,13 @@ def test_holds_cover_every_coordinate_alone_and_the_corners_of_the_stroke_box():
 
 
 def test_a_reference_with_a_negative_stiffness_axis_is_refused_naming_the_hold():
-    v = vet_planar_reference(_linear(k_scale=(1.0, -0.5, 1.0)), "bad", STROKE, FLOORS)
+    v = vet_coupled_reference(_linear(k_scale=(1.0, -0.5, 1.0)), "bad", STROKE, FLOORS)
     assert not v.passed
     assert "pushing into the deflection" in v.checks[0].detail and "mm" in v.checks[0].detail
 
 
 def test_a_reference_with_negative_damping_holds_still_but_is_refused_as_active():
-    v = vet_planar_reference(_linear(c_scale=(1.0, 1.0, -0.5)), "active", STROKE, FLOORS)
+    v = vet_coupled_reference(_linear(c_scale=(1.0, 1.0, -0.5)), "active", STROKE, FLOORS)
     holds, _, passive, _ = v.checks
     assert holds.passed is True  # a hold cannot show a negative damper
     assert passive.passed is False and "gives energy back" in passive.detail
@@ -52,7 +53,7 @@ def test_a_reference_with_negative_damping_holds_still_but_is_refused_as_active(
 
 
 def test_a_reference_three_times_as_stiff_as_the_model_is_a_warning_not_a_refusal():
-    v = vet_planar_reference(_linear(k_scale=(3.0, 3.0, 3.0)), "stiff", STROKE, FLOORS,
+    v = vet_coupled_reference(_linear(k_scale=(3.0, 3.0, 3.0)), "stiff", STROKE, FLOORS,
                              model=_linear())  # fmt: skip
     comp = v.checks[3]
     assert comp.passed is None and comp.detail.startswith("WARNING") and "factor" in comp.detail
@@ -78,8 +79,9 @@ def test_the_attack_refuses_a_reference_that_fails_its_vetting_unless_trusted(tm
 def test_a_coordinate_held_at_rest_whose_force_is_noise_is_not_judged_by_a_ratio(tmp_path):
     """A preload sweep holds the axial coordinate at zero: its load cell reads only noise, and
     a ratio to noise would refuse the very bushing that made the record."""
-    from bushenv.planar.records import save_planar_csv
-    from bushenv.planar.vetting import RECORD_LIMIT, _record_errors
+    from bushenv.record_files import save_columns
+    from bushenv.vetting import RECORD_LIMIT
+    from bushenv.vetting_records import reference_errors
 
     ref = _linear()
     t = np.arange(4000) * ref.dt
@@ -88,19 +90,19 @@ def test_a_coordinate_held_at_rest_whose_force_is_noise_is_not_judged_by_a_ratio
     q[:, 2] = 0.05 * np.sin(2 * np.pi * 0.7 * t)
     rng = np.random.default_rng(0)
     noise = rng.normal(0, 1, q.shape) * np.array([2.0, 5.0, 0.05])
-    path = save_planar_csv(tmp_path / "sweep.csv", t, q, ref.simulate(q) + noise)
-    [(_, worst)] = _record_errors(ref, [path])
+    path = save_columns(tmp_path / "sweep.csv", t, q, ref.simulate(q) + noise)
+    [(_, worst)] = reference_errors(ref, [path])
     assert worst < 0.05 < RECORD_LIMIT
     # an axis at rest that carries a real force (coupling) is still judged
     coupled = _linear(radial_into_axial=0.3)
-    path = save_planar_csv(tmp_path / "coupled.csv", t, q, coupled.simulate(q) + noise)
-    [(_, worst)] = _record_errors(ref, [path])
+    path = save_columns(tmp_path / "coupled.csv", t, q, coupled.simulate(q) + noise)
+    [(_, worst)] = reference_errors(ref, [path])
     assert worst > RECORD_LIMIT
 
 
 def test_a_card_gives_no_ratio_on_an_axis_at_rest_reading_noise(tmp_path):
     """The card says how much force the model invents there (N), not a ratio to noise."""
-    from bushenv.planar.card import axis_metrics
+    from bushenv.identify.card_records import coordinate_metrics
 
     ref = _linear()
     t = np.arange(3000) * ref.dt
@@ -109,7 +111,9 @@ def test_a_card_gives_no_ratio_on_an_axis_at_rest_reading_noise(tmp_path):
     noise = np.random.default_rng(1).normal(0, 1, q.shape) * np.array([2.0, 5.0, 0.05])
     f = ref.simulate(q) + noise
     pred = ref.simulate(q) + np.array([30.0, 0.0, 0.0])
-    m = axis_metrics(f, pred, q)
+    m = coordinate_metrics(ref.coords, f, pred, q)
     assert m["axial"]["rms_ratio"] is None and m["axial"]["max_error"] > 25.0
     assert m["rotation"]["rms_ratio"] is None and m["radial"]["rms_ratio"] < 0.01
-    assert axis_metrics(f, pred)["axial"]["rms_ratio"] > 1.0  # without q: a ratio to noise
+    assert (
+        coordinate_metrics(ref.coords, f, pred)["axial"]["rms_ratio"] > 1.0
+    )  # without q: a ratio to noise
