@@ -87,7 +87,7 @@ def check_record(x, f, dt: float, v=None, label: str = "record") -> Segment:
         bad = np.argwhere(~np.isfinite(a))
         if bad.size:
             at = tuple(int(i) for i in bad[0])
-            where = at[0] if a.ndim == 1 else at
+            where = ", ".join(map(str, at))
             raise IdentificationError(f"{label}: {name}[{where}] is {a[at]}: record holds NaN/inf")
     if v is None:
         v = velocity_of(x, dt)

@@ -37,3 +37,30 @@ def test_bad_records_are_refused_naming_the_problem():
         fit_model("linear", y, f[:50], DT)
     with pytest.raises(IdentificationError, match="no identification for model 'rubber'"):
         fit_model("rubber", y, y, DT)
+
+
+@pytest.mark.parametrize("coords", [1, 3])
+def test_one_least_squares_recovers_the_stiffness_and_damping_of_any_number_of_coordinates(coords):
+    # the same function for every C: k, c for one coordinate, the C x C matrices for several
+    rng = np.random.default_rng(1)
+    q = np.cumsum(rng.normal(size=(2000, coords)), axis=0) * 1e-5
+    q = q[:, 0] if coords == 1 else q
+    v = np.gradient(q, DT, axis=0)
+    k = 3.7e5 * np.eye(coords) + 2e4 * np.triu(np.ones((coords, coords)), 1)
+    c = 2.1e3 * np.eye(coords)
+    f = (q.reshape(-1, coords) @ k.T + v.reshape(-1, coords) @ c.T).reshape(q.shape)
+    m = fit_model("linear", q, f, DT, progress=False)
+    assert m.n_coords == coords
+    np.testing.assert_allclose(m.simulate(q), f, rtol=1e-8, atol=1e-6)
+
+
+@pytest.mark.parametrize("coords", [1, 3])
+def test_a_record_constant_in_every_coordinate_or_with_a_nan_is_refused_whatever_c(coords):
+    shape = (100,) if coords == 1 else (100, coords)
+    with pytest.raises(IdentificationError, match="x is constant"):
+        fit_model("linear", np.full(shape, 1e-3), np.ones(shape), DT)
+    y = np.linspace(0, 1e-3, 100 * coords).reshape(shape)
+    f = y.copy()
+    f[17] = np.nan
+    with pytest.raises(IdentificationError, match=r"f\[17.*\] is nan"):
+        fit_model("linear", y, f, DT)

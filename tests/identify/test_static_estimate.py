@@ -62,3 +62,25 @@ def test_records_whose_slow_force_falls_with_the_displacement_are_refused():
 def test_constant_displacement_is_refused():
     with pytest.raises(IdentificationError, match="constant"):
         slow_cutoff_hz([np.full(500, 1e-3)], DT)
+
+
+@pytest.mark.parametrize("coords", [1, 3])
+def test_the_band_of_one_coordinate_is_the_scalar_band_and_a_falling_coordinate_is_named(coords):
+    x = standin_drive(20.0, seed=6)
+    q = np.stack([x, 0.7 * np.roll(x, 300), 0.4 * np.roll(x, 700)], axis=1)[:, :coords]
+    f = np.stack([standin_force(q[:, i]) for i in range(coords)], axis=1)
+    one = (lambda a: a[:, 0]) if coords == 1 else (lambda a: a)  # (T,) arrays for one coordinate
+    est = static_estimate([(one(q), one(f))], DT)
+    assert est.k.shape == (coords,) and np.all(est.k > 0)
+    held = np.linspace(-5e-3, 5e-3, 11)
+    hold = one(np.outer(held, np.eye(coords)[0]))  # the first coordinate held, the others at rest
+    sign, lo, hi, scale = (a.reshape(len(held), -1)[:, 0] for a in est.band(hold, 0.8, 1.9))
+    size = np.abs(est.f0[0] + est.k[0] * held)
+    floor = 0.01 * est.force_rms[0]
+    np.testing.assert_allclose(lo, 0.8 * size - floor)  # the others at rest: no coupling
+    np.testing.assert_allclose(hi, 1.9 * size + floor)
+    np.testing.assert_allclose(scale, np.maximum(size, floor))
+    falling = f.copy()
+    falling[:, -1] *= -1
+    with pytest.raises(IdentificationError, match="static .*stiffness of -"):
+        static_estimate([(one(q), one(falling))], DT)
