@@ -26,6 +26,7 @@ from bushenv.persist import atomic_write
 from bushenv.record_columns import (
     HINT,
     NAME_UNIT,
+    ONE_AXIS,
     PLAUSIBLE,
     SI,
     Columns,
@@ -59,7 +60,15 @@ def record_coordinates(path: str | os.PathLike) -> int:
 def load_record(path: str | os.PathLike, coords: int | None = None) -> Record:
     """A record of any number of coordinates, the checks of the module doc applied; ``coords``:
     the number wanted (a file of another is refused, saying what it holds)."""
-    c = record_coordinates(path) if coords is None else coords
+    found = record_coordinates(path)
+    c = found if coords is None else coords
+    if c == 1 and found != 1:  # the reverse says so in ``column_order``
+        cols = columns_of(found)
+        raise RecordError(
+            f"{path} line 1: a {found}-axis record ({', '.join(cols.coords)}: header "
+            f"'{cols.header_text}'); this needs a one-axis record ('{ONE_AXIS.header_text}'): "
+            f"give one-axis records to a one-axis fit, {found}-axis ones to a {found}-axis fit"
+        )
     return load_csv(path) if c == 1 else load_columns(path, columns_of(c))
 
 

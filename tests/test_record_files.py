@@ -93,3 +93,19 @@ def test_bad_records_name_file_line_and_value(tmp_path, text, match):
 def test_missing_file_is_named(tmp_path):
     with pytest.raises(RecordError, match="no such record file"):
         load_record(tmp_path / "none.csv", coords=3)
+
+
+@pytest.mark.parametrize("written, wanted", [(1, 3), (3, 1)])
+def test_a_record_of_the_other_number_of_coordinates_is_refused_saying_which_it_is(
+    tmp_path, written, wanted
+):
+    from bushenv.record_files import load_record, save_record
+    from bushenv.records import Record
+
+    t = np.arange(100) / 204.8
+    q = 1e-3 * np.sin(np.outer(t, np.arange(1, written + 1)))
+    rec = Record(t, q[:, 0] if written == 1 else q, (q * 1e5)[:, 0] if written == 1 else q * 1e5)
+    path = save_record(rec, tmp_path / "r.csv")
+    assert load_record(path).n_coords == written  # read as it is when nothing is wanted
+    with pytest.raises(RecordError, match=f"line 1: .*{'one' if written == 1 else written}-axis"):
+        load_record(path, coords=wanted)
