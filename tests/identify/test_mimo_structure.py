@@ -1,5 +1,5 @@
-"""Structured planar networks (planar/structure.py): the mirror network holds, and runs, exactly
-zero force in a coordinate kept at rest where the free one does not; the rate network's held
+"""Structured MIMO networks (identify/mimo_structure.py): the mirror network holds, and runs,
+exactly zero force in a coordinate kept at rest where the free one does not; the rate network's held
 recurrence is the same at every hold; the certified term's gradients reach the tied
 parameters; and a certified mirror hybrid keeps its network where the free one falls silent."""
 
@@ -7,16 +7,17 @@ import numpy as np
 import pytest
 import torch
 
+from bushenv.certify.fixed_points import fixed_points
+from bushenv.certify.network import narx_net
+from bushenv.identify import fit
+from bushenv.identify.mimo_certified import MimoCertifiedHolds, MimoProblem
+from bushenv.identify.mimo_structure import SIGNS, StructuredNet, fit_diagonal_linear
+from bushenv.identify.mimo_train import _Net
+from bushenv.identify.static_estimate import static_estimate
 from bushenv.models.base import PAPER_DT
 from bushenv.models.planar_base import PlanarModelError
 from bushenv.models.planar_narx import PlanarHybrid, input_axes
-from bushenv.planar.certified import PlanarCertifiedHolds, PlanarProblem
-from bushenv.planar.fitting import fit_planar
-from bushenv.planar.fixed_points import HeldNetwork, fixed_points
-from bushenv.planar.programme import random_independent
-from bushenv.planar.static_estimate import planar_static_estimate
-from bushenv.planar.structure import SIGNS, StructuredNet, fit_diagonal_linear
-from bushenv.planar.train import _Net
+from bushenv.motions import random_independent
 from bushenv.reference.planar import PlanarRubber
 
 Q_SCALE = np.array([2e-3, 2e-3, 0.05])
@@ -79,7 +80,7 @@ def test_a_coordinate_at_rest_carries_exactly_no_force_in_the_mirror_hybrid(stil
 def test_the_rate_networks_held_recurrence_is_the_same_at_every_hold():
     for structure in ("rate", "mirror-rate"):
         model = _hybrid(_net(structure, seed=2))
-        held = HeldNetwork.of(model)
+        held = narx_net(model)
         q = np.array([[0.0, 0.0, 0.0], [12e-3, -7e-3, 0.15], [-3e-3, 12e-3, -0.1]])
         c = held.held(q)
         assert np.allclose(c, c[0], atol=1e-12, rtol=0)
@@ -89,18 +90,18 @@ def test_the_rate_networks_held_recurrence_is_the_same_at_every_hold():
         each = [f[np.lexsort(f.T[::-1])] for f in net_force]
         assert np.allclose(each, each[0], atol=1e-5, rtol=0)
     # and a free network's is not
-    c = HeldNetwork.of(_hybrid(_net("free"))).held(q)
+    c = narx_net(_hybrid(_net("free"))).held(q)
     assert np.abs(c - c[0]).max() > 0.1
 
 
 def test_the_certified_terms_gradient_reaches_the_tied_parameters():
     q = random_independent(1.0, 20.0, PAPER_DT, 0)
-    estimate = planar_static_estimate([(q, PlanarRubber.preset(seed=0).simulate(q))], PAPER_DT)
-    problem = PlanarProblem(np.zeros(3), Q_SCALE, np.zeros(3), F_SCALE,
+    estimate = static_estimate([(q, PlanarRubber.preset(seed=0).simulate(q))], PAPER_DT)
+    problem = MimoProblem(np.zeros(3), Q_SCALE, np.zeros(3), F_SCALE,
                             np.diag(1.2 * estimate.k), PAPER_DT, estimate)  # fmt: skip
     for structure in ("mirror", "rate"):
         net = _net(structure, seed=3)
-        term = PlanarCertifiedHolds(1.0, holds=7)
+        term = MimoCertifiedHolds(1.0, holds=7)
 
         def value(term=term, net=net):
             term.calls = 0
@@ -139,16 +140,16 @@ def test_the_diagonal_backbone_fits_each_coordinate_alone():
 
 
 def test_structure_is_an_option_of_nn_and_hybrid_only():
+    from bushenv.identify.mimo_options import MimoOptions
     from bushenv.identify.options import options_of
-    from bushenv.planar.fitting import PlanarNetworkOptions
 
-    assert options_of(PlanarNetworkOptions, {"structure": "mirror"}, "hybrid").structure == "mirror"
+    assert options_of(MimoOptions, {"structure": "mirror"}, "hybrid").structure == "mirror"
     with pytest.raises(Exception, match="structure must be one of"):
-        options_of(PlanarNetworkOptions, {"structure": "odd"}, "hybrid")
+        options_of(MimoOptions, {"structure": "odd"}, "hybrid")
     q = random_independent(1.0, 8.0, PAPER_DT, 0)
     rec = (q, PlanarRubber.preset(seed=0).simulate(q))
     with pytest.raises(PlanarModelError, match="nn-axis takes structure 'free' only"):
-        fit_planar([rec], "nn-axis", {"structure": "mirror"}, dt=PAPER_DT)
+        fit([rec], "nn-axis", {"structure": "mirror"}, progress=False, dt=PAPER_DT)
 
 
 def _share(model, q, f):
@@ -164,9 +165,9 @@ def test_a_certified_mirror_hybrid_keeps_its_network_where_the_free_one_falls_si
     rec = (q, PlanarRubber.preset(seed=0).simulate(q))
     qu = random_independent(1.0, 10.0, PAPER_DT, 99)
     fu = PlanarRubber.preset(seed=99).simulate(qu)
-    free = fit_planar([rec], "hybrid", {"certified": "on"}, dt=PAPER_DT, seed=0).model
+    free = fit([rec], "hybrid", {"certified": "on"}, 0, progress=False, dt=PAPER_DT).model
     opts = {"certified": "on", "structure": "mirror"}
-    mirror = fit_planar([rec], "hybrid", opts, dt=PAPER_DT, seed=0).model
+    mirror = fit([rec], "hybrid", opts, 0, progress=False, dt=PAPER_DT).model
     assert mirror.training["certified"]["admitted"]
     assert np.all(_share(mirror, qu, fu) > 0.04)
     assert np.all(_share(free, qu, fu) < 0.03)
