@@ -52,7 +52,7 @@ from bushenv.search.planar_models import (  # noqa: F401 (DEFAULT_REFERENCE, vet
 )
 from bushenv.search.searchers import SEARCHERS
 from bushenv.search.shrink import shrink
-from bushenv.search.target_rig3 import covered_search
+from bushenv.search.target_base import covered_search
 from bushenv.search.targets import TARGETS
 
 

@@ -7,31 +7,91 @@ verdict's inputs, the vector env RL agents act in, the env's limits on a profile
 evaluator, shrinking, campaigns and the corpus ask the target; none of them compares env names.
 ``bushenv/search/checks.py`` holds the contract as checks every ``TARGETS`` entry passes.
 
+The rig target over three coordinates (``rig3``): a profile is (T, 3) (axial m, radial m,
+rotation rad) within a stroke and rate per coordinate (``families_planar.Rig3Limits``: the
+rig's, or a user's bushing's, passed as the evaluator's ``scales``); each coordinate's force
+(or moment) is judged by ``divergence.judge`` on its own scale: the env's force limit there and
+a force floor per coordinate (``reference_floors``: the papers' bushing's -- the one-axis
+200 N, and for the rotation that floor scaled by the moment cell's range over the force cell's,
+2500 N m / 25 kN -- times the judging reference's static stiffness over the built-in
+reference's, as the one-axis judge sets the floor from its reference). A profile fails when any
+coordinate fails; the verdict names the coordinate. The static criterion does not run there
+(the coupled reference has no static curve yet), nor does RL.
+
 | name       | profile                          | simulation                                       |
 |------------|----------------------------------|--------------------------------------------------|
 | rig        | bushing displacement, m          | the models' batched kernels on prescribed motion |
 | quartercar | road height under the wheel, m   | ``QuarterCarBatch``: the car, model vs twin      |
-| rig3       | (T, 3) axial m, radial m, rot rad| planar model vs the coupled planar reference,    |
-|            |                                  | judged per coordinate (``target_rig3.py``)       |
+| rig3       | (T, 3) axial m, radial m, rot rad| the models' batched kernels on prescribed motion |
+|            |                                  | in three coordinates, each judged on its own     |
+|            |                                  | scale (``target_base.judge_coordinates``)        |
 | halfcar    | (T, 3) road left m, road right m,| HalfCar-v0, model car vs reference twin, judged  |
 |            | lateral acceleration m/s^2       | on the wheel load (``target_halfcar.py``)        |
 """
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.divergence import judge
-from bushenv.errors import DIVERGENCE_RAISES, ModelRaised
-from bushenv.models.base import BushingModel, velocity_of
+from bushenv.identify.static_estimate import coordinate_stiffness
 from bushenv.registry import Registry
-from bushenv.scales import MACHINE
+from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
 from bushenv.search.base import SearchError
+from bushenv.search.families_planar import COORDS, UNITS, clip3, limits3
 from bushenv.search.roads import quarter_car_responses
-from bushenv.search.target_base import Responses, Target
+from bushenv.search.target_base import (  # noqa: F401 (simulate_or_nan: the evaluator's)
+    Responses,
+    Target,
+    judge_coordinates,
+    simulate_or_nan,
+)
 from bushenv.search.target_halfcar import HalfCarTarget
-from bushenv.search.target_rig3 import Rig3Target
+
+ROTATION_FLOOR_NM = FORCE_FLOOR_N * 2500.0 / 25000.0
+MACHINE_FLOORS = np.array([FORCE_FLOOR_N, FORCE_FLOOR_N, ROTATION_FLOOR_NM])
+
+
+def coordinate_scales(env_id: str, coords: tuple[str, ...], floors) -> list[BushingScales]:
+    """One ``BushingScales`` per coordinate: its force floor and the env's force limit there
+    (``judge`` reads only those two; the stroke and rate are the target's, not a scale's)."""
+    from bushenv.rigs.specs import load_spec
+
+    kw = load_spec(env_id)["kwargs"]
+    return [
+        BushingScales(
+            force_floor_n=floors[i],
+            force_limit_n=float(kw["force_limit"][c]),
+            source=f"{env_id} spec, {c}",
+        )
+        for i, c in enumerate(coords)
+    ]
+
+
+@lru_cache(maxsize=8)
+def _builtin_stiffness(dt: float) -> np.ndarray:
+    from bushenv.rigs.common import resolve_model
+
+    ref = resolve_model("reference", dt=dt, coords=len(COORDS), env_id="BushRig3-v0")
+    return coordinate_stiffness(ref)
+
+
+def reference_floors(reference) -> tuple[np.ndarray, str]:
+    """(floors (3,) N, N, N m; where they come from): ``MACHINE_FLOORS`` times the reference's
+    static stiffness over the built-in reference's, per coordinate. A coordinate whose
+    stiffness is not a positive number keeps the machine's floor (the vetting's holds then
+    say why the reference cannot judge)."""
+    k, k0 = coordinate_stiffness(reference), _builtin_stiffness(reference.dt)
+    ratio = np.where(np.isfinite(k) & (k > 0), k / k0, 1.0)
+    floors = MACHINE_FLOORS * ratio
+    text = ", ".join(f"{c} x{r:.3g}" for c, r in zip(COORDS, ratio, strict=True))
+    return (
+        floors,
+        f"the papers' floors times the reference's static stiffness over the built-in's ({text})",
+    )
 
 
 class RigTarget(Target):
@@ -103,6 +163,56 @@ class QuarterCarTarget(Target):
         return road_agent_env(evaluator, n_envs, episode_steps, on_episodes, actions)
 
 
+class Rig3Target(Target):
+    """BushRig3-v0: prescribed motion in axial, radial and rotation; model and reference see
+    the same motion, each coordinate judged on its own scale."""
+
+    name = "rig3"
+    env_id = "BushRig3-v0"
+    profile_label = "deflection [mm, mm, mrad]"
+    cma_family = "any3"
+    default_searchers = ("random", "cma")
+    coords = COORDS
+    shown_units = UNITS
+
+    def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
+        return clip3(x, dt, limits)
+
+    def judging_facts(self, reference) -> dict[str, dict[str, float]]:
+        floors = reference_floors(reference)[0]
+        return {"force_floors": dict(zip(COORDS, floors.tolist(), strict=True))}
+
+    def profile_bounds(self, limits=MACHINE) -> tuple[np.ndarray, np.ndarray]:
+        """Per coordinate (3,) arrays: the stroke and rate of ``limits`` when they are
+        ``Rig3Limits``, else BushRig3-v0's (a one-axis bushing's ``BushingScales`` do not apply)."""
+        return limits3(limits)
+
+    def responses(
+        self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE
+    ) -> Responses:
+        if x.ndim != 3 or x.shape[2] != 3:
+            raise SearchError(f"the rig3 target takes (T, B, 3) profiles, got {x.shape}")
+        fm = simulate_or_nan(model, x)
+        fr = reference.forces(x, lengths)
+        floors = reference.cached("rig3 floors", lambda m: reference_floors(m)[0])
+        scales = coordinate_scales(self.env_id, self.coords, floors)
+        verdict = judge_coordinates(x, fm, fr, dt, lengths, scales, self.coords, self.shown_units)
+        return Responses(verdict, x, fm, fr)
+
+    def check_models(self, kind: str):
+        """(model, reference) the contract checks run: ``active`` a planar Kelvin-Voigt with
+        negative damping, ``passive`` one 20 % softer, both against the planar linear preset."""
+        from bushenv.models.planar_linear import PlanarLinear
+
+        ref = PlanarLinear.preset()
+        if kind == "active":
+            return PlanarLinear(ref.k_matrix, -0.5 * ref.c_matrix, ref.dt), ref
+        return PlanarLinear(0.8 * ref.k_matrix, ref.c_matrix, ref.dt), ref
+
+    def rl_env(self, evaluator, n_envs, episode_steps, on_episodes, actions):
+        raise SearchError("the rig3 target has no RL env for the search yet")
+
+
 TARGETS: Registry[Target] = Registry("target", SearchError)
 TARGETS.add("rig", RigTarget())
 TARGETS.add("quartercar", QuarterCarTarget())
@@ -112,38 +222,3 @@ TARGETS.add("halfcar", HalfCarTarget())
 
 def get_target(target: str | Target) -> Target:
     return target if isinstance(target, Target) else TARGETS[target]
-
-
-def simulate_or_nan(model: BushingModel, x: np.ndarray) -> np.ndarray:
-    """``model.simulate(x)`` for (T, B) ``x``; a model that refuses (``ModelRefused``, e.g.
-    Bouc-Wen's step-size control, or an ``ArithmeticError``) gives NaN from the sample it
-    refused on, in the histories that made it refuse -- a non-finite output, which ``judge``
-    calls a divergence. Anything else it raises is its own bug: ``ModelRaised``, never a
-    verdict."""
-    try:
-        return model.simulate(x)
-    except DIVERGENCE_RAISES:
-        pass
-    except Exception as exc:
-        raise ModelRaised(model.name, exc) from exc
-    out = np.empty_like(x)
-    for b in range(x.shape[1]):
-        col = np.ascontiguousarray(x[:, b])
-        try:
-            out[:, b] = model.simulate(col)
-            continue
-        except DIVERGENCE_RAISES:
-            pass
-        except Exception as exc:
-            raise ModelRaised(model.name, exc) from exc
-        v = velocity_of(col, model.dt)  # the velocity simulate would have used
-        model.reset(1)
-        out[:, b] = np.nan
-        for t in range(col.size):
-            try:
-                out[t, b] = model.step(col[t], v[t])
-            except DIVERGENCE_RAISES:
-                break
-            except Exception as exc:
-                raise ModelRaised(model.name, exc) from exc
-    return out

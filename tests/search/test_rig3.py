@@ -189,7 +189,8 @@ def test_a_coordinate_held_while_another_moves_is_not_in_a_hold():
     """A radial step moves a coupled model's moment; the rotation was held all along, but the
     bushing was not at rest: no ``self_sustained`` verdict on it (it was, when each coordinate
     was judged on its own hold)."""
-    from bushenv.search.target_rig3 import held_vector, judge_axes
+    from bushenv.search.target_base import held_vector, judge_coordinates
+    from bushenv.search.targets import MACHINE_FLOORS, coordinate_scales
 
     ref = PlanarLinear.preset()
     k = ref.k_matrix.copy()
@@ -200,16 +201,19 @@ def test_a_coordinate_held_while_another_moves_is_not_in_a_hold():
     q = np.zeros((n0 + n1 + n2, 3))
     q[n0 : n0 + n1, 1] = np.linspace(0.0, 3e-3, n1)
     q[n0 + n1 :, 1] = 3e-3
-    hold = held_vector(q[:, None, :])
+    target = TARGETS["rig3"]
+    hold = held_vector(q[:, None, :], target.shown_units)
     assert hold[n0 - 1, 0] == 0.0 and hold[-1, 0] == hold[n0 + n1, 0] > 0.0
-    v = judge_axes(q[:, None, :], model.simulate(q)[:, None, :], ref.simulate(q)[:, None, :],
-                   dt, np.array([q.shape[0]]))  # fmt: skip
+    scales = coordinate_scales(target.env_id, target.coords, MACHINE_FLOORS)
+    v = judge_coordinates(q[:, None, :], model.simulate(q)[:, None, :],
+                          ref.simulate(q)[:, None, :], dt, np.array([q.shape[0]]), scales,
+                          target.coords, target.shown_units)  # fmt: skip
     assert not v.flags["self_sustained"][0] and not v.diverged[0]
 
 
 def test_the_floors_follow_the_judging_references_stiffness_and_the_builtin_keeps_the_papers():
     from bushenv.rigs.common import resolve_model
-    from bushenv.search.target_rig3 import MACHINE_FLOORS, reference_floors
+    from bushenv.search.targets import MACHINE_FLOORS, reference_floors
 
     builtin, why = reference_floors(
         resolve_model("reference", dt=DT, coords=3, what="reference", env_id="BushRig3-v0")

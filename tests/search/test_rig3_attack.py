@@ -65,7 +65,7 @@ def test_a_planar_case_whose_model_changed_no_longer_replays(tmp_path):
 
 
 def test_a_planar_case_records_its_floors_and_a_replay_says_when_they_changed(tmp_path):
-    """The rig3 judge's force floors follow from the reference (target_rig3.reference_floors):
+    """The rig3 judge's force floors follow from the reference (targets.reference_floors):
     a case keeps the floors it was judged at, and a replay at other floors says so, verdicts
     holding or not, as it does for a reference whose parameters changed."""
     _, path = _one_case(tmp_path)
