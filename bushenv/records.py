@@ -714,10 +714,16 @@ def resample(record: Record, dt: float) -> Record:
         )
     t = t0 + np.arange(n) * float(dt)
     t[-1] = min(t[-1], t1)
+
+    def interp(a: np.ndarray) -> np.ndarray:  # each coordinate's column on its own
+        cols = [np.interp(t, record.time, c) for c in a.reshape(len(record), -1).T]
+        return cols[0] if a.ndim == 1 else np.column_stack(cols)
+
     return Record(
         time=t,
-        displacement=np.interp(t, record.time, record.displacement),
-        force=np.interp(t, record.time, record.force),
+        displacement=interp(record.displacement),
+        force=interp(record.force),
         name=record.name,
         info=dict(record.info),
+        coords=record.coords,
     )
