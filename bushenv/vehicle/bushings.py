@@ -2,11 +2,11 @@
 coupled reference's three-axis records (kept in a cache folder, so a rerun reuses them), or
 given as model files.
 
-Identification records: ``bushenv.planar.reproduce3.identification_records`` -- random motion
+Identification records: ``bushenv.reproduce.identification_records`` -- random motion
 of all three coordinates at n = 1, independent and correlated (``identification_s`` each), and
 the coupled sine sets at n = 1 (``identification_s`` / 2 each), the reference measured with its
 load cell, each record its own noise seed: what ``bushenv reproduce --planar`` identifies on.
-Each kind is fitted by ``bushenv.planar.fitting.fit_planar`` with its default options and the
+Each kind is fitted by ``bushenv.identify.fit`` with its default options and the
 seed, as ``bushenv fit REC... --model KIND --seed SEED`` would.
 """
 
@@ -91,8 +91,8 @@ def vehicle_bushings(
     """Each kind's model: its file from ``files`` if given, else the cached fit in ``cache_dir``
     if its key matches ``recipe``, else identified now and saved there. Every model is the one
     read back from its file, so a first run and a rerun use the same numbers."""
-    from bushenv.planar.fitting import fit_planar
-    from bushenv.planar.reproduce3 import identification_records
+    from bushenv.identify import fit
+    from bushenv.reproduce import identification_records
 
     kinds = check_kinds(kinds)
     files = files or {}
@@ -119,7 +119,7 @@ def vehicle_bushings(
                 )
             if say:
                 say(f"identifying {kind} (seed {recipe.seed}, default options)")
-            result = fit_planar(histories, kind, {}, recipe.dt_s, recipe.seed, say)
+            result = fit(histories, kind, {}, recipe.seed, say or False, dt=recipe.dt_s)
             cache.mkdir(parents=True, exist_ok=True)
             result.model.save(path)
             meta = {"key": key, "fit_seconds": result.seconds, "info": plain(result.info)}
@@ -132,7 +132,7 @@ def vehicle_bushings(
         samples = f"random {ident:g} s x 2, coupled sets {ident / 2:g} s x 3"
         out[kind] = VehicleBushing(
             kind, model, str(path), sha256_file(path),
-            f"fit_planar({kind!r}, default options, seed {recipe.seed}) on the coupled "
+            f"fit({kind!r}, default options, seed {recipe.seed}) on the coupled "
             f"reference's n = 1 records ({samples}); {how}",
             meta["fit_seconds"], meta.get("info", {}),
         )  # fmt: skip

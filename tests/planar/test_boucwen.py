@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
+from bushenv.identify.vector_boucwen import VectorBoucWenOptions, fit_vector_boucwen
 from bushenv.models.base import PAPER_DT
 from bushenv.models.boucwen.planar import PlanarBoucWen
 from bushenv.models.planar_base import PlanarModelError
-from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
-from bushenv.planar.programme import random_independent
+from bushenv.motions import random_independent
 
 D = np.array([0.3e-3, 0.4e-3, 0.01])
 
@@ -71,9 +71,9 @@ def test_identification_recovers_a_vector_boucwen_and_is_deterministic():
     q = random_independent(1.0, 6.0, PAPER_DT, 0)
     truth = _truth()
     f = truth.simulate(q)
-    opts = PlanarBoucWenOptions(evaluations=60, time_limit_s=0.0)
-    model, info = fit_planar_boucwen([(q, f)], PAPER_DT, opts)
-    again, _ = fit_planar_boucwen([(q, f)], PAPER_DT, opts)
+    opts = VectorBoucWenOptions(evaluations=60, time_limit_s=0.0)
+    model, info = fit_vector_boucwen([(q, f)], PAPER_DT, opts)
+    again, _ = fit_vector_boucwen([(q, f)], PAPER_DT, opts)
     assert np.array_equal(model.k_matrix, again.k_matrix)
     assert np.array_equal(model.d_yield, again.d_yield)
     q_new = random_independent(1.3, 8.0, PAPER_DT, 9)
@@ -88,8 +88,8 @@ def test_the_clock_stops_the_search_and_says_so():
     q = random_independent(1.0, 8.0, PAPER_DT, 1)
     f = _truth().simulate(q)
     for selection in ("all", "extrapolation"):
-        opts = PlanarBoucWenOptions(300, time_limit_s=1e-6, relaxation_selection=selection)
-        model, info = fit_planar_boucwen([(q, f)], PAPER_DT, opts)
+        opts = VectorBoucWenOptions(300, time_limit_s=1e-6, relaxation_selection=selection)
+        model, info = fit_vector_boucwen([(q, f)], PAPER_DT, opts)
         # each search evaluates its first shape whatever the clock: a second search runs
         # only when the selection dropped a branch
         again = len(model.relax_tau) < len(opts.taus())
@@ -110,12 +110,12 @@ def test_hybrid_bw_is_its_backbone_plus_its_network():
 
 
 def test_hybrid_bw_fit_runs_backbone_then_network():
-    from bushenv.planar.fitting import fit_planar
+    from bushenv.identify import fit
 
     q = random_independent(1.0, 6.5, PAPER_DT, 4)
     f = _truth().simulate(q)
     opts = {"evaluations": 1, "teacher_steps": 20, "free_run_steps": 0}
-    result = fit_planar([(q, f)], "hybrid-bw", opts, PAPER_DT, seed=0)
+    result = fit([(q, f)], "hybrid-bw", opts, 0, False, dt=PAPER_DT)
     assert result.model.name == "hybrid-bw" and result.info["backbone evaluations"] >= 8
     err = result.model.simulate(q) - f
     assert np.all(np.sqrt(np.mean(err**2, axis=0) / np.mean(f**2, axis=0)) < 0.05)
