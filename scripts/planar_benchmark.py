@@ -6,7 +6,7 @@ For each seed: the planar reference (with load-cell noise, its own noise seed) i
 60 s of independent random motion at n = 1 on all axes; linear (3x3 K, C by least squares),
 the per-axis networks (seed 000 §4.2's kind), the MIMO network, the MIMO hybrid, the vector
 Bouc-Wen and the hybrid on it (``hybrid-bw``; default options) are identified from it; each
-is run free on the unseen records of ``bushenv.planar.programme`` (n = 1.5) against the
+is run free on the unseen records of ``bushenv.motions`` (n = 1.5) against the
 reference. Prints RMS ratio and MAX error
 (% of max |f|, as seed 000 Table 3) per axis, beside Table 3, and writes the numbers as JSON.
 """
@@ -20,14 +20,15 @@ import time
 
 import numpy as np
 
+from bushenv.identify.mimo_options import MimoOptions as TrainOptions
+from bushenv.identify.mimo_train import fit_mimo
+from bushenv.identify.vector_boucwen import fit_vector_boucwen
 from bushenv.metrics import max_error_ratio, rms_ratio
 from bushenv.models.base import PAPER_DT, velocity_of
 from bushenv.models.planar_base import COORDS
 from bushenv.models.planar_hybrid_bw import compose
 from bushenv.models.planar_linear import fit_linear
-from bushenv.planar.boucwen_fit import fit_planar_boucwen
-from bushenv.planar.programme import programme, random_independent
-from bushenv.planar.train import TrainOptions, fit_planar_network
+from bushenv.motions import random_independent, verification_motions
 from bushenv.progress import Progress
 from bushenv.reference.planar import PlanarRubber
 
@@ -71,21 +72,21 @@ def run_seed(
     models = {"linear": fit_linear(q, velocity_of(q, dt), f, dt)}
     for kind in MODELS[1:4]:
         t0 = time.perf_counter()
-        models[kind] = fit_planar_network(q, f, dt, kind=kind, seed=seed, options=options)
+        models[kind] = fit_mimo(q, f, dt, kind=kind, seed=seed, options=options)
         done[0] += 1
         progress.update(done[0], f"seed {seed}: {kind} trained in {time.perf_counter() - t0:.0f} s")
     t0 = time.perf_counter()
-    models["boucwen"] = fit_planar_boucwen([(q, f)], dt)[0]
+    models["boucwen"] = fit_vector_boucwen([(q, f)], dt)[0]
     done[0] += 1
     progress.update(done[0], f"seed {seed}: boucwen fitted in {time.perf_counter() - t0:.0f} s")
     t0 = time.perf_counter()  # hybrid-bw: that Bouc-Wen as backbone, the MIMO net on its residual
     residual = f - models["boucwen"].simulate(q)
-    net = fit_planar_network(q, residual, dt, kind="nn", seed=seed, options=options)
+    net = fit_mimo(q, residual, dt, kind="nn", seed=seed, options=options)
     models["hybrid-bw"] = compose(models["boucwen"], net)
     done[0] += 1
     progress.update(done[0], f"seed {seed}: hybrid-bw trained in {time.perf_counter() - t0:.0f} s")
     out = {}
-    for name, qt in programme(dt, seed).items():
+    for name, qt in verification_motions(dt, seed).items():
         ft = reference(uncoupled, seed + 100).simulate(qt)
         out[name] = {}
         for kind, m in models.items():
@@ -105,7 +106,7 @@ def run_seed(
 def coupling_shares(seed: int = 0) -> str:
     """How much of the reference's force the coupling carries on the n = 1.5 independent record:
     RMS of (coupled - switched off) / RMS of coupled, per axis, specimen without noise."""
-    q = programme(PAPER_DT, seed)["random independent"]
+    q = verification_motions(PAPER_DT, seed)["random independent"]
     full = PlanarRubber.preset(measurement=False)
     f = full.simulate(q)
     cases = {

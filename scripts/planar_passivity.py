@@ -21,14 +21,14 @@ from pathlib import Path
 
 import numpy as np
 
+from bushenv.certify.fixed_points import fixed_points, folds, grid
+from bushenv.certify.passivity import passivity
 from bushenv.models import MODELS, load_model
 from bushenv.models.base import PAPER_DT, velocity_of
 from bushenv.models.planar_base import PlanarModelError
 from bushenv.models.planar_linear import fit_linear
 from bushenv.models.planar_narx import PlanarNarx
-from bushenv.planar.fixed_points import fixed_points, fold_crossings, grid
-from bushenv.planar.passivity import passivity
-from bushenv.planar.programme import random_independent
+from bushenv.motions import random_independent
 from bushenv.progress import Progress
 
 HOLDS = grid([0.0], [0.0, 2e-3, 4e-3], [0.0, 0.05, 0.10])
@@ -58,17 +58,17 @@ def build_models(names: list[str], seed: int, progress: Progress, training: str 
         elif name == "reference":
             models[name] = MODELS["reference"].model_class(3).preset(measurement=False)
         elif name in TRAINED:
-            from bushenv.planar.train import fit_planar_network
+            from bushenv.identify.mimo_train import fit_mimo
 
             opts = None
             if name == "hybrid" and training == "noisy-feedback":
-                from bushenv.planar.train_options import (
+                from bushenv.identify.mimo_options import (
                     NOISY_FEEDBACK_TRAINING,
-                    PlanarNetworkOptions,
+                    MimoOptions,
                 )
 
-                opts = PlanarNetworkOptions(**NOISY_FEEDBACK_TRAINING)
-            models[name] = fit_planar_network(q, f, dt, kind=name, options=opts, seed=seed)
+                opts = MimoOptions(**NOISY_FEEDBACK_TRAINING)
+            models[name] = fit_mimo(q, f, dt, kind=name, options=opts, seed=seed)
         else:
             raise PlanarModelError(
                 f"--models {name!r}: unknown three-axis model; known: linear, linear-preset, "
@@ -118,12 +118,12 @@ def certificate_table(models: dict) -> str:
             continue
         t0 = time.perf_counter()
         fp = fixed_points(m, grid(*CERT_AXES))
-        folds = fold_crossings(m, *CERT_AXES, fp=fp, refine=False)  # counted, not located
+        crossings = folds(m, fp, CERT_AXES, refine=False)  # counted, not located
         n = fp.count
         un = int(fp.unresolved.sum())
         rows.append(
             f"| {name} | {len(n)} | {n.min()}-{n.max()} | {int((n > 1).sum())} "
-            f"| {int((fp.stable_count == 0).sum())} | {len(folds)} "
+            f"| {int((fp.stable_count == 0).sum())} | {len(crossings)} "
             f"| {time.perf_counter() - t0:.1f}{f' ({un} unresolved boxes)' if un else ''} |"
         )
     return "\n".join(rows)

@@ -270,7 +270,7 @@ VARIANTS = {  # the outside bushing as built, and with one coupling taken out (`
 
 def check_outside(bushing: OutsideBushing, dt: float, seed: int = 0) -> dict:
     """Stability and passivity of the specimen alone (no noise); raises if a check fails."""
-    from bushenv.planar.programme import random_correlated, random_independent
+    from bushenv.motions import random_correlated, random_independent
 
     out: dict = {}
     # static stability: a convex strain energy over 1.5x the n = 1 range on every coordinate
@@ -338,7 +338,7 @@ EFFORT = {"linear": 0.1, "hybrid": 8.0, "hybrid-bw": 240.0}  # wall s on set A, 
 def unseen_motions(dt: float, seed: int, held: float, swept: float, f_hz, duration_s: float):
     """The unseen records by name: 12 held sweeps (held at +-``held`` x the n = 1 peak, the
     other swept at ``swept`` x it over ``f_hz``), and random n = 1 of new seeds."""
-    from bushenv.planar.programme import preload_sweep, random_correlated, random_independent
+    from bushenv.motions import preload_sweep, random_correlated, random_independent
 
     out = {}
     for h in range(3):
@@ -457,12 +457,13 @@ def training_sets(
     dt: float, seed: int, ident_s: float, held_s: float, variant: str = "as-built"
 ) -> tuple[dict, list]:
     """{"reference": {"A": [(q, f)], "B": [...]}, "outside": ...}, and the motions' names."""
-    from bushenv.planar.machine import items, reference_for
-    from bushenv.planar.reproduce3 import identification_records
+    from bushenv.machine import reference_for
+    from bushenv.programmes import programme_items
+    from bushenv.reproduce import identification_records
 
     a_ref = identification_records(dt, seed, ident_s, "programme")
-    combined = items("combined", dt, seed, 1.0, held_s)
-    measure = reference_for(seed, dt)
+    combined = [(i.name, i.x) for i in programme_items("combined", 3, dt, seed, 1.0, held_s)]
+    measure = reference_for("rubber", 3, seed, dt)
     b_extra = [(q, measure(300 + k).simulate(q)) for k, (_, q) in enumerate(combined)]
     outside = OutsideBushing(OutsideParams(**VARIANTS[variant]), dt_s=dt)
     a_out = [(q, outside.simulate(q, 100_000 + 50 * seed + k)[0]) for k, (q, _) in enumerate(a_ref)]
@@ -499,13 +500,15 @@ def judge(model, records: dict, measured: dict, moving: dict, traces: dict | Non
 
 
 def card_coverage(fit, hist, unseen, measured, models_dir, key, dt) -> dict:
-    """Write the fit's card as ``bushenv fit`` does (``save_planar_fit``: the unseen records
+    """Write the fit's card as ``bushenv fit`` does (``save_fit``: the unseen records
     as its held-out records; into ``models_dir``, else a temporary folder) and return what it
     says of the held combinations: those never shown, and per unseen record the ones it holds
     that training never did."""
     import tempfile
 
-    from bushenv.planar.card import save_planar_fit
+    from dataclasses import replace
+
+    from bushenv.identify.card import save_fit
     from bushenv.records import Record
 
     def record(name, q, f):
@@ -517,7 +520,7 @@ def card_coverage(fit, hist, unseen, measured, models_dir, key, dt) -> dict:
         folder = Path(tmp) if models_dir is None else models_dir
         folder.mkdir(parents=True, exist_ok=True)
         path = folder / f"{key.replace('/', '_')}.npz"
-        card = save_planar_fit(fit, path, train, held_out, plots=False)
+        card = save_fit(replace(fit, records=train), path, held_out, plots=False)
     return {
         "held_shown": sorted(card["coverage"]["held_shown"]),
         "held_not_shown": card["coverage"]["held_not_shown"],
@@ -538,8 +541,8 @@ def worst(result: dict) -> tuple[float, str, str]:
 
 
 def run(args: argparse.Namespace) -> dict:
+    from bushenv.identify import fit as fit_model
     from bushenv.identify.coverage import coverage, not_shown
-    from bushenv.planar.fitting import fit_planar
     from bushenv.progress import Progress, format_seconds
     from bushenv.reference.planar import PlanarRubber
 
@@ -556,7 +559,7 @@ def run(args: argparse.Namespace) -> dict:
     outside = OutsideBushing(OutsideParams(**VARIANTS[args.variant]), dt_s=dt)
     progress.say("checking the outside bushing: tangent, passivity, stability")
     checks = check_outside(outside, dt, seed)
-    q_id = __import__("bushenv.planar.programme", fromlist=["x"]).random_independent(
+    q_id = __import__("bushenv.motions", fromlist=["x"]).random_independent(
         1.0, 40.0, dt, seed
     )
     stiff = {
@@ -599,7 +602,7 @@ def run(args: argparse.Namespace) -> dict:
                 key = f"{bushing}/{s}/{kind}"
                 progress.say(f"fitting {key} on {len(hist)} records, {length_s:.0f} s")
                 t0 = time.perf_counter()
-                fit = fit_planar(hist, kind, opts, dt, seed)
+                fit = fit_model(hist, kind, opts, seed, progress=False, dt=dt)
                 seconds[key] = time.perf_counter() - t0
                 notes[key] = [f"{k}: {v}" for k, v in fit.info.items() if "warning" in k]
                 traces[key] = {}

@@ -17,10 +17,10 @@ from pathlib import Path
 
 import torch
 
+from bushenv.identify.mimo_options import NOISY_FEEDBACK_TRAINING, MimoOptions
+from bushenv.identify.mimo_train import fit_mimo
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.programme import random_independent
-from bushenv.planar.train import fit_planar_network
-from bushenv.planar.train_options import NOISY_FEEDBACK_TRAINING, PlanarNetworkOptions
+from bushenv.motions import random_independent
 from bushenv.progress import Progress
 from bushenv.reference.planar import PlanarRubber
 from bushenv.search.campaign_config import CampaignConfig
@@ -40,8 +40,8 @@ def train(out: Path, seed: int, progress: Progress, training: str = "plain") -> 
         path = out / "models" / f"planar-{kind}{tag}-seed{seed}.npz"
         if not path.is_file():
             t0 = time.perf_counter()
-            opts = PlanarNetworkOptions(**NOISY_FEEDBACK_TRAINING) if noisy else None
-            fit_planar_network(q, f, dt, kind=kind, options=opts, seed=seed).save(path)
+            opts = MimoOptions(**NOISY_FEEDBACK_TRAINING) if noisy else None
+            fit_mimo(q, f, dt, kind=kind, options=opts, seed=seed).save(path)
             progress.say(f"{kind} trained in {time.perf_counter() - t0:.0f} s")
         paths[kind] = path
     return paths

@@ -27,10 +27,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from bushenv.identify.mimo_train import fit_mimo
 from bushenv.models import load_model
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.programme import random_independent
-from bushenv.planar.train import fit_planar_network
+from bushenv.motions import random_independent
 from bushenv.progress import Progress
 from bushenv.reference.planar import PlanarRubber
 from bushenv.search.evaluate import BatchEvaluator
@@ -46,7 +46,7 @@ def network(out: Path, kind: str, seed: int):
     if not path.is_file():
         q = random_independent(1.0, 60.0, PAPER_DT, seed)
         f = PlanarRubber.preset(seed=seed).simulate(q)
-        fit_planar_network(q, f, PAPER_DT, kind=kind, seed=seed).save(path)
+        fit_mimo(q, f, PAPER_DT, kind=kind, seed=seed).save(path)
     return load_model(path)
 
 

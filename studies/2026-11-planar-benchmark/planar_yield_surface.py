@@ -4,7 +4,7 @@
 
 The benchmark's protocol (``planar_benchmark.py``): 60 s of independent random motion at n = 1
 on the planar reference identifies both (default options); each runs free on the random
-records of ``bushenv.planar.programme``. Prints the RMS ratio per axis, mean over the seeds,
+records of ``bushenv.motions``. Prints the RMS ratio per axis, mean over the seeds,
 and axis / vector. ``--uncoupled``: the reference with coupling off and friction axis by axis.
 """
 
@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
+from bushenv.identify.vector_boucwen import VectorBoucWenOptions, fit_vector_boucwen
 from bushenv.metrics import rms_ratio
 from bushenv.models.base import PAPER_DT
-from bushenv.planar.boucwen_fit import PlanarBoucWenOptions, fit_planar_boucwen
-from bushenv.planar.programme import programme, random_independent
+from bushenv.motions import random_independent, verification_motions
 from bushenv.progress import Progress
 
 _spec = importlib.util.spec_from_file_location(
@@ -42,9 +42,9 @@ def main() -> None:
         q = random_independent(1.0, 60.0, dt, seed)
         f = _bench.reference(args.uncoupled, seed).simulate(q)
         for j, surface in enumerate(("vector", "axis")):
-            model, _ = fit_planar_boucwen([(q, f)], dt, PlanarBoucWenOptions(yield_surface=surface))
+            model, _ = fit_vector_boucwen([(q, f)], dt, VectorBoucWenOptions(yield_surface=surface))
             progress.update(2 * k + j + 1, f"seed {seed}: {surface} fitted")
-            for name, qt in programme(dt, seed).items():
+            for name, qt in verification_motions(dt, seed).items():
                 if not name.startswith("random"):
                     continue
                 ft = _bench.reference(args.uncoupled, seed + 100).simulate(qt)

@@ -25,12 +25,12 @@ import sys
 
 import numpy as np
 
+from bushenv import reproduce as r3
+from bushenv.identify import fit
 from bushenv.metrics import max_error_ratio, rms_ratio
 from bushenv.models.base import PAPER_DT
+from bushenv.motions import coupled_sets
 from bushenv.persist import write_figure
-from bushenv.planar import reproduce3 as r3
-from bushenv.planar.fitting import fit_planar
-from bushenv.planar.machine import coupled_sets
 from bushenv.progress import Progress
 from bushenv.reference.planar import PlanarRubber
 
@@ -52,7 +52,7 @@ def identified(seed: int, coupled: bool, identification: str, dt: float):
         hist = [
             (q, reference(seed + 50 * k, False, dt).simulate(q)) for k, (q, _) in enumerate(hist)
         ]
-    return fit_planar(hist, "boucwen", r3._untimed("boucwen"), dt, seed).model
+    return fit(hist, "boucwen", r3._untimed("boucwen"), seed, progress=False, dt=dt).model
 
 
 def worst_on_sets(model, seed: int, coupled: bool, scale: float, dt: float) -> tuple[float, float]:
