@@ -3,10 +3,12 @@ options, card and outputs follow for one axis and for three."""
 
 import json
 
+import numpy as np
 import pytest
 
 from bushenv.cli import main
 from bushenv.models import load_model
+from bushenv.record_files import load_record
 
 # the flags that cut each kind's training short: --teacher-steps is the same flag for both
 BUDGET = {
@@ -79,3 +81,18 @@ def test_a_flag_of_the_other_coordinate_count_is_refused_naming_what_the_kind_ta
     err = capsys.readouterr().err
     assert "--free-run-steps is not an option of model hybrid" in err
     assert "hybrid (3-axis)" in err and "--iters-per-length" in err
+
+
+@pytest.mark.parametrize("axes", [1, 3])
+def test_the_same_seed_gives_the_same_model_to_the_bit_whatever_c(records, tmp_path, axes):
+    # budgets are iterations: no clock decides where a training stops unless asked
+    train, held = records[axes]
+    runs = []
+    for name in ("a", "b"):
+        out = tmp_path / f"{name}.npz"
+        argv = ["fit", train, "--model", "hybrid", "--seed", "2", "--no-plots", "--quiet",
+                "--out", str(out), *BUDGET[axes]]  # fmt: skip
+        assert main(argv) == 0
+        runs.append(load_model(out, coords=axes))
+    x = load_record(held).displacement  # the held-out record drives both
+    assert np.array_equal(runs[0].simulate(x), runs[1].simulate(x))
