@@ -150,6 +150,8 @@ def _ranges(x: np.ndarray, mask: np.ndarray) -> list[list[float]]:
 def _fold_entry(f, one: bool) -> dict:
     entry = {
         "q": list(f.q),
+        "q_from": list(f.q_from),
+        "q_to": list(f.q_to),
         "force": list(f.force),
         "from": f.count_from,
         "to": f.count_to,

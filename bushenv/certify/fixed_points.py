@@ -11,9 +11,8 @@ Krawczyk's uniqueness test; boxes left at the depth limit are counted, ``unresol
 spectral radius of its block companion matrix is below 1 (C = 1: the scalar companion matrix
 of the a_j). Since phi's Jacobian is sum_l A_l - I, a singular root has the eigenvalue 1: that
 is where, as q moves, a stable and an unstable fixed point meet and vanish (a fold). Over a grid
-of holds the folds are points (C = 1) or surfaces: :func:`fold_crossings` finds where they cut
-the grid's edges, :func:`folds` the same for one coordinate's sorted holds, located to a
-nanometre.
+of holds the folds are points (C = 1) or surfaces: :func:`folds` finds where they cut the grid's
+edges and locates each by bisection (to a nanometre of translation).
 """
 
 from __future__ import annotations

@@ -24,7 +24,7 @@ from importlib import resources
 from pathlib import Path
 
 from bushenv.errors import BadInput
-from bushenv.export.certificate import Carried, carried_certificate
+from bushenv.export.certificate import carried_certificate
 from bushenv.export.description import (
     FMI_VERSIONS,
     MODEL_IDENTIFIER,
@@ -39,6 +39,7 @@ from bushenv.export.facts import (
     find_card,
     refuse_three_axis_overrides,
 )
+from bushenv.export.flagged import Carried
 from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE_BY_COORDS, model_source
 from bushenv.models import ModelError, ModelSpec, file_hash, get_model, model_file
 from bushenv.persist import atomic_write, json_text

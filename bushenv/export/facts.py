@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bushenv import excitation as ex
-from bushenv.export.certificate import Carried, Flagged
+from bushenv.export.flagged import Carried, Flagged
 from bushenv.identify.card import CardError, card_paths, load_card
 from bushenv.models import BushingModel, ModelError, model_file
 
@@ -168,7 +168,7 @@ def refuse_three_axis_overrides(card_path, stroke_m, velocity_m_per_s) -> None:
 
 def _three_axis(model, lines, card_path, certificate, stroke_m, velocity_m_per_s) -> Facts:
     """A model over several coordinates carries the three-axis test machine's envelope and the
-    boxes of its certificate (``certify_vector``); its card is not read into the FMU yet."""
+    boxes of its certificate (``bushenv.certify``); its card is not read into the FMU yet."""
     refuse_three_axis_overrides(card_path, stroke_m, velocity_m_per_s)
     source = "the three-axis test machine (BushRig3-v0's stroke and rate; no model card)"
     flagged = () if certificate is None else certificate.flagged
