@@ -70,7 +70,8 @@ MAX_ROTATION_RAD = 0.15  # the rotation the planar programmes stay within (assum
 FRICTION_YIELDS = ("vector", "axis")
 
 
-def _preset() -> dict[str, Any]:
+def default_parameters() -> dict[str, Any]:
+    """The coupled rubber's default parameters, from the one-axis axial and radial presets."""
     ax, rad = ONE_AXIS["axial"], ONE_AXIS["radial"]
     k_t = ROTATION_K_NM_PER_RAD
     loss_s = rad["c_ns_per_m"] / rad["k_n_per_m"]
@@ -316,7 +317,7 @@ class PlanarRubber(PlanarModel):
         """The preset specimen: ``effects=None`` switches on the physical effects, and
         ``measurement`` adds the load cell's noise; ``overrides`` replace preset parameters
         (or set ``friction_yield``, ``friction_elements``)."""
-        params = _preset()
+        params = default_parameters()
         unknown = [
             k
             for k in overrides

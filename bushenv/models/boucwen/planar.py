@@ -184,9 +184,9 @@ class PlanarBoucWen(PlanarModel):
         """The linear preset (seed 000 Table 1, the assumed rotation) plus the reference's
         friction as one hysteretic element: h = its friction force, d = its slip deflection."""
         from bushenv.models.planar_linear import PlanarLinear
-        from bushenv.reference.planar import _preset
+        from bushenv.reference.planar import default_parameters
 
-        lin, ref = PlanarLinear.preset(dt), _preset()
+        lin, ref = PlanarLinear.preset(dt), default_parameters()
         return cls(
             lin.k_matrix,
             lin.c_matrix,
