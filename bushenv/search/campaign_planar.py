@@ -43,7 +43,7 @@ from bushenv.search.campaign_planar_holds import PlanarHolds, listed_holds3
 from bushenv.search.campaign_planar_report import format_planar_table, fresh_report, resumed
 from bushenv.search.campaign_search import MAX_SAVED_FAILURES
 from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.families_planar import Rig3Limits, machine_limits
+from bushenv.search.limits import Rig3Limits, machine_limits
 from bushenv.search.planar_models import (  # noqa: F401 (DEFAULT_REFERENCE, vetted_judge: the zoo's)
     DEFAULT_REFERENCE,
     Planar,

@@ -23,7 +23,7 @@ import numpy as np
 
 from bushenv.search.base import SearchContext, Searcher
 from bushenv.search.campaign_holds import HOLD_PROFILE_S, MAX_HOLDS, NAME
-from bushenv.search.families_planar import Rig3Limits
+from bushenv.search.limits import Rig3Limits
 
 GRID_POINTS = 5  # per coordinate: 125 held vectors, rest among them
 KINDS = ("several_fixed_points", "no_stable_fixed_point", "pushes_into_the_deflection")

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from bushenv.search.base import SearchError
 from bushenv.search.campaign_config import CampaignConfig
-from bushenv.search.families_planar import UNITS, limits_text
+from bushenv.search.limits import UNITS, limits_text
 from bushenv.search.planar_models import DEFAULT_REFERENCE, Planar
 from bushenv.search.targets import TARGETS
 

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.families import SPEED_MARGIN
+from bushenv.search.family_base import SPEED_MARGIN
 
 SCALES = (0.5, 0.7, 0.85, 0.95)
 MIN_CHUNK_S = 0.05

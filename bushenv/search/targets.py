@@ -8,7 +8,7 @@ evaluator, shrinking, campaigns and the corpus ask the target; none of them comp
 ``bushenv/search/checks.py`` holds the contract as checks every ``TARGETS`` entry passes.
 
 The rig target over three coordinates (``rig3``): a profile is (T, 3) (axial m, radial m,
-rotation rad) within a stroke and rate per coordinate (``families_planar.Rig3Limits``: the
+rotation rad) within a stroke and rate per coordinate (``limits.Rig3Limits``: the
 rig's, or a user's bushing's, passed as the evaluator's ``scales``); each coordinate's force
 (or moment) is judged by ``divergence.judge`` on its own scale: the env's force limit there and
 a force floor per coordinate (``reference_floors``: the papers' bushing's -- the one-axis
@@ -41,7 +41,7 @@ from bushenv.identify.static_estimate import coordinate_stiffness
 from bushenv.registry import Registry
 from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
 from bushenv.search.base import SearchError
-from bushenv.search.families_planar import COORDS, UNITS, clip3, limits3
+from bushenv.search.limits import COORDS, UNITS, clip3, limits3
 from bushenv.search.roads import quarter_car_responses
 from bushenv.search.target_base import (  # noqa: F401 (simulate_or_nan: the evaluator's)
     Responses,

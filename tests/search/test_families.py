@@ -5,15 +5,13 @@ from hypothesis import strategies as st
 
 from bushenv import excitation as ex
 from bushenv.models.base import PAPER_DT as DT
-from bushenv.search.families import (
-    FAMILIES,
+from bushenv.search.families import FAMILIES, get_family, pad_batch
+from bushenv.search.family_base import (
     MAX_PROFILE_S,
     MIN_HOLD_S,
     ROAD_MAX_HEIGHT_M,
     ROAD_MAX_RATE_M_PER_S,
     FamilyError,
-    get_family,
-    pad_batch,
 )
 from bushenv.search.targets import TARGETS
 

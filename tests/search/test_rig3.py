@@ -7,7 +7,7 @@ from bushenv.models.base import PAPER_DT
 from bushenv.models.planar_linear import PlanarLinear
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.families import FAMILIES, pad_batch
-from bushenv.search.families_planar import COORDS, rig3_limits
+from bushenv.search.limits import COORDS, rig3_limits
 from bushenv.search.shrink import shrink
 from bushenv.search.targets import TARGETS
 
