@@ -198,7 +198,7 @@ def narx_net(model) -> NarxNet:
     """The certificate's view of ``model`` (a NARX network of any number of coordinates: nn,
     hybrid, nn-axis); ``CertifyError`` for any other kind."""
     from bushenv.models.narx import NarxBushing
-    from bushenv.models.planar_narx import N_PAST_F, N_PAST_Q, PlanarNarx
+    from bushenv.models.planar_narx import N_PAST_F, N_PAST_Q, PlanarHybrid, PlanarNarx
 
     if isinstance(model, NarxBushing):
         one = np.ones(1)
@@ -225,8 +225,11 @@ def narx_net(model) -> NarxNet:
             coords=tuple(model.coords),
         )
     if isinstance(model, PlanarNarx):
+        # the linear backbone of a matrix hybrid; a pure network has none, and the vector
+        # Bouc-Wen backbone of hybrid-bw is not part of the held recurrence (as before the merge)
         zero = np.zeros((model.n_coords, model.n_coords))
-        k, c = getattr(model, "k_matrix", zero), getattr(model, "c_matrix", zero)
+        linear = isinstance(model, PlanarHybrid)
+        k, c = (model.k_matrix, model.c_matrix) if linear else (zero, zero)
         hidden = model.w1.shape[0]
         return NarxNet(
             n_past_x=N_PAST_Q,
