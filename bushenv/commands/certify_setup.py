@@ -4,8 +4,9 @@ One coordinate: the one judging setup (``bushenv.judge``: the reference resolved
 the stroke the model card's, the machine's for the shipped models, ``--stroke-mm`` on top).
 Several coordinates: the span per coordinate 1.5 x the card's training range (the one-axis
 stroke rule), ``--stroke-mm`` for translations and ``--rotation-mrad`` for rotations on top;
-the reference a model of as many coordinates (a registered name or a file), not vetted: the
-judging setup's vetting and scales are one coordinate's.
+the reference a model of as many coordinates (a registered name or a file), vetted over the
+span (``vetting.vet_coupled_reference``; ``--trust-reference`` certifies against one that
+failed), the judging setup being one coordinate's.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from bushenv.certify.network import CertifyError
 from bushenv.models import MODELS, get_model
@@ -109,22 +112,43 @@ def _span(args: argparse.Namespace, model) -> tuple[tuple[float, ...], str]:
 
 
 def _several(args: argparse.Namespace, model) -> Setup:
+    from bushenv.search.targets import reference_floors
+    from bushenv.vetting import vet_coupled_reference
+
     span, source = _span(args, model)
-    spec = None if args.reference in (None, "none") else args.reference
-    reference = None
-    if spec is not None:
-        reference = get_model(
-            spec, axis=args.axis, dt=model.dt, coords=model.n_coords,
-            wanted_by="bushenv certify --reference",
-        )  # fmt: skip
-    line = "none" if spec is None else f"{spec} (not vetted: the vetting is one coordinate's)"
-    return Setup(
-        span,
-        source,
-        _shown(model, span),
+    spec = None if args.reference in (None, "none") else str(args.reference)
+    if spec is None:
+        return Setup(span, source, _shown(model, span), None, None, "none", None, _title(args))
+    reference = get_model(
+        spec, axis=args.axis, dt=model.dt, coords=model.n_coords,
+        wanted_by="bushenv certify --reference",
+    )  # fmt: skip
+    floors, floors_source = reference_floors(reference)
+    vetting = vet_coupled_reference(
         reference,
         spec,
-        line,
-        None,
-        f"{Path(args.model).name}",
+        np.array(span),
+        floors,
+        reference_file=spec if spec.endswith(".npz") else None,
+        model=model,
+        model_file=args.model if str(args.model).endswith(".npz") else None,
     )
+    if not vetting.passed and not args.trust_reference:
+        raise CertifyError(
+            f"the reference {spec} failed its vetting ({vetting.summary()}): it cannot judge; "
+            "give another --reference, or pass --trust-reference to certify against it anyway"
+        )
+    judge = {
+        "reference": spec,
+        "vetting": vetting.describe(),
+        "vetting_verdict": vetting.verdict,
+        "trusted_despite_failed_vetting": bool(not vetting.passed),
+        "force_floors": dict(zip(model.coords, np.asarray(floors).tolist(), strict=True)),
+        "force_floors_source": floors_source,
+    }
+    line = f"{spec}, vetting {vetting.headline()}"
+    return Setup(span, source, _shown(model, span), reference, spec, line, judge, _title(args))
+
+
+def _title(args: argparse.Namespace) -> str:
+    return Path(args.model).name

@@ -113,7 +113,8 @@ def test_the_command_certifies_against_a_three_axis_reference(tmp_path, capsys):
     doc = json.loads((tmp_path / "d" / "certificate.json").read_text())
     assert doc["reference"]["source"] == ref and doc["reference"]["class"] == "PlanarLinear"
     assert all(h["reference_static_force"] is not None for h in doc["holds"])
-    assert "reference: " + ref in capsys.readouterr().out
+    assert doc["judge"]["vetting"] and "vetting_verdict" in doc["judge"]  # vetted first
+    assert "reference: " + ref + ", vetting" in capsys.readouterr().out
     one_axis = str(tmp_path / "lin1.npz")
     from bushenv.models.linear import LinearBushing
 
@@ -122,3 +123,15 @@ def test_the_command_certifies_against_a_three_axis_reference(tmp_path, capsys):
             "75", "--out", str(tmp_path / "e"), "--quiet"]  # fmt: skip
     assert main(argv) == 2
     assert "is a one-axis model" in capsys.readouterr().err
+
+
+def test_a_three_axis_reference_that_fails_its_vetting_is_refused_unless_trusted(tmp_path, capsys):
+    path = str(network().save(tmp_path / "nn3.npz"))
+    pulling = str(network(w1_scale=0.0, b_out=(-1.0, 0.0, 0.0)).save(tmp_path / "pull3.npz"))
+    argv = ["certify", path, "--reference", pulling, "--stroke-mm", "3", "--rotation-mrad", "75",
+            "--holds", "27", "--hold-s", "4", "--out", str(tmp_path / "f"), "--quiet"]  # fmt: skip
+    assert main(argv) == 2
+    assert "failed its vetting" in capsys.readouterr().err
+    assert main([*argv, "--trust-reference"]) in (0, 1)
+    doc = json.loads((tmp_path / "f" / "certificate.json").read_text())
+    assert doc["judge"]["trusted_despite_failed_vetting"]
