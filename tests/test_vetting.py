@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from bushenv.cli import main
 from bushenv.models import MODELS
@@ -117,3 +118,32 @@ def test_a_card_gives_no_ratio_on_an_axis_at_rest_reading_noise(tmp_path):
     assert (
         coordinate_metrics(ref.coords, f, pred)["axial"]["rms_ratio"] > 1.0
     )  # without q: a ratio to noise
+
+
+@pytest.mark.parametrize("n_coords", [1, 3])
+def test_the_records_check_judges_a_reference_on_its_records_whatever_its_coordinates(
+    tmp_path, n_coords
+):
+    """One records check over C: the reference's worst coordinate's RMS ratio on the records,
+    within ``RECORD_LIMIT`` for the bushing that made them, beyond it for one three times as
+    stiff."""
+    from bushenv.models import get_model
+    from bushenv.record_files import save_record
+    from bushenv.records import Record
+    from bushenv.vetting import RECORD_LIMIT
+    from bushenv.vetting_records import reference_errors
+
+    ref = get_model("linear", coords=n_coords)
+    t = np.arange(3000) * ref.dt
+    q = 1e-3 * np.sin(2 * np.pi * np.outer(t, np.arange(1, n_coords + 1) * 0.7))
+    x = q[:, 0] if n_coords == 1 else q
+    path = save_record(Record(t, x, ref.simulate(x)), tmp_path / "r.csv")
+    [(name, worst)] = reference_errors(ref, [path])
+    assert name == "r.csv" and worst < 1e-9
+    stiff = ref.copy()
+    if n_coords == 1:
+        stiff.k_n_per_m *= 3.0
+    else:
+        stiff = PlanarLinear(3.0 * ref.k_matrix, ref.c_matrix, ref.dt)
+    [(_, worst)] = reference_errors(stiff, [path])
+    assert worst > RECORD_LIMIT
