@@ -34,6 +34,11 @@ def read_document(path: str | os.PathLike) -> dict:
         raise ModelError(
             f"{p}: not a certificate written by bushenv certify (no summary, holds or model)"
         )
+    if any(isinstance(h.get("fixed_points"), int) for h in doc["holds"]):
+        raise ModelError(
+            f"{p}: a three-axis certificate of the layout before the one certificate (its holds "
+            "without free runs); certify the model again (bushenv certify) or drop --certificate"
+        )
     return doc
 
 

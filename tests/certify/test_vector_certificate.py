@@ -135,3 +135,37 @@ def test_a_three_axis_reference_that_fails_its_vetting_is_refused_unless_trusted
     assert main([*argv, "--trust-reference"]) in (0, 1)
     doc = json.loads((tmp_path / "f" / "certificate.json").read_text())
     assert doc["judge"]["trusted_despite_failed_vetting"]
+
+
+@pytest.mark.parametrize("coords", [1, 3])
+def test_one_layout_for_any_number_of_coordinates(coords):
+    from .conftest import fold_nn
+
+    model = fold_nn() if coords == 1 else network()
+    span = (1e-3,) if coords == 1 else SPAN
+    doc = certify(model, None, CertifyOptions(holds=27, span=span, **SMALL)).document
+    assert doc["format"] == "bushenv-certificate" and len(doc["coords"]) == coords
+    assert doc["settings"]["span"] == list(span)
+    for h in doc["holds"]:
+        assert len(h["q"]) == coords and all(len(p["force"]) == coords for p in h["fixed_points"])
+        assert {"reached", "departs", "oscillates", "wrong_sign", "static_off"} <= set(h)
+    for f in doc["folds"]:
+        assert len(f["q_from"]) == len(f["q_to"]) == coords
+    for p in doc["passivity"]["holds"]:
+        assert np.array(p["loss_eigenvalues_j"]).shape[1:] == (512, coords)
+    common = {"holds", "holds_settling_stably", "holds_with_more_than_one", "folds",
+              "wrong_sign_holds", "least_loss_eigenvalue_j", "passes_holds",
+              "passes_passivity"}  # fmt: skip
+    assert common <= set(doc["summary"])
+    assert (doc["passivity"]["energy_scan"] is None) == (coords > 1)
+
+
+def test_a_three_axis_certificate_of_the_layout_before_is_refused_by_name(tmp_path):
+    from bushenv.export.certificate import read_document
+    from bushenv.models import ModelError
+
+    old = {"summary": {}, "model": {"name": "nn"}, "holds": [{"q": [0, 0, 0], "fixed_points": 2}]}
+    path = tmp_path / "certificate.json"
+    path.write_text(json.dumps(old))
+    with pytest.raises(ModelError, match="layout before the one certificate"):
+        read_document(path)
