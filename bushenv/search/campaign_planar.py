@@ -14,8 +14,8 @@ A short pipeline through the one-axis search contracts, as the one-axis attack d
 2. **search**: each searcher on a ``BatchEvaluator`` of the ``rig3`` target, its failing
    profiles (and its worst) saved in ``failures/<model>-<searcher>.npz`` (``load_profiles``
    reads them: (T, 3) each), its coverage per coordinate in its unit;
-   then the **hold stage** (``campaign_planar_holds``): the holds a planar network's fixed
-   points mark as suspect, each stepped to and held, judged, filed as a search;
+   then the **hold stage** (``campaign_holds``, over C coordinates): the held vectors a
+   network's fixed points mark as suspect, each stepped to and held, judged, filed as a search;
 3. **recheck**: the control (which must stay clean) and the hybrid on every saved failure;
 4. **shrink**: the first ``max_shrink`` failures shrunk per axis and written as cases
    (``case_file.py``; ``--save`` adds them to the corpus);
@@ -38,8 +38,8 @@ from bushenv.persist import load_profiles, save_profiles, write_json
 from bushenv.progress import Progress
 from bushenv.search.base import Searcher, SearchError
 from bushenv.search.campaign_config import CampaignConfig
-from bushenv.search.campaign_planar_holds import NAME as HOLDS
-from bushenv.search.campaign_planar_holds import PlanarHolds, listed_holds3
+from bushenv.search.campaign_holds import GRID_POINTS, CertificateHolds, listed_vectors
+from bushenv.search.campaign_holds import NAME as HOLDS
 from bushenv.search.campaign_planar_report import format_planar_table, fresh_report, resumed
 from bushenv.search.campaign_search import MAX_SAVED_FAILURES
 from bushenv.search.evaluate import BatchEvaluator
@@ -84,6 +84,8 @@ def tally(failures) -> dict:
         "by_family_axis": dict(pairs.most_common()),
     }
 
+
+FAMILY = "step_hold3"  # the hold stage's profiles, as the coverage names them
 
 # How each of the rig3 target's searchers is held to one family.
 HELD_TO = {"random": lambda f: {"families": (f,)}, "cma": lambda f: {"family": f}}
@@ -197,9 +199,10 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
         shown = []
     plots = []
     if c.plots and shown:
-        from bushenv.search.campaign_planar_plots import plot_shrunk
+        from bushenv.search.campaign_plots import plot_shrunk_coordinates
 
-        plots = [str(q) for q in plot_shrunk(p.model, p.reference, shown, out / "plots")]
+        shrunk_plots = plot_shrunk_coordinates(p.model, p.reference, shown, out / "plots")
+        plots = [str(q) for q in shrunk_plots]
     report["plots"] = plots or report["plots"]
     report["complete"] = True
     save()
@@ -209,20 +212,20 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
 
 
 def _hold_stage(c, p: Planar, threads: int, progress: Progress) -> tuple[dict, dict | None]:
-    """The hold stage (``campaign_planar_holds``): its report entry and its search's."""
+    """The hold stage (``campaign_holds`` over C coordinates): its report entry and its
+    search's."""
     floors = np.array(list(p.judge["force_floors"].values()))
-    holds = listed_holds3(p.model, p.limits, floors)
+    holds = listed_vectors(p.model, p.limits.stroke, floors)
     if holds is None:
         return {"run": False, "why": "not a planar network (no fixed points)"}, None
+    stage = CertificateHolds(holds, p.limits.rate, FAMILY)
     if not holds:
         progress.say(f"[{c.model}] {HOLDS}: the fixed points mark no hold")
-        stage = PlanarHolds([], p.limits)
-        return stage.entry(), None
-    stage = PlanarHolds(holds, p.limits)
+        return stage.entry(grid_points=GRID_POINTS), None
     progress.total += len(holds)
     summary = _search_one(c, p, HOLDS, progress.total - len(holds), threads, progress, stage,
                           len(holds))  # fmt: skip
-    return stage.entry(), summary
+    return stage.entry(grid_points=GRID_POINTS), summary
 
 
 def _search_one(c, p: Planar, name: str, start: int, threads: int, progress: Progress,

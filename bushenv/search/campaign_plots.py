@@ -1,4 +1,5 @@
-"""A campaign's pictures: the worst profile of every search and every shrunk failure.
+"""A campaign's pictures: the worst profile of every search and every shrunk failure (over
+three coordinates, ``plot_shrunk_coordinates``: motion and force per coordinate).
 
 Each row shows the profile over time, the model's force beside the reference's (the reference
 always blue, the model red, the moment of divergence a dashed line named in the legend), and
@@ -15,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.divergence import cumulative_work
+from bushenv.models.base import BushingModel
 from bushenv.persist import write_figure
 from bushenv.search.campaign_cases import Shrunk
 from bushenv.search.campaign_resolve import Resolved
@@ -129,3 +131,50 @@ def plot_campaign(
     plot_dir.mkdir(parents=True, exist_ok=True)
     worst = plot_worst(resolved, searched, threads, plt, plot_dir)
     return worst + plot_shrunk(resolved, shrunk, out, threads, plt, plot_dir)
+
+
+# per coordinate: motion label, its factor from SI, force label
+COORDINATE_ROWS = (
+    ("axial [mm]", 1e3, "axial force [N]"),
+    ("radial [mm]", 1e3, "radial force [N]"),
+    ("rotation [mrad]", 1e3, "moment [N m]"),
+)
+
+
+def plot_shrunk_coordinates(
+    model: BushingModel,
+    reference: BushingModel,
+    shrunk: list[tuple[str, np.ndarray]],
+    plot_dir: Path,
+) -> list[Path]:
+    """One PNG per shrunk failure over three coordinates (``(title, profile (T, 3))``): a row
+    per coordinate (axial, radial, rotation), the motion on the left, the model's and the
+    reference's force on the right."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    paths = []
+    for i, (title, q) in enumerate(shrunk):
+        t = np.arange(q.shape[0]) * model.dt
+        with np.errstate(all="ignore"):
+            f_model = model.copy().simulate(q)
+            f_ref = reference.copy().simulate(q)
+        fig, axes = plt.subplots(3, 2, figsize=(12, 7.5), sharex=True, squeeze=False)
+        for row, (motion, scale, force) in enumerate(COORDINATE_ROWS):
+            ax_q, ax_f = axes[row]
+            ax_q.plot(t, q[:, row] * scale, "k", lw=0.9)
+            ax_q.set_ylabel(motion)
+            ax_f.plot(t, f_ref[:, row], REF_COLOUR, lw=1.0, label="reference")
+            ax_f.plot(t, f_model[:, row], MODEL_COLOUR, lw=1.0, label=model.name)
+            ax_f.set_ylabel(force)
+            if row == 0:
+                ax_q.set_title(f"shrunk failure {i + 1}: {title} -- motion")
+                ax_f.set_title("force and moment")
+                ax_f.legend(loc="best", fontsize=8)
+        for ax in axes[-1]:
+            ax.set_xlabel("time [s]")
+        fig.tight_layout()
+        paths.append(write_figure(fig, plot_dir / f"shrunk_{i + 1}.png"))
+    return paths
