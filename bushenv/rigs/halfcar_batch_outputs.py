@@ -10,10 +10,10 @@ import numpy as np
 
 from bushenv.rigs.halfcar_batch_kernels import ANG, PX, PY, VX, VY, W
 from bushenv.rigs.halfcar_batch_layout import UPRIGHT
+from bushenv.rigs.halfcar_car import SIGN
 from bushenv.rigs.halfcar_outputs import PIVOT_KEYS
 from bushenv.rigs.halfcar_params import SIDES, HalfCarParameters
 
-SIGN = {"left": 1.0, "right": -1.0}
 CAR_KEYS = (
     "body_y_m", "body_x_m", "body_vx_m_per_s", "body_vy_m_per_s",
     "body_vertical_accel_m_per_s2", "body_lateral_accel_m_per_s2", "roll_rad",
