@@ -61,3 +61,25 @@ def test_a_three_axis_card_written_before_the_one_card_still_reads(tmp_path):
     path.write_text(json.dumps(old))
     card = load_card(path)
     assert coordinates(card.data) == ["axial", "radial", "rotation"]
+
+
+def test_the_card_warns_where_the_network_is_worse_than_its_backbone_on_unseen_records():
+    from bushenv.identify.card_text import backbone_lines
+    from bushenv.models.planar_base import COORDS
+
+    def metrics(rms):
+        return {
+            c: {"rms_ratio": r, "max_error_ratio": 2 * r} for c, r in zip(COORDS, rms, strict=True)
+        }
+
+    card = {
+        "model": "hybrid-bw",
+        "records": [{"role": "train", "metrics": metrics([9, 9, 9])},
+                    {"role": "held-out", "metrics": metrics([0.01, 0.03, 0.02])}],
+        "backbone": {"model": "boucwen", "records": [{"metrics": metrics([0.02, 0.02, 0.02])}]},
+    }  # fmt: skip
+    line, warning = backbone_lines(card)
+    assert "hybrid-bw 1.00 (2.00) / 3.00 (6.00) / 2.00 (4.00)" in line  # held-out only
+    assert "makes the radial worse" in warning and "axial" not in warning
+    card["backbone"]["records"][0]["metrics"] = metrics([0.02, 0.0289, 0.02])
+    assert len(backbone_lines(card)) == 1  # within 5 % of the backbone (3.8 %): no warning
