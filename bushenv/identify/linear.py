@@ -16,7 +16,6 @@ from bushenv.models.base import BushingModel, velocity_of
 from bushenv.models.linear import LinearBushing
 from bushenv.models.registry import MODELS
 from bushenv.progress import ProgressSpec
-from bushenv.scales import BushingScales
 
 __all__ = ["IdentificationError", "check_record", "fit_linear", "least_squares_kc"]
 
@@ -67,26 +66,37 @@ def fit_linear(
 CONTROL_RECORD_S = 40.0  # the papers' identification record length (seed 000 §4.1)
 
 
-def fitted_linear(
-    source, scales: BushingScales, displacements: list | None = None, seed: int = 0
-) -> LinearBushing:
+def fitted_linear(source, scales, displacements: list | None = None, seed: int = 0):
     """Least-squares Kelvin-Voigt fit of ``source``'s response, from rest, to
     ``displacements`` (the records the reference was identified on, so the control sees the
-    same band), else to an n = 1 random record scaled to the bushing's stroke (the papers'
-    n = 1 peak is 2 mm of a 12.5 mm stroke)."""
-    dt = source.dt
+    same band), else to an n = 1 random record per coordinate (seeds ``seed``, ``seed`` + 1,
+    ...) scaled to the bushing's stroke (the papers' n = 1 peak is 2 mm of a 12.5 mm stroke)
+    and kept within its rate. ``scales``: one coordinate's ``BushingScales`` (``stroke_m``,
+    ``velocity_m_per_s``), or limits per coordinate (``stroke``, ``rate``: sequences of C, as
+    ``search.limits.Rig3Limits``). A ``LinearBushing``, or the linear model over C."""
+    dt, c = source.dt, source.n_coords
+    if c == 1:
+        stroke, rate = [scales.stroke_m], [scales.velocity_m_per_s]
+    else:
+        stroke, rate = list(scales.stroke), list(scales.rate)
     if not displacements:
-        x = ex.random_rpc(1.0, CONTROL_RECORD_S, dt, seed)
-        x = x * (scales.stroke_m / ex.MAX_DISPLACEMENT_M)
-        speed = np.max(np.abs(np.diff(x))) / dt
-        if speed > scales.velocity_m_per_s:
-            x = x * (scales.velocity_m_per_s / speed)
-        displacements = [x]
+        cols = []
+        for i in range(c):
+            x = ex.random_rpc(1.0, CONTROL_RECORD_S, dt, seed + i)
+            x = x * (stroke[i] / ex.MAX_DISPLACEMENT_M)
+            speed = np.max(np.abs(np.diff(x))) / dt
+            if speed > rate[i]:
+                x = x * (rate[i] / speed)
+            cols.append(x)
+        displacements = [cols[0] if c == 1 else np.stack(cols, axis=1)]
     xs, vs, fs = [], [], []
     for x in displacements:
-        v = velocity_of(np.asarray(x, dtype=np.float64), dt)
+        x = np.asarray(x, dtype=np.float64)
+        v = velocity_of(x, dt)
         xs.append(x)
         vs.append(v)
         fs.append(source.copy().simulate(x, v))
-    k, c = least_squares_kc(np.concatenate(xs), np.concatenate(fs), np.concatenate(vs))
-    return LinearBushing(k_n_per_m=k, c_ns_per_m=c, dt=dt)
+    k, damping = least_squares_kc(np.concatenate(xs), np.concatenate(fs), np.concatenate(vs))
+    if c == 1:
+        return LinearBushing(k_n_per_m=k, c_ns_per_m=damping, dt=dt)
+    return MODELS["linear"].model_class(c)(k, damping, dt=dt)
