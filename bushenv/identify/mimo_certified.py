@@ -41,15 +41,16 @@ import torch
 
 from bushenv.certify.fixed_points import fixed_points, grid
 from bushenv.certify.network import NarxNet, narx_net
+
+# the one-axis term's admission tolerance and its "reached" (per coordinate, of f_scale)
+from bushenv.identify.certified import ADMIT_TOLERANCE, SETTLE_TOLERANCE
 from bushenv.identify.static_estimate import COUPLING, StaticEstimate
 from bushenv.models.planar_narx import N_PAST_F, N_PAST_Q, PlanarNarx
 
 STROKE = (12.5e-3, 12.5e-3, 0.15)  # BushRig3-v0's stroke (m, m, rad): the box the search drives
 RAMP_S = 0.02  # the step's rise, within the rig's rates (0.63 m/s, 7.5 rad/s at full stroke)
 SETTLE_HOLD_S = 0.6  # hold after the step; its second half must sit on a fixed point
-SETTLE_TOLERANCE = 0.01  # of f_scale per coordinate: the one-axis certificate's "reached"
 CHECK_LEVELS = 7  # the admission grid: u in linspace(-1, 1, 7) per coordinate, q = stroke u |u|
-ADMIT_TOLERANCE = 0.02  # relative distance outside the band still admitted (a hinge's rest)
 HARD_HOLDS = 12  # holds of the last check that failed it, added to every later training step
 MIN_PIVOT = 1e-9  # |det J0|, |u^T v| below this are clipped (a fold: the gradient is unbounded)
 # which coordinates a training hold moves, in turn: each alone, each pair, all three
