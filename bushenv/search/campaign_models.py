@@ -57,22 +57,27 @@ def roles(config: CampaignConfig, judge: Judge, notes: list[str]) -> list[tuple[
     return out
 
 
-def card_displacements(reference: ResolvedModel | None) -> list[np.ndarray] | None:
-    """The displacement of the training records the reference's card names, when they are
-    all still there (checked against the card's hashes, with the card read once, at
-    resolving), else None."""
-    if reference is None or reference.card is None:
+def card_records(resolved: ResolvedModel | None) -> list | None:
+    """The training records (``Record``, of the model's number of coordinates) the card of
+    ``resolved`` names, when they are all still there (checked against the card's hashes, with
+    the card read once, at resolving; a record made in memory has no file and is left out),
+    else None."""
+    if resolved is None or resolved.card is None:
         return None
     from bushenv.identify.card import ModelCard
-    from bushenv.records import load_csv
+    from bushenv.record_files import load_record
 
-    # record files are relative to the card (older cards: absolute)
-    card = ModelCard(reference.card_file, reference.card)
-    here = card.path.parent
-    records = card.records
-    paths = [here / r["file"] for r in records if r.get("role") == "train" and r["file"]]
+    card = ModelCard(resolved.card_file, resolved.card)
+    train = [card.record_path(r) for r in card.records if r.get("role") == "train"]
+    paths = [p for p in train if p is not None]
     if not paths or not all(p.is_file() for p in paths):
         return None
-
     card.verify_records(paths)  # CardError naming a record that changed since
-    return [load_csv(p).displacement for p in paths]
+    return [load_record(p, coords=resolved.model.n_coords) for p in paths]
+
+
+def card_displacements(resolved: ResolvedModel | None) -> list[np.ndarray] | None:
+    """The displacement of each of ``card_records`` ((T,), or (T, C) over C coordinates), or
+    None."""
+    records = card_records(resolved)
+    return None if records is None else [r.displacement for r in records]
