@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bushenv.records import RecordError
+from bushenv.errors import BadInput
 
 # units a header may state per kind of column, and their factor to SI
 UNITS = {
@@ -43,6 +43,12 @@ HINT = {
     "force": "write the force unit in the header, e.g. 'force_axial [N]'",
     "moment": "N mm? write 'moment [N mm]' in the header",
 }
+
+
+class RecordError(BadInput):
+    """A record file or record array is invalid; the message names file, line and value."""
+
+
 # a column name with its unit in brackets or parentheses, e.g. "displacement [mm]"
 NAME_UNIT = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]*?)\s*[\])]\s*$")
 
@@ -92,8 +98,17 @@ THREE_AXES = Columns(
 LAYOUTS = {1: ONE_AXIS, 3: THREE_AXES}
 
 
-def columns_of(n_coords: int) -> Columns:
-    """The columns of a record of ``n_coords`` coordinates (1 or 3)."""
+def columns_of(n_coords: int, coords: tuple[str, ...] | None = None) -> Columns:
+    """The columns of a record of ``n_coords`` coordinates (1 or 3 in files); ``coords``: a
+    record's own coordinate names, for records of other counts made in memory."""
+    if n_coords not in LAYOUTS and coords is not None and len(coords) == n_coords:
+        return Columns(
+            tuple(coords),
+            tuple(f"displacement_{c}" for c in coords),
+            tuple(f"force_{c}" for c in coords),
+            ("displacement",) * n_coords,
+            ("force",) * n_coords,
+        )
     if n_coords not in LAYOUTS:
         raise RecordError(
             f"no record file format for {n_coords} coordinates; known: "

@@ -1,14 +1,22 @@
 """Measured or simulated test records as CSV files: load, validate, save, resample.
 
-The format (one record per file):
+One record type (``Record``) and one reader (``load_csv``) for a bushing of C coordinates: a
+time column, C displacement columns and C force columns (``bushenv.record_columns``). One
+coordinate (one record per file):
 
     time,displacement,force
     0.0,0.0,0.0
     0.0048828125,1.2e-05,4.61
     ...
 
-- The header is exactly ``time,displacement,force`` (spaces around names are tolerated, nothing
-  else: no extra columns, no other order). Columns are s, m, N, unless a column's unit is
+The three in-plane coordinates: ``time,displacement_axial,displacement_radial,rotation,
+force_axial,force_radial,moment`` (s, m, m, rad, N, N, N m), its names in any order, units in
+brackets (``rotation [deg]``, ``moment [N mm]``), plausibility per kind of column; every other
+rule below holds for it too.
+
+- The one-axis header is exactly ``time,displacement,force`` (spaces around names are
+  tolerated, nothing else: no extra columns, no other order). Columns are s, m, N, unless a
+  column's unit is
   written after its name in brackets, ``displacement [mm]`` or ``force (kN)`` (``UNITS``): the
   values are then converted to SI on load.
 - Values are decimal numbers (anything Python's ``float`` reads except NaN and inf), comma
@@ -53,8 +61,18 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.errors import BadInput
 from bushenv.persist import atomic_write
+from bushenv.record_columns import (
+    HINT,
+    ONE_AXIS,
+    PLAUSIBLE,
+    SI,
+    Columns,
+    RecordError,
+    column_order,
+    columns_of,
+    header_coordinates,
+)
 
 HEADER = ("time", "displacement", "force")
 HEADER_TEXT = ",".join(HEADER)
@@ -94,10 +112,6 @@ _BINARY_MAGIC = (
     (b"\xff\xfe", "UTF-16 text (save it as UTF-8)"),
     (b"\xfe\xff", "UTF-16 text (save it as UTF-8)"),
 )
-
-
-class RecordError(BadInput):
-    """A record file or record array is invalid; the message names file, line and value."""
 
 
 @dataclass(eq=False)
@@ -212,6 +226,7 @@ class Record:
             self.force,
             self.label,
             where=lambda i: f"{self.label} sample {i}",
+            cols=columns_of(self.n_coords, self.coords),
         )
         return self
 
@@ -234,11 +249,22 @@ def _check_columns(
     where,
     max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
     max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+    cols: Columns = ONE_AXIS,
+    stated: np.ndarray | None = None,
 ) -> None:
-    """Semantic checks; ``where(i)`` names sample i (a file line or a sample index)."""
+    """Semantic checks; ``where(i)`` names sample i (a file line or a sample index). ``cols``:
+    the record's columns (several coordinates: (T, C) ``x`` and ``f``, each column against the
+    plausibility limit of its kind unless ``stated``, per column, says its unit was written)."""
     if t.size < 2:
         raise RecordError(f"{label}: {t.size} sample(s); need at least 2 to know the sample time")
-    for key, a in zip(HEADER, (t, x, f), strict=True):
+    c = len(cols.coords)
+    named = [("time", "time", t)]  # (column, kind, values) in the header's order
+    for names, kinds, a in (
+        (cols.displacement, cols.displacement_kinds, x.reshape(len(t), c)),
+        (cols.force, cols.force_kinds, f.reshape(len(t), c)),
+    ):
+        named += [(n, k, a[:, i]) for i, (n, k) in enumerate(zip(names, kinds, strict=True))]
+    for key, _, a in named:
         bad = ~np.isfinite(a)
         if bad.any():
             i = int(np.argmax(bad))
@@ -262,7 +288,23 @@ def _check_columns(
             f"{dt!r} s by more than the tolerance {tol:.3g} s "
             f"({STEP_RTOL:.0%} of dt + {STEP_ATOL_S:g} s); records must be uniformly sampled"
         )
-    plausible = (
+    plausible = [
+        (key, a, np.inf if stated is not None and stated[j] else PLAUSIBLE[kind], SI[kind],
+         HINT[kind])
+        for j, (key, kind, a) in enumerate(named) if j > 0
+    ]  # fmt: skip
+    if cols is ONE_AXIS:  # the one-axis columns' own limits (overridable) and hints
+        plausible = _one_axis_limits(x, f, max_displacement_m, max_force_n)
+    for key, a, limit, unit, hint in plausible:
+        i = int(np.argmax(np.abs(a)))
+        if abs(a[i]) > limit:
+            raise RecordError(
+                f"{where(i)}: {key} {float(a[i])!r} {unit} exceeds {limit:g} {unit}; {hint}"
+            )
+
+
+def _one_axis_limits(x, f, max_displacement_m: float, max_force_n: float) -> tuple:
+    return (
         (
             "displacement",
             x,
@@ -284,12 +326,6 @@ def _check_columns(
             "'force [N]' or 'force [kN]'",
         ),
     )
-    for key, a, limit, unit, hint in plausible:
-        i = int(np.argmax(np.abs(a)))
-        if abs(a[i]) > limit:
-            raise RecordError(
-                f"{where(i)}: {key} {float(a[i])!r} {unit} exceeds {limit:g} {unit}; {hint}"
-            )
 
 
 def check_rate(t: np.ndarray, label: str, where) -> None:
@@ -430,8 +466,13 @@ def load_csv(
     max_bytes: int = MAX_RECORD_BYTES,
     max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
     max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
+    coords: int | None = 1,
 ) -> Record:
     """Read and validate one record file; refuse anything off-format with ``RecordError``.
+
+    The one reader of record files of C coordinates (``bushenv.record_columns``): the header
+    says which columns; ``coords`` the number wanted (1 by default; None: any), a file of
+    another number is refused saying which it is.
 
     Files above ``max_bytes`` are refused before reading. A file of plain numbers under the
     plain header goes through numpy's parser (``_load_plain``: within 2x of ``np.loadtxt``,
@@ -452,7 +493,8 @@ def load_csv(
             "for one record; split it into shorter records"
         )
     if size == 0:
-        raise RecordError(f"{path}: empty file; expected the header '{HEADER_TEXT}' and data")
+        want = columns_of(coords or 1).header_text
+        raise RecordError(f"{path}: empty file; expected the header '{want}' and data")
     with open(path, "rb") as fh:
         head = fh.read(_SNIFF_BYTES)
     for magic, what in _BINARY_MAGIC:
@@ -462,15 +504,39 @@ def load_csv(
     if nul >= 0:
         raise RecordError(f"{path}: binary data (NUL byte at byte {nul}); expected a text CSV file")
 
+    cols = _columns_wanted(path, coords)
     limits = {"max_displacement_m": max_displacement_m, "max_force_n": max_force_n}
-    if _plain_numbers(path):
-        record = _load_plain(path, **limits)
+    if _plain_numbers(path, cols):
+        record = _load_plain(path, cols, **limits)
         if record is not None:
             return record
-    return _load_line_by_line(path, **limits)
+    return _load_line_by_line(path, cols, **limits)
 
 
-def _plain_numbers(path: Path) -> bool:
+def header_fields(path: str | os.PathLike) -> list[str]:
+    """The record file's first row as fields ([] when unreadable: the reader names why)."""
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as fh:
+            return next(csv.reader(fh), [])
+    except (OSError, UnicodeDecodeError, csv.Error):
+        return []
+
+
+def _columns_wanted(path: Path, coords: int | None) -> Columns:
+    """The columns to read ``path`` with: those its header is meant for, or those of
+    ``coords`` (the reverse direction is named by ``column_order``)."""
+    found = header_coordinates(header_fields(path))
+    if coords == 1 and found != 1:
+        cols = columns_of(found)
+        raise RecordError(
+            f"{path} line 1: a {found}-axis record ({', '.join(cols.coords)}: header "
+            f"'{cols.header_text}'); this needs a one-axis record ('{HEADER_TEXT}'): give "
+            f"one-axis records to a one-axis fit, {found}-axis ones to a {found}-axis fit"
+        )
+    return columns_of(found if coords is None else coords)
+
+
+def _plain_numbers(path: Path, cols: Columns = ONE_AXIS) -> bool:
     """Whether numpy's parser reads ``path`` exactly as ``_parse`` would: the header on line 1,
     then only plain-number bytes, LF or CRLF line ends, no blank line before the end and no
     line beyond the csv module's field limit. Scanned in chunks of whole lines (memory flat)."""
@@ -481,7 +547,7 @@ def _plain_numbers(path: Path) -> bool:
         if not head.endswith(b"\n") or b'"' in head or not head.isascii():
             return False
         fields = head.decode("ascii").removesuffix("\n").removesuffix("\r")
-        if "\r" in fields or tuple(n.strip() for n in fields.split(",")) != HEADER:
+        if "\r" in fields or tuple(n.strip() for n in fields.split(",")) != cols.names:
             return False  # units in the header, or a header to complain about: line by line
         blank_seen = False
         while chunk := fh.read(_SCAN_CHUNK_BYTES) + fh.readline():
@@ -512,6 +578,7 @@ def _first_blank_line(chunk: bytes) -> int:
 
 def _load_plain(
     path: Path,
+    cols: Columns = ONE_AXIS,
     max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
     max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
 ) -> Record | None:
@@ -526,15 +593,9 @@ def _load_plain(
             )
     except ValueError:
         return None
-    if a.shape[1] != 3 or a.shape[0] < 2 or not np.isfinite(a).all():
+    if a.shape[1] != len(cols.names) or a.shape[0] < 2 or not np.isfinite(a).all():
         return None
-    record = Record(
-        time=a[:, 0].copy(),
-        displacement=a[:, 1].copy(),
-        force=a[:, 2].copy(),
-        name=path.stem,
-        path=path,
-    )
+    record = _record_of(path, cols, a)
     # no blank lines before the data ends: sample i is on line i + 2
     where = lambda i: f"{path} line {i + 2}"  # noqa: E731
     _check_columns(
@@ -545,22 +606,37 @@ def _load_plain(
         where=where,
         max_displacement_m=max_displacement_m,
         max_force_n=max_force_n,
+        cols=cols,
     )
     check_rate(record.time, str(path), where)
     return record
 
 
+def _record_of(path: Path, cols: Columns, a: np.ndarray) -> Record:
+    """The record of the (T, 1 + 2C) columns ``a`` in ``cols.names`` order."""
+    c = len(cols.coords)
+    return Record(
+        time=a[:, 0].copy(),
+        displacement=a[:, 1].copy() if c == 1 else a[:, 1 : 1 + c].copy(),
+        force=a[:, 2].copy() if c == 1 else a[:, 1 + c :].copy(),
+        name=path.stem,
+        path=path,
+        coords=cols.coords,
+    )
+
+
 def _load_line_by_line(
     path: Path,
+    cols: Columns = ONE_AXIS,
     max_displacement_m: float = MAX_PLAUSIBLE_DISPLACEMENT_M,
     max_force_n: float = MAX_PLAUSIBLE_FORCE_N,
 ) -> Record:
     """Parse ``path`` line by line (``_parse``), naming the first problem's line."""
-    t, x, f = array.array("d"), array.array("d"), array.array("d")
+    columns = [array.array("d") for _ in cols.names]
     lines = array.array("q")
     try:
         with open(path, encoding="utf-8-sig", newline="") as fh:
-            factors = _parse(fh, path, t, x, f, lines)
+            factors, stated = _parse(fh, path, columns, lines, cols)
     except UnicodeDecodeError as exc:
         raise RecordError(
             f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start} of a read block); "
@@ -569,13 +645,8 @@ def _load_line_by_line(
     except csv.Error as exc:
         raise RecordError(f"{path}: not a readable CSV file: {exc}") from None
 
-    record = Record(
-        time=np.frombuffer(t, dtype=np.float64) * factors.get("time", 1.0),
-        displacement=np.frombuffer(x, dtype=np.float64) * factors.get("displacement", 1.0),
-        force=np.frombuffer(f, dtype=np.float64) * factors.get("force", 1.0),
-        name=path.stem,
-        path=path,
-    )
+    values = [np.frombuffer(a, dtype=np.float64) * k for a, k in zip(columns, factors, strict=True)]
+    record = _record_of(path, cols, np.column_stack(values))
     line_of = np.frombuffer(lines, dtype=np.int64)
     if len(record) < 2:
         raise RecordError(
@@ -588,16 +659,21 @@ def _load_line_by_line(
         record.force,
         str(path),
         where=lambda i: f"{path} line {int(line_of[i])}",
-        max_displacement_m=np.inf if "displacement" in factors else max_displacement_m,
-        max_force_n=np.inf if "force" in factors else max_force_n,
+        max_displacement_m=np.inf if stated[1] else max_displacement_m,
+        max_force_n=np.inf if stated[-1] else max_force_n,
+        cols=cols,
+        stated=stated,
     )
-    if "time" not in factors:  # a stated unit is taken as stated
+    if not stated[0]:  # a stated unit is taken as stated
         check_rate(record.time, str(path), lambda i: f"{path} line {int(line_of[i])}")
     return record
 
 
-def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> dict[str, float]:
-    """Fill the columns; returns the header's stated units as factors to SI."""
+def _parse(
+    fh: io.TextIOBase, path: Path, columns: list, lines, cols: Columns = ONE_AXIS
+) -> tuple[np.ndarray, np.ndarray]:
+    """Fill ``columns`` (in ``cols.names`` order); returns the factors to SI of the header's
+    stated units and which columns state one."""
     reader = csv.reader(fh, strict=True)
     header = None
     for row in reader:
@@ -607,16 +683,14 @@ def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> dict[str, float]:
         break
     if header is None:
         raise RecordError(
-            f"{path}: no header and no data (only blank lines); expected '{HEADER_TEXT}'"
+            f"{path}: no header and no data (only blank lines); expected '{cols.header_text}'"
         )
     if reader.line_num != 1:
         raise RecordError(f"{path} line {reader.line_num}: blank lines before the header")
-    problem = _header_problem(header)
-    if problem:
-        raise RecordError(f"{path} line 1: {problem}")
-    factors = header_units(header)[1]
+    order, factors, stated = _header_columns(path, header, cols)
+    t = columns[0]
+    width = len(cols.names)
     blank_at = 0
-    columns = (t, x, f)
     last_line = 1
     for row in reader:
         line = reader.line_num
@@ -628,16 +702,17 @@ def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> dict[str, float]:
             continue
         if blank_at:
             raise RecordError(f"{path} line {blank_at}: blank line inside the data")
-        if len(row) != 3:
+        if len(row) != width:
             raise RecordError(
-                f"{path} line {line}: {len(row)} value(s) {','.join(row)!r}, expected 3 "
-                f"({HEADER_TEXT})"
+                f"{path} line {line}: {len(row)} value(s) {','.join(row)!r}, expected {width} "
+                f"({','.join(h.strip() for h in header)})"
             )
         if not t:
             units_row = _units_row_problem(row, header)
             if units_row:
                 raise RecordError(f"{path} line {line}: {units_row}")
-        for key, column, text in zip(HEADER, columns, row, strict=True):
+        for key, column, j in zip(cols.names, columns, order, strict=True):
+            text = row[j]
             try:
                 value = float(text)
             except ValueError:
@@ -656,7 +731,24 @@ def _parse(fh: io.TextIOBase, path: Path, t, x, f, lines) -> dict[str, float]:
                 f"{path} line {line}: time goes backwards ({t[-1]!r} after {t[-2]!r})"
             )
         lines.append(line)
-    return factors
+    return factors, stated
+
+
+def _header_columns(
+    path: Path, header: list[str], cols: Columns
+) -> tuple[list[int], np.ndarray, np.ndarray]:
+    """(file column of each of ``cols.names``, factor to SI of each, whether its unit is
+    stated): the one-axis header exactly in order, the others' names in any order."""
+    if cols is not ONE_AXIS:
+        order, factors = column_order(path, header, cols)
+        stated = np.array([bool(NAME_UNIT.match(header[j])) for j in order])
+        return list(order), factors, stated
+    problem = _header_problem(header)
+    if problem:
+        raise RecordError(f"{path} line 1: {problem}")
+    given = header_units(header)[1]
+    factors = np.array([given.get(n, 1.0) for n in HEADER])
+    return [0, 1, 2], factors, np.array([n in given for n in HEADER])
 
 
 # ----- save ------------------------------------------------------------------------------------
@@ -664,27 +756,22 @@ def save_csv(record: Record, path: str | os.PathLike, overwrite: bool = False) -
     """Validate ``record`` and write it to ``path`` atomically; returns the path.
 
     Refuses (``RecordError``) a record ``load_csv`` would refuse, and an existing ``path``
-    unless ``overwrite=True``. A record sampled outside ``PLAUSIBLE_RATE_HZ`` gets the header
-    ``time [s],displacement,force``, so that it reads back as it was written. The data go
+    unless ``overwrite=True``. Its header is that of its number of coordinates
+    (``bushenv.record_columns``), in SI; a record sampled outside ``PLAUSIBLE_RATE_HZ`` gets
+    ``time [s]`` there, so that it reads back as it was written. The data go
     to a temporary file in the same folder first, so a crash never leaves a half-written
     record under the final name.
     """
     path = Path(path)
-    if record.n_coords > 1:
-        raise RecordError(
-            f"{record.label}: a record of {record.n_coords} coordinates has the three-axis "
-            "header; write it with bushenv.record_files.save_record"
-        )
+    cols = columns_of(record.n_coords)  # the file format's columns (1 or 3 coordinates)
     record.validate()
     if path.exists() and not overwrite:
         raise RecordError(f"{path} already exists; refusing to overwrite it (pass overwrite=True)")
-    plain = is_plausible_rate(record.time)
-    head = (HEADER_TEXT if plain else "time [s],displacement,force") + "\n"
+    head = cols.header_text
+    head = (head if is_plausible_rate(record.time) else head.replace("time", "time [s]", 1)) + "\n"
     # tolist() gives Python floats, whose repr is the shortest exact round-trip text.
-    rows = zip(
-        record.time.tolist(), record.displacement.tolist(), record.force.tolist(), strict=True
-    )
-    text = head + "".join(f"{a!r},{b!r},{c!r}\n" for a, b, c in rows)
+    rows = np.column_stack([record.time, record.q, record.f]).tolist()
+    text = head + "".join(",".join(map(repr, row)) + "\n" for row in rows)
     try:
         atomic_write(path, lambda fh: fh.write(text.encode("utf-8")), replace=overwrite)
     except FileExistsError:  # appeared while writing: never replaced silently

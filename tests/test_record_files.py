@@ -52,15 +52,15 @@ def test_units_in_the_header_are_converted(tmp_path):
         ),
         (
             THREE_AXES.header_text + "\ns,m,m,rad,N,N,N m\n",
-            r"line 2: time 's' is not a number \(units go",
+            r"line 2: 's,m,m,rad,N,N,N m' looks like a row of units under the header",
         ),
         (
             THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0\n",
-            r"line 3: 6 values, expected 7",
+            r"line 3: 6 value\(s\) '0.1,0,0,0,0,0', expected 7",
         ),
         (
             THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n0.1,0,0,nan,0,0,0\n",
-            r"line 3: rotation is nan",
+            r"line 3: rotation is 'nan', expected a finite number",
         ),
         (
             THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n0.1,0,0,45,0,0,0\n",
@@ -74,7 +74,7 @@ def test_units_in_the_header_are_converted(tmp_path):
             THREE_AXES.header_text + "\n0.1,0,0,0,0,0,0\n0.0,0,0,0,0,0,0\n",
             r"line 3: time goes backwards",
         ),
-        (THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n", r"1 sample\(s\)"),
+        (THREE_AXES.header_text + "\n0,0,0,0,0,0,0\n", r"only one data row"),
         (
             THREE_AXES.header_text
             + "\n0,0,0,0,0,0,0\n0.1,0,0,0,0,0,0\n0.3,0,0,0,0,0,0\n0.4,0,0,0,0,0,0\n",
