@@ -104,10 +104,19 @@ def resolve_model(
     *,
     reference: bool = False,
     card: bool = False,
+    coords: int = 1,
+    wanted_by: str = "",
 ) -> ResolvedModel:
-    """``spec`` (a registered name, a model file or an object) resolved: loaded (as a
-    reference with ``reference``: ``get_reference``), its file hashed and, with ``card``, its
-    card read. Only the model under test and the reference need their cards (they set the
-    scales and are vetted), so the others do not read theirs."""
-    model = (get_reference if reference else get_model)(spec, axis=axis, dt=dt)
+    """``spec`` (a registered name, a model file or an object) resolved over ``coords``
+    coordinates: loaded (as a reference with ``reference``: ``get_reference``), its file hashed
+    and, with ``card``, its card read. Only the model under test and the reference need their
+    cards (they set the scales and are vetted), so the others do not read theirs. Over several
+    coordinates a registered name is its preset's reference form (without load-cell noise),
+    whatever its role, and ``dt`` None takes a file at its own rate (a name at the papers');
+    a file of another number of coordinates is refused, naming ``wanted_by``."""
+    if coords == 1:
+        model = (get_reference if reference else get_model)(spec, axis=axis, dt=dt)
+    else:
+        preset = MODELS[spec].reference_preset if isinstance(spec, str) and spec in MODELS else None
+        model = get_model(spec, dt=dt, preset=preset, coords=coords, wanted_by=wanted_by)
     return resolved(spec, model, axis, card=card)

@@ -100,13 +100,14 @@ Resolver = Callable[[str, str, float], BushingModel]
 
 
 def _resolve(case: Case, spec: str, reference: bool = False) -> ResolvedModel:
-    """A model a case names, resolved for its target: a planar model (``PLANAR_MODELS`` name
-    or file) on a target whose profiles have coordinates, a one-axis model otherwise."""
-    if not TARGETS[case.env].coords:
-        return resolve_model(spec, axis=case.axis, dt=case.dt, reference=reference)
-    from bushenv.search.planar_models import resolved_planar
-
-    return resolved_planar(spec, case.dt, "reference" if reference else "model")
+    """A model a case names, resolved for its target: over as many coordinates as the
+    target's profiles have columns (one for a (T,) profile; the rig over three drives models of
+    three, the half car's three inputs its pivots of three)."""
+    coords = len(TARGETS[case.env].coords) or 1
+    what = f"the case {case.name}'s {'reference' if reference else 'model'}"
+    return resolve_model(
+        spec, axis=case.axis, dt=case.dt, reference=reference, coords=coords, wanted_by=what
+    )
 
 
 def model_spec(case: Case, spec: str, notes: list[str] | None = None) -> str:
