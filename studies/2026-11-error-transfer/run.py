@@ -26,7 +26,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 RUNS = {
     "default": [],
-    "wide": ["--held=-1,0.5,2", "--combinations", "48"],
+    "wide": ["--held=-1.5,0.5,2", "--combinations", "48"],
 }
 
 
@@ -47,11 +47,15 @@ def run(name: str) -> dict:
         "cars": report["cars"],
         "car_steps": report["car_steps"],
         "load_average_start_end": [load0[0], os.getloadavg()[0]],
-        "predictor": found["predictor"],
+        "predictors": found["predictors"],
         "singles": {
-            k: {**v["cells"], "influence_rank": v["influence"]["overall"]}
+            k: {
+                n: {**v[n]["cells"], "influence_rank": v[n]["influence"]["overall"]}
+                for n in checks["predictors"]
+            }
             for k, v in checks["singles"].items()
         },  # fmt: skip
+        "first_order_sign": checks.get("first_order_sign"),
         "combined": checks.get("combined"),
         "never_reach": [" ".join(r["component"]) for r in found["never_reach"]],
         "amplified": {
@@ -63,18 +67,18 @@ def run(name: str) -> dict:
     }
 
 
-def breakdown(report: dict) -> dict:
-    """The combinations' median relative error by type (even: one error in all four pivots,
-    odd: random mixes), by kind for the all-four ones, and by the size of the measured change
-    (also below the judged 5 % of the size)."""
+def breakdown(report: dict, name: str) -> dict:
+    """Predictor ``name``'s median relative error on the combinations by type (even: one
+    error in all four pivots, odd: random mixes), by kind for the all-four ones, and by the size
+    of the measured change (also below the judged 5 % of the size)."""
     import numpy as np
 
-    least = report["checks"]["combined"]["least_pct"]
+    least = report["checks"]["combined"][name]["least_pct"]
     combos = report["checks"]["combinations"]
 
     def rel(cs: list, lo: float = least, hi: float = np.inf) -> dict:
         m = np.concatenate([np.ravel(np.asarray(c["measured_pct"], float)) for c in cs])
-        p = np.concatenate([np.ravel(np.asarray(c["predicted_pct"], float)) for c in cs])
+        p = np.concatenate([np.ravel(np.asarray(c[f"{name}_pct"], float)) for c in cs])
         ok = np.isfinite(m) & (m > 0) & (m >= lo) & (m < hi)
         r = np.abs(p[ok] - m[ok]) / m[ok]
         return {"cells": int(ok.sum()), "median": float(np.median(r)) if ok.any() else None}
@@ -160,13 +164,15 @@ def main() -> None:
         summary[name] = run(name)
         summary[name]["same_map_as_default"] = drop_duplicates(name)
         report = json.loads((HERE / name / "transfer.json").read_text())
-        summary[name]["breakdown"] = breakdown(report)
+        summary[name]["breakdown"] = {
+            n: breakdown(report, n) for n in report["checks"]["predictors"]
+        }
         path.write_text(json.dumps(summary, indent=1) + "\n")
         rewrite(name)
     if not args.rewrite:
         summary["symmetric_track"] = symmetric_track()
         path.write_text(json.dumps(summary, indent=1) + "\n")
-    print(json.dumps({k: v.get("predictor", v) for k, v in summary.items()}, indent=1))
+    print(json.dumps({k: v.get("predictors", v) for k, v in summary.items()}, indent=1))
 
 
 if __name__ == "__main__":
