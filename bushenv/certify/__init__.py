@@ -11,6 +11,7 @@ stability over held deflection vectors and small-signal passivity as a matrix te
 | ``stiffness``     | dynamic stiffness K (C x C) about a hold: analytic, linearised, sines |
 | ``passivity``     | the loss matrix test (C = 1: Im K < 0 bands), the passivity report   |
 | ``energy``        | where the divergence judge's energy criterion fires on sines         |
+| ``options``       | ``CertifyOptions``: the grid, the spans, the passivity holds         |
 | ``certificate``   | ``certify``: the whole certificate; cheap pieces for searchers       |
 | ``document``      | the certificate's JSON layout, one for every C                       |
 | ``reached_holds`` | the failing holds alone, reached after sines: the reference's vetting |
@@ -19,11 +20,9 @@ stability over held deflection vectors and small-signal passivity as a matrix te
 
 from bushenv.certify.certificate import (
     Certificate,
-    CertifyOptions,
     certify,
     least_stable_holds,
     non_passive_bands,
-    per_coordinate,
     stability_margin,
 )
 from bushenv.certify.fixed_points import (
@@ -35,6 +34,7 @@ from bushenv.certify.fixed_points import (
     spectral_radius,
 )
 from bushenv.certify.network import CertifyError, NarxNet, narx_net
+from bushenv.certify.options import CertifyOptions, per_coordinate
 from bushenv.certify.passivity import PassivityReport, passivity
 from bushenv.certify.range_holds import range_holds
 

@@ -227,7 +227,7 @@ def _summary(holds: list[dict], fo: list, pas: list[dict], one: bool) -> dict:
 
 def document(net, opts, holds, fo, pas, scan, timing, has_reference: bool) -> dict:
     """The whole certificate document (``certificate.json``)."""
-    from bushenv.certify.certificate import per_coordinate
+    from bushenv.certify.options import per_coordinate
 
     one = net.n_coords == 1
     settings = {

@@ -15,8 +15,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from bushenv.certify.certificate import CertifyOptions, certify
+from bushenv.certify.certificate import certify
 from bushenv.certify.network import CertifyError, narx_net
+from bushenv.certify.options import CertifyOptions
 from bushenv.certify.plots import certificate_plots
 from bushenv.commands.certify_setup import Setup, setup
 from bushenv.models import get_model

@@ -189,7 +189,8 @@ def _judged(model, spec, axis, reference, stroke_m) -> tuple[Any, float, str, st
 
 
 def _run(model, spec, axis, reference, stroke_m, spans) -> tuple[dict, str]:
-    from bushenv.certify.certificate import CertifyOptions, certify, per_coordinate
+    from bushenv.certify.certificate import certify
+    from bushenv.certify.options import CertifyOptions, per_coordinate
     from bushenv.models import get_model
 
     if model.n_coords == 1:
