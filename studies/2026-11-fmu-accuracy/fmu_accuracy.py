@@ -111,9 +111,9 @@ def errors(path: Path, model) -> tuple[dict[str, float], dict[tuple[str, str], f
 
 
 def programme_table(paths: dict[str, Path]) -> None:
-    """The papers' programme (bushenv.machine.papers_programme: harmonic grid, n = 1 and
+    """The papers' programme (bushenv.programmes.papers_programme: harmonic grid, n = 1 and
     n = 1.5 records, 4 mm step held 10 s; 28 records, 65,638 samples) at h = dt."""
-    from bushenv.machine import papers_programme
+    from bushenv.programmes import papers_programme
 
     items = papers_programme(DT)
     print("\n| FMU | simulate_fmu h = dt, vs F one step earlier | set-then-read h = dt |")

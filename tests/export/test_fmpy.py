@@ -175,7 +175,7 @@ def test_simulate_fmu_runs_the_papers_programme_as_bushenv_does(fmu):
     """Every record of the papers' programme through FMPy (hybrid, FMI 3.0), one step late."""
     from fmpy import simulate_fmu
 
-    from bushenv.machine import papers_programme
+    from bushenv.programmes import papers_programme
 
     model = get_model("hybrid")
     for item in papers_programme(PAPER_DT):

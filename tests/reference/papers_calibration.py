@@ -6,7 +6,7 @@ axial, 11.9 % radial). ``calibration_numbers(axis)`` repeats that on the referen
 
 1. drive it with the RPC-like random record of ``bushenv.excitation.random_rpc`` (durability
    spectrum, 0.5-20 Hz, 204.8 Hz, peak n * 2 mm) at n = 1, 40 s, and fit F ~ k x + c v by least
-   squares (``linear_fit``), as ``bushenv.machine.papers_programme`` records it;
+   squares (``linear_fit``), as ``bushenv.programmes.papers_programme`` records it;
 2. run that linear model on the unseen n = 1.5 record (20 s, next seed); ``rms_ratio``.
 
 tests/reference/test_rubber.py holds the reference to these numbers; ``python
