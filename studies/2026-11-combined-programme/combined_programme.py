@@ -505,7 +505,6 @@ def card_coverage(fit, hist, unseen, measured, models_dir, key, dt) -> dict:
     says of the held combinations: those never shown, and per unseen record the ones it holds
     that training never did."""
     import tempfile
-
     from dataclasses import replace
 
     from bushenv.identify.card import save_fit
