@@ -34,7 +34,7 @@ from bushenv.models.base import PAPER_DT
 from bushenv.motions import random_correlated, random_independent
 from bushenv.reference.planar import PlanarRubber
 from bushenv.search.campaign_planar import DEFAULT_REFERENCE, planar_search, tally
-from bushenv.search.families_planar import COORDS
+from bushenv.search.limits import COORDS
 from bushenv.search.planar_models import resolve_planar_spec
 from bushenv.zoo.summary import shown_options
 

@@ -13,7 +13,7 @@ from bushenv.models.planar_linear import PlanarLinear, fit_linear
 from bushenv.persist import load_profiles
 from bushenv.record_files import load_record
 from bushenv.search.families import FAMILIES
-from bushenv.search.families_planar import COORDS, Rig3Limits, machine_limits
+from bushenv.search.limits import COORDS, Rig3Limits, machine_limits
 from bushenv.search.targets import TARGETS
 
 TRAIN = "random_independent_n1_8s_seed0.csv"
@@ -213,19 +213,19 @@ def network(bushing) -> Path:
 
 def test_the_hold_stage_steps_to_each_suspect_hold_within_the_limits_and_judges_it(network):
     from bushenv.models import load_model
-    from bushenv.search.campaign_planar_holds import KINDS, PlanarHolds, listed_holds3
+    from bushenv.search.campaign_holds import VECTOR_KINDS, CertificateHolds, listed_vectors
     from bushenv.search.evaluate import BatchEvaluator
     from bushenv.search.target_base import covered_search
 
     model = load_model(network, coords=3)
     lim = Rig3Limits((3e-3, 3e-3, 0.075), (0.2, 0.2, 5.0))
-    holds = listed_holds3(model, lim, floors=np.zeros(3))  # no floor: every inward push counts
+    holds = listed_vectors(model, lim.stroke, floors=np.zeros(3))  # no floor: every push counts
     assert holds, "a network with no floor to its pushes lists some hold"
     for h in holds:
-        assert set(h["kinds"]) <= set(KINDS) and h["kinds"]
+        assert set(h["kinds"]) <= set(VECTOR_KINDS) and h["kinds"]
         assert np.all(np.abs(h["q"]) <= np.array(lim.stroke) * (1 + 1e-12))
-    assert listed_holds3(PlanarLinear.preset(), lim, np.zeros(3)) is None
-    stage = PlanarHolds(holds, lim)
+    assert listed_vectors(PlanarLinear.preset(), lim.stroke, np.zeros(3)) is None
+    stage = CertificateHolds(holds, lim.rate, "step_hold3")
     with BatchEvaluator(model, PlanarLinear.preset(), "rig3", scales=lim) as ev:
         result, covered = covered_search(stage, ev, len(holds), 0)
     assert result.evaluations == len(holds) and set(covered) == {"step_hold3"}
