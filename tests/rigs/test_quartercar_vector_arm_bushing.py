@@ -7,7 +7,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from stable_baselines3.common.vec_env import VecCheckNan
-from test_quartercar_planar import diagonal_linear3
+from test_quartercar_arm_bushing import diagonal_linear3
 from test_quartercar_vector import bump_then_rough_road, make_vec
 
 from bushenv import excitation
