@@ -202,7 +202,7 @@ class HalfCarParameters:
     def pivot_splits(self, models: Any) -> np.ndarray:
         """(4, 2, 3) (k_in, c_in) of each pivot's split coupling: what a model states (a linear
         model's diagonal K, C: its held remainder is then exactly zero, as in the quarter car's
-        ``car_planar.rotation_split``), else the planar linear preset's (the reference rubber's
+        ``car_bushings.rotation_split``), else the planar linear preset's (the reference rubber's
         tangent at rest)."""
         out = np.empty((len(POSITIONS), 2, 3))
         for i, k in enumerate(POSITIONS):
@@ -272,12 +272,12 @@ def resolve_bushings(spec: Any, dt: float, what: str) -> tuple[Any, str]:
     three-axis ``.npz`` or a model object), run as ONE model with four histories (one batched
     step per car), or a table ``{lower_left = ..., upper_left = ..., lower_right = ...,
     upper_right = ...}`` of four, each its own model. Returns (model or dict, label)."""
-    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.common import resolve_model
 
     def one(value: Any, where: str):
         if what == "reference" and isinstance(value, str) and value == "none":
             raise RigError(f"{ENV_ID}: {where}: the car runs a reference twin; give one")
-        return resolve_planar(value, dt, where, env_id=ENV_ID)
+        return resolve_model(value, dt=dt, coords=3, what=where, env_id=ENV_ID)
 
     if isinstance(spec, dict):
         if sorted(spec) != sorted(POSITIONS):
