@@ -288,10 +288,10 @@ def judge_of(
     envelope = None if ref is None else envelope_of(ref_card, scales)
     vetting = None
     if ref is not None and vet:
-        from bushenv.vetting import vet_reference
+        from bushenv.vetting import of_scales, vet_reference
 
         vetting = vet_reference(
-            ref, label, scales, card=ref_card, card_file=reference.file,
+            ref, label, **of_scales(scales), card=ref_card, card_file=reference.file,
             model=model.model if model is not None and compare else None,
             model_card=model_card, model_file=None if model is None else model.file,
             envelope=envelope[:2], builtin=builtin,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +19,13 @@ from bushenv.models import BushingModel
 from bushenv.scales import STIFFNESS_MISMATCH, BushingScales
 from bushenv.vetting_check import RECORD_LIMIT, Check
 
-DRIVE_S = 20.0  # the random drive of the vector stiffness comparison
+
+@dataclass(frozen=True)
+class _Limits:
+    """A stroke and a rate per coordinate, as ``fitted_linear`` takes them."""
+
+    stroke: np.ndarray
+    rate: np.ndarray
 
 
 def card_records(card: dict | None, card_file: Any) -> tuple[list[Path], list[str]]:
@@ -72,13 +79,17 @@ def reference_errors(reference: BushingModel, paths: list[Path]) -> list[tuple[s
     return record_errors(paths, reference.dt, lambda p: load_record(p, reference.n_coords), error)
 
 
-def records_check(reference: BushingModel, card: dict | None, card_file: Any, what: str) -> Check:
-    """Check 2: the reference's error on the records its card names."""
+def records_check(reference: BushingModel, card: dict | None, card_file: Any) -> Check:
+    """Check 3: the reference's error on the records its card names (the worst coordinate's
+    over several); ``card`` None: the card beside the model file ``card_file``, if any."""
+    if card is None:
+        card, card_file = read_card(card_file)
     if card is None:
         return Check(
             "records", None, "no model card naming the records it was fitted on: give a "
             "reference file with its card beside it (MODEL.card.json; bushenv fit writes it)",
         )  # fmt: skip
+    what = "its own card's records" + _worst(reference)
     paths, missing = card_records(card, card_file)
     if not paths:
         where = "" if card_file is None else f" beside {Path(os.fspath(card_file)).parent}"
@@ -86,8 +97,11 @@ def records_check(reference: BushingModel, card: dict | None, card_file: Any, wh
             "records", None, f"{what} ({', '.join(missing) or 'none named'}) are not there: "
             f"put the record files{where} or at the paths the card names",
         )  # fmt: skip
-    errors = reference_errors(reference, paths)
-    return judged_errors("records", errors, what, RECORD_LIMIT)
+    return judged_errors("records", reference_errors(reference, paths), what, RECORD_LIMIT)
+
+
+def _worst(model: BushingModel) -> str:
+    return " (worst coordinate)" if model.n_coords > 1 else ""
 
 
 def judged_errors(name: str, errors: list[tuple[str, float]], what: str, limit: float) -> Check:
@@ -106,36 +120,51 @@ def judged_errors(name: str, errors: list[tuple[str, float]], what: str, limit: 
 
 def compatibility_check(
     reference: BushingModel,
-    scales: BushingScales,
+    stroke,
+    velocity,
     model: BushingModel | None,
     model_card: dict | None,
     model_file: Any,
 ) -> Check:
-    """Check 3: the reference and the model under test are models of one bushing."""
-    paths, _ = card_records(model_card, model_file)
+    """Check 5: the reference and the model under test are models of one bushing: on the
+    records the model's card names (``model_card`` None: the card beside ``model_file``), else
+    by the diagonal of their stiffness (``identify.linear.fitted_linear`` on one random drive
+    within ``stroke`` and ``velocity`` per coordinate; None: no rate limit)."""
+    if model_card is None:
+        model_card, card_file = read_card(model_file)
+    else:
+        card_file = model_file
+    paths, _ = card_records(model_card, card_file)
     if paths:
         errors = reference_errors(reference, paths)
-        return judged_errors("compatibility", errors, "the model's card's records", RECORD_LIMIT)
+        what = "the model's card's records" + _worst(reference)
+        return judged_errors("compatibility", errors, what, RECORD_LIMIT)
     if model is None:
         return Check("compatibility", None, "no model under test to compare with (a rig judges "
                      "the model's own limits only)")  # fmt: skip
-    from bushenv.identify.linear import fitted_linear
-
     try:
-        k_ref = fitted_linear(reference, scales).k_n_per_m
-        k_mod = fitted_linear(model, scales).k_n_per_m
+        k_ref, k_mod = _stiffness(reference, stroke, velocity), _stiffness(model, stroke, velocity)
     except Exception as exc:
         return Check("compatibility", None, f"no stiffness to compare ({type(exc).__name__}: "
                      f"{exc}); give the model's card with its records")  # fmt: skip
-    if not (np.isfinite(k_ref) and np.isfinite(k_mod) and k_ref > 0 and k_mod > 0):
+    if not (np.all(np.isfinite(k_ref)) and np.all(np.isfinite(k_mod))) or np.any(k_ref <= 0) or \
+            np.any(k_mod <= 0):  # fmt: skip
         return Check("compatibility", None, "a stiffness is not finite or not positive; give "
                      "the model's card with its records")  # fmt: skip
-    ratio = max(k_ref / k_mod, k_mod / k_ref)
-    text = (
-        f"dynamic stiffness on a random drive: reference {k_ref / 1e3:.4g} N/mm, model "
-        f"{k_mod / 1e3:.4g} N/mm, a factor {ratio:.3g}"
-    )
-    if ratio <= STIFFNESS_MISMATCH:
+    ratio = np.maximum(k_ref / k_mod, k_mod / k_ref)
+    worst = int(ratio.argmax())
+    units = ["N m/mrad" if u == "rad" else "N/mm" for u in reference.units]
+    shown = [f"reference {kr / 1e3:.4g} {u}, model {km / 1e3:.4g} {u}"
+             for kr, km, u in zip(k_ref, k_mod, units, strict=True)]  # fmt: skip
+    if reference.n_coords == 1:
+        text = f"dynamic stiffness on a random drive: {shown[0]}, a factor {ratio[0]:.3g}"
+    else:
+        text = (
+            "dynamic stiffness on a random drive: "
+            + "; ".join(f"{c} {s}" for c, s in zip(reference.coords, shown, strict=True))
+            + f"; a factor {ratio[worst]:.3g} on the {reference.coords[worst]} coordinate"
+        )
+    if ratio[worst] <= STIFFNESS_MISMATCH:
         return Check("compatibility", True, f"{text} (within {STIFFNESS_MISMATCH:g}: one bushing)")
     # without records the model is the only word on which bushing it is, and the model is
     # what is under suspicion: another bushing, or a broken model -- records would decide
@@ -148,6 +177,22 @@ def compatibility_check(
     )
 
 
+def _stiffness(model: BushingModel, stroke, velocity) -> np.ndarray:
+    """(C,) the diagonal of the stiffness of the Kelvin-Voigt least-squares fit of ``model``
+    (``identify.linear.fitted_linear``) on a random drive per coordinate."""
+    from bushenv.identify.linear import fitted_linear
+
+    c = model.n_coords
+    stroke = np.broadcast_to(np.asarray(stroke, dtype=np.float64), (c,))
+    if c == 1:
+        scales = BushingScales(stroke_m=float(stroke[0]))  # the papers' rate unless given
+        if velocity is not None:
+            scales = BushingScales(stroke_m=float(stroke[0]), velocity_m_per_s=float(velocity))
+        return np.array([fitted_linear(model, scales).k_n_per_m])
+    rate = np.broadcast_to(np.asarray(np.inf if velocity is None else velocity, float), (c,))
+    return np.diag(np.atleast_2d(fitted_linear(model, _Limits(stroke, rate)).k_matrix)).copy()
+
+
 def read_card(path: Any) -> tuple[dict | None, Path | None]:
     """The card beside a model file (None when there is none or it is unreadable)."""
     if path is None or not str(path).endswith(".npz"):
@@ -157,75 +202,3 @@ def read_card(path: Any) -> tuple[dict | None, Path | None]:
         return json.loads(card_file.read_text(encoding="utf-8")), card_file
     except (OSError, ValueError):
         return None, None
-
-
-def file_records_check(reference: BushingModel, reference_file: Any) -> Check:
-    """Check 2 for a reference given as a file: the worst coordinate's error on the records
-    the card beside it names."""
-    card, card_file = read_card(reference_file)
-    if card is None:
-        return Check("records", None, "no model card: nothing to check it against")
-    paths, missing = card_records(card, card_file)
-    if not paths:
-        return Check("records", None, f"its card's records are not there ({', '.join(missing)})")
-    return judged_errors("records", reference_errors(reference, paths), "its card's records (worst "
-                   "coordinate)", RECORD_LIMIT)  # fmt: skip
-
-
-def _stiffness(model: BushingModel, stroke: np.ndarray) -> np.ndarray:
-    """Diagonal of the C x C K of ``f = K q + C v + b`` least-squares fitted on a random drive."""
-    dt = model.dt
-    n = int(round(DRIVE_S / dt))
-    rng = np.random.default_rng(0)
-    t = np.arange(n) * dt
-    c = len(stroke)
-    q = np.zeros((n, c))
-    for i in range(c):  # a few incommensurate sines per coordinate, 0.3-3 Hz, half the stroke
-        hz = rng.uniform(0.3, 3.0, size=4)
-        ph = rng.uniform(0, 2 * np.pi, size=4)
-        q[:, i] = 0.5 * stroke[i] * np.sin(2 * np.pi * hz[:, None] * t + ph[:, None]).sum(0) / 2
-    q *= np.minimum(1.0, t / 1.0)[:, None]  # from rest
-    f = model.copy().simulate(q)
-    v = np.gradient(q, dt, axis=0)
-    a = np.column_stack([q, v, np.ones(n)])
-    w, *_ = np.linalg.lstsq(a, f, rcond=None)
-    return np.diag(w[:c].T)
-
-
-def vector_compatibility_check(
-    reference: BushingModel, model: BushingModel | None, model_file: Any, stroke: np.ndarray
-) -> Check:
-    """Check 4 over several coordinates: on the model's card's records the worst coordinate's
-    RMS ratio; without them, the diagonal of the two stiffness matrices least-squares fitted on
-    one random drive within ``stroke``, each within ``STIFFNESS_MISMATCH``."""
-    card, card_file = read_card(model_file)
-    paths, _ = card_records(card, card_file)
-    if paths:
-        return judged_errors("compatibility", reference_errors(reference, paths),
-                       "the model's card's records (worst coordinate)", RECORD_LIMIT)  # fmt: skip
-    if model is None:
-        return Check("compatibility", None, "no model under test to compare with")
-    try:
-        k_ref, k_mod = _stiffness(reference, stroke), _stiffness(model, stroke)
-    except Exception as exc:
-        return Check("compatibility", None, f"no stiffness to compare ({type(exc).__name__})")
-    if not (np.all(np.isfinite(k_ref)) and np.all(np.isfinite(k_mod))) or np.any(k_ref <= 0) or \
-            np.any(k_mod <= 0):  # fmt: skip
-        return Check("compatibility", None, "a stiffness is not finite or not positive")
-    ratio = np.maximum(k_ref / k_mod, k_mod / k_ref)
-    units = ["N m/mrad" if u == "rad" else "N/mm" for u in reference.units]
-    text = "dynamic stiffness on a random drive, reference / model: " + ", ".join(
-        f"{c} {kr / 1e3:.4g} / {km / 1e3:.4g} {u}"
-        for c, kr, km, u in zip(reference.coords, k_ref, k_mod, units, strict=True)
-    )
-    worst = float(ratio.max())
-    if worst <= STIFFNESS_MISMATCH:
-        return Check("compatibility", True, f"{text} (within {STIFFNESS_MISMATCH:g}: one bushing)")
-    return Check(
-        "compatibility",
-        None,
-        f"WARNING: {text}: a factor {worst:.3g} on the "
-        f"{reference.coords[int(ratio.argmax())]} axis (beyond "
-        f"{STIFFNESS_MISMATCH:g}: another bushing, or a broken model; a model card with its "
-        "records decides)",
-    )

@@ -123,7 +123,7 @@ def test_the_same_inputs_give_the_same_judge_in_every_command_and_env(tmp_path, 
     env_judge = env.unwrapped.params.judge
     assert env_judge.reference_spec == want.reference_spec
     assert env_judge.scales == want.scales and env_judge.criteria == want.criteria
-    names = ["holds", "certificate holds", "records", "compatibility"]  # a NARX reference
+    names = ["holds", "certificate holds", "records", "passivity", "compatibility"]  # a NARX one
     assert [c.name for c in env_judge.vetting.checks] == names
 
 
@@ -308,7 +308,7 @@ def test_missing_records_are_not_checked_naming_them_and_the_headline_is_not_pas
     report = {"reference": {"spec": str(ref)}, "criteria": {"run": []}, "models": {},
               "judge": json.loads(json.dumps(judge.describe()))}  # fmt: skip
     text = format_table(report, "nn")
-    assert "vetted, not fully checked: 2 of 3 passed, not checked: records" in text
+    assert "vetted, not fully checked: 3 of 4 passed, not checked: records" in text
     assert "  records: not checked (its own card's records (train.csv) are not there" in text
     assert "vetted, passed" not in text
 

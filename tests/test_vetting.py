@@ -1,4 +1,4 @@
-"""A reference of several coordinates is checked before it judges (``bushenv.vetting``)."""
+"""A reference of any number of coordinates is checked before it judges (``bushenv.vetting``)."""
 
 import json
 
@@ -7,15 +7,22 @@ import pytest
 
 from bushenv.cli import main
 from bushenv.models import MODELS
+from bushenv.models.linear import LinearBushing
 from bushenv.models.planar_linear import PlanarLinear
-from bushenv.vetting import vet_coupled_reference
-from bushenv.vetting_holds import held_vectors
+from bushenv.vetting import HOLDS, vet_reference
+from bushenv.vetting_holds import held_vectors, hold_check
 
-STROKE = np.array([0.0125, 0.0125, 0.15])
-FLOORS = np.array([200.0, 200.0, 20.0])
+STROKES = {1: 0.0125, 3: np.array([0.0125, 0.0125, 0.15])}
+FLOORS = {1: 200.0, 3: np.array([200.0, 200.0, 20.0])}
 
 
-def _linear(k_scale=(1.0, 1.0, 1.0), c_scale=(1.0, 1.0, 1.0), radial_into_axial=0.0):
+def _linear(n_coords=3, k_scale=1.0, c_scale=1.0, radial_into_axial=0.0):
+    """The preset linear bushing of ``n_coords`` coordinates, its stiffness and damping
+    diagonals scaled (a number, or one per coordinate)."""
+    if n_coords == 1:
+        ref = LinearBushing.preset()
+        k, c = ref.k_n_per_m * np.ravel(k_scale)[0], ref.c_ns_per_m * np.ravel(c_scale)[0]
+        return LinearBushing(k_n_per_m=k, c_ns_per_m=c, dt=ref.dt)
     ref = PlanarLinear.preset()
     k, c = ref.k_matrix.copy(), ref.c_matrix.copy()
     k[np.diag_indices(3)] *= k_scale
@@ -24,41 +31,75 @@ def _linear(k_scale=(1.0, 1.0, 1.0), c_scale=(1.0, 1.0, 1.0), radial_into_axial=
     return PlanarLinear(k, c, ref.dt)
 
 
-def test_the_coupled_reference_and_a_linear_bushing_pass_their_holds():
-    ref = MODELS["reference"].model_class(3).preset(dt=PlanarLinear.preset().dt, measurement=False)
-    for model in (ref, _linear()):
-        v = vet_coupled_reference(model, "m", STROKE, FLOORS)
-        assert v.passed and v.checks[0].passed is True and v.checks[2].passed is True, v.lines()
+def _vet(reference, n_coords, **kw):
+    return vet_reference(reference, "m", STROKES[n_coords], FLOORS[n_coords], **kw)
+
+
+def _checks(vetting):
+    return {c.name: c for c in vetting.checks}
+
+
+@pytest.mark.parametrize("n_coords", [1, 3])
+def test_the_reference_rubber_and_a_linear_bushing_pass_their_holds_and_passivity(n_coords):
+    dt = _linear(n_coords).dt
+    rubber = MODELS["reference"].model_class(n_coords).preset(dt=dt, measurement=False)
+    for model in (rubber, _linear(n_coords)):
+        v = _vet(model, n_coords)
+        checks = _checks(v)
+        assert v.passed and checks["holds"].passed is True, v.lines()
+        assert checks["passivity"].passed is True, v.lines()
+        assert [c.name for c in v.checks] == ["holds", "records", "passivity", "compatibility"]
 
 
 def test_holds_cover_every_coordinate_alone_and_the_corners_of_the_stroke_box():
-    qs = held_vectors(STROKE)
-    assert qs.shape == (32, 3)
-    assert np.all(np.abs(qs) <= STROKE + 1e-12)
-    alone = np.count_nonzero(qs, axis=1) == 1
-    assert alone.sum() == 24 and np.all(np.abs(qs[~alone]) > 0)
+    qs = held_vectors(STROKES[3])
+    assert qs.shape == (3 * (HOLDS - 1) + 1 + 8, 3)
+    assert np.all(np.abs(qs) <= STROKES[3] + 1e-12)
+    alone = np.count_nonzero(qs, axis=1) <= 1
+    assert alone.sum() == 3 * (HOLDS - 1) + 1 and np.all(np.abs(qs[~alone]) > 0)
+    assert len({tuple(q) for q in qs}) == len(qs)  # the rest held once
+    # one coordinate: the one-axis holds exactly
+    np.testing.assert_array_equal(held_vectors(0.0125)[:, 0], np.linspace(-0.0125, 0.0125, HOLDS))
 
 
-def test_a_reference_with_a_negative_stiffness_axis_is_refused_naming_the_hold():
-    v = vet_coupled_reference(_linear(k_scale=(1.0, -0.5, 1.0)), "bad", STROKE, FLOORS)
+@pytest.mark.parametrize("n_coords", [1, 3])
+def test_a_reference_with_a_negative_stiffness_axis_is_refused_naming_the_hold(n_coords):
+    scale = -0.5 if n_coords == 1 else (1.0, -0.5, 1.0)
+    v = _vet(_linear(n_coords, k_scale=scale), n_coords)
+    holds = _checks(v)["holds"]
+    assert not v.passed and holds.passed is False
+    assert "wrong sign" in holds.detail and "mm" in holds.detail
+    assert bool(holds.ranges_m) is (n_coords == 1)  # a range of x only on one axis
+
+
+@pytest.mark.parametrize("n_coords", [1, 3])
+def test_a_reference_with_negative_damping_holds_still_but_is_refused_as_active(n_coords):
+    scale = -0.5 if n_coords == 1 else (1.0, 1.0, -0.5)
+    v = _vet(_linear(n_coords, c_scale=scale), n_coords)
+    checks = _checks(v)
+    assert checks["holds"].passed is True  # a hold cannot show a negative damper
+    assert checks["passivity"].passed is False
+    assert "gives energy back" in checks["passivity"].detail
     assert not v.passed
-    assert "pushing into the deflection" in v.checks[0].detail and "mm" in v.checks[0].detail
 
 
-def test_a_reference_with_negative_damping_holds_still_but_is_refused_as_active():
-    v = vet_coupled_reference(_linear(c_scale=(1.0, 1.0, -0.5)), "active", STROKE, FLOORS)
-    holds, _, passive, _ = v.checks
-    assert holds.passed is True  # a hold cannot show a negative damper
-    assert passive.passed is False and "gives energy back" in passive.detail
-    assert not v.passed
+@pytest.mark.parametrize("n_coords", [1, 3])
+def test_a_reference_three_times_as_stiff_as_the_model_is_undecided_not_a_refusal(n_coords):
+    v = _vet(_linear(n_coords, k_scale=3.0), n_coords, model=_linear(n_coords))
+    comp = _checks(v)["compatibility"]
+    assert comp.passed is None and comp.detail.startswith("undecided") and "factor" in comp.detail
+    assert v.passed  # the model is the only word on which bushing it is
 
 
-def test_a_reference_three_times_as_stiff_as_the_model_is_a_warning_not_a_refusal():
-    v = vet_coupled_reference(_linear(k_scale=(3.0, 3.0, 3.0)), "stiff", STROKE, FLOORS,
-                             model=_linear())  # fmt: skip
-    comp = v.checks[3]
-    assert comp.passed is None and comp.detail.startswith("WARNING") and "factor" in comp.detail
-    assert v.passed  # a warning: the model is the only word on which bushing it is
+@pytest.mark.parametrize("n_coords", [1, 3])
+def test_the_threshold_is_the_references_own_per_coordinate_capped_at_its_floor(n_coords):
+    model = _linear(n_coords)
+    _, limits = hold_check(model, STROKES[n_coords], FLOORS[n_coords])
+    assert limits.shape == (n_coords,) and np.all(limits <= FLOORS[n_coords])
+    # a noiseless linear bushing: 1 % of its largest held force per coordinate
+    _, coarse = hold_check(model, STROKES[n_coords], np.full(n_coords, np.inf))
+    k = np.atleast_1d(model.k_n_per_m) if n_coords == 1 else np.diag(model.k_matrix)
+    np.testing.assert_allclose(coarse, 0.01 * k * STROKES[n_coords], rtol=1e-3)
 
 
 def test_the_attack_refuses_a_reference_that_fails_its_vetting_unless_trusted(tmp_path, capsys):

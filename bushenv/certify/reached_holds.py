@@ -87,24 +87,32 @@ def ring_threshold(f_rest: np.ndarray, dt: float) -> Threshold:
     return Threshold(max(NOISE_FACTOR * noise, RING_FRACTION * scale), noise, scale)
 
 
-def judge_holds(f: np.ndarray, x_m: np.ndarray, n_hold: int, threshold: float, dt: float) -> dict:
-    """Flags (B,) per kind for forces (T, B) whose last ``n_hold`` samples hold ``x_m`` (B,):
-    {"not finite", "oscillating", "departing", "wrong sign"}, and "ripple_n" (B,)."""
-    finite = np.all(np.isfinite(f), axis=0)
-    g = np.where(finite, f, 0.0)
+def judge_holds(f: np.ndarray, q: np.ndarray, n_hold: int, threshold, dt: float) -> dict:
+    """Flags (B,) per kind for forces (T, B), or (T, B, C) over C coordinates, whose last
+    ``n_hold`` samples hold ``q`` (B,) or (B, C), each coordinate against its ``threshold``
+    (a number, or (C,)): {"not finite", "oscillating", "departing", "wrong sign"}, and
+    "ripple_n" (B,), the largest coordinate's. Wrong sign: the work ``q . f`` of the tail's mean
+    below ``-sum(threshold |q|)`` (one coordinate: the mean opposes x by more than the
+    threshold); a coupled bushing may push sideways, never back into the deflection it holds."""
+    g3 = f.reshape(f.shape[0], f.shape[1], -1)
+    c = g3.shape[2]
+    q2 = np.asarray(q, dtype=np.float64).reshape(-1, c)
+    th = np.broadcast_to(np.asarray(threshold, dtype=np.float64), (c,))
+    finite = np.all(np.isfinite(g3), axis=(0, 2))
+    g = np.where(finite[None, :, None], g3, 0.0)
     tail = g[-max(3, int(round(TAIL_S / dt))) :]
-    ripple = tail_ripple(tail)
+    ripple = tail_ripple(tail.reshape(tail.shape[0], -1)).reshape(-1, c)
     f0 = g[-n_hold + int(round(SETTLE_S / dt))]
     f1 = g[-1]
-    grows = np.abs(f1) - np.abs(f0) > np.maximum(threshold, DEPART_FRACTION * np.abs(f0))
-    flips = (np.abs(f0) > threshold) & (np.abs(f1) > threshold) & (np.sign(f0) != np.sign(f1))
-    mean = tail.mean(axis=0)
+    grows = np.abs(f1) - np.abs(f0) > np.maximum(th, DEPART_FRACTION * np.abs(f0))
+    flips = (np.abs(f0) > th) & (np.abs(f1) > th) & (np.sign(f0) != np.sign(f1))
+    work = np.sum(q2 * tail.mean(axis=0), axis=1)
     return {
         "not finite": ~finite,
-        "oscillating": finite & (ripple > threshold),
-        "departing": finite & (grows | flips),
-        "wrong sign": finite & (mean * np.sign(x_m) < -threshold),
-        "ripple_n": np.where(finite, ripple, np.inf),
+        "oscillating": finite & np.any(ripple > th, axis=1),
+        "departing": finite & np.any(grows | flips, axis=1),
+        "wrong sign": finite & (work < -np.sum(th * np.abs(q2), axis=1)),
+        "ripple_n": np.where(finite, ripple.max(axis=1), np.inf),
     }
 
 
@@ -222,31 +230,38 @@ def hold_entries(
     stroke_m: float = 12.5e-3,
     holds: int = 201,
     hold_s: float = CERTIFY_HOLD_S,
+    q: np.ndarray | None = None,
 ) -> list[dict]:
     """The certificate's ``holds`` entries (fixed points, free runs, static force) over a
-    uniform grid of ``holds`` over -stroke..+stroke, without the passivity and the energy scan;
-    ``reference`` None: wrong sign against the deflection (``certificate.wrong_sign``). Raises
-    ``CertifyError`` for a model that is not a NARX network."""
+    uniform grid of ``holds`` over -stroke..+stroke, or over the held vectors ``q`` (M, C) of a
+    model of C coordinates, without the passivity and the energy scan; ``reference`` None:
+    wrong sign against the deflection (``certificate.wrong_sign``). Raises ``CertifyError`` for
+    a model that is not a NARX network."""
     from bushenv.certify.certificate import wrong_sign
     from bushenv.certify.document import hold_entry
 
     net = narx_net(model)
-    x = np.linspace(-stroke_m, stroke_m, holds)
+    x = np.linspace(-stroke_m, stroke_m, holds) if q is None else np.asarray(q, np.float64)
     fp = fixed_points(net, x)
     gh = ghosts(net, x)
     runs, _, _ = free_runs(model, net, fp, gh, hold_s)
-    ref = np.full(x.size, np.nan) if reference is None else reference_static_force(reference, x)
-    return [
-        hold_entry(net, fp, gh, r, i, ref[i : i + 1], [], wrong_sign) for i, r in enumerate(runs)
-    ]
+    n = len(x)
+    ref = np.full((n, net.n_coords), np.nan)
+    if reference is not None:
+        ref = reference_static_force(reference, x).reshape(n, net.n_coords)
+    return [hold_entry(net, fp, gh, r, i, ref[i], [], wrong_sign) for i, r in enumerate(runs)]
 
 
 def failing_holds(entries: list[dict]) -> list[dict]:
-    """[{"x_m", "kinds", "departure_s"}] of the entries listed as oscillating, departing or
-    wrong-sign (``kinds`` among ``FAILING_KINDS``), by increasing x."""
+    """[{"q", "x_m", "kinds", "departure_s"}] of the entries listed as oscillating, departing or
+    wrong-sign (``kinds`` among ``FAILING_KINDS``), in the entries' order; ``x_m`` only for one
+    coordinate (its held x)."""
     out = []
     for h in entries:
         kinds = [k for k in FAILING_KINDS if h.get(k)]
         if kinds:
-            out.append({"x_m": h["x_m"], "kinds": kinds, "departure_s": h.get("departure_s")})
+            hold = {"q": h["q"], "kinds": kinds, "departure_s": h.get("departure_s")}
+            if "x_m" in h:
+                hold["x_m"] = h["x_m"]
+            out.append(hold)
     return out

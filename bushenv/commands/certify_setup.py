@@ -5,7 +5,7 @@ the stroke the model card's, the machine's for the shipped models, ``--stroke-mm
 Several coordinates: the span per coordinate 1.5 x the card's training range (the one-axis
 stroke rule), ``--stroke-mm`` for translations and ``--rotation-mrad`` for rotations on top;
 the reference a model of as many coordinates (a registered name or a file), vetted over the
-span (``vetting.vet_coupled_reference``; ``--trust-reference`` certifies against one that
+span (``vetting.vet_reference``; ``--trust-reference`` certifies against one that
 failed), the judging setup being one coordinate's.
 """
 
@@ -113,7 +113,7 @@ def _span(args: argparse.Namespace, model) -> tuple[tuple[float, ...], str]:
 
 def _several(args: argparse.Namespace, model) -> Setup:
     from bushenv.search.targets import reference_floors
-    from bushenv.vetting import vet_coupled_reference
+    from bushenv.vetting import vet_reference
 
     span, source = _span(args, model)
     spec = None if args.reference in (None, "none") else str(args.reference)
@@ -124,12 +124,12 @@ def _several(args: argparse.Namespace, model) -> Setup:
         wanted_by="bushenv certify --reference",
     )  # fmt: skip
     floors, floors_source = reference_floors(reference)
-    vetting = vet_coupled_reference(
+    vetting = vet_reference(
         reference,
         spec,
         np.array(span),
         floors,
-        reference_file=spec if spec.endswith(".npz") else None,
+        card_file=spec if spec.endswith(".npz") else None,
         model=model,
         model_file=args.model if str(args.model).endswith(".npz") else None,
     )

@@ -17,9 +17,10 @@ from bushenv.certify.reached_holds import (
 from bushenv.judge import JudgeError, build_judge
 from bushenv.models import get_model
 from bushenv.scales import BushingScales
-from bushenv.vetting import hold_check, vet_reference
+from bushenv.vetting import of_scales, vet_reference
+from bushenv.vetting_holds import hold_check
 
-from .conftest import ringing_hybrid
+from .conftest import bistable, ringing_hybrid
 
 SCALES = BushingScales()  # the papers' machine: +-12.5 mm, 1.26 m/s, 200 N floor
 RING_MM = -1.25
@@ -47,7 +48,7 @@ def test_the_test_hybrid_rings_after_a_sine_and_not_after_a_slow_ramp():
 
 def test_the_holds_from_rest_pass_it_and_its_certificate_lists_the_ring():
     model = ringing_hybrid()
-    holds, _ = hold_check(model, SCALES)
+    holds, _ = hold_check(model, SCALES.stroke_m, SCALES.force_floor_n)
     assert holds.passed is True  # the slow ramps see nothing: why the old vetting passed it
     listed = failing_holds(hold_entries(model, None, SCALES.stroke_m))
     x = [h["x_m"] * 1e3 for h in listed]
@@ -56,7 +57,7 @@ def test_the_holds_from_rest_pass_it_and_its_certificate_lists_the_ring():
 
 
 def test_the_vetting_refuses_a_hybrid_that_rings_after_excitation():
-    vet = vet_reference(ringing_hybrid(), "ring", SCALES)
+    vet = vet_reference(ringing_hybrid(), "ring", **of_scales(SCALES))
     cert = {c.name: c for c in vet.checks}["certificate holds"]
     assert cert.passed is False and not vet.passed and vet.verdict == "FAILED"
     assert "oscillating" in cert.detail and "sine" in cert.detail
@@ -67,7 +68,7 @@ def test_the_vetting_refuses_a_hybrid_that_rings_after_excitation():
 @pytest.mark.parametrize("axis", ["axial", "radial"])
 def test_the_vetting_passes_the_shipped_hybrid(axis):
     model = get_model("hybrid", axis=axis)
-    vet = vet_reference(model, "hybrid", SCALES)
+    vet = vet_reference(model, "hybrid", **of_scales(SCALES))
     checks = {c.name: c for c in vet.checks}
     assert checks["holds"].passed is True
     assert checks["certificate holds"].passed is True
@@ -114,3 +115,20 @@ def test_the_judge_refuses_it_and_trusted_marks_verdicts_in_its_range(tmp_path):
     described = judge.describe()
     assert described["vetting_verdict"] == "FAILED"
     assert described["unvetted_ranges_m"] == [list(r) for r in judge.unvetted_ranges_m]
+
+
+STROKE3, FLOORS3 = np.array([2e-3, 2e-3, 0.05]), np.array([200.0, 200.0, 20.0])
+
+
+def test_a_network_of_three_coordinates_is_vetted_on_its_own_certificate():
+    """Over C > 1 the certificate runs over the vetting's held vectors: none listed passes; a
+    listed hold is not checked (reached only along one coordinate), never silently skipped."""
+    quiet = vet_reference(bistable(out=0.3), "quiet", STROKE3, FLOORS3)
+    cert = {c.name: c for c in quiet.checks}["certificate holds"]
+    assert cert.passed is True and "129 held vectors" in cert.detail and "lists none" in cert.detail
+    pulling = vet_reference(bistable(gain_q=-2.0, out=0.3), "pulling", STROKE3, FLOORS3)
+    checks = {c.name: c for c in pulling.checks}
+    assert checks["holds"].passed is False and "wrong sign" in checks["holds"].detail
+    cert = checks["certificate holds"]
+    assert cert.passed is None and "wrong_sign" in cert.detail and "not confirmed" in cert.detail
+    assert "(-2 mm, +0 mm, +0 mrad)" in cert.detail
