@@ -3,7 +3,7 @@ closes it there, how far.
 
 Records are any objects with ``.time`` (T,) s, ``.q`` (T, C) and ``.f`` (T, C) in the
 coordinates' SI units (three-axis: m, m, rad and N, N, N m) and ``.dt`` s, such as
-``bushenv.planar.records.PlanarRecord``. The steps:
+``bushenv.records.Record``. The steps:
 
 1. **Baseline**: the linear model over C coordinates, ``f = K q + C v`` (C x C matrices, the
    ``linear`` form of ``bushenv.models.MODELS`` for C), identified on the TRAIN records.
@@ -164,12 +164,15 @@ def check_coordinate_records(trains: list, tests: list, t_names: list, names: li
 
 
 def linear_baseline(trains: list, c: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """(K, C) of the ``linear`` form over ``c`` coordinates identified on ``trains``."""
-    from bushenv.identify.options import options_of
+    """(K, C) of the ``linear`` form over ``c`` coordinates identified on ``trains``: least
+    squares of f on K q + C v over every TRAIN sample (v by ``velocity_of``, the project's
+    convention), as that form's own identification does; computed here so the diagnosis does
+    not depend on how the identification functions are called."""
     from bushenv.models import MODELS, ModelError
+    from bushenv.models.base import velocity_of
 
     try:
-        form = MODELS[LINEAR].form(c)
+        MODELS[LINEAR].form(c)
     except ModelError:
         have = ", ".join(str(n) for n in MODELS[LINEAR].coordinate_counts())
         raise DiagnoseError(
@@ -177,10 +180,14 @@ def linear_baseline(trains: list, c: int, dt: float) -> tuple[np.ndarray, np.nda
             f"bushenv.models.MODELS has for {have} coordinate(s) only (register its form for "
             f"{c})"
         ) from None
-    opts = options_of(form.options_class(), None, LINEAR)
-    hist = [(np.asarray(r.q, float), np.asarray(r.f, float)) for r in trains]
-    model, _ = form.fit_function()(hist, dt, opts, 0, None)
-    return np.asarray(model.k_matrix, float), np.asarray(model.c_matrix, float)
+    q = np.concatenate([np.asarray(r.q, float) for r in trains])
+    v = np.concatenate([velocity_of(np.asarray(r.q, float), dt) for r in trains])
+    f = np.concatenate([np.asarray(r.f, float) for r in trains])
+    a = np.hstack([q, v])
+    scale = np.maximum(np.abs(a).max(axis=0), 1e-300)  # metres and radians differ by orders
+    coef, *_ = np.linalg.lstsq(a / scale, f, rcond=None)
+    coef = (coef / scale[:, None]).T  # (c, 2c): force row i = [K_i, C_i]
+    return coef[:, :c], coef[:, c:]
 
 
 def cross_terms(q: np.ndarray, dt: float, k: np.ndarray, c: np.ndarray) -> np.ndarray:

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose import evidence, partner, regimes, rule
+from bushenv.diagnose import evidence, partner, regimes, rule, showing
 from bushenv.diagnose.candidates import candidate_sets, get_effect
 from bushenv.diagnose.coordinates import coordinate_count, diagnose_coordinates
 from bushenv.diagnose.design import ColumnStore, Prepared
@@ -240,9 +240,15 @@ def diagnose(
     )
     singles, pairs = _judge_all(run, eff, say, ctx)
     ans = rule.answer(singles, pairs, ctx)
+    on_records: list[str] = []
+    if ans.effect == rule.OUTSIDE:  # the records that show the effect may still name it
+        alt = showing.answer_on_showing(singles, ctx)
+        if alt is not None:
+            ans, on_records = alt[0], [run.judged[i].name for i in alt[1]]
     say(f"answer: {ans.effect}" + (f" ({' or '.join(ans.between)})" if ans.between else ""))
     result = _result(run, singles, pairs, ans, ctx, baseline, cross)
     result["delay_evidence"] = lag.as_dict()
+    result["named_on_records"] = on_records  # empty: named on all judged records together
     result["shift_warnings"] = shift_warnings(
         [(p.signals.x, p.dt) for p in tr], [(p.name, p.signals.x, p.dt) for p in te]
     )

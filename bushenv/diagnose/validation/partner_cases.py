@@ -167,8 +167,9 @@ def _poor_train(rng, dt: float, peak: float) -> np.ndarray:
     return peak / 3 * x * np.minimum(1.0, t / 0.5)
 
 
-def make_partner_case(seed: int, index: int) -> Case:
-    """Case ``index`` of partner run ``seed`` (deterministic)."""
+def make_partner_case(seed: int, index: int, poor_train: bool | None = None) -> Case:
+    """Case ``index`` of partner run ``seed`` (deterministic); ``poor_train`` True / False
+    forces the poor TRAIN on or off (None: one single-effect case in four)."""
     from bushenv.records import Record
 
     rng = np.random.default_rng([seed, index, 41])
@@ -177,6 +178,7 @@ def make_partner_case(seed: int, index: int) -> Case:
     dt_f = 1.0 / (rate * OVERSAMPLE)
     train_x, test_x, info = bushing_programmes(rng, dt_f, rate)
     poor = len(label) == 1 and rng.random() < 0.25
+    poor = poor if poor_train is None else poor_train
     peak = max(float(np.max(np.abs(x))) for x in train_x + test_x)
     if poor:
         train_x = [_poor_train(rng, dt_f, peak)]
