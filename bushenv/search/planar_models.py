@@ -2,9 +2,9 @@
 attack and the corpus's replay of planar cases share; and the planar attack's resolve stage
 (``resolve_planar_attack`` -> ``Planar``): what a user's bushing gives it through the card
 beside its file -- the limits the search drives (``search_limits``, ``limits_of_card``) and the
-linear control fitted to the reference (``fitted_planar_linear``), as the one-axis attack takes
-both from its reference's card (``judge.judging_scales``, ``campaign_models.roles``) -- and the
-reference vetted within those limits (``vetted_judge``).
+linear control fitted to the reference (``identify.linear.fitted_linear``, over C), as the
+one-axis attack takes both from its reference's card (``judge.judging_scales``,
+``campaign_models.roles``) -- and the reference vetted within those limits (``vetted_judge``).
 """
 
 from __future__ import annotations
@@ -14,12 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from bushenv import excitation as ex
+from bushenv.identify.linear import fitted_linear
 from bushenv.progress import Progress
 from bushenv.scales import RECORD_MARGIN
 from bushenv.search.base import SearchError
 from bushenv.search.campaign_config import CampaignConfig
-from bushenv.search.families_planar import (
+from bushenv.search.campaign_models import card_displacements, card_records
+from bushenv.search.limits import (
     COORDS,
     Rig3Limits,
     limits_of_records,
@@ -28,7 +29,6 @@ from bushenv.search.families_planar import (
 )
 from bushenv.search.targets import TARGETS
 
-CONTROL_RECORD_S = 40.0  # the fitted control's drive when the card's records are not there
 DEFAULT_REFERENCE = "reference"
 DEFAULT_CONTROL = "linear"
 FITTED_CONTROL = "linear-fit"  # the control's key when it is fitted to the user's reference
@@ -39,11 +39,12 @@ def resolve_planar_spec(spec: str, dt: float | None, what: str):
     a file at its own rate (a fit on 500 Hz records runs at 500 Hz), a preset at the papers'."""
     from bushenv.models import load_model
     from bushenv.models.base import PAPER_DT
-    from bushenv.rigs.bushrig3 import resolve_planar
+    from bushenv.rigs.common import resolve_model
 
     if dt is None and str(spec).endswith(".npz") and Path(spec).is_file():
         return load_model(spec, coords=3, wanted_by=f"the {what}")
-    return resolve_planar(spec, PAPER_DT if dt is None else dt, what)
+    dt = PAPER_DT if dt is None else dt
+    return resolve_model(spec, dt=dt, coords=3, what=what, env_id="BushRig3-v0")
 
 
 def resolved_planar(spec: str, dt: float | None, what: str, card: bool = False):
@@ -71,34 +72,10 @@ def resolved_planar(spec: str, dt: float | None, what: str, card: bool = False):
 def read_planar_card(path: Path):
     """The planar ``ModelCard`` beside model file ``path``, or None when there is none."""
     from bushenv.identify.card import card_paths, load_card
-    from bushenv.planar.card import CARD_FORMAT
 
     if not card_paths(path)[0].is_file():
         return None
-    return load_card(path, formats=(CARD_FORMAT,))
-
-
-def card_train_q(resolved) -> list[np.ndarray] | None:
-    """(T, 3) displacements of ``card_train_records``, or None."""
-    records = card_train_records(resolved)
-    return None if records is None else [r.q for r in records]
-
-
-def card_train_records(resolved) -> list | None:
-    """The training records (``PlanarRecord``) ``resolved``'s card names, when they are all
-    still there and match the card's hashes (``CardError`` naming one that changed); else
-    None."""
-    from bushenv.identify.card import ModelCard
-    from bushenv.planar.records import load_planar_csv
-
-    if resolved is None or resolved.card is None:
-        return None
-    card = ModelCard(resolved.card_file, resolved.card)
-    paths = [card.record_path(r) for r in card.records if r.get("role") == "train"]
-    if not paths or not all(p is not None and p.is_file() for p in paths):
-        return None
-    card.verify_records(paths)
-    return [load_planar_csv(p) for p in paths]
+    return load_card(path)
 
 
 def limits_of_card(resolved) -> Rig3Limits | None:
@@ -109,7 +86,7 @@ def limits_of_card(resolved) -> Rig3Limits | None:
     if resolved is None or resolved.card is None:
         return None
     name = f"the training records of {resolved.card_file}"
-    records = card_train_records(resolved)
+    records = card_records(resolved)
     if records is not None:
         return limits_of_records([r.q for r in records], records[0].dt, name)
     train = [r for r in resolved.card.get("records", []) if r.get("role") == "train"]
@@ -126,34 +103,6 @@ def limits_of_card(resolved) -> Rig3Limits | None:
         "the machine's rates)",
         tuple(peak.tolist()),
     )
-
-
-def fitted_planar_linear(reference, limits: Rig3Limits, q: list[np.ndarray] | None, seed=0):
-    """Least-squares K, C (``planar.linear.fit_linear``) of ``reference``'s response, from
-    rest, to the (T, 3) displacements ``q`` (the card's records: the control sees the band
-    the bushing was identified on), else to an n = 1 random drive per coordinate (seeds
-    ``seed``, ``seed`` + 1, + 2) scaled to ``limits``' stroke and kept within its rate, as
-    the one-axis control is fitted (``identify.linear.fitted_linear``)."""
-    from bushenv.models.base import velocity_of
-    from bushenv.models.planar_linear import fit_linear
-
-    dt = reference.dt
-    if not q:
-        cols = []
-        for i in range(3):
-            x = ex.random_rpc(1.0, CONTROL_RECORD_S, dt, seed + i)
-            x = x * (limits.stroke[i] / ex.MAX_DISPLACEMENT_M)
-            speed = np.max(np.abs(np.diff(x))) / dt
-            cols.append(x * min(1.0, limits.rate[i] / speed))
-        q = [np.stack(cols, axis=1)]
-    qs, vs, fs = [], [], []
-    for x in q:
-        x = np.ascontiguousarray(x, dtype=np.float64)
-        v = velocity_of(x, dt)
-        qs.append(x)
-        vs.append(v)
-        fs.append(reference.copy().simulate(x, v))
-    return fit_linear(np.concatenate(qs), np.concatenate(vs), np.concatenate(fs), dt=dt)
 
 
 @dataclass(frozen=True)
@@ -225,8 +174,8 @@ def resolve_planar_attack(c: CampaignConfig, progress: Progress) -> Planar:
         models["control"] = resolved_planar(c.control, dt, "--control")
         control = {"label": c.control, "how": "given (--control)"}
     elif reference.file is not None:
-        q = card_train_q(reference) or card_train_q(subject)
-        fit = fitted_planar_linear(reference.model, limits, q)
+        q = card_displacements(reference) or card_displacements(subject)
+        fit = fitted_linear(reference.model, limits, q)
         path = fit.save(Path(c.out) / "models" / "control-linear.npz")
         models["control"] = replace(resolved_planar(str(path), dt, "--control"), key=FITTED_CONTROL)
         drive = "its card's training records" if q else "a random drive within the limits"
@@ -263,21 +212,21 @@ def vetted_judge(
     error: type[Exception] = SearchError,
     stroke: np.ndarray | None = None,
 ) -> dict:
-    """The reference checked before it judges (``planar.vetting``) within ``stroke`` (None:
+    """The reference checked before it judges (``bushenv.vetting``) within ``stroke`` (None:
     the target's): ``error`` when it fails, unless ``trust``; what judged (the vetting,
     floors, stroke) for a report."""
-    from bushenv.planar.vetting import vet_planar_reference
-    from bushenv.search.target_rig3 import reference_floors
+    from bushenv.search.targets import reference_floors
+    from bushenv.vetting import vet_reference
 
     if stroke is None:
         stroke, _ = target.profile_bounds()
     floors, floors_source = reference_floors(reference)
-    vetting = vet_planar_reference(
+    vetting = vet_reference(
         reference,
         ref_spec,
         stroke,
         floors,
-        reference_file=ref_spec if ref_spec.endswith(".npz") else None,
+        card_file=ref_spec if ref_spec.endswith(".npz") else None,
         model=model,
         model_file=model_file,
     )
