@@ -314,7 +314,7 @@ def test_missing_records_are_not_checked_naming_them_and_the_headline_is_not_pas
 
 
 def test_a_trusted_reference_that_rings_marks_the_verdicts_where_it_rings(tmp_path):
-    from tests.certify.conftest import ringing_hybrid
+    from certify.conftest import ringing_hybrid
 
     ring = ringing_hybrid().save(tmp_path / "ring.npz")
     t = TABLE1["axial"]
