@@ -1,5 +1,5 @@
-"""``bushenv zoo``: argparse in, a ``ZooConfig`` out, the population study (``zoo/study.py``);
-with ``--env rig3`` a ``PlanarZooConfig``, the MIMO population (``zoo/planar_study.py``)."""
+"""``bushenv zoo``: argparse in, a ``ZooConfig`` out, the population study (``zoo/study.py``)
+over the number of coordinates of the ``--env``'s target (rig3: the MIMO population)."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ from pathlib import Path
 
 from bushenv.execution import get_backend
 from bushenv.identify.mimo_options import HYBRID_TRAININGS
+from bushenv.identify.narx_options import RECIPES
 from bushenv.models.planar_narx import STRUCTURES
 from bushenv.progress import Progress
 from bushenv.search.matrix import parse_seeds
-from bushenv.zoo.planar_study import PlanarZooConfig, refuse_other_kind, run_planar_study
-from bushenv.zoo.study import ZooConfig, ZooError, run_study
+from bushenv.zoo.study import ENVS, ZooConfig, refuse_other_kind, run_study
 
 EXAMPLE = (
     "bushenv zoo --recipes teacher-forcing,free-run --models nn,hybrid --seeds 0-9 "
@@ -23,15 +23,15 @@ EXAMPLE = (
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    d = ZooConfig()
+    d = ZooConfig().checked()
     p.add_argument(
         "--env",
-        choices=("rig", "rig3"),
+        choices=ENVS,
         default="rig",
         help="rig: one-axis NARX models per axis; rig3: MIMO planar networks, the single-axis "
         "check then the attack across axes",
     )
-    p.add_argument("--recipes", default=",".join(d.recipes), help="training recipes")
+    p.add_argument("--recipes", default=",".join(RECIPES), help="training recipes")
     p.add_argument("--models", default=",".join(d.models), help="NARX models to train")
     p.add_argument(
         "--axes", default=None, help=f"bushing axes (default {','.join(d.axes)}; rig only)"
@@ -76,50 +76,32 @@ def _names(text: str) -> tuple[str, ...]:
     return tuple(n.strip() for n in text.split(",") if n.strip())
 
 
-def config_from(args: argparse.Namespace) -> ZooConfig | PlanarZooConfig:
-    """The study the arguments describe (checked)."""
-    if getattr(args, "env", "rig") == "rig3":
-        return planar_config_from(args)
-    d = ZooConfig()
-    if getattr(args, "training", "plain") != "plain":
-        raise ZooError("--training: the planar hybrid's option; use it with --env rig3")
-    if _structure(args):
-        raise ZooError("--structure: the planar networks' option; use it with --env rig3")
-    axes = _names(args.axes) if args.axes is not None else d.axes
-    return ZooConfig(axes=axes, **_shared(args, d.searchers)).checked()
-
-
-def _shared(args: argparse.Namespace, default_searchers: tuple[str, ...]) -> dict:
-    """The arguments both studies take, as config fields."""
-    return {
-        "recipes": _names(args.recipes),
-        "models": _names(args.models),
-        "seeds": tuple(parse_seeds(args.seeds)),
-        "searchers": _names(args.searchers) if args.searchers is not None else default_searchers,
-        "budget": args.budget,
-        "out": Path(args.out),
-        "resume": args.resume,
-        "train_options": {"certified": "on"} if args.certified == "on" else {},
+def config_from(args: argparse.Namespace) -> ZooConfig:
+    """The study the arguments describe (checked); C is the env's target's."""
+    env = getattr(args, "env", "rig")
+    options = {
+        **({"certified": "on"} if args.certified == "on" else {}),
+        **_given(args, "structure", "free"),
+        **_given(args, "training", "plain"),
     }
+    return ZooConfig(
+        env=env,
+        recipes=_names(args.recipes),
+        models=_names(args.models),
+        axes=_names(args.axes) if args.axes is not None else None,
+        seeds=tuple(parse_seeds(args.seeds)),
+        searchers=_names(args.searchers) if args.searchers is not None else None,
+        budget=args.budget,
+        out=Path(args.out),
+        resume=args.resume,
+        train_options=options,
+    ).checked()
 
 
-def _structure(args: argparse.Namespace) -> dict:
-    """``--structure`` and ``--training`` as planar training options (none for the defaults)."""
-    structure = getattr(args, "structure", "free")
-    training = getattr(args, "training", "plain")
-    return {
-        **({} if structure == "free" else {"structure": structure}),
-        **({} if training == "plain" else {"training": training}),
-    }
-
-
-def planar_config_from(args: argparse.Namespace) -> PlanarZooConfig:
-    """The MIMO population the arguments describe (checked)."""
-    if args.axes is not None:
-        raise ZooError("--axes: --env rig3 drives all three coordinates; leave --axes out")
-    shared = _shared(args, PlanarZooConfig().searchers)
-    shared["train_options"] = {**shared["train_options"], **_structure(args)}
-    return PlanarZooConfig(**shared).checked()
+def _given(args: argparse.Namespace, name: str, default: str) -> dict:
+    """A training option given on the command line (none for its default)."""
+    value = getattr(args, name, default)
+    return {} if value == default else {name: value}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -129,15 +111,12 @@ def run(args: argparse.Namespace) -> int:
         workers=args.workers,
         address=args.ray_address,
     )
-    planar = isinstance(config, PlanarZooConfig)
     if config.resume:
-        refuse_other_kind(config.out / "cells.jsonl", planar)
-    if planar:
-        run_planar_study(config, backend, Progress(quiet=args.quiet))
-        print((config.out / "summary.md").read_text())
-        print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md")
-        return 0
+        refuse_other_kind(config.out / "cells.jsonl", config.coords)
     run_study(config, backend, Progress(quiet=args.quiet))
     print((config.out / "summary.md").read_text())
-    print(f"wrote {config.out}/cells.jsonl, summary.json, summary.md, accuracy_vs_robustness.png")
+    written = ("cells.jsonl", "summary.json", "summary.md")
+    if config.coords == 1:
+        written += ("accuracy_vs_robustness.png",)
+    print(f"wrote {config.out}/" + ", ".join(written))
     return 0

@@ -1,7 +1,8 @@
 """The population study (``bushenv zoo``): how often NARX bushing models fail, and why.
 
-Many models per training recipe (``cell.py``: train, certify, judge, attack one), their failure
-rates with 95 % intervals (``summary.py``), the study (``study.py``). With ``--env rig3`` the
-MIMO population: planar networks given the single-axis check, then the attack across axes
-(``planar_cell.py``, ``planar_summary.py``, ``planar_study.py``).
+Many models per training recipe, over the target's number of coordinates (``cell.py``: train,
+judge, check the holds, attack one member; ``holds.py``, ``attack.py``), their failure rates
+with 95 % intervals (``rates.py``, ``summary.py``, ``tables.py``), the study (``study.py``).
+With ``--env rig3`` the MIMO population: networks over three coordinates given the
+single-axis check, then the attack across axes.
 """

@@ -1,57 +1,40 @@
-"""The population study's summary: failure rates with 95 % intervals, the papers' step, static
-force errors, accuracy beside robustness; tables (JSON, markdown) and plots.
+"""The population study's summary, its members grouped by recipe x model, failure rates with
+Wilson 95 % intervals (``rates.py``); the tables and the plot are ``tables.py``'s.
 
-Rates are counts of cells (one trained model each) out of the cells of a group, with Wilson's
-95 % score interval: with 10 seeds per group a rate of 0/10 still allows up to 28 %.
+With one coordinate: each group's rates of failing any searcher, per searcher, criterion and
+family, the papers' step (bounded, departures, wrong sign, static error at +-4 mm), the hold
+certificate and accuracy on the unseen records.
+
+With several: how many members pass every single-axis check and how many of those the attack
+across axes breaks; the MIMO networks pooled against the target of 90 %. Members trained with
+``--certified on`` (``identify/mimo_certified.py``) are grouped apart (``free-run +certified /
+hybrid``) and kept out of the pool: the pool is the plain MIMO networks the target is about.
+The certified hybrids get their own rates (``certified_hybrids``): passing the single-axis
+check, broken across axes among those passing (any coordinate, and in a moving one), per
+searcher, with the certified training's own admission and every member's hold check. Without
+certified hybrid members the summary says so rather than counting plain ones.
 """
 
 from __future__ import annotations
 
-import math
-from collections import defaultdict
+from collections import Counter, defaultdict
 from pathlib import Path
 from typing import Any
 
-import numpy as np
+from bushenv.persist import write_json, write_text
+from bushenv.zoo.rates import median_of, rate, recipe_label
+from bushenv.zoo.tables import markdown, plot
 
-from bushenv.persist import write_figure, write_json, write_text
-
-Z95 = 1.959963984540054
-STEP_AT_S = 1.0  # the papers' step starts 1 s into its profile (cell.py)
-
-
-def wilson(k: int, n: int) -> tuple[float, float]:
-    """Wilson score 95 % interval of a rate k / n (0, 1 for n = 0)."""
-    if n == 0:
-        return 0.0, 1.0
-    p = k / n
-    centre = (p + Z95**2 / (2 * n)) / (1 + Z95**2 / n)
-    half = Z95 * math.sqrt(p * (1 - p) / n + Z95**2 / (4 * n * n)) / (1 + Z95**2 / n)
-    return max(0.0, centre - half), min(1.0, centre + half)
+MIMO_MODELS = ("nn", "hybrid")  # "nn-axis" is three single-axis networks, not MIMO
+TARGET_RATE = 0.9  # share of MIMO networks that pass the attack across axes
+NO_CERTIFIED = "none in this study (train them with --certified on)"
 
 
-def rate(k: int, n: int) -> dict[str, Any]:
-    lo, hi = wilson(k, n)
-    return {"failed": k, "of": n, "rate": k / n if n else None, "ci95": [lo, hi]}
-
-
-def shown_options(train_options: dict) -> list[str]:
-    """The training switches that name a member's group: those on, and the planar structure
-    and hybrid training when not the default (``certified``, ``mirror-rate``,
-    ``noisy-feedback``)."""
-    opts = sorted(train_options.items())
-    return [k if v == "on" else v for k, v in opts if v == "on" or k in ("structure", "training")]
-
-
-def recipe_label(row: dict) -> str:
-    """The recipe with the training switches that are on (``free-run +certified``)."""
-    return " +".join([row["recipe"], *shown_options(row.get("train_options", {}))])
-
-
-def _groups(rows: list[dict]) -> dict[tuple[str, str], list[dict]]:
-    out: dict[tuple[str, str], list[dict]] = defaultdict(list)
+def groups(rows: list[dict]) -> dict[str, list[dict]]:
+    """Members by ``recipe label/model``, in the order first seen."""
+    out: dict[str, list[dict]] = defaultdict(list)
     for r in rows:
-        out[(recipe_label(r), r["model"])].append(r)
+        out[f"{recipe_label(r)}/{r['model']}"].append(r)
     return dict(out)
 
 
@@ -64,12 +47,8 @@ def _by(rows: list[dict], pick) -> dict[str, dict]:
     }
 
 
-def median_of(values) -> float | None:
-    vals = [v for v in values if v is not None]
-    return float(np.median(vals)) if vals else None
-
-
-def group_summary(rows: list[dict]) -> dict[str, Any]:
+def one_axis_group(rows: list[dict]) -> dict[str, Any]:
+    """A group of one-coordinate members (module docstring)."""
     searchers = sorted({s for r in rows for s in r["attacks"]})
     steps = [v for r in rows for v in r["step"].values()]
     return {
@@ -118,90 +97,138 @@ def group_summary(rows: list[dict]) -> dict[str, Any]:
     }
 
 
-def summarise(rows: list[dict]) -> dict[str, Any]:
-    return {f"{rec}/{model}": group_summary(g) for (rec, model), g in _groups(rows).items()}
+def _broken(rows: list[dict]) -> list[dict]:
+    return [r for r in rows if r["diverged"]]
 
 
-def pct(r: dict) -> str:
-    lo, hi = r["ci95"]
-    return f"{r['failed']}/{r['of']} ({100 * lo:.0f}-{100 * hi:.0f} %)"
+def _quiet_at_rest(row: dict) -> bool:
+    """No single-axis profile failed the member in any coordinate, at rest ones included: what
+    a single-axis rig reading all three load-cell channels would pass."""
+    return all(v["passed"] and v["cross_axis_failures"] == 0 for v in row["single_axis"].values())
 
 
-def markdown(summary: dict[str, Any]) -> str:
-    """The tables of studies/2026-11-training-recipes."""
-    lines = ["| recipe / model | cells | any searcher | " + "by searcher |", "|---|---|---|---|"]
-    for key, g in summary.items():
-        per = "; ".join(
-            f"{s} {pct(v)}, median {v['median_evaluations_to_failure']} evals"
-            for s, v in g["by_searcher"].items()
-        )
-        lines.append(f"| {key} | {g['cells']} | {pct(g['diverged_any_searcher'])} | {per} |")
-    lines += ["", "| recipe / model | by criterion | by family |", "|---|---|---|"]
-    for key, g in summary.items():
-        crit = "; ".join(f"{c} {pct(v)}" for c, v in g["by_criterion"].items()) or "-"
-        fam = "; ".join(f"{c} {pct(v)}" for c, v in g["by_family"].items()) or "-"
-        lines.append(f"| {key} | {crit} | {fam} |")
-    lines += [
-        "",
-        "| recipe / model | papers' step bounded | departures (after the step) | "
-        "wrong sign at +-4 mm | "
-        "median static error at +-4 mm | hold certificate passes | folds | non-passive at rest "
-        "| RMS ratio n = 1 / n = 1.5 (median) |",
-        "|---|---|---|---|---|---|---|---|---|",
-    ]
-    for key, g in summary.items():
-        st, ce, ac = g["papers_step"], g["certificate"], g["accuracy"]
-        deps = st["departures_s"]
-        dep = f"{len(deps)}, median {np.median(deps) - STEP_AT_S:.1f} s" if deps else "-"
-        lines.append(
-            f"| {key} | {pct(st['bounded'])} | {dep} | {pct(st['wrong_sign'])} | "
-            f"{100 * (st['median_static_error_4mm'] or 0):.0f} % | {pct(ce['passes_holds'])} | "
-            f"{pct(ce['with_folds'])} | {pct(ce['non_passive_at_rest'])} | "
-            f"{100 * ac['rms_ratio_n1']['median']:.1f} / "
-            f"{100 * ac['rms_ratio_n15']['median']:.1f} % |"
-        )
-    return "\n".join(lines) + "\n"
+def certified(row: dict) -> bool:
+    return row.get("train_options", {}).get("certified") == "on"
 
 
-def _worst(row: dict) -> float:
-    found = [a["worst_robustness"] for a in row["attacks"].values()]
-    return min(r for r in found if r is not None)
+def _holds(rows: list[dict]) -> dict[str, Any]:
+    """Members whose hold check (``planar_cell._certificate``) found an out-of-band, an
+    unstable fixed point or a hold not settling; rows without a check are left out."""
+    checked = [r["certificate"] for r in rows if r.get("certificate")]
+    return {
+        "out_of_band": rate(sum(c["out_of_band"] > 0 for c in checked), len(checked)),
+        "unstable": rate(sum(c["unstable"] > 0 for c in checked), len(checked)),
+        "unsettled": rate(sum(c["unsettled_holds"] > 0 for c in checked), len(checked)),
+        "median_out_of_band_fixed_points": median_of(c["out_of_band"] for c in checked),
+    }
 
 
-def plot(rows: list[dict], path: Path) -> Path:
-    """Accuracy (RMS ratio on the unseen n = 1.5 record) against robustness (the worst STL
-    robustness any searcher reached), one colour per recipe, one marker per model."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    markers = {"nn": "o", "hybrid": "s"}
-    for (recipe, model), g in sorted(_groups(rows).items()):
-        acc = [100 * r["accuracy"]["rms_ratio_n15"] for r in g]
-        rob = [
-            min(
-                a["worst_robustness"]
-                for a in r["attacks"].values()
-                if a["worst_robustness"] is not None
-            )
-            for r in g
-        ]
-        ax.scatter(acc, rob, marker=markers.get(model, "^"), label=f"{recipe}, {model}", alpha=0.8)
-    ax.axhline(0.0, color="k", lw=0.8, ls="--", label="divergence (robustness 0)")
-    ax.set_xlabel("RMS ratio on the unseen n = 1.5 record [%]")
-    ax.set_ylabel("worst robustness found [-]")
-    ax.set_title("accuracy against robustness, per recipe")
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    write_figure(fig, path, dpi=110)
-    return path
+def _coords(rows: list[dict], record: str) -> list[str]:
+    """The coordinates the members' accuracy names, in their order."""
+    return list(rows[0]["accuracy"][record]) if rows else []
 
 
-def write(out: Path, rows: list[dict]) -> dict[str, Any]:
-    summary = summarise(rows)
+def across_axes_group(rows: list[dict]) -> dict[str, Any]:
+    """A group of members over several coordinates (module docstring)."""
+    passed = [r for r in rows if r["passed_single_axis"]]
+    searchers = sorted({s for r in rows for s in r["attacks"]})
+    return {
+        "members": len(rows),
+        "passed_single_axis": rate(len(passed), len(rows)),
+        "passed_single_axis_all_channels": rate(sum(map(_quiet_at_rest, rows)), len(rows)),
+        "broken_of_passed": rate(len(_broken(passed)), len(passed)),
+        "broken_moving_of_passed": rate(sum(r["diverged_moving"] for r in passed), len(passed)),
+        "broken": rate(len(_broken(rows)), len(rows)),
+        "by_searcher": {
+            s: {
+                **rate(sum(r["attacks"][s]["diverged"] for r in passed), len(passed)),
+                "median_evaluations_to_failure": median_of(
+                    r["attacks"][s]["evaluations_to_failure"] for r in passed
+                ),
+            }
+            for s in searchers
+        },
+        # of those passing, failed somewhere in a coordinate the profile never moved
+        "failed_in_a_coordinate_at_rest": rate(
+            sum(any(a["in_a_coordinate_at_rest"] for a in r["attacks"].values()) for r in passed),
+            len(passed),
+        ),
+        "failures_by_axis": dict(
+            sum(
+                (Counter(a["by_axis"]) for r in passed for a in r["attacks"].values()),
+                Counter(),
+            ).most_common()
+        ),
+        "median_single_axis_driven_failures": median_of(
+            sum(v["driven_failures"] for v in r["single_axis"].values()) for r in rows
+        ),
+        "median_rms_ratio_correlated": {
+            c: median_of(r["accuracy"]["correlated"][c] for r in rows)
+            for c in _coords(rows, "correlated")
+        },
+        "holds": _holds(rows),
+        # the network's part of a hybrid's force (RMS ratio, unseen correlated record)
+        "median_network_share_correlated": {
+            c: median_of((r.get("network_share") or {}).get(c) for r in rows)
+            for c in _coords(rows, "correlated")
+        },
+        "train_s": sum(r["train_s"] for r in rows),
+        "judge_s": sum(r["judge_s"] for r in rows),
+    }
+
+
+def certified_summary(rows: list[dict]) -> dict[str, Any] | str:
+    """The certified MIMO hybrids' rates (module docstring), or ``NO_CERTIFIED``."""
+    hyb = [r for r in rows if certified(r) and r["model"] == "hybrid"]
+    if not hyb:
+        return NO_CERTIFIED
+    g = across_axes_group(hyb)
+    admitted = [r.get("certified_admitted") for r in hyb]
+    return {
+        **g,
+        "weights_admitted": rate(sum(a is True for a in admitted), len(hyb)),
+        "bounded_of_passed": rate(
+            g["broken_of_passed"]["of"] - g["broken_of_passed"]["failed"],
+            g["broken_of_passed"]["of"],
+        ),
+    }
+
+
+def summarise(rows: list[dict], coords: int | None = None) -> dict[str, Any]:
+    """Per group; over several coordinates also the MIMO pool and the certified hybrids.
+    ``coords``: the study's C (default: one when the rows name an axis, else as many as
+    their accuracy names)."""
+    if coords is None:
+        coords = 1 if any("axis" in r for r in rows) else max(1, len(_coords(rows, "correlated")))
+    if coords == 1:
+        return {k: one_axis_group(g) for k, g in groups(rows).items()}
+    mimo = [r for r in rows if r["model"] in MIMO_MODELS and not certified(r)]
+    passed = [r for r in mimo if r["passed_single_axis"]]
+    pooled = rate(len(_broken(passed)), len(passed))
+    moving = rate(sum(r["diverged_moving"] for r in passed), len(passed))
+    return {
+        "groups": {k: across_axes_group(g) for k, g in groups(rows).items()},
+        "mimo_pooled": {
+            "broken_of_passed": pooled,
+            "target": TARGET_RATE,
+            # met when the interval's lower end clears the target, not the point estimate
+            "target_met": bool(passed) and pooled["ci95"][0] >= TARGET_RATE,
+            "broken_moving_of_passed": moving,
+            "target_met_moving": bool(passed) and moving["ci95"][0] >= TARGET_RATE,
+        },
+        "certified_hybrids": certified_summary(rows),
+    }
+
+
+def write(out: Path, rows: list[dict], coords: int, judge: dict | None = None) -> dict[str, Any]:
+    """``summary.json`` and ``summary.md`` (with one coordinate also
+    ``accuracy_vs_robustness.png``); ``judge``: what judged every member over several
+    coordinates (the vetted reference, ``campaign_planar.vetted_judge``)."""
+    summary = summarise(rows, coords)
+    if judge is not None:
+        summary["judge"] = judge
     write_json(out / "summary.json", summary, indent=2)
     write_text(out / "summary.md", markdown(summary))
-    plot(rows, out / "accuracy_vs_robustness.png")
+    if coords == 1:
+        plot(groups(rows), out / "accuracy_vs_robustness.png")
     return summary

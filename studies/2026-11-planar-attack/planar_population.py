@@ -12,7 +12,7 @@ motion at n = 1, default options, as ``scripts/planar_benchmark.py``), then for 
 2. the attack across axes: random search over the planar families, ``--budget`` evaluations.
 
 Prints, per kind, how many passed the single-axis test and how many of those the attack broke,
-with Wilson 95 % intervals (``bushenv.zoo.summary.rate``). Trained networks are kept under
+with Wilson 95 % intervals (``bushenv.zoo.rates.rate``). Trained networks are kept under
 ``--out``/models and reused. ``bushenv zoo --env rig3`` is the study this script began: both
 searchers, recipes, resumable members (docs/planar_search.md).
 """
@@ -34,9 +34,10 @@ from bushenv.motions import random_independent
 from bushenv.progress import Progress
 from bushenv.reference.planar import PlanarRubber
 from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.limits import COORDS
 from bushenv.search.searchers import RandomSearch
-from bushenv.zoo.planar_cell import driven_failed
-from bushenv.zoo.summary import rate
+from bushenv.zoo.attack import driven_failed
+from bushenv.zoo.rates import rate
 
 KINDS = ("nn", "nn-axis", "hybrid")
 
@@ -58,7 +59,7 @@ def member(model, seed: int, single_budget: int, budget: int) -> dict:
         planar = RandomSearch().run(ev, budget, seed=seed)
     # a single-axis rig measures the driven coordinate only: a failure there fails the test;
     # one in a coordinate at rest is a cross-axis failure such a rig does not see
-    driven = [c for c in single.failures if driven_failed(c)]
+    driven = [c for c in single.failures if driven_failed(c, COORDS)]
     return {
         "seed": seed,
         "single_axis_failures": len(driven),

@@ -1,27 +1,23 @@
-"""The MIMO population (``bushenv zoo --env rig3``): trained planar networks, the single-axis
-check, the attack across axes, rates with intervals, resumable; the one-axis study unchanged."""
+"""The population over three coordinates (``bushenv zoo --env rig3``): MIMO networks, the
+single-axis check, the attack across axes, its rates with intervals; the one-axis study
+unchanged (what both do alike: ``test_zoo.py``)."""
 
 import argparse
-import json
 
 import numpy as np
 import pytest
 
 from bushenv.commands.zoo import add_arguments, config_from
-from bushenv.execution import LocalBackend
-from bushenv.progress import Progress
-from bushenv.runlog import RunLog, run_cells
 from bushenv.search.base import Candidate
-from bushenv.zoo.planar_cell import driven_failed, run_planar_cell
-from bushenv.zoo.planar_study import (
-    PLANAR_CELL_KEYS,
-    PLANAR_RESULT_KEYS,
-    PlanarZooConfig,
-    refuse_other_kind,
-    run_planar_study,
+from bushenv.search.limits import COORDS
+from bushenv.zoo.attack import driven_failed
+from bushenv.zoo.cell import run_cell
+from bushenv.zoo.study import (
+    ZooConfig,
+    ZooError,
 )
-from bushenv.zoo.planar_summary import markdown, summarise
-from bushenv.zoo.study import ZooConfig, ZooError
+from bushenv.zoo.summary import summarise
+from bushenv.zoo.tables import markdown
 
 # seconds, not minutes: a few full-batch steps, no free run
 TINY = {"teacher_steps": 20, "free_run_steps": 0, "hidden": 6}
@@ -35,14 +31,14 @@ def _parse(*argv):
 
 def test_the_one_axis_study_is_what_it_was_without_env():
     plain = config_from(_parse("--seeds", "0"))
-    assert isinstance(plain, ZooConfig)
+    assert plain.coords == 1
     assert plain == ZooConfig(seeds=(0,), out=plain.out).checked()
     assert "env" not in plain.cells()[0]  # its cells (and so its results files) keep their keys
 
 
 def test_env_rig3_builds_the_mimo_population_and_refuses_what_does_not_apply():
     c = config_from(_parse("--env", "rig3", "--seeds", "0-1", "--models", "nn,nn-axis,hybrid"))
-    assert isinstance(c, PlanarZooConfig)
+    assert c.coords == 3 and c.env == "rig3"
     assert c.searchers == ("random", "cma")
     cells = c.cells()
     assert len(cells) == 2 * 3 * 2 and {x["env"] for x in cells} == {"rig3"}
@@ -66,8 +62,8 @@ def _candidate(profile, rob):
 def test_a_single_axis_failure_counts_only_in_the_coordinate_it_drives():
     q = np.zeros((10, 3))
     q[3:, 1] = 1e-3  # drives radial only
-    assert driven_failed(_candidate(q, (0.5, -0.1, 0.5)))
-    assert not driven_failed(_candidate(q, (-0.5, 0.1, None)))  # failed at rest: cross-axis
+    assert driven_failed(_candidate(q, (0.5, -0.1, 0.5)), COORDS)
+    assert not driven_failed(_candidate(q, (-0.5, 0.1, None)), COORDS)  # failed at rest: cross-axis
 
 
 def _row(model, passed, diverged, at_rest=0, moving=None, cross=0):
@@ -148,7 +144,7 @@ def test_a_member_trains_checks_single_axes_and_is_attacked_deterministically(tm
         "out": str(tmp_path),
         "train_options": TINY,
     }
-    row = run_planar_cell(cell)
+    row = run_cell(cell)
     assert (tmp_path / row["model_file"]).is_file()
     for s in ("random", "cma"):
         assert row["single_axis"][s]["evaluations"] == 8 == row["attacks"][s]["evaluations"]
@@ -158,94 +154,11 @@ def test_a_member_trains_checks_single_axes_and_is_attacked_deterministically(tm
         assert (a["moving_evaluations_to_failure"] is None) == (a["moving_failures"] == 0)
     assert row["passed_single_axis"] == all(v["passed"] for v in row["single_axis"].values())
     assert set(row["accuracy"]) == {"independent", "correlated"}
-    again = run_planar_cell(cell)
+    again = run_cell(cell)
     drop = {"train_s", "judge_s"}
     assert {k: v for k, v in again.items() if k not in drop} == {
         k: v for k, v in row.items() if k not in drop
     }
-
-
-def test_a_small_mimo_population_runs_summarises_and_resumes(tmp_path):
-    config = PlanarZooConfig(
-        recipes=("teacher-forcing",),
-        models=("nn", "hybrid"),
-        seeds=(0,),
-        searchers=("random",),
-        budget=8,
-        out=tmp_path,
-        train_options=TINY,
-    ).checked()
-    log = RunLog(tmp_path / "cells.jsonl", PLANAR_CELL_KEYS, PLANAR_RESULT_KEYS, ZooError)
-    with LocalBackend(workers=1) as backend:
-        cells = config.cells()
-        first = run_cells(
-            cells[:1], run_planar_cell, log, backend, False, Progress(quiet=True), str
-        )
-    rows = run_planar_study(
-        PlanarZooConfig(**{**config.__dict__, "resume": True}),
-        LocalBackend(workers=1),
-        Progress(quiet=True),
-    )
-    assert rows[0] == first[0]  # resumed: the finished member is not trained again
-    assert len(rows) == 2
-    summary = json.loads((tmp_path / "summary.json").read_text())
-    assert set(summary["groups"]) == {"teacher-forcing/nn", "teacher-forcing/hybrid"}
-    assert "broken_of_passed" in summary["mimo_pooled"]
-    assert "| teacher-forcing/hybrid | 1 |" in (tmp_path / "summary.md").read_text()
-    judge = summary["judge"]  # the reference every member was judged by, vetted first
-    assert judge["vetting"]["passed"] is True and judge["vetting"]["reference"] == "reference"
-    assert [c["check"] for c in judge["vetting"]["checks"]][0] == "holds"
-    assert "vetted first (holds ok" in (tmp_path / "summary.md").read_text()
-
-
-def test_resuming_the_other_kind_of_study_is_refused_and_its_file_kept(tmp_path, capsys):
-    from bushenv.cli import main
-
-    one_axis = tmp_path / "cells.jsonl"
-    one_axis.write_text(json.dumps({"recipe": "free-run", "axis": "axial", "seed": 0}) + "\n")
-    before = one_axis.read_bytes()
-    argv = ["zoo", "--env", "rig3", "--seeds", "0", "--resume", "--out", str(tmp_path)]
-    assert main(argv) == 2
-    assert "cells.jsonl line 1: a one-axis (--env rig) study's results" in capsys.readouterr().err
-    assert one_axis.read_bytes() == before  # not read as a torn line and cut
-    refuse_other_kind(one_axis, planar=False)  # the same kind resumes as before
-    one_axis.write_text(json.dumps({"env": "rig3", "seed": 0}) + "\n")
-    with pytest.raises(ZooError, match="line 1: a MIMO"):
-        refuse_other_kind(one_axis, planar=False)
-
-
-@pytest.mark.slow
-def test_a_member_run_on_ray_gives_the_local_result(tmp_path):
-    ray = pytest.importorskip("ray", reason="Ray not installed (pip install 'bushenv[ray]')")
-    from bushenv.execution import RayBackend
-
-    def run(out, backend):
-        config = PlanarZooConfig(
-            models=("hybrid",),
-            recipes=("teacher-forcing",),
-            seeds=(1,),
-            searchers=("random",),
-            budget=4,
-            out=out,
-            train_options=TINY,
-        ).checked()
-        log = RunLog(out / "cells.jsonl", PLANAR_CELL_KEYS, PLANAR_RESULT_KEYS, ZooError)
-        return run_cells(config.cells(), run_planar_cell, log, backend, False, Progress(True), str)
-
-    def same(row):  # what a member found, without where and how long
-        return {
-            k: v for k, v in row.items() if k not in {"out", "train_s", "judge_s", "worker_backend"}
-        }
-
-    with LocalBackend(workers=1) as one:
-        local = run(tmp_path / "local", one)
-    backend = RayBackend(num_cpus=1)
-    try:
-        remote = run(tmp_path / "ray", backend)
-    finally:
-        backend.close()
-    assert not ray.is_initialized()
-    assert [same(r) for r in remote] == [same(r) for r in local]
 
 
 def test_only_the_searchers_that_can_be_held_to_one_family_run_the_single_axis_check():

@@ -7,9 +7,10 @@ import json
 from bushenv.commands.zoo import add_arguments, config_from
 from bushenv.execution import LocalBackend
 from bushenv.progress import Progress
-from bushenv.zoo.planar_cell import planar_cell_name
-from bushenv.zoo.planar_study import PlanarZooConfig, run_planar_study
-from bushenv.zoo.planar_summary import NO_CERTIFIED, markdown, summarise
+from bushenv.zoo.cell import cell_name
+from bushenv.zoo.study import ZooConfig, run_study
+from bushenv.zoo.summary import NO_CERTIFIED, summarise
+from bushenv.zoo.tables import markdown
 
 TINY = {"teacher_steps": 12, "free_run_steps": 0, "hidden": 6, "certified_holds": 7}
 
@@ -20,28 +21,17 @@ def _parse(*argv):
     return p.parse_args(["--out", "x", *argv])
 
 
-def test_certified_on_trains_the_planar_networks_with_the_term():
-    c = config_from(_parse("--env", "rig3", "--seeds", "0", "--certified", "on"))
-    assert isinstance(c, PlanarZooConfig)
-    assert {x["train_options"]["certified"] for x in c.cells()} == {"on"}
-    plain = config_from(_parse("--env", "rig3", "--seeds", "0"))
-    assert plain.cells()[0]["train_options"] == {}
-    # certified and plain members of one study write different model files
-    names = {planar_cell_name(x) for x in (c.cells()[0], plain.cells()[0])}
-    assert len(names) == 2
-
-
 def test_structure_trains_the_planar_networks_tied_and_names_them_apart():
     import pytest
 
+    from bushenv.zoo.rates import recipe_label
     from bushenv.zoo.study import ZooError
-    from bushenv.zoo.summary import recipe_label
 
     args = ("--env", "rig3", "--seeds", "0", "--certified", "on", "--structure", "mirror")
     mirror = config_from(_parse(*args)).cells()[0]
     assert mirror["train_options"] == {"certified": "on", "structure": "mirror"}
     free = config_from(_parse(*args[:-2])).cells()[0]
-    assert planar_cell_name(mirror) != planar_cell_name(free)
+    assert cell_name(mirror) != cell_name(free)
     assert recipe_label(mirror) == "free-run +certified +mirror"
     assert recipe_label(free) == "free-run +certified"
     with pytest.raises(ZooError, match="--structure.*--env rig3"):
@@ -99,7 +89,8 @@ def test_certified_hybrids_get_their_own_rates_and_stay_out_of_the_pool():
 
 
 def test_a_tiny_certified_study_runs_end_to_end(tmp_path):
-    config = PlanarZooConfig(
+    config = ZooConfig(
+        env="rig3",
         recipes=("teacher-forcing",),
         models=("hybrid",),
         seeds=(0,),
@@ -108,7 +99,7 @@ def test_a_tiny_certified_study_runs_end_to_end(tmp_path):
         out=tmp_path,
         train_options={**TINY, "certified": "on"},
     ).checked()
-    rows = run_planar_study(config, LocalBackend(workers=1), Progress(quiet=True))
+    rows = run_study(config, LocalBackend(workers=1), Progress(quiet=True))
     row = rows[0]
     assert isinstance(row["certified_admitted"], bool)
     assert row["certificate"]["holds"] == 343
@@ -127,16 +118,17 @@ def test_the_network_share_of_a_silent_hybrid_is_zero_and_of_a_live_one_is_not()
     import numpy as np
 
     from bushenv.models.planar_narx import PlanarHybrid, PlanarNarx
-    from bushenv.zoo.planar_cell import _network_share, planar_records
+    from bushenv.search.limits import COORDS
+    from bushenv.zoo.cell import network_share, records
 
     live = PlanarHybrid.untrained(seed=0)
     p = live.params
     silent = PlanarHybrid(**{**p, "w_out": 0 * p["w_out"], "b_out": -p["f_offset"] / p["f_scale"]})
-    _, unseen = planar_records(0)
-    assert max(_network_share(silent, unseen).values()) < 1e-12
-    assert min(_network_share(live, unseen).values()) > 0.01
-    assert _network_share(PlanarNarx.untrained(seed=0), unseen) is None  # all network
-    assert np.isfinite(list(_network_share(live, unseen).values())).all()
+    _, unseen = records(3, 0)
+    assert max(network_share(silent, unseen, COORDS).values()) < 1e-12
+    assert min(network_share(live, unseen, COORDS).values()) > 0.01
+    assert network_share(PlanarNarx.untrained(seed=0), unseen, COORDS) is None  # all network
+    assert np.isfinite(list(network_share(live, unseen, COORDS).values())).all()
 
 
 def test_certified_hybrids_whose_network_carries_force_are_not_called_silent():
@@ -157,7 +149,7 @@ def test_training_noisy_feedback_is_the_hybrids_and_names_its_members_apart():
     assert noisy["train_options"] == {"training": "noisy-feedback"}
     plain = config_from(_parse(*args)).cells()[0]
     assert plain["train_options"] == {}
-    assert planar_cell_name(noisy) != planar_cell_name(plain)
+    assert cell_name(noisy) != cell_name(plain)
     with pytest.raises(ZooError, match="--training.*--models hybrid"):
         config_from(_parse("--env", "rig3", "--seeds", "0", "--training", "noisy-feedback"))
     with pytest.raises(ZooError, match="--training.*--env rig3"):
