@@ -42,8 +42,10 @@ NARX_MODELS = ("nn", "hybrid")  # the one-coordinate models with a recipe and a 
 # 52-72 s per model on a loaded machine). Three: 60 members at budget 256, one worker (5.0 s
 # teacher forcing, 7.1 s with the free-run stage); the certified term's fixed points and step
 # runs at every step cost 4x (seed 0).
-RECIPE_EFFORT = {1: {"teacher-forcing": 1.0, "free-run": 6.0}, 3: {"teacher-forcing": 1.0}}
-FREE_RUN_EFFORT = {1: 6.0, 3: 1.4}
+RECIPE_EFFORT = {
+    1: {"teacher-forcing": 1.0, "free-run": 6.0},
+    3: {"teacher-forcing": 1.0, "free-run": 1.4},
+}
 CERTIFIED_EFFORT = {1: 1.0, 3: 4.0}
 
 
@@ -186,9 +188,7 @@ def _describe(row: dict[str, Any]) -> str:
 def _weight(cell: dict[str, Any]) -> float:
     c = coordinate_count(cell.get("env", "rig"))
     certified = cell["train_options"].get("certified") == "on"
-    return RECIPE_EFFORT[c].get(cell["recipe"], FREE_RUN_EFFORT[c]) * (
-        CERTIFIED_EFFORT[c] if certified else 1.0
-    )
+    return RECIPE_EFFORT[c][cell["recipe"]] * (CERTIFIED_EFFORT[c] if certified else 1.0)
 
 
 def run_study(config: ZooConfig, backend, progress: Progress) -> list[dict[str, Any]]:
@@ -196,7 +196,7 @@ def run_study(config: ZooConfig, backend, progress: Progress) -> list[dict[str, 
     summary written; all rows returned."""
     config = config.checked()
     c = config.coords
-    judge = None if c == 1 else _vetted_reference(progress)
+    judge = None if c == 1 else _vetted_reference(config.env, progress)
     log = RunLog(config.out / "cells.jsonl", cell_keys(c), result_keys(c), ZooError, progress.say)
     what = "zoo" if c == 1 else f"zoo {config.env}"
     with backend:
@@ -215,7 +215,7 @@ def run_study(config: ZooConfig, backend, progress: Progress) -> list[dict[str, 
     return rows
 
 
-def _vetted_reference(progress: Progress) -> dict[str, Any]:
+def _vetted_reference(env: str, progress: Progress) -> dict[str, Any]:
     """Every member over several coordinates is judged by the coupled reference: it is vetted
     once, before any member."""
     from bushenv.models.base import PAPER_DT
@@ -223,4 +223,4 @@ def _vetted_reference(progress: Progress) -> dict[str, Any]:
     from bushenv.search.planar_models import resolve_planar_spec
 
     reference = resolve_planar_spec(DEFAULT_REFERENCE, PAPER_DT, "reference")
-    return vetted_judge(reference, DEFAULT_REFERENCE, TARGETS["rig3"], progress, error=ZooError)
+    return vetted_judge(reference, DEFAULT_REFERENCE, TARGETS[env], progress, error=ZooError)
