@@ -41,15 +41,11 @@ from bushenv.search.campaign_config import CampaignConfig
 from bushenv.search.campaign_holds import GRID_POINTS, CertificateHolds, listed_vectors
 from bushenv.search.campaign_holds import NAME as HOLDS
 from bushenv.search.campaign_planar_report import format_planar_table, fresh_report, resumed
+from bushenv.search.campaign_resolve import Resolved, resolve
 from bushenv.search.campaign_search import MAX_SAVED_FAILURES
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.limits import Rig3Limits, machine_limits
-from bushenv.search.planar_models import (  # noqa: F401 (DEFAULT_REFERENCE, vetted_judge: the zoo's)
-    DEFAULT_REFERENCE,
-    Planar,
-    resolve_planar_attack,
-    vetted_judge,
-)
+from bushenv.search.planar_models import DEFAULT_REFERENCE
 from bushenv.search.searchers import SEARCHERS
 from bushenv.search.shrink import shrink
 from bushenv.search.target_base import covered_search
@@ -147,7 +143,8 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
         if s not in target.default_searchers:
             known = ", ".join(target.default_searchers)
             raise SearchError(f"--searchers {s}: the {c.target} target takes {known}")
-    p = resolve_planar_attack(c, progress)
+    p = resolve(c, progress.say)
+    model, reference = p.models[p.target_key].model, p.judge.reference
     report = fresh_report(c, p)
     if c.resume and report_path.exists():
         report = resumed(report_path, report)
@@ -182,12 +179,12 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     profiles = [q for _, q, _ in failing]
     if not report["recheck"]:
         report["recheck"] = {
-            role: _recheck(p.models[role].model, p.reference, profiles, target, threads, p.limits)
-            for role in ("control", "hybrid")
-            if role in p.models
+            role: _recheck(p.models[key].model, reference, profiles, target, threads, p.limits)
+            for role, key in (("control", p.control_key), ("hybrid", p.hybrid_key))
+            if key is not None
         }
         for role, r in report["recheck"].items():
-            r["model"] = p.control["label"] if role == "control" else p.models[role].spec
+            r["model"] = p.control["label"] if role == "control" else p.models[p.hybrid_key].spec
         save()
     reach = failure_reach(profiles, p.limits)
     if reach is not None:
@@ -201,7 +198,7 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     if c.plots and shown:
         from bushenv.search.campaign_plots import plot_shrunk_coordinates
 
-        shrunk_plots = plot_shrunk_coordinates(p.model, p.reference, shown, out / "plots")
+        shrunk_plots = plot_shrunk_coordinates(model, reference, shown, out / "plots")
         plots = [str(q) for q in shrunk_plots]
     report["plots"] = plots or report["plots"]
     report["complete"] = True
@@ -211,11 +208,11 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     return PlanarAttack(report, report_path, flagged)
 
 
-def _hold_stage(c, p: Planar, threads: int, progress: Progress) -> tuple[dict, dict | None]:
+def _hold_stage(c, p: Resolved, threads: int, progress: Progress) -> tuple[dict, dict | None]:
     """The hold stage (``campaign_holds`` over C coordinates): its report entry and its
     search's."""
-    floors = np.array(list(p.judge["force_floors"].values()))
-    holds = listed_vectors(p.model, p.limits.stroke, floors)
+    floors = np.array(list(p.judged["force_floors"].values()))
+    holds = listed_vectors(p.models[p.target_key].model, p.limits.stroke, floors)
     if holds is None:
         return {"run": False, "why": "not a planar network (no fixed points)"}, None
     stage = CertificateHolds(holds, p.limits.rate, FAMILY)
@@ -228,7 +225,7 @@ def _hold_stage(c, p: Planar, threads: int, progress: Progress) -> tuple[dict, d
     return stage.entry(grid_points=GRID_POINTS), summary
 
 
-def _search_one(c, p: Planar, name: str, start: int, threads: int, progress: Progress,
+def _search_one(c, p: Resolved, name: str, start: int, threads: int, progress: Progress,
                 searcher: Searcher | None = None, budget: int | None = None) -> dict:  # fmt: skip
     """One search (``searcher``, else ``name``'s), its failures and worst saved under
     ``failures/``: its report entry."""
@@ -239,8 +236,8 @@ def _search_one(c, p: Planar, name: str, start: int, threads: int, progress: Pro
         progress.update(start + evaluations, f"  {msg}")
 
     result, covered = planar_search(
-        p.model, p.reference, searcher or name, budget, c.seed, threads, said, c.target,
-        limits=p.limits, coverage=True,
+        p.models[p.target_key].model, p.judge.reference, searcher or name, budget, c.seed,
+        threads, said, c.target, limits=p.limits, coverage=True,
     )  # fmt: skip
     progress.update(start + budget, f"[{c.model}] {name}: {result.n_failures} failures", force=True)
     summary = result.summary()
@@ -256,7 +253,7 @@ def _search_one(c, p: Planar, name: str, start: int, threads: int, progress: Pro
     if result.worst is not None:
         profiles.append(result.worst.profile)
         meta.append({**result.worst.to_json(), "worst": True})
-    path = Path(c.out) / "failures" / f"{p.models['target'].key}-{name}.npz"
+    path = Path(c.out) / "failures" / f"{p.target_key}-{name}.npz"
     save_profiles(path, profiles, meta)
     summary["profiles_file"] = str(path.relative_to(c.out))
     return summary
@@ -303,19 +300,20 @@ def _recheck(model, reference, profiles, target, threads, limits) -> dict:
     return {"profiles": len(profiles), "diverged": int(v.diverged.sum()), "by_axis": dict(axes)}
 
 
-def _shrink_some(p: Planar, target, failing, c, progress, out: Path):
+def _shrink_some(p: Resolved, target, failing, c, progress, out: Path):
     """The first ``max_shrink`` failures shrunk per axis and written as cases: their report
     rows and ``(title, shrunk profile)`` for the plots."""
     from bushenv.models import params_sha
     from bushenv.search.corpus import make_case, save_case
 
-    subject, control, reference = p.models["target"], p.models["control"], p.reference
+    subject, control = p.models[p.target_key], p.models[p.control_key]
+    reference = p.judge.reference
     ref_spec = c.reference or DEFAULT_REFERENCE
     ref_record = {"spec": ref_spec, "file_sha256": None, "params_sha256": params_sha(reference)}
     kept, shown = [], []
     for name, profile, meta in failing[: c.max_shrink]:
         family = meta["family"]
-        with BatchEvaluator(p.model, reference, target, scales=p.limits) as ev:
+        with BatchEvaluator(subject.model, reference, target, scales=p.limits) as ev:
             res = shrink(profile, ev, budget=c.shrink_budget)
         moving = [a for i, a in enumerate(target.coords) if np.any(res.profile[:, i] != 0.0)]
         progress.say(
@@ -334,7 +332,7 @@ def _shrink_some(p: Planar, target, failing, c, progress, out: Path):
                 "model": c.model,
                 "model_sha256": subject.sha256,
             },
-            models={c.model: p.model, control.spec: control.model},
+            models={c.model: subject.model, control.spec: control.model},
             reference=reference,
             reference_spec=ref_spec,
             shas={c.model: subject.sha256, control.spec: control.sha256},

@@ -21,8 +21,9 @@ from pathlib import Path
 
 from bushenv.search.base import SearchError
 from bushenv.search.campaign_config import CampaignConfig
+from bushenv.search.campaign_resolve import Resolved
 from bushenv.search.limits import UNITS, limits_text
-from bushenv.search.planar_models import DEFAULT_REFERENCE, Planar
+from bushenv.search.planar_models import DEFAULT_REFERENCE
 from bushenv.search.targets import TARGETS
 
 RESUMED = ("searchers", "hold_stage", "recheck", "shrunk", "plots", "seconds")  # kept by --resume
@@ -34,13 +35,13 @@ def arguments(c: CampaignConfig) -> dict:
     return {**c.arguments(), "searchers": list(c.searchers), **{k: getattr(c, k) for k in keep}}
 
 
-def fresh_report(c: CampaignConfig, p: Planar) -> dict:
+def fresh_report(c: CampaignConfig, p: Resolved) -> dict:
     """The report before any search."""
     return {
         "env": c.target,
         "model": c.model,
         "reference": c.reference or DEFAULT_REFERENCE,
-        "judge": p.judge,
+        "judge": p.judged,
         "scales": p.limits.to_json(),
         "control": p.control,
         "budget": c.budget,

@@ -3,15 +3,21 @@ hybrid, the control and the models rechecked beside them, each resolved once
 (``bushenv.resolved``) into one ``Resolved``.
 
 ``resolve_target`` is the stage for one model (a cell of ``bushenv campaign``, a member of the
-zoo); ``resolve`` adds the roles of a whole attack (``campaign_models.roles``).
+zoo); ``resolve`` adds the roles of a whole attack (``campaign_models.roles``), for a target of
+any number of coordinates: over several, the limits the search drives are scaled to the user's
+card (``planar_models.search_limits``), the reference is vetted within them, and the control is
+the user's own (``--control``), a linear fit to the user's reference, or the Table-1 preset.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
+from pathlib import Path
 from types import MappingProxyType
 from typing import Any
+
+import numpy as np
 
 from bushenv.judge import (
     Judge,
@@ -31,6 +37,14 @@ from bushenv.search.campaign_models import (
     roles,
 )
 from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.limits import Rig3Limits, limits_text
+from bushenv.search.planar_models import (
+    DEFAULT_CONTROL,
+    DEFAULT_REFERENCE,
+    resolved_planar,
+    search_limits,
+    vetting,
+)
 from bushenv.search.targets import Target, get_target
 
 Say = Callable[[str], None]
@@ -53,6 +67,12 @@ class Resolved:
     roles: Mapping[str, str]
     keys: Mapping[str, str]  # the report key of each role (target, hybrid, control)
     notes: tuple[str, ...] = ()
+    # over several coordinates (None over one, where ``judge.scales`` are the limits): the
+    # limits the search drives, what judged (the vetting, the force floors, the stroke) and how
+    # the control was made (label, how, spec, file), as the report records them
+    limits: Rig3Limits | None = None
+    judged: dict | None = None
+    control: dict | None = None
 
     @property
     def dt(self) -> float:
@@ -164,6 +184,8 @@ def resolve_target(
 def resolve(config: CampaignConfig, say: Say = _quiet) -> Resolved:
     """The stage for a whole attack: ``resolve_target``, then every other role's model."""
     c = config
+    if get_target(c.target).coords:
+        return _resolve_coordinates(c, say)
     one = resolve_target(
         c.model,
         c.reference,
@@ -201,3 +223,56 @@ def _other(one: Resolved, spec: str, config: CampaignConfig) -> ResolvedModel:
         path = model.save(config.out / "models" / "control-linear.npz")
         return resolved(str(path), model, one.axis, key=FITTED_CONTROL)
     return resolve_model(spec, one.axis, one.dt)
+
+
+def _resolve_coordinates(c: CampaignConfig, say: Say) -> Resolved:
+    """``resolve`` over several coordinates (see the module doc)."""
+    tgt = get_target(c.target)
+    subject = resolved_planar(c.model, None, "--model", card=True)
+    dt = subject.model.dt
+    ref = resolved_planar(c.reference or DEFAULT_REFERENCE, dt, "--reference", card=True)
+    limits = search_limits(c, subject, ref)
+    vetted, judged = vetting(
+        ref.model, ref.spec, tgt, say, model=subject.model, model_file=subject.file,
+        trust=c.trust_reference, stroke=np.array(limits.stroke),
+    )  # fmt: skip
+    if c.control:
+        control = resolved_planar(c.control, dt, "--control")
+        how = {"label": c.control, "how": "given (--control)"}
+    elif ref.file is not None:
+        q = card_displacements(ref) or card_displacements(subject)
+        fit = fitted_linear(ref.model, limits, q)
+        path = fit.save(Path(c.out) / "models" / "control-linear.npz")
+        control = replace(resolved_planar(str(path), dt, "--control"), key=FITTED_CONTROL)
+        drive = "its card's training records" if q else "a random drive within the limits"
+        how = {
+            "label": f"{path}, a linear fit to {ref.spec}",
+            "how": f"linear, least squares on {ref.spec}'s response to {drive}",
+        }
+    else:
+        control = resolved_planar(DEFAULT_CONTROL, dt, "--control")
+        how = {"label": DEFAULT_CONTROL, "how": "the planar Table-1 linear preset"}
+    how.update(spec=control.spec, file=None if control.file is None else str(control.file))
+    by_role = {"target": subject, "control": control}
+    if c.hybrid and c.hybrid != "none":
+        by_role["hybrid"] = resolved_planar(c.hybrid, dt, "--hybrid")
+    models: dict[str, ResolvedModel] = {}
+    for m in by_role.values():
+        models.setdefault(m.key, m)
+    judge = Judge(
+        reference_spec=ref.spec, builtin=ref.registered, scales=limits, static=True,
+        criteria=(), why="per coordinate, as the target judges (target_base.judge_coordinates)",
+        vetting=vetted, trusted_by_flag=bool(c.trust_reference and not vetted.passed),
+        reference=ref.model,
+    )  # fmt: skip
+    for line in (
+        f"searching within {limits_text(limits.to_json())}",
+        f"control: {how['label']}: {how['how']}",
+    ):
+        say(line)
+    return Resolved(
+        axis=c.axis, target=tgt, judge=judge, reference=ref, models=_frozen(models),
+        roles=_frozen({m.key: r for r, m in reversed(by_role.items())}),
+        keys=_frozen({r: m.key for r, m in by_role.items()}),
+        notes=tuple(judge_notes(judge, tgt)), limits=limits, judged=judged, control=how,
+    )  # fmt: skip

@@ -1,37 +1,32 @@
-"""A three-axis model or reference named in an attack or a case, resolved: what the planar
-attack and the corpus's replay of planar cases share; and the planar attack's resolve stage
-(``resolve_planar_attack`` -> ``Planar``): what a user's bushing gives it through the card
-beside its file -- the limits the search drives (``search_limits``, ``limits_of_card``) and the
-linear control fitted to the reference (``identify.linear.fitted_linear``, over C), as the
-one-axis attack takes both from its reference's card (``judge.judging_scales``,
-``campaign_models.roles``) -- and the reference vetted within those limits (``vetted_judge``).
+"""What is truly three-coordinate in resolving an attack (``campaign_resolve.resolve`` is the
+one stage): a three-axis model or reference named in an attack or a case (what the attack and
+the corpus's replay of three-axis cases share); the limits the search drives, from the card
+beside a user's file (``search_limits``, ``limits_of_card``: per coordinate, the rotation with
+its own flag), as the one-axis attack takes its scales from its reference's card
+(``judge.judging_scales``); and the reference vetted within those limits (``vetting``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from bushenv.identify.linear import fitted_linear
-from bushenv.progress import Progress
 from bushenv.scales import RECORD_MARGIN
 from bushenv.search.base import SearchError
 from bushenv.search.campaign_config import CampaignConfig
-from bushenv.search.campaign_models import card_displacements, card_records
+from bushenv.search.campaign_models import card_records
 from bushenv.search.limits import (
     COORDS,
     Rig3Limits,
     limits_of_records,
-    limits_text,
     machine_limits,
 )
-from bushenv.search.targets import TARGETS
 
 DEFAULT_REFERENCE = "reference"
 DEFAULT_CONTROL = "linear"
-FITTED_CONTROL = "linear-fit"  # the control's key when it is fitted to the user's reference
 
 
 def resolve_planar_spec(spec: str, dt: float | None, what: str):
@@ -105,25 +100,6 @@ def limits_of_card(resolved) -> Rig3Limits | None:
     )
 
 
-@dataclass(frozen=True)
-class Planar:
-    """Stage 1's result: the models by role (target, reference, control, maybe hybrid), the
-    limits searched, what judged, and how the control was made."""
-
-    models: dict
-    limits: Rig3Limits
-    judge: dict
-    control: dict  # label, spec, file, how
-
-    @property
-    def model(self):
-        return self.models["target"].model
-
-    @property
-    def reference(self):
-        return self.models["reference"].model
-
-
 def search_limits(config: CampaignConfig, subject, reference) -> Rig3Limits:
     """What the search drives (see the module doc, step 1)."""
     c = config
@@ -153,75 +129,27 @@ def search_limits(config: CampaignConfig, subject, reference) -> Rig3Limits:
     return replace(limits, stroke=tuple(stroke), rate=tuple(rate), source=source)
 
 
-def resolve_planar_attack(c: CampaignConfig, progress: Progress) -> Planar:
-    """Stage 1 (see the module doc)."""
-    subject = resolved_planar(c.model, None, "--model", card=True)
-    dt = subject.model.dt
-    reference = resolved_planar(c.reference or DEFAULT_REFERENCE, dt, "--reference", card=True)
-    limits = search_limits(c, subject, reference)
-    judge = vetted_judge(
-        reference.model,
-        reference.spec,
-        TARGETS[c.target],
-        progress,
-        model=subject.model,
-        model_file=subject.file,
-        trust=c.trust_reference,
-        stroke=np.array(limits.stroke),
-    )
-    models = {"target": subject, "reference": reference}
-    if c.control:
-        models["control"] = resolved_planar(c.control, dt, "--control")
-        control = {"label": c.control, "how": "given (--control)"}
-    elif reference.file is not None:
-        q = card_displacements(reference) or card_displacements(subject)
-        fit = fitted_linear(reference.model, limits, q)
-        path = fit.save(Path(c.out) / "models" / "control-linear.npz")
-        models["control"] = replace(resolved_planar(str(path), dt, "--control"), key=FITTED_CONTROL)
-        drive = "its card's training records" if q else "a random drive within the limits"
-        control = {
-            "label": f"{path}, a linear fit to {reference.spec}",
-            "how": f"linear, least squares on {reference.spec}'s response to {drive}",
-        }
-    else:
-        models["control"] = resolved_planar(DEFAULT_CONTROL, dt, "--control")
-        control = {"label": DEFAULT_CONTROL, "how": "the planar Table-1 linear preset"}
-    control.update(spec=models["control"].spec, file=_path(models["control"].file))
-    if c.hybrid and c.hybrid != "none":
-        models["hybrid"] = resolved_planar(c.hybrid, dt, "--hybrid")
-    for line in (
-        f"searching within {limits_text(limits.to_json())}",
-        f"control: {control['label']}: {control['how']}",
-    ):
-        progress.say(line)
-    return Planar(models, limits, judge, control)
-
-
-def _path(p) -> str | None:
-    return None if p is None else str(p)
-
-
-def vetted_judge(
+def vetting(
     reference,
     ref_spec: str,
     target,
-    progress: Progress,
+    say: Callable[[str], None],
     model=None,
     model_file=None,
     trust: bool = False,
     error: type[Exception] = SearchError,
     stroke: np.ndarray | None = None,
-) -> dict:
+):
     """The reference checked before it judges (``bushenv.vetting``) within ``stroke`` (None:
-    the target's): ``error`` when it fails, unless ``trust``; what judged (the vetting,
-    floors, stroke) for a report."""
+    the target's): ``error`` when it fails, unless ``trust``; (the ``Vetting``, what judged --
+    the vetting, floors, stroke -- for a report)."""
     from bushenv.search.targets import reference_floors
     from bushenv.vetting import vet_reference
 
     if stroke is None:
         stroke, _ = target.profile_bounds()
     floors, floors_source = reference_floors(reference)
-    vetting = vet_reference(
+    vetted = vet_reference(
         reference,
         ref_spec,
         stroke,
@@ -230,17 +158,17 @@ def vetted_judge(
         model=model,
         model_file=model_file,
     )
-    for line in vetting.lines():
-        progress.say(f"reference {ref_spec}: {line}")
-    if not vetting.passed and not trust:
+    for line in vetted.lines():
+        say(f"reference {ref_spec}: {line}")
+    if not vetted.passed and not trust:
         raise error(
-            f"the reference {ref_spec} failed its vetting ({vetting.summary()}): it cannot judge; "
+            f"the reference {ref_spec} failed its vetting ({vetted.summary()}): it cannot judge; "
             "give another --reference, or pass --trust-reference to judge with it anyway "
             "(every verdict is then marked)"
         )
-    return {
-        "vetting": vetting.describe(),
-        "trusted_despite_failed_vetting": bool(not vetting.passed),
+    return vetted, {
+        "vetting": vetted.describe(),
+        "trusted_despite_failed_vetting": bool(not vetted.passed),
         "force_floors": dict(zip(target.coords, floors.tolist(), strict=True)),
         "force_floors_source": floors_source,
         "stroke": dict(zip(target.coords, np.asarray(stroke).tolist(), strict=True)),

@@ -130,8 +130,7 @@ def _on_one_axis(cell, model, path, train, unseen) -> dict[str, Any]:
 def _across_axes(cell, model, path, train, unseen) -> dict[str, Any]:
     """The hold check, the single-axis check and the attack across axes, judged by the
     coupled reference."""
-    from bushenv.search.campaign_planar import DEFAULT_REFERENCE
-    from bushenv.search.planar_models import resolve_planar_spec
+    from bushenv.search.planar_models import DEFAULT_REFERENCE, resolve_planar_spec
 
     coords = TARGETS[cell["env"]].coords
     seed, budget = int(cell["seed"]), int(cell["budget"])

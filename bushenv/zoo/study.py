@@ -219,8 +219,7 @@ def _vetted_reference(env: str, progress: Progress) -> dict[str, Any]:
     """Every member over several coordinates is judged by the coupled reference: it is vetted
     once, before any member."""
     from bushenv.models.base import PAPER_DT
-    from bushenv.search.campaign_planar import DEFAULT_REFERENCE, vetted_judge
-    from bushenv.search.planar_models import resolve_planar_spec
+    from bushenv.search.planar_models import DEFAULT_REFERENCE, resolve_planar_spec, vetting
 
     reference = resolve_planar_spec(DEFAULT_REFERENCE, PAPER_DT, "reference")
-    return vetted_judge(reference, DEFAULT_REFERENCE, TARGETS[env], progress, error=ZooError)
+    return vetting(reference, DEFAULT_REFERENCE, TARGETS[env], progress.say, error=ZooError)[1]

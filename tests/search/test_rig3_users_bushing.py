@@ -96,6 +96,26 @@ def test_the_control_is_a_linear_fit_to_the_users_reference_and_named_as_such(bu
     assert f"recheck control ({control['label']})" in md
 
 
+def test_the_one_resolve_stage_scales_to_the_users_card_and_fits_the_control(bushing, tmp_path):
+    """The three-axis attack resolves through the one ``resolve`` (as a one-axis attack does):
+    a ``Resolved`` whose limits come from the user's card, whose reference is vetted within
+    them and whose control is a linear fit to the user's reference, under its own role."""
+    from bushenv.search.campaign_config import CampaignConfig
+    from bushenv.search.campaign_resolve import Resolved, resolve
+
+    config = CampaignConfig(model=str(bushing / "active3.npz"), reference=str(bushing / "ref3.npz"),
+                            target="rig3", out=tmp_path)  # fmt: skip
+    r = resolve(config)
+    assert isinstance(r, Resolved) and r.target.coords == COORDS
+    assert r.limits.stroke != machine_limits().stroke and "ref3.card.json" in r.limits.source
+    assert r.judge.scales == r.limits and r.judge.vetting.passed
+    assert r.judged["stroke"] == pytest.approx(dict(zip(COORDS, r.limits.stroke, strict=True)))
+    assert r.roles == {"active3": "target", "linear-fit": "control"}
+    assert r.control_key == "linear-fit" and r.hybrid_key is None
+    assert r.control["file"] == str(tmp_path / "models" / "control-linear.npz")
+    assert r.models[r.control_key].model.dt == r.dt == r.judge.reference.dt
+
+
 def test_the_warning_names_a_flagged_control_given_by_the_user(bushing, capsys):
     _attack(bushing, "att-ctl", "--control", str(bushing / "active3.npz"), "--searchers",
             "random", quiet=False)  # fmt: skip
