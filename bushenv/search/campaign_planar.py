@@ -179,7 +179,7 @@ def run_planar_attack(config: CampaignConfig, progress: Progress) -> PlanarAttac
     profiles = [q for _, q, _ in failing]
     if not report["recheck"]:
         report["recheck"] = {
-            role: _recheck(p.models[key].model, reference, profiles, target, threads, p.limits)
+            role: _recheck(p, key, profiles, threads)
             for role, key in (("control", p.control_key), ("hybrid", p.hybrid_key))
             if key is not None
         }
@@ -235,10 +235,11 @@ def _search_one(c, p: Resolved, name: str, start: int, threads: int, progress: P
     def said(msg: str, evaluations: int) -> None:
         progress.update(start + evaluations, f"  {msg}")
 
-    result, covered = planar_search(
-        p.models[p.target_key].model, p.judge.reference, searcher or name, budget, c.seed,
-        threads, said, c.target, limits=p.limits, coverage=True,
-    )  # fmt: skip
+    with p.evaluator(p.target_key, threads) as ev:
+        result, covered = covered_search(
+            _searcher(searcher or name, None), ev, budget, c.seed,
+            lambda msg: said(msg, ev.n_evaluations),
+        )  # fmt: skip
     progress.update(start + budget, f"[{c.model}] {name}: {result.n_failures} failures", force=True)
     summary = result.summary()
     summary["coverage"] = covered
@@ -291,10 +292,10 @@ def failure_reach(profiles: list[np.ndarray], limits: Rig3Limits) -> dict | None
     }
 
 
-def _recheck(model, reference, profiles, target, threads, limits) -> dict:
+def _recheck(p: Resolved, key: str, profiles, threads: int) -> dict:
     if not profiles:
         return {"profiles": 0, "diverged": 0}
-    with BatchEvaluator(model, reference, target, threads=threads, scales=limits) as ev:
+    with p.evaluator(key, threads) as ev:
         v = ev.evaluate(profiles).verdict
     axes = Counter(str(a) for a, d in zip(v.first_axis, v.diverged, strict=True) if d)
     return {"profiles": len(profiles), "diverged": int(v.diverged.sum()), "by_axis": dict(axes)}
@@ -313,7 +314,7 @@ def _shrink_some(p: Resolved, target, failing, c, progress, out: Path):
     kept, shown = [], []
     for name, profile, meta in failing[: c.max_shrink]:
         family = meta["family"]
-        with BatchEvaluator(subject.model, reference, target, scales=p.limits) as ev:
+        with p.evaluator(p.target_key) as ev:
             res = shrink(profile, ev, budget=c.shrink_budget)
         moving = [a for i, a in enumerate(target.coords) if np.any(res.profile[:, i] != 0.0)]
         progress.say(
