@@ -2,7 +2,8 @@
 
 A short pipeline through the one-axis search contracts, as the one-axis attack does it:
 
-1. **resolve**: the planar model and the reference (the coupled planar reference unless
+1. **resolve** (``campaign_resolve.resolve``, the one stage for any number of coordinates
+   -> ``Resolved``): the planar model and the reference (the coupled planar reference unless
    ``--reference``), each with the card beside its file; the **limits** the search drives
    (``Rig3Limits``: for a user's reference, from its card's training records -- else the
    model's card -- 1.5 x their peak |q| and |dq/dt| per coordinate, the one-axis rule;
