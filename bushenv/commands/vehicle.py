@@ -35,12 +35,10 @@ def _names(text: str) -> list[str]:
     return [t.strip() for t in text.split(",") if t.strip()]
 
 
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    from bushenv.vehicle.bushings import DEFAULT_KINDS
+def add_manoeuvre_arguments(p: argparse.ArgumentParser) -> None:
+    """--manoeuvres and --duration-s, as every vehicle command takes them."""
     from bushenv.vehicle.manoeuvres import NAMES
-    from bushenv.vehicle.study import IDENTICAL_PCT
 
-    p.add_argument("--out", required=True, metavar="DIR", help="folder for the report")
     p.add_argument(
         "--manoeuvres",
         type=_names,
@@ -55,6 +53,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="S",
         help="every manoeuvre this long (default: each its own, 3-7.7 s)",
     )
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    from bushenv.vehicle.bushings import DEFAULT_KINDS
+    from bushenv.vehicle.study import IDENTICAL_PCT
+
+    p.add_argument("--out", required=True, metavar="DIR", help="folder for the report")
+    add_manoeuvre_arguments(p)
     p.add_argument(
         "--kinds",
         type=_names,

@@ -17,11 +17,9 @@ import argparse
 import time
 from pathlib import Path
 
+from bushenv.commands.vehicle import add_manoeuvre_arguments
+
 EXAMPLE = "bushenv vehicle-transfer --out runs/transfer"
-
-
-def _names(text: str) -> list[str]:
-    return [t.strip() for t in text.split(",") if t.strip()]
 
 
 def _multiples(text: str) -> list[float]:
@@ -32,7 +30,6 @@ def _multiples(text: str) -> list[float]:
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    from bushenv.vehicle.manoeuvres import NAMES
     from bushenv.vehicle.transfer import HELD_MULTIPLES
 
     p.add_argument("--out", required=True, metavar="DIR", help="folder for the report")
@@ -68,20 +65,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="the predictor: 1, first-order superposition of the +size runs; 2, also the "
         "-size runs (each error's own curvature; 48 more cars)",
     )
-    p.add_argument(
-        "--manoeuvres",
-        type=_names,
-        default=list(NAMES),
-        metavar="LIST",
-        help=f"comma-separated, of: {', '.join(NAMES)} (default: all)",
-    )
-    p.add_argument(
-        "--duration-s",
-        type=float,
-        default=None,
-        metavar="S",
-        help="every manoeuvre this long (default: each its own, 3-7.7 s)",
-    )
+    add_manoeuvre_arguments(p)
     p.add_argument(
         "--seed", type=int, default=0, help="the ISO 8608 road's and the combinations' draws"
     )

@@ -26,7 +26,13 @@ from bushenv.rigs.common import (
 )
 from bushenv.rigs.halfcar_car import HalfCar, HalfCarPair
 from bushenv.rigs.halfcar_inputs import replay_inputs, unit_actions3
-from bushenv.rigs.halfcar_outputs import PIVOT_KEYS, car_outputs, out_of_bounds, sample
+from bushenv.rigs.halfcar_outputs import (
+    PIVOT_KEYS,
+    car_outputs,
+    observation_values,
+    out_of_bounds,
+    sample,
+)
 from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, HalfCarParameters
 from bushenv.rigs.specs import spec_kwargs
 
@@ -263,19 +269,7 @@ class HalfCarEnv(gym.Env):
         return self._obs.copy(), reward, terminated, truncated, info
 
     def _observe(self, info: dict[str, Any]) -> None:
-        p = self.params
-        f = [math.hypot(info[f"force_{k}_axial_model_n"], info[f"force_{k}_radial_model_n"])
-             for k in POSITIONS]  # fmt: skip
-        values = (
-            info["road_left_m"] / p.max_road, info["road_right_m"] / p.max_road,
-            info["lateral_accel_m_per_s2"] / p.max_ay, info["body_y_m"] / p.max_body,
-            info["body_vy_m_per_s"] / p.v_scale, info["body_x_m"] / p.max_body,
-            info["roll_rad"] / p.max_roll, info["roll_rate_rad_per_s"] / p.roll_rate_scale,
-            (info["wheel_load_left_n"] - p.tyre_static_n) / p.tyre_static_n,
-            (info["wheel_load_right_n"] - p.tyre_static_n) / p.tyre_static_n,
-            *(x / p.force_limit for x in f), info["error_n"] / p.force_limit,
-            info["roll_error_rad"] / p.max_roll,
-        )  # fmt: skip
+        values = observation_values(self.params, info, math.hypot)
         o = self._obs
         for i, v in enumerate(values):
             o[i] = 0.0 if v != v else (1.0 if v > 1.0 else (-1.0 if v < -1.0 else v))

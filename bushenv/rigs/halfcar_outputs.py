@@ -122,3 +122,20 @@ def out_of_bounds(p: HalfCarParameters, out: dict[str, Any], q: np.ndarray) -> s
     if worst > p.max_body:
         return f"body or wheel displacement {worst:.4g} m exceeds {p.max_body:.4g} m"
     return ""
+
+
+def observation_values(p: HalfCarParameters, info: dict[str, Any], hypot: Any) -> tuple:
+    """HalfCar-v0's 16 observation entries before clipping, from one step's ``info`` (floats
+    with ``math.hypot``, or the vector env's (N,) arrays with ``np.hypot``)."""
+    f = [hypot(info[f"force_{k}_axial_model_n"], info[f"force_{k}_radial_model_n"])
+         for k in POSITIONS]  # fmt: skip
+    return (
+        info["road_left_m"] / p.max_road, info["road_right_m"] / p.max_road,
+        info["lateral_accel_m_per_s2"] / p.max_ay, info["body_y_m"] / p.max_body,
+        info["body_vy_m_per_s"] / p.v_scale, info["body_x_m"] / p.max_body,
+        info["roll_rad"] / p.max_roll, info["roll_rate_rad_per_s"] / p.roll_rate_scale,
+        (info["wheel_load_left_n"] - p.tyre_static_n) / p.tyre_static_n,
+        (info["wheel_load_right_n"] - p.tyre_static_n) / p.tyre_static_n,
+        *(x / p.force_limit for x in f), info["error_n"] / p.force_limit,
+        info["roll_error_rad"] / p.max_roll,
+    )  # fmt: skip

@@ -27,7 +27,12 @@ from bushenv.rigs.halfcar_batch_kernels import ANG, PX, PY
 from bushenv.rigs.halfcar_batch_layout import BODIES
 from bushenv.rigs.halfcar_batch_outputs import RESULT_KEYS
 from bushenv.rigs.halfcar_inputs import REPLAY_KEYS, replay_inputs
-from bushenv.rigs.halfcar_outputs import PIVOT_KEYS, force_reason, out_of_bounds
+from bushenv.rigs.halfcar_outputs import (
+    PIVOT_KEYS,
+    force_reason,
+    observation_values,
+    out_of_bounds,
+)
 from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS
 from bushenv.rigs.vector_base import ArrayVectorEnv
 
@@ -218,18 +223,7 @@ class HalfCarVectorEnv(ArrayVectorEnv):
 
 def observations(p: Any, info: dict[str, Any]) -> np.ndarray:
     """(N, 16) float32: ``HalfCarEnv``'s observation of every column's info."""
-    f = [np.hypot(info[f"force_{k}_axial_model_n"], info[f"force_{k}_radial_model_n"])
-         for k in POSITIONS]  # fmt: skip
-    rows = (
-        info["road_left_m"] / p.max_road, info["road_right_m"] / p.max_road,
-        info["lateral_accel_m_per_s2"] / p.max_ay, info["body_y_m"] / p.max_body,
-        info["body_vy_m_per_s"] / p.v_scale, info["body_x_m"] / p.max_body,
-        info["roll_rad"] / p.max_roll, info["roll_rate_rad_per_s"] / p.roll_rate_scale,
-        (info["wheel_load_left_n"] - p.tyre_static_n) / p.tyre_static_n,
-        (info["wheel_load_right_n"] - p.tyre_static_n) / p.tyre_static_n,
-        *(x / p.force_limit for x in f), info["error_n"] / p.force_limit,
-        info["roll_error_rad"] / p.max_roll,
-    )  # fmt: skip
+    rows = observation_values(p, info, np.hypot)
     obs = np.nan_to_num(np.stack(rows, axis=1), nan=0.0, posinf=1.0, neginf=-1.0)
     return np.clip(obs, -1.0, 1.0).astype(np.float32)
 
