@@ -2,50 +2,12 @@
 
 import numpy as np
 import pytest
+from standin import bushing, user_columns, write
 
 from bushenv.record_columns import THREE_AXES
 from bushenv.record_files import load_record, save_columns
 from bushenv.record_notes import start_notes
 from bushenv.records import RecordError
-
-
-def bushing(fs=500.0, seconds=4.0, preload=(0.0, 0.0, 0.0), rest_s=0.2):
-    """A small coupled bushing of its own (no bushenv code): 3x3 stiffness with off-diagonal
-    terms, viscous damping, a cubic radial-torsion coupling and a radial Maxwell branch,
-    driven from rest by three sines (after ``rest_s`` at rest), around ``preload``."""
-    t = np.arange(int(fs * seconds)) / fs
-    ramp = np.clip((t - rest_s) / 0.5, 0.0, 1.0)[:, None]
-    drive = np.column_stack(
-        [1.5e-3 * np.sin(2.2 * t), 1e-3 * np.sin(3.1 * t + 1.0), 0.04 * np.sin(1.7 * t + 2.0)]
-    )
-    q = ramp * (drive + np.asarray(preload))
-    v = np.gradient(q, 1.0 / fs, axis=0)
-    k = np.array([[5e5, -4e4, 600.0], [-4e4, 2e6, -1500.0], [600.0, -1500.0, 1000.0]])
-    f = q @ k.T + v * [200.0, 600.0, 0.4]
-    s = q[:, 1] ** 2 + (0.04 * q[:, 2]) ** 2
-    f[:, 1] += 2e10 * s * q[:, 1]
-    f[:, 2] += 2e10 * s * 0.04**2 * q[:, 2]
-    a, p = np.exp(-1.0 / (fs * 0.05)), 0.0
-    for i in range(t.size):  # Maxwell branch, tau 50 ms, on the radial axis
-        p = a * p + 3e5 * 0.05 * (1.0 - a) * v[i, 1]
-        f[i, 1] += p
-    return t, q, f
-
-
-def write(path, header, cols):
-    rows = [",".join(f"{x:.10g}" for x in r) for r in np.column_stack(cols)]
-    path.write_text(header + "\n" + "\n".join(rows) + "\n")
-    return path
-
-
-def user_columns(t, q, f):
-    """Grouped per axis, in ms, mm, deg, kN and N m, as a rig's own export might be."""
-    header = (
-        "time [ms],displacement_axial [mm],force_axial [kN],displacement_radial [mm],"
-        "force_radial [kN],rotation [deg],moment [N m]"
-    )
-    cols = [1e3 * t, 1e3 * q[:, 0], 1e-3 * f[:, 0], 1e3 * q[:, 1], 1e-3 * f[:, 1]]
-    return header, [*cols, np.degrees(q[:, 2]), f[:, 2]]
 
 
 def test_a_header_in_another_order_and_units_reads_as_the_si_record(tmp_path):
