@@ -89,16 +89,20 @@ def vet_reference(
     """The checks of the module doc on ``reference`` (C coordinates) within ``stroke`` with the
     verdicts' force ``floors`` (each a number for C = 1, else (C,): m or rad, N or N m);
     ``velocity``: the judged rate (one axis: the certificate's sines and the stiffness drive
-    stay within it; None: the papers' machine for one axis, no limit over C). ``card``: the
-    reference's model card (None: the card beside ``card_file``, a model file); ``model_card``
-    likewise beside ``model_file``. ``envelope``: the largest |x| and |dx/dt| the reference's
-    records cover (default: the stroke and velocity); ``builtin``: the built-in rubber (the
-    specimen itself). One-axis callers pass their ``BushingScales`` with ``of_scales``."""
+    stay within it; None: the papers' machine for one axis, no limit over C; a number for
+    C = 1, else (C,): m/s or rad/s). ``card``: the reference's model card (None: the card
+    beside ``card_file``, a model file); ``model_card`` likewise beside ``model_file``.
+    ``envelope``: the largest |q| and |dq/dt| the reference's records cover, each a number or
+    (C,) (default: the stroke and velocity; over C with no velocity, ``machine_rate`` of the
+    stroke); ``builtin``: the built-in rubber (the specimen itself). One-axis callers pass
+    their ``BushingScales`` with ``of_scales``."""
     holds, thresholds = hold_check(reference, stroke, floors)
     checks = [holds]
     if envelope is None and reference.n_coords == 1:
         v = BushingScales().velocity_m_per_s if velocity is None else velocity
         envelope = (float(np.asarray(stroke).ravel()[0]), float(np.asarray(v).ravel()[0]))
+    elif envelope is None:
+        envelope = (stroke, machine_rate(stroke) if velocity is None else velocity)
     cert = certificate_check(reference, stroke, envelope, thresholds)
     if cert is not None:
         checks.append(cert)
@@ -116,6 +120,15 @@ def vet_reference(
     checks.append(passivity_check(reference, stroke))
     checks.append(compatibility_check(reference, stroke, velocity, model, model_card, model_file))
     return Vetting(label, tuple(checks))
+
+
+def machine_rate(stroke) -> np.ndarray:
+    """The rate per coordinate of the papers' machine's rule for a stroke (m or rad): 2 pi 80 Hz
+    x a fifth of it (``excitation.MAX_VELOCITY_M_PER_S`` over ``MAX_DISPLACEMENT_M``; the
+    rule BushRig3-v0's rates follow, the rotation's included)."""
+    from bushenv import excitation as ex
+
+    return np.asarray(stroke, dtype=np.float64) * (ex.MAX_VELOCITY_M_PER_S / ex.MAX_DISPLACEMENT_M)
 
 
 def of_scales(scales: BushingScales) -> dict[str, float]:

@@ -9,6 +9,7 @@ import numpy as np
 
 from bushenv.certify.reached_holds import (
     HOLD_S,
+    boxes_of,
     confirm_holds,
     failing_holds,
     hold_entries,
@@ -23,6 +24,7 @@ CORNER = 0.6  # the corners of the stroke box held, as a fraction of the stroke
 PASSIVE_PRELOAD = 0.3  # the passivity's holds: at rest, and this fraction along each coordinate
 PASSIVE_HZ = np.geomspace(0.2, 40.0, 12)
 KINDS = ("not finite", "oscillating", "departing", "wrong sign")
+SHOWN = 3  # confirmed held vectors named in a detail
 
 
 def held_vectors(stroke) -> np.ndarray:
@@ -72,7 +74,10 @@ def hold_check(reference: BushingModel, stroke, floors) -> tuple[Check, np.ndarr
                      f"({how})"), limits  # fmt: skip
     if c > 1:
         parts = [f"{len(v)} {k} (first at {_vector(qs[v[0]], reference)})" for k, v in bad.items()]
-        return Check("holds", False, f"{span}: " + ", ".join(parts) + f" ({how})"), limits
+        flagged = qs[np.unique(np.concatenate(list(bad.values())))]
+        boxes = tuple(boxes_of(flagged, 2 * stroke / (HOLDS - 1)))
+        text = f"{span}: " + ", ".join(parts) + f" ({how})"
+        return Check("holds", False, text, boxes=boxes), limits
     xs = qs[:, 0]
     parts = [
         f"{len(v)} {k} between {xs[v].min() * 1e3:+.3g} and {xs[v].max() * 1e3:+.3g} mm"
@@ -107,9 +112,11 @@ def _how(reference: BushingModel, ths: list, limits: np.ndarray) -> str:
 
 
 def certificate_check(
-    reference: BushingModel, stroke, envelope: tuple[float, float], thresholds: np.ndarray
+    reference: BushingModel, stroke, envelope: tuple, thresholds: np.ndarray
 ) -> Check | None:
-    """Check 2 of ``bushenv.vetting``; None for a reference that is not a NARX network."""
+    """Check 2 of ``bushenv.vetting``; None for a reference that is not a NARX network.
+    ``envelope``: the largest |q| and |dq/dt| the reaching stays within (each a number or
+    (C,)); ``thresholds`` (C,): check 1's, per coordinate."""
     from bushenv.certify.network import CertifyError
 
     c = reference.n_coords
@@ -122,20 +129,64 @@ def certificate_check(
     except CertifyError:
         return None
     listed = failing_holds(entries)
-    if c > 1:
-        span = f"its certificate, over the {len(entries)} held vectors of the holds check,"
-        if not listed:
-            return Check("certificate holds", True, f"{span} lists none oscillating, "
-                         "departing or wrong-sign")  # fmt: skip
-        kinds = sorted({k for h in listed for k in h["kinds"]})
-        first = _vector(np.asarray(listed[0]["q"]), reference)
-        return Check(
-            "certificate holds", None, f"{span} lists {len(listed)} ({', '.join(kinds)}), "
-            f"first at {first}; not confirmed: a listed hold is reached after sines along one "
-            "coordinate only (certify.reached_holds.reach_profiles); judge these holds with "
-            "--trust-reference or vet the reference on one coordinate",
-        )  # fmt: skip
-    return _confirmed(reference, listed, float(stroke[0]), envelope, float(thresholds[0]))
+    if c == 1:
+        return _confirmed(reference, listed, float(stroke[0]), envelope, float(thresholds[0]))
+    return _confirmed_vectors(reference, listed, len(entries), stroke, envelope, thresholds)
+
+
+def _confirmed_vectors(reference, listed, n_held, stroke, envelope, thresholds) -> Check:
+    """The certificate check over C > 1: its listed held vectors reached as a search would."""
+    span = f"its certificate, over the {n_held} held vectors of the holds check,"
+    if not listed:
+        return Check("certificate holds", True, f"{span} lists none oscillating, "
+                     "departing or wrong-sign")  # fmt: skip
+    c = reference.n_coords
+    env = [np.broadcast_to(np.asarray(e, dtype=np.float64), (c,)) for e in envelope]
+    kinds = sorted({k for h in listed for k in h["kinds"]})
+    said = (
+        f"{span} lists {len(listed)} ({', '.join(kinds)}), first at "
+        f"{_vector(np.asarray(listed[0]['q']), reference)}"
+    )
+    confirmed, n = confirm_holds(reference, listed, env, thresholds)
+    rates = zip(env[1], reference.units, strict=True)
+    reach = (
+        f"{n} profiles reaching them after a step or sines along each coordinate and along "
+        f"each hold's direction inside its envelope (|q| <= {_vector(env[0], reference, '')}, "
+        f"|dq/dt| <= ({', '.join(f'{v:.3g} {u}/s' for v, u in rates)})); "
+        + _thresholds(reference, thresholds)
+    )
+    if not confirmed:
+        return Check("certificate holds", True, f"{said}; none confirmed by {reach}")
+    worst = max(confirmed, key=lambda h: h.ripple_n)
+    found = sorted({k for h in confirmed for k in h.kinds})
+    names = [reference.coords[i] for i in sorted({i for h in confirmed for i in h.coords})]
+    shown = "; ".join(
+        f"{_vector(np.asarray(h.q), reference)} {'/'.join(h.kinds)} on "
+        f"{', '.join(reference.coords[i] for i in h.coords)}"
+        for h in confirmed[:SHOWN]
+    )
+    more = f"; and {len(confirmed) - SHOWN} more" if len(confirmed) > SHOWN else ""
+    w = worst.worst_coord
+    text = (
+        f"{said}; {len(confirmed)} confirmed ({', '.join(found)}; on {', '.join(names)}): "
+        f"{shown}{more}; by {reach}; worst {worst.ripple_n:.4g} {reference.force_units[w]} "
+        f"p-p on {reference.coords[w]} at {_vector(np.asarray(worst.q), reference)} after "
+        f"{worst.after}"
+    )
+    # the chains of listed vectors holding a confirmed one (not every listed hold is simulated)
+    step = 2 * stroke / (HOLDS - 1)
+    qs = np.array([h["q"] for h in listed], dtype=np.float64)
+    boxes = [b for b in boxes_of(qs, step) if any(_inside(h.q, b) for h in confirmed)]
+    return Check("certificate holds", False, text, boxes=tuple(boxes))
+
+
+def _inside(q, box) -> bool:
+    return all(a <= v <= b for v, (a, b) in zip(q, box, strict=True))
+
+
+def _thresholds(reference: BushingModel, thresholds) -> str:
+    each = zip(reference.coords, thresholds, reference.force_units, strict=True)
+    return "thresholds " + ", ".join(f"{n} {t:.4g} {u}" for n, t, u in each) + " (check 1's)"
 
 
 def _confirmed(reference, listed, stroke_m, envelope, threshold) -> Check:
@@ -205,6 +256,6 @@ def _units(model: BushingModel) -> tuple[str, ...]:
     return tuple("mrad" if u == "rad" else "mm" for u in model.units)
 
 
-def _vector(q: np.ndarray, model: BushingModel) -> str:
+def _vector(q: np.ndarray, model: BushingModel, sign: str = "+") -> str:
     shown = zip(np.atleast_1d(q), _units(model), strict=True)
-    return "(" + ", ".join(f"{1e3 * v:+.3g} {u}" for v, u in shown) + ")"
+    return "(" + ", ".join(f"{1e3 * v:{sign}.3g} {u}" for v, u in shown) + ")"

@@ -91,9 +91,12 @@ def judge_holds(f: np.ndarray, q: np.ndarray, n_hold: int, threshold, dt: float)
     """Flags (B,) per kind for forces (T, B), or (T, B, C) over C coordinates, whose last
     ``n_hold`` samples hold ``q`` (B,) or (B, C), each coordinate against its ``threshold``
     (a number, or (C,)): {"not finite", "oscillating", "departing", "wrong sign"}, and
-    "ripple_n" (B,), the largest coordinate's. Wrong sign: the work ``q . f`` of the tail's mean
-    below ``-sum(threshold |q|)`` (one coordinate: the mean opposes x by more than the
-    threshold); a coupled bushing may push sideways, never back into the deflection it holds."""
+    "ripple_n" (B,), the largest coordinate's ("worst_coordinate" (B,) which), and
+    "coordinates" (B, C), those that show any kind (wrong sign there: the tail's mean
+    opposing that coordinate's deflection by more than its threshold). Wrong sign: the work
+    ``q . f`` of the tail's mean below ``-sum(threshold |q|)`` (one coordinate: the mean
+    opposes x by more than the threshold); a coupled bushing may push sideways, never back
+    into the deflection it holds."""
     g3 = f.reshape(f.shape[0], f.shape[1], -1)
     c = g3.shape[2]
     q2 = np.asarray(q, dtype=np.float64).reshape(-1, c)
@@ -107,17 +110,22 @@ def judge_holds(f: np.ndarray, q: np.ndarray, n_hold: int, threshold, dt: float)
     grows = np.abs(f1) - np.abs(f0) > np.maximum(th, DEPART_FRACTION * np.abs(f0))
     flips = (np.abs(f0) > th) & (np.abs(f1) > th) & (np.sign(f0) != np.sign(f1))
     work = np.sum(q2 * tail.mean(axis=0), axis=1)
+    opposes = q2 * tail.mean(axis=0) < -th * np.abs(q2)
+    shows = ~np.all(np.isfinite(g3), axis=0) | (ripple > th) | grows | flips | opposes
     return {
         "not finite": ~finite,
         "oscillating": finite & np.any(ripple > th, axis=1),
         "departing": finite & np.any(grows | flips, axis=1),
         "wrong sign": finite & (work < -np.sum(th * np.abs(q2), axis=1)),
         "ripple_n": np.where(finite, ripple.max(axis=1), np.inf),
+        "coordinates": shows,
+        "worst_coordinate": np.argmax(ripple, axis=1),
     }
 
 
 def excitations(x_env_m: float, v_env_m_per_s: float, dt: float) -> list[tuple[float, float]]:
-    """(amplitude m, frequency Hz) of the sines inside the envelope (see the module doc)."""
+    """(amplitude, frequency Hz) of the sines inside one coordinate's envelope (see the module
+    doc): |x| <= ``x_env_m`` and |dx/dt| <= ``v_env_m_per_s`` (m and m/s, or rad and rad/s)."""
     out = []
     for frac in AMPLITUDE_FRACTIONS:
         a = frac * x_env_m
@@ -132,63 +140,127 @@ def _move(x0: float, x1: float, speed: float, dt: float) -> np.ndarray:
     return np.linspace(x0, x1, n + 1)[1:]
 
 
+def _move_to(q: np.ndarray, speed: np.ndarray, dt: float) -> np.ndarray:
+    """(n, C) from rest to ``q``, each coordinate at its own ``speed`` (then held there)."""
+    moves = [_move(0.0, float(x), float(s), dt) for x, s in zip(q, speed, strict=True)]
+    n = max(m.size for m in moves)
+    return np.stack([np.r_[m, np.full(n - m.size, m[-1])] for m in moves], axis=1)
+
+
+def _sine(a, f: float, dt: float) -> np.ndarray:
+    """(n, C) two cycles at least of amplitude ``a`` (C,) at ``f``, ending at rest."""
+    cycles = max(2, int(np.ceil(SINE_S * f)))
+    t = np.arange(int(round(cycles / (f * dt))) + 1) * dt
+    sine = np.outer(np.sin(2 * np.pi * f * t), a) if np.ndim(a) else a * np.sin(2 * np.pi * f * t)
+    sine[-1] = 0.0
+    return sine.reshape(t.size, -1)
+
+
+def _label(a: float, unit: str) -> str:
+    return f"{a * 1e3:.3g} {'mrad' if unit == 'rad' else 'mm'}"
+
+
 def reach_profiles(
-    x_m: float, x_env_m: float, v_env_m_per_s: float, hold_s: float, dt: float
+    q, x_env, v_env, hold_s: float, dt: float, coords=None, units=None
 ) -> tuple[list[np.ndarray], list[str]]:
-    """Profiles that reach the hold ``x_m`` (each ends with ``hold_s`` at ``x_m``), and how."""
+    """Profiles that reach the hold ``q`` (each ends with ``hold_s`` at ``q``), and how: a
+    step, every coordinate at its own velocity limit; from rest, sines inside the envelope
+    (|q_i| <= ``x_env``, |dq_i/dt| <= ``v_env``, each a number or (C,)) along each
+    coordinate, and for a hold off the coordinate axes along its own direction (scaled to
+    touch the envelope's box), each then a move to the hold at the sine's peak speed as a
+    fraction of each coordinate's limit. A number ``q`` (one coordinate) gives (T,) profiles,
+    a (C,) vector (T, C); ``coords``, ``units`` name the coordinates in ``how``."""
+    one = np.ndim(q) == 0
+    q = np.atleast_1d(np.asarray(q, dtype=np.float64))
+    c = q.size
+    x_env = np.broadcast_to(np.asarray(x_env, dtype=np.float64), (c,))
+    v_env = np.broadcast_to(np.asarray(v_env, dtype=np.float64), (c,))
+    coords = coords or ("",) * c
+    units = units or ("m",) * c
     n_hold = int(round(hold_s / dt))
-    pre = np.zeros(max(1, int(round(PRE_S / dt))))
-    profiles = [np.r_[pre, _move(0.0, x_m, v_env_m_per_s, dt), np.full(n_hold, x_m)]]
-    how = ["a step at the velocity limit"]
-    for a, f in excitations(x_env_m, v_env_m_per_s, dt):
-        cycles = max(2, int(np.ceil(SINE_S * f)))
-        t = np.arange(int(round(cycles / (f * dt))) + 1) * dt
-        sine = a * np.sin(2 * np.pi * f * t)
-        sine[-1] = 0.0
-        move = _move(0.0, x_m, min(2 * np.pi * f * a, v_env_m_per_s), dt)
-        profiles.append(np.r_[pre, sine, move, np.full(n_hold, x_m)])
-        how.append(f"a {a * 1e3:.3g} mm {f:g} Hz sine")
+    pre = np.zeros((max(1, int(round(PRE_S / dt))), c))
+    held = np.repeat(q[None], n_hold, axis=0)
+    profiles = [np.concatenate([pre, _move_to(q, v_env, dt), held])]
+    how = ["a step at the velocity limit" if c == 1 else
+           "a step, each coordinate at its velocity limit"]  # fmt: skip
+    for j in range(c):
+        for a, f in excitations(x_env[j], v_env[j], dt):
+            path = np.zeros((_sine(a, f, dt).shape[0], c))
+            path[:, j] = _sine(a, f, dt)[:, 0]
+            speed = v_env * (2 * np.pi * f * a / v_env[j])
+            speed[j] = min(2 * np.pi * f * a, v_env[j])
+            move = _move_to(q, np.minimum(speed, v_env), dt)
+            profiles.append(np.concatenate([pre, path, move, held]))
+            along = "" if c == 1 else f" along {coords[j]}"
+            how.append(f"a {_label(a, units[j])} {f:g} Hz sine{along}")
+    if np.count_nonzero(q) >= 2:  # off the axes: along its own direction too
+        e = q / np.max(np.abs(q) / x_env)
+        for frac in AMPLITUDE_FRACTIONS:
+            for f in FREQUENCIES_HZ:
+                r = float(np.max(2 * np.pi * f * frac * np.abs(e) / v_env))
+                if r > 1 + 1e-9 or f > 0.25 / dt:
+                    continue
+                move = _move_to(q, np.minimum(r * v_env, v_env), dt)
+                profiles.append(np.concatenate([pre, _sine(frac * e, f, dt), move, held]))
+                how.append(f"a {f:g} Hz sine along the hold's direction, {frac:g} x the envelope")
+    if one:
+        profiles = [p[:, 0] for p in profiles]
     return profiles, how
 
 
 @dataclass(frozen=True)
 class Confirmed:
-    """A listed hold the simulation confirms: where, as what, how large, after what."""
+    """A listed hold the simulation confirms: where (``q``, (C,)), as what, how large (the
+    worst coordinate's ripple, in its force unit), on which coordinates, after what."""
 
-    x_m: float
+    q: tuple[float, ...]
     kinds: tuple[str, ...]
     ripple_n: float
     after: str
+    coords: tuple[int, ...] = (0,)  # the coordinates that show it
+    worst_coord: int = 0  # the coordinate of ``ripple_n``
+
+    @property
+    def x_m(self) -> float:
+        """The held deflection of a one-coordinate hold, m."""
+        return self.q[0]
+
+
+def _held(h: dict) -> np.ndarray:
+    return np.atleast_1d(np.asarray(h["x_m"] if "x_m" in h else h["q"], dtype=np.float64))
 
 
 def confirm_holds(
     model,
     listed: list[dict],
-    envelope: tuple[float, float],
-    threshold: float,
+    envelope: tuple,
+    threshold,
 ) -> tuple[list[Confirmed], int]:
-    """The ``listed`` holds ([{"x_m", "departure_s"?}]) each simulated after every
-    ``reach_profiles`` history inside ``envelope`` (|x|, |dx/dt| limits); the confirmed ones
-    (any history shows a kind of the module doc) and the number of profiles simulated."""
+    """The ``listed`` holds ([{"x_m" or "q", "departure_s"?}]) each simulated after every
+    ``reach_profiles`` history inside ``envelope`` (the |q| and |dq/dt| limits, each a number
+    or (C,)), judged per coordinate against ``threshold`` (a number or (C,)); the confirmed
+    ones (any history shows a kind of the module doc) and the number of profiles simulated."""
     if not listed:
         return [], 0
     if len(listed) > MAX_LISTED:
         keep = np.unique(np.linspace(0, len(listed) - 1, MAX_LISTED).round().astype(int))
         listed = [listed[i] for i in keep]
-    dt = model.dt
+    dt, c = model.dt, model.n_coords
     later = [h.get("departure_s") or 0.0 for h in listed]
     hold_s = float(min(MAX_HOLD_S, max(HOLD_S, max(later) + TAIL_S)))
     n_hold = int(round(hold_s / dt))
+    names = (model.coords, model.units)
     profiles, owner, how = [], [], []
     for i, h in enumerate(listed):
-        p, w = reach_profiles(h["x_m"], envelope[0], envelope[1], hold_s, dt)
+        p, w = reach_profiles(_held(h), envelope[0], envelope[1], hold_s, dt, *names)
         profiles += p
         owner += [i] * len(p)
         how += w
-    T = max(p.size for p in profiles)
-    x = np.zeros((T, len(profiles)))
+    T = max(p.shape[0] for p in profiles)
+    x = np.zeros((T, len(profiles), c))
     for b, p in enumerate(profiles):  # left-padded with rest: every hold ends the profile
-        x[T - p.size :, b] = p
+        x[T - p.shape[0] :, b] = p
+    x = x[..., 0] if c == 1 else x
     try:
         f = model.copy().simulate(x)
     except Exception:  # a model that cannot run its holds: every one confirmed, not finite
@@ -204,7 +276,11 @@ def confirm_holds(
             continue
         hit = cols[np.any(np.stack([flags[k][cols] for k in kinds]), axis=0)]
         worst = int(hit[np.argmax(flags["ripple_n"][hit])])
-        out.append(Confirmed(h["x_m"], found, float(flags["ripple_n"][worst]), how[worst]))
+        shows = np.flatnonzero(flags["coordinates"][hit].any(axis=0))
+        out.append(Confirmed(
+            tuple(_held(h).tolist()), found, float(flags["ripple_n"][worst]), how[worst],
+            tuple(int(k) for k in shows), int(flags["worst_coordinate"][worst]),
+        ))  # fmt: skip
     return out, len(profiles)
 
 
@@ -217,6 +293,28 @@ def ranges_of(x_m: list[float], step_m: float) -> list[tuple[float, float]]:
             out[-1] = (out[-1][0], v)
         else:
             out.append((v, v))
+    return out
+
+
+def boxes_of(q: np.ndarray, step) -> list[tuple[tuple[float, float], ...]]:
+    """Boxes about held vectors ``q`` (M, C): the vectors chained by neighbours at most 1.5
+    ``step`` (a number or (C,)) apart on every coordinate, each chain's per-coordinate (lo, hi)
+    widened by one ``step`` (the holds were seen, not what lies between them); in the order
+    of each chain's first vector."""
+    q = np.asarray(q, dtype=np.float64).reshape(len(q), -1)
+    step = np.broadcast_to(np.asarray(step, dtype=np.float64), (q.shape[1],))
+    near = np.all(np.abs(q[:, None] - q[None]) <= 1.5 * step, axis=2)
+    group = np.arange(len(q))
+    for _ in range(len(q)):  # join each vector to its neighbours' lowest label until settled
+        new = np.array([group[near[i]].min() for i in range(len(q))])
+        if np.array_equal(new, group):
+            break
+        group = new
+    out = []
+    for g in dict.fromkeys(group.tolist()):
+        members = q[group == g]
+        lo, hi = members.min(axis=0) - step, members.max(axis=0) + step
+        out.append(tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True)))
     return out
 
 

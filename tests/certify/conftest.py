@@ -217,3 +217,25 @@ def scalar_roots(c):
             a, b = (m, b) if np.sign(g(m)) == np.sign(g(a)) else (a, m)
         roots.append(0.5 * (a + b))
     return np.array(roots)
+
+
+def ringing3(g=1.004, beta=0.25, ring_m=-1.25e-3, f_scale_n=3000.0):
+    """``ringing_hybrid``'s ring on the radial coordinate of a three-axis hybrid (Table-1-like
+    diagonal backbone): the radial residual y_t = tanh(-g y_{t-1} + beta (qs_t + qs_{t-1}) / 2),
+    qs = (radial - ``ring_m``) / 1 mm, rings at the Nyquist rate when held within about
+    +-0.3 mm of ``ring_m`` after a sine or a step, barely after a slow ramp; the axial and
+    rotation residuals are zero. F = 0 at rest."""
+    from bushenv.models.planar_narx import N_IN, PlanarHybrid
+
+    y = 0.0
+    for _ in range(5000):  # the radial residual's fixed point at rest, by damped iteration
+        y = 0.5 * y + 0.5 * np.tanh(-g * y + beta * (0.0 - ring_m) / X_SCALE_M)
+    w1, w_out = np.zeros((3, N_IN)), np.zeros((3, 3))
+    w1[1, [1, 4, 19]] = beta / 2, beta / 2, -g  # radial lags 0, 1; its own output, lag 1
+    w_out[1, 1] = 1.0
+    return PlanarHybrid(
+        k_matrix=np.diag([3.8e5, 3.8e5, 3.0e3]), c_matrix=np.diag([500.0, 500.0, 5.0]),
+        q_offset=np.array([0.0, ring_m, 0.0]), q_scale=np.array([X_SCALE_M, X_SCALE_M, 0.01]),
+        f_offset=np.array([0.0, -f_scale_n * y, 0.0]), f_scale=np.array([1.0, f_scale_n, 1.0]),
+        w1=w1, b1=np.zeros(3), w_out=w_out, b_out=np.zeros(3),
+    )  # fmt: skip
