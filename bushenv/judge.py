@@ -70,6 +70,7 @@ class ScaleFlags:
     max_velocity_m_per_s: float | None = None
     force_floor_n: float | None = None
     force_scale_n: float | None = None
+    rotation_mrad: float | None = None  # a three-axis bushing's rotation range (+-mrad)
 
     def given(self) -> dict[str, float]:
         values = {
@@ -174,8 +175,9 @@ def check_reference_needed(spec: Any, target: Any) -> None:
     """Refuse to judge without a reference where ``target`` cannot (``JudgeError``)."""
     if spec is None and not target.reference_free:
         raise JudgeError(
-            f"the {target.name} target needs a reference (its twin runs on it); pass "
-            "--reference NAME|FILE"
+            f"the {target.name} target judges against a reference and none was given: pass "
+            f"--reference NAME|FILE (a model of your bushing, or {BUILTIN_REFERENCE}, the "
+            "built-in)"
         )
 
 
@@ -210,7 +212,8 @@ def criteria_of(
         run, why = list(CRITERIA), "all, against the reference"
     if "static" in run and not getattr(target, "judges_static", True):
         run.remove("static")
-        why += f"; static is judged on the rig only (the {target.name} has no hold)"
+        why += (f"; static is judged on the one-axis rig only (the {target.name} compares no "
+                "held force with a static curve of its reference)")  # fmt: skip
     elif "static" in run and not static:
         run.remove("static")
         why += (

@@ -113,9 +113,13 @@ def test_the_attack_refuses_a_reference_that_fails_its_vetting_unless_trusted(tm
     assert not (tmp_path / "a" / "report.json").exists()
     assert main(argv + ["--out", str(tmp_path / "b"), "--trust-reference"]) == 0
     report = json.loads((tmp_path / "b" / "report.json").read_text())
-    assert report["judge"]["trusted_despite_failed_vetting"] is True
+    assert report["judge"]["trusted_by_flag"] is True
+    assert report["judged"]["trusted_despite_failed_vetting"] is True
     assert report["judge"]["vetting"]["passed"] is False
-    assert "FAILED ITS VETTING" in (tmp_path / "b" / "report.md").read_text()
+    assert (
+        "FAILED (--trust-reference: verdicts UNVETTED)"
+        in (tmp_path / "b" / "report.md").read_text()
+    )
 
 
 def test_a_coordinate_held_at_rest_whose_force_is_noise_is_not_judged_by_a_ratio(tmp_path):

@@ -1,8 +1,11 @@
 """``bushenv attack``: the command; argparse in, a ``CampaignConfig`` out, the table printed.
 
-    bushenv attack --model nn --budget 256 [--axis axial] [--env rig|quartercar]
-    bushenv attack --env rig3 --model PLANAR.npz|linear   (planar: ``campaign_planar.py``)
+    bushenv attack --model nn --budget 256 [--axis axial] [--env rig|quartercar|rig3]
                    [--searchers random,cma,ppo,sac] [--seed S] [--out DIR] [--save]
+
+One attack for a bushing of any number of coordinates: ``--env rig3`` searches a three-axis
+model (a three-axis .npz file, or a registered kind with a three-axis preset) in the limits of
+the user's card, with the same stages, report and resume as one axis.
 
 Outputs in ``DIR`` (default ``runs/attack``): ``report.json`` (see ``campaign_report.py``),
 ``plots/*.png``, ``failures/*.npz`` (the profiles each search found), ``cases/*.json`` (the
@@ -32,8 +35,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--model",
         default=d.model,
         help="model under attack: name or .npz file (default: nn-paper, the papers' NARX "
-        "network as seed 000 trained it; nn is the certified one; with --env rig3 a planar "
-        "model: a PLANAR_MODELS name with a preset or a planar .npz file)",
+        "network as seed 000 trained it; nn is the certified one; with --env rig3 a three-axis "
+        "model: a registered kind with a three-axis preset or a three-axis .npz file)",
     )
     p.add_argument("--budget", type=int, default=d.budget, help="model evaluations per search")
     p.add_argument("--rl-budget", type=int, default=d.rl_budget, help="cap on RL episodes")
@@ -165,22 +168,15 @@ def run(args: argparse.Namespace) -> int:
             f"--rotation-mrad is the rotation's range of a three-axis bushing; --env {args.env} "
             "has no rotation (add --env rig3, or drop it)"
         )
-    if TARGETS[args.env].coords:  # planar profiles: the planar attack
-        from bushenv.search.campaign_planar import format_planar_table, run_planar_attack
-
-        planar = run_planar_attack(config_from(args), progress)
-        print(format_planar_table(planar.report))
-        print(f"\nreport: {planar.report_path}  ({planar.report['seconds']:.1f} s in total)")
-        if planar.control_flagged:
-            progress.say(f"WARNING: the control ({planar.report['control']['label']}) was flagged")
-        return 0
     attacked = run_attack(config_from(args), progress)
     report = attacked.report
     print(format_table(report, attacked.target_key))
     print(f"\nreport: {attacked.report_path}  ({report['seconds']:.1f} s in total)")
     if attacked.control_flagged:
+        control = report.get("control") or {}
         progress.say(
-            f"WARNING: the control ({attacked.control_key}) was flagged: the divergence criteria "
-            "or the coupling are at fault, not only the model under attack"
+            f"WARNING: the control ({control.get('label', attacked.control_key)}) was flagged: "
+            "the divergence criteria or the coupling are at fault, not only the model under "
+            "attack"
         )
     return 0

@@ -111,6 +111,17 @@ class ModelEntry:
     def options_class(self, coords: int = 1) -> Any:
         return self.form(coords).options_class()
 
+    def ready_made(self, coords: int = 1) -> bool:
+        """Whether this kind over ``coords`` coordinates is there without a file of the user's
+        (a shipped model or a preset; a network over several must be trained first)."""
+        if coords not in self.coordinate_counts():
+            return False
+        if coords == 1 and self.shipped:
+            return True
+        from bushenv.models import has_preset
+
+        return has_preset(self.model_class(coords))
+
     def fits(self, coords: int = 1) -> bool:
         """Whether this kind can be identified from records over ``coords`` coordinates."""
         return coords in self.coordinate_counts() and self.form(coords).fit is not None

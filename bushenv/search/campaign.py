@@ -31,6 +31,7 @@ from bushenv.progress import Progress
 from bushenv.search.campaign_cases import Shrunk, shrink_failures
 from bushenv.search.campaign_config import CampaignConfig, CampaignError
 from bushenv.search.campaign_holds import hold_stage
+from bushenv.search.campaign_limits import failure_reach
 from bushenv.search.campaign_plots import plot_campaign
 from bushenv.search.campaign_recheck import Rechecked, recheck
 from bushenv.search.campaign_report import (
@@ -114,8 +115,9 @@ def run_attack(config: CampaignConfig, progress: Progress | None = None) -> Atta
     progress.total = work_units(resolved, c)
     for note in resolved.notes:
         progress.say(f"note: {note}")
+    where = c.axis if not resolved.target.coords else ", ".join(resolved.target.coords)
     progress.say(
-        f"attack: {c.model} ({c.axis}, {c.target}), searchers {','.join(c.searchers)}, "
+        f"attack: {c.model} ({where}; {c.target}), searchers {','.join(c.searchers)}, "
         f"budget {c.budget} (RL {min(c.budget, c.rl_budget)} episodes), seed {c.seed} "
         f"-> {c.out}"
     )
@@ -140,6 +142,9 @@ def run_attack(config: CampaignConfig, progress: Progress | None = None) -> Atta
     else:
         rechecked = recheck(resolved, searched, threads, progress)
         report.data["recheck"] = rechecked.to_json()
+        reach = failure_reach(searched.failures(target)[0], resolved.limits)
+        if reach is not None:
+            report.data["failure_reach"] = reach
         report.save()
 
     others = [k for k in resolved.models if resolved.roles[k] in ("hybrid", "control")]

@@ -16,6 +16,7 @@ import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.progress import Progress
+from bushenv.scales import MACHINE, BushingScales
 from bushenv.search.campaign_config import CampaignConfig
 from bushenv.search.campaign_recheck import Rechecked
 from bushenv.search.campaign_resolve import Resolved
@@ -78,17 +79,19 @@ def _case(resolved: Resolved, config: CampaignConfig, profile, family, params, f
           **extra) -> Case:  # fmt: skip
     """``profile`` judged on every model of the campaign, as a corpus case."""
     judge = resolved.judge
+    # a case's scales are one coordinate's (over several the reference's floors judge each)
+    scales = judge.scales if isinstance(judge.scales, BushingScales) else MACHINE
     return make_case(
         profile,
         env=config.target,
-        axis=config.axis,
+        axis=resolved.case_axis,
         family=family,
         params=params,
         found_by=found_by,
         models={m.spec: m.model for m in resolved.models.values()},
         reference=judge.reference,
         reference_spec=judge.reference_spec,
-        scales=judge.scales,
+        scales=scales,
         static=judge.static,
         judge=judge.describe(),
         shas={m.spec: m.sha256 for m in resolved.models.values()},
@@ -120,6 +123,14 @@ class _Keeper:
             return
         say(f"corpus: added {saved}")
         self.added.append(str(saved))
+
+
+def _moving(resolved: Resolved, profile: np.ndarray) -> list[str] | None:
+    """The coordinates a profile over several moves (None over one)."""
+    coords = resolved.target.coords
+    if not coords:
+        return None
+    return [a for i, a in enumerate(coords) if np.any(profile[:, i] != 0.0)]
 
 
 def _shrunk_case(
@@ -155,9 +166,15 @@ def _shrunk_case(
         "model_sha256": model.sha256,
         "campaign_budget": c.budget,
     }
+    moving = _moving(resolved, res.profile)
+    notes = (
+        ""
+        if moving is None
+        else f"moving: {', '.join(moving)}; failed in {res.verdict.get('axis')}"
+    )
     case = _case(
         resolved, c, res.profile, meta["family"], meta.get("params"), found_by,
-        shrink=res.summary(),
+        shrink=res.summary(), notes=notes,
     )  # fmt: skip
     path = save_case(case, out / "cases", force=True)
     say(
@@ -165,9 +182,11 @@ def _shrunk_case(
         f"(segments, samples, peak um) in {res.evaluations} evaluations: {_verdicts(case)}"
     )
     keeper.keep(case, model.spec)
+    extra = {} if moving is None else {"axis": res.verdict.get("axis"), "moving": moving}
     return {
         "failed_model": key,
         "family": meta["family"],
+        **extra,
         "searcher": meta.get("searcher"),
         "shrink": res.summary(),
         "verdicts": case.expect,

@@ -66,7 +66,11 @@ class CampaignConfig:
     def flags(self) -> ScaleFlags:
         """The bushing's limits given on the command line."""
         return ScaleFlags(
-            self.stroke_mm, self.max_velocity_m_per_s, self.force_floor_n, self.force_scale_n
+            self.stroke_mm,
+            self.max_velocity_m_per_s,
+            self.force_floor_n,
+            self.force_scale_n,
+            self.rotation_mrad,
         )
 
     def budget_of(self, searcher: str) -> int:
@@ -90,4 +94,9 @@ class CampaignConfig:
             "max_shrink": self.max_shrink,
             "shrink_budget": self.shrink_budget,
             "trust_reference": self.trust_reference,
+            "stroke_mm": self.stroke_mm,
+            "max_velocity_m_per_s": self.max_velocity_m_per_s,
+            "rotation_mrad": self.rotation_mrad,
+            "force_floor_n": self.force_floor_n,
+            "force_scale_n": self.force_scale_n,
         }

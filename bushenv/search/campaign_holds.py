@@ -43,6 +43,7 @@ NAME = "cert-holds"
 HOLD_PROFILE_S = 10.0
 MAX_HOLDS = 64
 KINDS = ("oscillates", "departs", "wrong_sign")
+FAMILY = "step_hold3"  # the stage's profiles over several coordinates, as coverage names them
 GRID_POINTS = 5  # per coordinate over C > 1: 125 held vectors over three, rest among them
 VECTOR_KINDS = ("several_fixed_points", "no_stable_fixed_point", "pushes_into_the_deflection")
 
@@ -162,12 +163,22 @@ def hold_stage(
         progress.say(f"[{key}] {NAME}: done earlier (resumed)")
         return HoldStage()
     model = resolved.models[key].model
-    holds = listed_holds(model, resolved.judge.reference, resolved.judge.scales.stroke_m)
+    limits = resolved.limits
+    if limits is None:  # one coordinate: the holds its certificate lists
+        holds = listed_holds(model, resolved.judge.reference, resolved.judge.scales.stroke_m)
+        stage, extra = CertificateHolds(holds or []), {}
+    else:  # several: the suspect held vectors over the limits, each reached within its rate
+        floors = np.array(list(resolved.judged["force_floors"].values()))
+        holds = listed_vectors(model, limits.stroke, floors)
+        stage, extra = (
+            CertificateHolds(holds or [], limits.rate, FAMILY),
+            {"grid_points": GRID_POINTS},
+        )
     if holds is None:
         return HoldStage(entry={"run": False, "why": "not a NARX network (no certificate)"})
     if not holds:
         progress.say(f"[{key}] {NAME}: the certificate lists none")
-        return HoldStage(entry={"run": True, "listed": 0, "confirmed": 0, "holds": []})
-    stage = CertificateHolds(holds)
+        return HoldStage(entry=stage.entry(**extra))
+    progress.total += len(holds)
     summary = search_one(resolved, key, NAME, config, threads, progress, stage, len(holds))
-    return HoldStage(summary, stage.entry())
+    return HoldStage(summary, stage.entry(**extra))

@@ -21,16 +21,25 @@ from bushenv.search.campaign_config import CampaignConfig
 FITTED_CONTROL = "linear-fit"  # the control's spec while it is fitted; its file once saved
 
 
-def roles(config: CampaignConfig, judge: Judge, notes: list[str]) -> list[tuple[str, str]]:
+def roles(
+    config: CampaignConfig, judge: Judge, notes: list[str], coords: int = 1
+) -> list[tuple[str, str]]:
     """(role, spec) for the target, the hybrid (when there is one), the control and, for a
-    target whose registry entry names them, the models rechecked beside it (``also``)."""
+    target whose registry entry names them, the models rechecked beside it (``also``); over
+    ``coords`` coordinates, of the built-in's models only those there without a file."""
     builtin = judge.builtin
     entry = MODELS.get(config.model) if config.model in MODELS else None
     out = [("target", config.model)]
+    shipped_hybrid = (entry and entry.hybrid) or "hybrid"
     if config.hybrid is not None:
         out.append(("hybrid", config.hybrid))
+    elif builtin and MODELS[shipped_hybrid].ready_made(coords):
+        out.append(("hybrid", shipped_hybrid))
     elif builtin:
-        out.append(("hybrid", (entry and entry.hybrid) or "hybrid"))
+        notes.append(
+            f"no hybrid row: no {shipped_hybrid} over {coords} coordinates ships with bushenv "
+            "(a network must be trained: give yours with --hybrid FILE)"
+        )
     else:
         notes.append(
             "no hybrid row: the shipped hybrid is a model of the built-in rubber, not of this "
@@ -43,7 +52,7 @@ def roles(config: CampaignConfig, judge: Judge, notes: list[str]) -> list[tuple[
     elif judge.reference is not None:
         notes.append(
             "control: a linear model fitted by least squares to the reference's response to "
-            "the records of its model card (without a card: a "
+            "the records of its model card (without a card: the model's card's, else a "
             f"{CONTROL_RECORD_S:.0f} s random record within the bushing's stroke)"
         )
         out.append(("control", FITTED_CONTROL))
@@ -53,7 +62,7 @@ def roles(config: CampaignConfig, judge: Judge, notes: list[str]) -> list[tuple[
             "to (give --reference, or --control FILE)"
         )
     if builtin and entry is not None:
-        out += [("also", name) for name in entry.also]
+        out += [("also", name) for name in entry.also if MODELS[name].ready_made(coords)]
     return out
 
 

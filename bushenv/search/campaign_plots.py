@@ -129,6 +129,14 @@ def plot_campaign(
 
     plot_dir = out / "plots"
     plot_dir.mkdir(parents=True, exist_ok=True)
+    if resolved.target.coords:  # a row per coordinate: the shrunk failures on the target
+        model = resolved.models[resolved.target_key].model
+        shown = [
+            (f"{e['family']}, failed in {e.get('axis')}", load_case(out / e["case_file"]).profile)
+            for e in shrunk.entries
+        ]
+        paths = plot_shrunk_coordinates(model, resolved.judge.reference, shown, plot_dir)
+        return [q.name for q in paths]
     worst = plot_worst(resolved, searched, threads, plt, plot_dir)
     return worst + plot_shrunk(resolved, shrunk, out, threads, plt, plot_dir)
 

@@ -3,6 +3,7 @@ the target (the hybrid and the control must say whether they fail where it faile
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -61,6 +62,10 @@ def _recheck_one(
     entry["diverged"] = int(v.diverged.sum())
     entry["worst_robustness"] = float(np.min(v.robustness))
     entry["worst_deviation"] = float(np.max(v.worst_deviation))
+    first_axis = getattr(v, "first_axis", None)  # over several coordinates: which failed
+    if first_axis is not None:
+        failed = [str(a) for a, d in zip(first_axis, v.diverged, strict=True) if d]
+        entry["by_axis"] = dict(Counter(failed).most_common())
     for b in np.flatnonzero(v.diverged)[:SHOWN_FAILURES]:
         entry["failures"].append(
             {

@@ -9,8 +9,16 @@
      "models": {key: {"role", "spec", "class", "file", "sha256", "params_sha256",
                       "searchers": {name: SearchResult.summary() + first_failure, worst,
                                     profiles_file}}},
+     "control": {"label", "how", "spec", "file"} (how the control was made; null: none),
      "recheck": {"profiles": n, key: {"diverged", "failures", ...}},
      "shrunk": [...], "corpus": [...], "complete": bool, "seconds": float}
+
+Over C > 1 coordinates the same layout: ``scales`` are the limits searched, per coordinate with
+its unit in the key (``search.limits.Rig3Limits.to_json``); ``judged`` the force floors per
+coordinate and the stroke the reference was vetted within; each search's ``coverage`` is per
+family and coordinate and its ``failures`` tallied by family, coordinate and criterion; the
+recheck counts failures ``by_axis``; ``failure_reach`` says how far beyond the records' peak the
+failures sit; a shrunk failure names the coordinates it ``moving`` and the one that failed.
 """
 
 from __future__ import annotations
@@ -20,6 +28,8 @@ import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from bushenv.errors import BadInput
 from bushenv.models import params_sha
@@ -71,6 +81,8 @@ def fresh_report(resolved: Resolved, config: CampaignConfig) -> dict[str, Any]:
             key: {"role": resolved.roles[key], **model_identity(m), "searchers": {}}
             for key, m in resolved.models.items()
         },
+        "control": None if resolved.control is None else dict(resolved.control),
+        **({} if resolved.judged is None else {"judged": dict(resolved.judged)}),
         "recheck": {},
         "shrunk": [],
         "corpus": [],
@@ -96,10 +108,13 @@ def resumed_report(path: Path, fresh: dict[str, Any]) -> dict[str, Any]:
         ) from None
     if not isinstance(old, dict) or old.get("format") != REPORT_FORMAT:
         raise ReportError(f"{path}: not a bushenv attack report")
-    if old.get("arguments") != fresh["arguments"] or old.get("searchers") != fresh["searchers"]:
+    was = {**(old.get("arguments") or {}), "searchers": old.get("searchers")}
+    now = {**fresh["arguments"], "searchers": fresh["searchers"]}
+    differ = [k for k in now if was.get(k) != now[k]]
+    if differ:
+        k = differ[0]
         raise ReportError(
-            f"{path} was made with other arguments ({old.get('arguments')}, searchers "
-            f"{old.get('searchers')}); use another --out or --force"
+            f"{path} was made with {k}={was.get(k)!r}, not {now[k]!r}; use another --out or --force"
         )
     for key, entry in old.get("models", {}).items():
         if key in fresh["models"]:
@@ -111,6 +126,9 @@ def resumed_report(path: Path, fresh: dict[str, Any]) -> dict[str, Any]:
             fresh["models"][key]["searchers"] = entry.get("searchers", {})
     for key in ("recheck", "shrunk", "corpus"):
         fresh[key] = old.get(key, fresh[key])
+    for key in ("hold_stage", "failure_reach"):  # written by the stage that makes them
+        if key in old:
+            fresh[key] = old[key]
     fresh["seconds"] = old.get("seconds", 0.0)
     return fresh
 
@@ -266,6 +284,7 @@ def format_table(report: dict[str, Any], target_key: str, legend: bool = True) -
         f"reference: {ref if ref is not None else 'none'}; criteria run: "
         f"{', '.join(report['criteria']['run'])}",
         *_judge_lines(report.get("judge")),
+        *_limits_lines(report),
         *(f"note: {n}" for n in report.get("notes", [])),
         "",
         head,
@@ -276,12 +295,14 @@ def format_table(report: dict[str, Any], target_key: str, legend: bool = True) -
             lines.append(_search_row(key, entry["role"], name, s))
     lines += _hold_stage_lines(report.get("hold_stage"))
     lines += _coverage_lines(report, target_key)
+    lines += _reach_lines(report)
     rc = report.get("recheck", {})
     if rc:
         lines += ["", f"recheck on the {rc.get('profiles', 0)} profiles that broke {target_key}:"]
         roles = {k: e.get("role", "") for k, e in report["models"].items()}
         lines += [
             f"  {k:<12} {roles.get(k, ''):<8} diverged on {e['diverged']}"
+            + (f" (by coordinate {json.dumps(e['by_axis'])})" if e.get("by_axis") else "")
             for k, e in rc.items()
             if k != "profiles"
         ]
@@ -292,9 +313,12 @@ def format_table(report: dict[str, Any], target_key: str, legend: bool = True) -
                 lines.append(f"  the papers' 4 mm step held 10 s: {_verdicts(e['verdicts'])}")
                 continue
             fin = e["shrink"]["final"]
+            where = ""
+            if "moving" in e:
+                where = f"moving {', '.join(e['moving'])}, failed in {e['axis']}; "
             lines.append(
                 f"  {e['failed_model']}/{e['family']:<11} -> {fin['segments']} seg, "
-                f"{fin['samples']} samples, {fin['peak_um'] / 1e3:.2f} mm peak; "
+                f"{fin['samples']} samples, {fin['peak_um'] / 1e3:.2f} mm peak; {where}"
                 f"{_verdicts(e['verdicts'])}"
             )
     text = "\n".join(lines)
@@ -336,6 +360,41 @@ def _judge_lines(judge: dict | None) -> list[str]:
     return lines
 
 
+def _limits_lines(report: dict[str, Any]) -> list[str]:
+    """Over several coordinates, the limits searched and the force floors; the control."""
+    lines = []
+    judged = report.get("judged")
+    if judged:
+        from bushenv.search.limits import limits_text
+
+        floors = ", ".join(f"{k} {x:.4g}" for k, x in judged["force_floors"].items())
+        lines.append(f"searched within {limits_text(report['scales'])}")
+        lines.append(f"  force floors {floors} (N, N, N m): {judged['force_floors_source']}")
+    ctl = report.get("control")
+    if ctl:
+        lines.append(f"control: {ctl['label']} ({ctl['how']})")
+    return lines
+
+
+def _reach_lines(report: dict[str, Any]) -> list[str]:
+    reach = report.get("failure_reach")
+    if not reach:
+        return []
+    return [
+        f"failures reach {reach['median']:.3g}x the records' peak (median; {reach['min']:.3g}x "
+        f"to {reach['max']:.3g}x, {reach['failures']} failures)"
+    ]
+
+
+def _held(h: dict[str, Any]) -> str:
+    """A hold as listed: a deflection (mm) or a held vector (each coordinate in its unit)."""
+    if "x_mm" in h:
+        return f"{h['x_mm']:+.3g} mm"
+    key = next(k for k in h if k.startswith("q_"))
+    units = key[2:].split("_")
+    return "(" + ", ".join(f"{v:+.3g} {u}" for v, u in zip(h[key], units, strict=True)) + ")"
+
+
 def _hold_stage_lines(stage: dict | None) -> list[str]:
     if not stage:
         return []
@@ -348,30 +407,39 @@ def _hold_stage_lines(stage: dict | None) -> list[str]:
     )
     shown = [h for h in stage["holds"] if h["confirmed"]][:6]
     return ["", head] + [
-        f"  {h['x_mm']:+.3g} mm ({', '.join(h['listed_as'])}): confirmed ({h['criterion']})"
-        for h in shown
+        f"  {_held(h)} ({', '.join(h['listed_as'])}): confirmed ({h['criterion']})" for h in shown
     ]
 
 
 def _coverage_lines(report: dict[str, Any], target_key: str) -> list[str]:
-    """What the searches against the target tried: the scope of a "no divergence"."""
+    """What the searches against the target tried: the scope of a "no divergence". One
+    coordinate: per family, profiles, peak range (mm) and fastest rate; several: the same per
+    coordinate, each in its unit."""
     entry = report["models"].get(target_key, {})
-    fams: dict[str, list[float]] = {}
+    counts: dict[str, int] = {}
+    fams: dict[str, dict[str, list]] = {}
     for s in entry.get("searchers", {}).values():
-        for fam, c in (s.get("coverage") or {}).items():
-            f = fams.setdefault(fam, [0, float("inf"), 0.0, 0.0])
-            f[0] += c["profiles"]
-            f[1] = min(f[1], c["peak_mm_min"])
-            f[2] = max(f[2], c["peak_mm_max"])
-            f[3] = max(f[3], c["max_rate_m_per_s"])
+        for fam, row in (s.get("coverage") or {}).items():
+            counts[fam] = counts.get(fam, 0) + int(row["profiles"])
+            per = {k: v for k, v in row.items() if isinstance(v, dict)} or {"": row}
+            for coord, c in per.items():
+                peak = sorted(k for k in c if k.startswith("peak_"))  # *_max, *_min
+                rate = next(k for k in c if k.startswith("max_rate_"))
+                f = fams.setdefault(fam, {}).setdefault(coord, [np.inf, 0.0, 0.0, "", ""])
+                f[0], f[1] = min(f[0], c[peak[1]]), max(f[1], c[peak[0]])
+                f[2] = max(f[2], c[rate])
+                f[3] = peak[0][5:].rsplit("_", 1)[0]  # mm or mrad
+                f[4] = rate[9:].replace("_per_s", "/s")
     if not fams:
         return []
     seed = report.get("arguments", {}).get("seed")
-    lines = ["", f"covered on {target_key} (seed {seed}): family, profiles, peak mm, max m/s"]
-    lines += [
-        f"  {fam:<12} {int(c[0]):>5}  {c[1]:.3g}-{c[2]:.3g} mm  {c[3]:.3g} m/s"
-        for fam, c in sorted(fams.items())
-    ]
+    lines = ["", f"covered on {target_key} (seed {seed}): family, profiles, peak range, max rate"]
+    for fam, per in sorted(fams.items()):
+        parts = [
+            f"{coord + ' ' if coord else ''}{lo:.3g}-{hi:.3g} {u}  {r:.3g} {ru}"
+            for coord, (lo, hi, r, u, ru) in per.items()
+        ]
+        lines.append(f"  {fam:<12} {counts[fam]:>5}  " + "; ".join(parts))
     return lines
 
 
@@ -398,13 +466,16 @@ def report_markdown(report: dict[str, Any], target_key: str, plots: list[str]) -
     lines += ["## The columns", "", legend_markdown(table)]
     lines += ["", "## Criteria", "", report["criteria"]["why"], ""]
     sc = report["scales"]
-    lines += [
-        "## Scales",
-        "",
-        f"stroke {sc['stroke_m'] * 1e3:.4g} mm, velocity {sc['velocity_m_per_s']:.4g} m/s, "
-        f"force floor {sc['force_floor_n']:.4g} N, force limit {sc['force_limit_n']:.4g} N "
-        f"({sc['source']})",
-        "",
-    ]
+    if "stroke_m" in sc:
+        scales = (
+            f"stroke {sc['stroke_m'] * 1e3:.4g} mm, velocity {sc['velocity_m_per_s']:.4g} m/s, "
+            f"force floor {sc['force_floor_n']:.4g} N, force limit {sc['force_limit_n']:.4g} N "
+            f"({sc['source']})"
+        )
+    else:  # several coordinates: the limits searched, each in its unit
+        from bushenv.search.limits import limits_text
+
+        scales = limits_text(sc)
+    lines += ["## Scales", "", scales, ""]
     lines += [f"![{p}](plots/{p})\n" for p in plots]
     return "\n".join(lines)

@@ -1,19 +1,18 @@
 """Stage 1 of an attack, resolve: the model under attack, the reference, the judge, then the
 hybrid, the control and the models rechecked beside them, each resolved once
-(``bushenv.resolved``) into one ``Resolved``.
+(``bushenv.resolved``) into one ``Resolved``, whatever the number of coordinates C of the target.
 
 ``resolve_target`` is the stage for one model (a cell of ``bushenv campaign``, a member of the
-zoo); ``resolve`` adds the roles of a whole attack (``campaign_models.roles``), for a target of
-any number of coordinates: over several, the limits the search drives are scaled to the user's
-card (``planar_models.search_limits``), the reference is vetted within them, and the control is
-the user's own (``--control``), a linear fit to the user's reference, or the Table-1 preset.
+zoo); ``resolve`` adds the roles of a whole attack (``campaign_models.roles``). Over one
+coordinate the judge's scales come from the reference's card (``judge.judge_of``); over several
+they are the limits the search drives, per coordinate in its unit, scaled to the user's card
+(``campaign_limits.search_limits``), and the reference is vetted within them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
-from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
@@ -23,13 +22,15 @@ from bushenv.judge import (
     Judge,
     ScaleFlags,
     check_reference_needed,
+    criteria_of,
     judge_of,
     reference_spec_for,
 )
 from bushenv.models import params_sha
 from bushenv.resolved import ResolvedModel, report_key, resolve_model, resolved
-from bushenv.scales import stiffness_mismatch
+from bushenv.scales import BushingScales, stiffness_mismatch
 from bushenv.search.campaign_config import CampaignConfig
+from bushenv.search.campaign_limits import search_limits, vetted_within
 from bushenv.search.campaign_models import (
     FITTED_CONTROL,
     card_displacements,
@@ -38,13 +39,6 @@ from bushenv.search.campaign_models import (
 )
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.limits import Rig3Limits, limits_text
-from bushenv.search.planar_models import (
-    DEFAULT_CONTROL,
-    DEFAULT_REFERENCE,
-    resolved_planar,
-    search_limits,
-    vetting,
-)
 from bushenv.search.targets import Target, get_target
 
 Say = Callable[[str], None]
@@ -67,12 +61,27 @@ class Resolved:
     roles: Mapping[str, str]
     keys: Mapping[str, str]  # the report key of each role (target, hybrid, control)
     notes: tuple[str, ...] = ()
-    # over several coordinates (None over one, where ``judge.scales`` are the limits): the
-    # limits the search drives, what judged (the vetting, the force floors, the stroke) and how
-    # the control was made (label, how, spec, file), as the report records them
-    limits: Rig3Limits | None = None
-    judged: dict | None = None
-    control: dict | None = None
+    # how the control was made (label, how, spec, file), as the report records it
+    control: Mapping[str, Any] | None = None
+    # over several coordinates (None over one): what judged -- the force floors per coordinate
+    # and the stroke the reference was vetted within -- as the report records it
+    judged: Mapping[str, Any] | None = None
+
+    @property
+    def limits(self) -> Rig3Limits | None:
+        """The limits the search drives over several coordinates (the judge's scales); None
+        over one, where ``judge.scales`` (a ``BushingScales``) are the bushing's limits."""
+        return self.judge.scales if isinstance(self.judge.scales, Rig3Limits) else None
+
+    @property
+    def case_axis(self) -> str:
+        """The axis a corpus case of this attack records (``planar`` over several)."""
+        return self.axis if not self.target.coords else "planar"
+
+    @property
+    def n_coords(self) -> int:
+        """The number of coordinates C of the bushing searched."""
+        return max(1, len(self.target.coords))
 
     @property
     def dt(self) -> float:
@@ -157,18 +166,27 @@ def resolve_target(
 ) -> Resolved:
     """The stage for one model (a name, file, object, or resolved already, with its card)
     against ``reference`` (a name, file, object, ``"none"``, or None: see
-    ``judge.reference_spec_for``): both resolved, the reference vetted. Raises
-    ``JudgeError`` as ``judge_of`` does."""
+    ``judge.reference_spec_for``), over the target's coordinates: both resolved, the reference
+    vetted. Raises ``JudgeError`` as ``judge_of`` does (``SearchError`` over several
+    coordinates)."""
     tgt = get_target(target)
-    subject = model if isinstance(model, ResolvedModel) else resolve_model(model, axis, card=True)
+    n = max(1, len(tgt.coords))
+    flags = flags or ScaleFlags()
+    wanted = f"the {tgt.name} target"
+    subject = model
+    if not isinstance(model, ResolvedModel):
+        subject = resolve_model(model, axis, card=True, coords=n, wanted_by=f"{wanted}'s model")
     spec = reference_spec_for(subject.spec if subject.registered else None, reference)
     check_reference_needed(spec, tgt)
     ref = None
     if spec is not None:
-        ref = resolve_model(spec, axis, subject.model.dt, reference=True, card=True)
-    judge = judge_of(
-        subject, ref, target=tgt, flags=flags or ScaleFlags(), trust_reference=trust_reference
-    )
+        ref = resolve_model(spec, axis, subject.model.dt, reference=True, card=True, coords=n,
+                            wanted_by=f"{wanted}'s reference")  # fmt: skip
+    judged = None
+    if n == 1:
+        judge = judge_of(subject, ref, target=tgt, flags=flags, trust_reference=trust_reference)
+    else:
+        judge, judged = coordinate_judge(subject, ref, tgt, flags, trust_reference, say)
     return Resolved(
         axis=axis,
         target=tgt,
@@ -177,15 +195,41 @@ def resolve_target(
         models=_frozen({subject.key: subject}),
         roles=_frozen({subject.key: "target"}),
         keys=_frozen({"target": subject.key}),
-        notes=tuple(judge_notes(judge, tgt, say)),
+        notes=tuple(judge_notes(judge, tgt, say if n == 1 else _quiet)),
+        judged=judged,
     )
+
+
+def coordinate_judge(
+    subject: ResolvedModel,
+    ref: ResolvedModel,
+    target: Target,
+    flags: ScaleFlags,
+    trust_reference: bool,
+    say: Say,
+) -> tuple[Judge, dict]:
+    """The judge over several coordinates: the limits searched (``search_limits``), the
+    reference vetted within them, every criterion on each coordinate (``judge_coordinates``);
+    and what judged, for the report."""
+    limits = search_limits(flags, subject, ref)
+    vetted, judged = vetted_within(
+        ref.model, ref.spec, target, say, model=subject.model, model_file=subject.file,
+        trust=trust_reference, stroke=np.array(limits.stroke),
+    )  # fmt: skip
+    criteria, why = criteria_of(ref.model, True, target)
+    say(f"searching within {limits_text(limits.to_json())}")
+    judge = Judge(
+        reference_spec=ref.spec, builtin=ref.registered, scales=limits, static=True,
+        criteria=criteria, why=f"{why}, on each coordinate (target_base.judge_coordinates)",
+        vetting=vetted, trusted_by_flag=bool(trust_reference and not vetted.passed),
+        reference=ref.model,
+    )  # fmt: skip
+    return judge, judged
 
 
 def resolve(config: CampaignConfig, say: Say = _quiet) -> Resolved:
     """The stage for a whole attack: ``resolve_target``, then every other role's model."""
     c = config
-    if get_target(c.target).coords:
-        return _resolve_coordinates(c, say)
     one = resolve_target(
         c.model,
         c.reference,
@@ -199,80 +243,55 @@ def resolve(config: CampaignConfig, say: Say = _quiet) -> Resolved:
     models: dict[str, ResolvedModel] = {}
     role_of: dict[str, str] = {}
     keys: dict[str, str] = {}
-    for role, spec in roles(c, one.judge, notes):
+    control: dict[str, Any] | None = None
+    for role, spec in roles(c, one.judge, notes, coords=one.n_coords):
         key = report_key(spec)
         keys[role] = key
-        if key in models:  # e.g. --model hybrid: the hybrid step is the target step
+        known = key in models  # e.g. --model hybrid: the hybrid step is the target step
+        if not known:
+            models[key] = one.models[key] if role == "target" else _other(one, spec, c)
+            role_of[key] = role
+        if role == "control":
+            control = _control_how(one, spec, models[key], given=c.control is not None)
+            say(f"control: {control['label']}: {control['how']}")
+        if known:
             continue
-        models[key] = one.models[key] if role == "target" else _other(one, spec, c)
-        role_of[key] = role
-        if one.judge.static:  # static stiffness means something only where static is known
+        if one.judge.static and isinstance(one.judge.scales, BushingScales):
             warning = stiffness_mismatch(models[key].model, one.judge.reference)
-            if warning:
+            if warning:  # static stiffness means something only where static is known
                 notes.append(f"{key}: {warning}")
     return replace(
-        one, models=_frozen(models), roles=_frozen(role_of), keys=_frozen(keys), notes=tuple(notes)
-    )
+        one, models=_frozen(models), roles=_frozen(role_of), keys=_frozen(keys),
+        notes=tuple(notes), control=None if control is None else _frozen(control),
+    )  # fmt: skip
 
 
 def _other(one: Resolved, spec: str, config: CampaignConfig) -> ResolvedModel:
-    """A model beside the target; the fitted control is fitted and saved under ``out``."""
+    """A model beside the target; the fitted control is fitted (on the reference's card's
+    records, else the model's, else a random drive within the limits) and saved under
+    ``out``."""
     if spec == FITTED_CONTROL:
-        records = card_displacements(one.reference)
+        subject = one.models[one.target_key]
+        records = card_displacements(one.reference) or card_displacements(subject)
         model = fitted_linear(one.judge.reference, one.judge.scales, records)
         path = model.save(config.out / "models" / "control-linear.npz")
         return resolved(str(path), model, one.axis, key=FITTED_CONTROL)
-    return resolve_model(spec, one.axis, one.dt)
+    return resolve_model(spec, one.axis, one.dt, coords=one.n_coords,
+                         wanted_by="the attack's --hybrid or --control")  # fmt: skip
 
 
-def _resolve_coordinates(c: CampaignConfig, say: Say) -> Resolved:
-    """``resolve`` over several coordinates (see the module doc)."""
-    tgt = get_target(c.target)
-    subject = resolved_planar(c.model, None, "--model", card=True)
-    dt = subject.model.dt
-    ref = resolved_planar(c.reference or DEFAULT_REFERENCE, dt, "--reference", card=True)
-    limits = search_limits(c, subject, ref)
-    vetted, judged = vetting(
-        ref.model, ref.spec, tgt, say, model=subject.model, model_file=subject.file,
-        trust=c.trust_reference, stroke=np.array(limits.stroke),
-    )  # fmt: skip
-    if c.control:
-        control = resolved_planar(c.control, dt, "--control")
-        how = {"label": c.control, "how": "given (--control)"}
-    elif ref.file is not None:
-        q = card_displacements(ref) or card_displacements(subject)
-        fit = fitted_linear(ref.model, limits, q)
-        path = fit.save(Path(c.out) / "models" / "control-linear.npz")
-        control = replace(resolved_planar(str(path), dt, "--control"), key=FITTED_CONTROL)
+def _control_how(one: Resolved, spec: str, control: ResolvedModel, given: bool) -> dict:
+    """How the control was made, as the report says it."""
+    if given:
+        how = {"label": spec, "how": "given (--control)"}
+    elif spec == FITTED_CONTROL:
+        subject = one.models[one.target_key]
+        q = card_displacements(one.reference) or card_displacements(subject)
         drive = "its card's training records" if q else "a random drive within the limits"
-        how = {
-            "label": f"{path}, a linear fit to {ref.spec}",
-            "how": f"linear, least squares on {ref.spec}'s response to {drive}",
-        }
+        ref = one.judge.reference_spec
+        how = {"label": f"{control.spec}, a linear fit to {ref}",
+               "how": f"linear, least squares on {ref}'s response to {drive}"}  # fmt: skip
     else:
-        control = resolved_planar(DEFAULT_CONTROL, dt, "--control")
-        how = {"label": DEFAULT_CONTROL, "how": "the planar Table-1 linear preset"}
-    how.update(spec=control.spec, file=None if control.file is None else str(control.file))
-    by_role = {"target": subject, "control": control}
-    if c.hybrid and c.hybrid != "none":
-        by_role["hybrid"] = resolved_planar(c.hybrid, dt, "--hybrid")
-    models: dict[str, ResolvedModel] = {}
-    for m in by_role.values():
-        models.setdefault(m.key, m)
-    judge = Judge(
-        reference_spec=ref.spec, builtin=ref.registered, scales=limits, static=True,
-        criteria=(), why="per coordinate, as the target judges (target_base.judge_coordinates)",
-        vetting=vetted, trusted_by_flag=bool(c.trust_reference and not vetted.passed),
-        reference=ref.model,
-    )  # fmt: skip
-    for line in (
-        f"searching within {limits_text(limits.to_json())}",
-        f"control: {how['label']}: {how['how']}",
-    ):
-        say(line)
-    return Resolved(
-        axis=c.axis, target=tgt, judge=judge, reference=ref, models=_frozen(models),
-        roles=_frozen({m.key: r for r, m in reversed(by_role.items())}),
-        keys=_frozen({r: m.key for r, m in by_role.items()}),
-        notes=tuple(judge_notes(judge, tgt)), limits=limits, judged=judged, control=how,
-    )  # fmt: skip
+        how = {"label": spec, "how": "the papers' Table-1 linear preset"}
+    file = None if control.file is None else str(control.file)
+    return {**how, "spec": control.spec, "file": file}

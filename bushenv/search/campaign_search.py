@@ -9,6 +9,7 @@ member of the zoo call it as it is); ``search`` runs an attack's searches and re
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,10 +20,15 @@ import numpy as np
 
 from bushenv.persist import load_profiles, save_profiles
 from bushenv.progress import Progress
-from bushenv.search.base import Searcher, SearchResult
+from bushenv.scales import MACHINE
+from bushenv.search.base import Searcher, SearchError, SearchResult
 from bushenv.search.campaign_config import CampaignConfig
 from bushenv.search.campaign_resolve import Resolved
+from bushenv.search.evaluate import BatchEvaluator
+from bushenv.search.limits import machine_limits
 from bushenv.search.searchers import SEARCHERS, get_searcher
+from bushenv.search.target_base import covered_search
+from bushenv.search.targets import TARGETS
 
 MAX_SAVED_FAILURES = 256  # profiles per search written to failures/*.npz for the recheck
 
@@ -41,7 +47,8 @@ class Searched:
         return self.runs.get(key, MappingProxyType({}))
 
     def failures(self, key: str) -> tuple[list[np.ndarray], list[dict]]:
-        """Every failing profile the searches against ``key`` kept, with its metadata."""
+        """Every failing profile the searches against ``key`` kept, with its metadata (a
+        search's worst is saved beside its failures: when it failed, it is one of them)."""
         profiles, meta = [], []
         for name, summary in self.of(key).items():
             f = summary.get("profiles_file")
@@ -49,7 +56,7 @@ class Searched:
                 continue
             ps, ms = load_profiles(self.out / f)
             for p, m in zip(ps, ms, strict=True):
-                if m.get("diverged"):
+                if m.get("diverged") and not m.get("worst"):
                     profiles.append(p)
                     meta.append({**m, "searcher": name})
         return profiles, meta
@@ -95,6 +102,39 @@ def run_search(
         return s.run(ev, budget, seed=seed, progress=said)
 
 
+def _covered(resolved: Resolved, key: str, searcher: str | Searcher, budget: int, seed: int,
+             threads: int, progress: Callable[[str, int], None]):  # fmt: skip
+    """``run_search`` and, over several coordinates, what it tried per family and coordinate
+    (``covered_search``: the same seeding, the same result); (result, coverage or None)."""
+    if not resolved.target.coords:
+        return run_search(resolved, key, searcher, budget, seed, threads, progress), None
+    s = get_searcher(searcher) if isinstance(searcher, str) else searcher
+    with resolved.evaluator(key, threads) as ev:
+        return covered_search(s, ev, budget, seed, lambda msg: progress(msg, ev.n_evaluations))
+
+
+def tally(failures, coords: tuple[str, ...]) -> dict:
+    """Failures by family, by the coordinate that failed, by criterion; and those that failed
+    in a coordinate the profile never moved (a cross-coordinate failure)."""
+    fam = Counter(c.family for c in failures)
+    axis = Counter(str(c.verdict.get("axis")) for c in failures)
+    crit = Counter(str(c.verdict.get("first_criterion")) for c in failures)
+    pairs = Counter(f"{c.family}/{c.verdict.get('axis')}" for c in failures)
+    at_rest = sum(
+        1
+        for c in failures
+        if c.verdict.get("axis") in coords
+        and not np.any(c.profile[:, coords.index(c.verdict["axis"])])
+    )
+    return {
+        "in_a_coordinate_at_rest": at_rest,
+        "by_family": dict(fam.most_common()),
+        "by_axis": dict(axis.most_common()),
+        "by_criterion": dict(crit.most_common()),
+        "by_family_axis": dict(pairs.most_common()),
+    }
+
+
 def search_one(
     resolved: Resolved,
     key: str,
@@ -115,9 +155,13 @@ def search_one(
     def report(msg: str, evaluations: int) -> None:
         progress.update(start + cost * evaluations, f"[{key}]   {msg}")
 
-    res = run_search(resolved, key, searcher or name, max(1, budget), config.seed, threads, report)
+    res, covered = _covered(resolved, key, searcher or name, max(1, budget), config.seed,
+                            threads, report)  # fmt: skip
     progress.done = start + cost * budget
     summary = res.summary()
+    if covered is not None:  # over C coordinates: per family and coordinate, in its unit
+        summary["coverage"] = covered
+        summary["failures"] = tally(res.failures, resolved.target.coords)
     judge, dt = resolved.judge, resolved.dt
     if res.first_failure is not None:
         summary["first_failure"] = res.first_failure.to_json()
@@ -179,3 +223,43 @@ def search(
             runs[key][name] = search_one(resolved, key, name, config, threads, progress)
             on_search(key, name, runs[key][name])
     return Searched(config.out, _frozen(runs))
+
+
+# How each searcher that can be is held to one family (the zoo's single-axis check).
+HELD_TO = {"random": lambda f: {"families": (f,)}, "cma": lambda f: {"family": f}}
+
+
+def held_to(searcher: str, family: str) -> dict:
+    """The searcher's arguments that hold it to ``family``."""
+    if searcher not in HELD_TO:
+        raise SearchError(f"{searcher} cannot be held to one family; these can: {list(HELD_TO)}")
+    return HELD_TO[searcher](family)
+
+
+def family_search(
+    model,
+    reference,
+    searcher: str | Searcher,
+    budget: int,
+    seed: int,
+    *,
+    target: str = "rig3",
+    family: str | None = None,
+    limits=None,
+    threads: int = 1,
+    progress: Callable[[str, int], None] | None = None,
+) -> SearchResult:
+    """One search of ``model`` against ``reference`` on ``target`` within ``limits`` (None: the
+    machine's), outside an attack (the zoo runs it on every member); ``family``: the searcher
+    (given by name) held to that one family. ``progress`` gets each line of the searcher's with
+    the evaluations made so far."""
+    if isinstance(searcher, str):
+        s = get_searcher(searcher, **({} if family is None else held_to(searcher, family)))
+    elif family is None:
+        s = searcher
+    else:
+        raise SearchError("family_search: family= holds a searcher given by name only")
+    scales = limits or (machine_limits() if TARGETS[target].coords else MACHINE)
+    with BatchEvaluator(model, reference, TARGETS[target], threads=threads, scales=scales) as ev:
+        said = None if progress is None else (lambda msg: progress(msg, ev.n_evaluations))
+        return s.run(ev, budget, seed=seed, progress=said)

@@ -6,7 +6,7 @@ reference rubber. Several: first the single-axis check, each searcher over ``one
 the coordinate, CMA-ES searches it): a member passes when no profile fails in the coordinate it
 drives, on any axis, which is all a single-axis rig measures (a failure in a coordinate at rest
 is counted apart); then the attack across axes, each searcher over the families over all
-coordinates (``campaign_planar``'s search), its failures in a coordinate the profile moves
+coordinates (``campaign_search.family_search``), its failures in a coordinate the profile moves
 counted apart too (a member whose only failures are force in a coordinate held at rest has
 wrong coupling, not a runaway).
 """
@@ -17,9 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.search.campaign_planar import planar_search, tally
 from bushenv.search.campaign_resolve import Resolved
-from bushenv.search.campaign_search import run_search
+from bushenv.search.campaign_search import family_search, run_search, tally
 
 
 def attack(resolved: Resolved, searcher: str, budget: int, seed: int) -> dict[str, Any]:
@@ -51,7 +50,7 @@ def driven_failed(candidate, coords: tuple[str, ...]) -> bool:
 
 def single_axis(model, reference, coords, searcher: str, budget: int, seed: int) -> dict:
     """The single-axis check of a member over several coordinates (module docstring)."""
-    res = planar_search(model, reference, searcher, budget, seed, family="one_axis")
+    res = family_search(model, reference, searcher, budget, seed, family="one_axis")
     driven = [c for c in res.failures if driven_failed(c, coords)]
     by_axis = dict.fromkeys(coords, 0)
     for c in driven:  # a one_axis profile moves one coordinate
@@ -68,9 +67,9 @@ def single_axis(model, reference, coords, searcher: str, budget: int, seed: int)
 
 def across_axes(model, reference, coords, searcher: str, budget: int, seed: int) -> dict:
     """The attack across axes of a member over several coordinates (module docstring)."""
-    res = planar_search(model, reference, searcher, budget, seed)
+    res = family_search(model, reference, searcher, budget, seed)
     ff = res.first_failure
-    t = tally(res.failures)
+    t = tally(res.failures, coords)
     # failures in a coordinate the profile moves: not only force in a coordinate held at rest
     moving = [c.evaluation for c in res.failures if driven_failed(c, coords)]
     return {

@@ -130,11 +130,14 @@ def _on_one_axis(cell, model, path, train, unseen) -> dict[str, Any]:
 def _across_axes(cell, model, path, train, unseen) -> dict[str, Any]:
     """The hold check, the single-axis check and the attack across axes, judged by the
     coupled reference."""
-    from bushenv.search.planar_models import DEFAULT_REFERENCE, resolve_planar_spec
+    from bushenv.judge import BUILTIN_REFERENCE
+    from bushenv.resolved import resolve_model
 
     coords = TARGETS[cell["env"]].coords
     seed, budget = int(cell["seed"]), int(cell["budget"])
-    reference = resolve_planar_spec(DEFAULT_REFERENCE, model.dt, "--reference")
+    reference = resolve_model(
+        BUILTIN_REFERENCE, dt=model.dt, reference=True, coords=len(coords)
+    ).model
     searchers = cell["searchers"].split(",")
     certificate = holds.hold_check(model, train, PAPER_DT, coords)
     check = partial(attack.single_axis, model, reference, coords)

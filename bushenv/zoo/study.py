@@ -28,7 +28,7 @@ from bushenv.models import AXES, check_axis
 from bushenv.models.planar_narx import KINDS
 from bushenv.progress import Progress
 from bushenv.runlog import RunLog, run_cells
-from bushenv.search.campaign_planar import HELD_TO
+from bushenv.search.campaign_search import HELD_TO
 from bushenv.search.searchers import SEARCHERS
 from bushenv.search.targets import TARGETS
 from bushenv.zoo.cell import coordinate_count, run_cell
@@ -218,8 +218,12 @@ def run_study(config: ZooConfig, backend, progress: Progress) -> list[dict[str, 
 def _vetted_reference(env: str, progress: Progress) -> dict[str, Any]:
     """Every member over several coordinates is judged by the coupled reference: it is vetted
     once, before any member."""
+    from bushenv.judge import BUILTIN_REFERENCE
     from bushenv.models.base import PAPER_DT
-    from bushenv.search.planar_models import DEFAULT_REFERENCE, resolve_planar_spec, vetting
+    from bushenv.resolved import resolve_model
+    from bushenv.search.campaign_limits import vetted_within
 
-    reference = resolve_planar_spec(DEFAULT_REFERENCE, PAPER_DT, "reference")
-    return vetting(reference, DEFAULT_REFERENCE, TARGETS[env], progress.say, error=ZooError)[1]
+    target = TARGETS[env]
+    reference = resolve_model(BUILTIN_REFERENCE, dt=PAPER_DT, reference=True,
+                              coords=len(target.coords)).model  # fmt: skip
+    return vetted_within(reference, BUILTIN_REFERENCE, target, progress.say, error=ZooError)[1]

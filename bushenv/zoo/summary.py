@@ -223,7 +223,7 @@ def summarise(rows: list[dict], coords: int | None = None) -> dict[str, Any]:
 def write(out: Path, rows: list[dict], coords: int, judge: dict | None = None) -> dict[str, Any]:
     """``summary.json`` and ``summary.md`` (with one coordinate also
     ``accuracy_vs_robustness.png``); ``judge``: what judged every member over several
-    coordinates (the vetted reference, ``planar_models.vetting``)."""
+    coordinates (the vetted reference, ``campaign_limits.vetted_within``)."""
     summary = summarise(rows, coords)
     if judge is not None:
         summary["judge"] = judge

@@ -23,8 +23,8 @@ from bushenv.models.base import PAPER_DT
 from bushenv.motions import random_independent
 from bushenv.progress import Progress
 from bushenv.reference.planar import PlanarRubber
+from bushenv.search.campaign import run_attack
 from bushenv.search.campaign_config import CampaignConfig
-from bushenv.search.campaign_planar import run_planar_attack
 
 KINDS = ("nn", "nn-axis", "hybrid")
 
@@ -67,6 +67,7 @@ def main() -> None:
     for kind, path in paths.items():
         config = CampaignConfig(
             model=str(path),
+            reference="rubber",  # the coupled reference the networks were trained on
             budget=args.budget,
             target="rig3",
             seed=args.seed,
@@ -77,32 +78,36 @@ def main() -> None:
             threads=1,
         )
         one = Progress(quiet=args.quiet, label=kind)
-        rows[kind] = run_planar_attack(config, one).report
+        rows[kind] = run_attack(config, one).report
     print(
         "| model | searcher | failures / evals | in an axis at rest | evals to 1st failure |"
         " 1st: family (axis) | failures by family | by axis | control flagged |"
     )
     print("|---|---|---|---|---|---|---|---|---|")
     for kind, rep in rows.items():
-        ctrl = rep["recheck"]["control"]
-        for s in rep["searchers"]:
+        ctrl = rep["recheck"].get("linear", {"diverged": 0})
+        profiles = rep["recheck"].get("profiles", 0)
+        target = next(k for k, m in rep["models"].items() if m["role"] == "target")
+        for name, s in rep["models"][target]["searchers"].items():
             ff = s.get("first_failure")
-            first = f"{ff['family']} ({ff['axis']}, {ff['first_criterion']})" if ff else "-"
+            v = (ff or {}).get("verdict", {})
+            first = f"{ff['family']} ({v.get('axis')}, {v.get('first_criterion')})" if ff else "-"
             print(
-                f"| {kind} | {s['searcher']} | {s['n_failures']} / {s['evaluations']} | "
+                f"| {kind} | {name} | {s['n_failures']} / {s['evaluations']} | "
                 f"{s['failures']['in_a_coordinate_at_rest']} | "
                 f"{s['evaluations_to_failure'] or '-'} | {first} | "
                 f"{json.dumps(s['failures']['by_family'])} | "
                 f"{json.dumps(s['failures']['by_axis'])} | "
-                f"{ctrl['diverged']} of {ctrl['profiles']} |"
+                f"{ctrl['diverged']} of {profiles} |"
             )
     for kind, rep in rows.items():
         for k in rep["shrunk"]:
+            sh = k["shrink"]
             print(
-                f"{kind}: shrunk {k['family']} failure ({k['axis']}, {k['criterion']}): "
-                f"moving {k['moving']}, segments {k['original']['segments']} -> "
-                f"{k['final']['segments']}, samples {k['original']['samples']} -> "
-                f"{k['final']['samples']}"
+                f"{kind}: shrunk {k['family']} failure ({k.get('axis')}): "
+                f"moving {k.get('moving')}, segments {sh['original']['segments']} -> "
+                f"{sh['final']['segments']}, samples {sh['original']['samples']} -> "
+                f"{sh['final']['samples']}"
             )
     print(f"\n{time.perf_counter() - t0:.0f} s in total")
 

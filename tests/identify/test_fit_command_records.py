@@ -126,8 +126,10 @@ def test_attack_on_rig3_runs_a_model_fitted_at_500_hz_at_its_own_rate(tmp_path, 
     assert fit([rec], tmp_path / "m.npz", "--model", "linear") == 0
     args = ["attack", "--env", "rig3", "--model", str(tmp_path / "m.npz"), "--budget", "2"]
     args += ["--searchers", "random", "--max-shrink", "0", "--quiet", "--out", str(tmp_path / "a")]
+    # a user's file is judged by the reference given: none given, the attack says so
+    assert "judges against a reference and none was given" in fails(args, capsys)
     # bushenv's reference rubber is another bushing: its vetting refuses it on the fit's records
-    line = fails(args, capsys)
+    line = fails([*args, "--reference", "rubber"], capsys)
     assert "failed its vetting (compatibility" in line and "r.csv" in line
     # the fit itself as the judge: its 3x3 K is not symmetric (a circulatory stiffness gives
     # energy back on an orbit), so its vetting fails on passivity; trusted, it judges
@@ -135,8 +137,8 @@ def test_attack_on_rig3_runs_a_model_fitted_at_500_hz_at_its_own_rate(tmp_path, 
     assert "failed its vetting (passivity" in fails(own, capsys)
     assert main([*own, "--trust-reference"]) == 0  # before: "sampled at 500 Hz, expected 204.8"
     report = json.loads((tmp_path / "a" / "report.json").read_text())
-    assert report["model"].endswith("m.npz") and report["budget"] == 2
-    assert report["judge"]["trusted_despite_failed_vetting"] is True
+    assert report["arguments"]["model"].endswith("m.npz") and report["arguments"]["budget"] == 2
+    assert report["judge"]["trusted_by_flag"] is True
 
 
 def test_bushenv_card_reads_a_planar_card_checks_its_records_and_shows_ratios_per_axis(

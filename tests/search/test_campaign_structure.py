@@ -127,7 +127,16 @@ def test_a_campaign_cell_and_a_zoo_member_compose_the_stages_not_a_run_of_their_
     assert not names & {"build_judge", "judge_of", "BatchEvaluator", "get_searcher"}, names
 
 
-def test_a_mimo_zoo_member_runs_the_planar_attacks_search_not_one_of_its_own():
+def test_a_mimo_zoo_member_runs_the_attacks_search_not_one_of_its_own():
     names = _imported_names(PACKAGE / "zoo" / "attack.py")
-    assert "planar_search" in names
+    assert "family_search" in names
     assert not names & {"BatchEvaluator", "get_searcher", "SEARCHERS"}, names
+
+
+def test_one_attack_runner_for_every_number_of_coordinates():
+    """The attack command runs ``run_attack`` whatever the target's coordinates: no module of
+    its own for three axes, no branch on them in the command."""
+    search = PACKAGE / "search"
+    assert not [p.name for p in search.glob("*planar*.py")]
+    text = (PACKAGE / "commands" / "attack.py").read_text()
+    assert "run_attack" in text and "planar" not in text

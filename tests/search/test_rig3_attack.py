@@ -1,4 +1,5 @@
-"""``bushenv attack --env rig3``: a planar attack end to end, its cases replaying."""
+"""``bushenv attack --env rig3``: the one attack on a three-axis model end to end, its cases
+replaying."""
 
 import json
 
@@ -22,17 +23,20 @@ def test_a_planar_attack_finds_shrinks_and_keeps_the_axis_that_fails(tmp_path, c
     model = _rotation_active(tmp_path / "active.npz")
     out, corpus = tmp_path / "run", tmp_path / "corpus"
     argv = ["attack", "--env", "rig3", "--model", str(model), "--budget", "24", "--quiet",
-            "--searchers", "random", "--out", str(out), "--max-shrink", "1",
-            "--shrink-budget", "60", "--save", "--corpus", str(corpus)]  # fmt: skip
+            "--reference", "rubber", "--searchers", "random", "--out", str(out),
+            "--max-shrink", "1", "--shrink-budget", "60", "--save",
+            "--corpus", str(corpus)]  # fmt: skip
     assert main(argv) == 0
     report = json.loads((out / "report.json").read_text())
-    search = report["searchers"][0]
+    search = report["models"]["active"]["searchers"]["random"]
     assert search["n_failures"] > 0
     assert set(search["failures"]["by_axis"]) == {"rotation"}
-    assert report["recheck"]["control"]["diverged"] == 0
+    assert report["models"]["linear"]["role"] == "control"
+    assert report["recheck"]["linear"]["diverged"] == 0
     (shrunk,) = report["shrunk"]
     assert shrunk["axis"] == "rotation" and shrunk["moving"] == ["rotation"]
-    assert "| random |" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "active       target   random" in printed and "moving rotation" in printed
     (path,) = case_files(corpus)
     raw = json.loads(path.read_text())
     assert raw["env"] == "rig3" and raw["profile"]["shape"][1] == 3
@@ -47,8 +51,8 @@ def _one_case(tmp_path):
     model = _rotation_active(tmp_path / "active.npz")
     out = tmp_path / "run"
     argv = ["attack", "--env", "rig3", "--model", str(model), "--budget", "16", "--quiet",
-            "--searchers", "random", "--out", str(out), "--max-shrink", "1",
-            "--shrink-budget", "20"]  # fmt: skip
+            "--reference", "rubber", "--searchers", "random", "--out", str(out),
+            "--max-shrink", "1", "--shrink-budget", "20"]  # fmt: skip
     assert main(argv) == 0
     (path,) = case_files(out / "cases")
     return model, path
@@ -102,3 +106,13 @@ def test_the_matrix_refuses_a_planar_target_pointing_at_the_attack(tmp_path):
 
     with pytest.raises(MatrixError, match="bushenv attack --env rig3"):
         MatrixConfig(target="rig3", out=tmp_path).checked()
+
+
+def test_a_users_three_axis_file_without_a_reference_is_told_to_give_one(tmp_path, capsys):
+    model = _rotation_active(tmp_path / "active.npz")
+    argv = ["attack", "--env", "rig3", "--model", str(model), "--budget", "4", "--quiet",
+            "--out", str(tmp_path / "run")]  # fmt: skip
+    assert main(argv) == 2
+    (err,) = capsys.readouterr().err.strip().splitlines()
+    assert "rig3 target judges against a reference and none was given" in err
+    assert "--reference NAME|FILE" in err and "rubber, the built-in" in err

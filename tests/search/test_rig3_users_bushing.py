@@ -44,6 +44,11 @@ def _attack(d: Path, out: str, *extra: str, quiet: bool = True) -> dict:
     return json.loads((d / out / "report.json").read_text())
 
 
+def _searches(report: dict, key: str = "active3") -> list[dict]:
+    """The summaries of the searches against model ``key``, in the order they ran."""
+    return list(report["models"][key]["searchers"].values())
+
+
 @pytest.fixture(scope="module")
 def attacked(bushing) -> dict:
     return _attack(bushing, "att")
@@ -64,7 +69,7 @@ def test_a_users_reference_sets_stroke_and_rate_per_coordinate_from_its_cards_re
         assert lim[c][f"records_peak_{u}"] == pytest.approx(1e3 * peak[i], rel=1e-5)
     assert "ref3.card.json" in lim["source"]
     stroke = 1.5 * peak
-    for s in attacked["searchers"]:
+    for s in _searches(attacked):
         profiles, _ = load_profiles(bushing / "att" / s["profiles_file"])
         for q in profiles:
             assert np.all(np.max(np.abs(q), axis=0) <= stroke * (1 + 1e-9))
@@ -91,9 +96,10 @@ def test_the_control_is_a_linear_fit_to_the_users_reference_and_named_as_such(bu
     assert np.allclose(fitted.k_matrix, expected.k_matrix, rtol=1e-9)
     assert np.allclose(fitted.c_matrix, expected.c_matrix, rtol=1e-9)
     assert "ref3.npz" in control["label"] and control["file"] in control["label"]
-    assert attacked["recheck"]["control"]["model"] == control["label"]
+    assert attacked["models"]["linear-fit"]["role"] == "control"
+    assert "linear-fit" in attacked["recheck"]
     md = (bushing / "att" / "report.md").read_text()
-    assert f"recheck control ({control['label']})" in md
+    assert f"control: {control['label']} ({control['how']})" in md
 
 
 def test_the_one_resolve_stage_scales_to_the_users_card_and_fits_the_control(bushing, tmp_path):
@@ -125,7 +131,7 @@ def test_the_warning_names_a_flagged_control_given_by_the_user(bushing, capsys):
 
 
 def test_every_failing_profile_is_saved_with_three_coordinates(bushing, attacked):
-    for s in attacked["searchers"]:
+    for s in _searches(attacked):
         profiles, meta = load_profiles(bushing / "att" / s["profiles_file"])
         failing = [m for m in meta if m["diverged"] and not m.get("worst")]
         assert len(failing) == min(s["n_failures"], 256) > 0
@@ -135,7 +141,7 @@ def test_every_failing_profile_is_saved_with_three_coordinates(bushing, attacked
 
 def test_coverage_is_per_coordinate_with_its_unit_in_the_key(attacked):
     stroke = attacked["scales"]
-    for s in attacked["searchers"]:
+    for s in _searches(attacked):
         for row in s["coverage"].values():
             assert set(row) == {"profiles", *COORDS}
             assert set(row["axial"]) == {"peak_mm_min", "peak_mm_max", "max_rate_m_per_s"}
@@ -160,11 +166,14 @@ def test_resume_finishes_an_interrupted_attack_as_the_uninterrupted_one(bushing,
     out = bushing / "att-resume"
     shutil.copytree(bushing / "att", out)
     report = json.loads((out / "report.json").read_text())
-    report["searchers"] = report["searchers"][:1]  # stopped after the first search
-    report["recheck"], report["shrunk"], report["complete"] = {}, None, False
+    searches = report["models"]["active3"]["searchers"]
+    first = next(iter(searches))
+    report["models"]["active3"]["searchers"] = {first: searches[first]}  # stopped after one
+    report["recheck"], report["shrunk"], report["complete"] = {}, [], False
+    report.pop("failure_reach", None)
     (out / "report.json").write_text(json.dumps(report))
     resumed = _attack(bushing, "att-resume", "--resume")
-    for key in ("searchers", "recheck", "shrunk", "scales", "control", "failure_reach"):
+    for key in ("models", "recheck", "shrunk", "scales", "control", "failure_reach"):
         a, b = json.dumps(_untimed(resumed[key])), json.dumps(_untimed(attacked[key]))
         assert a.replace("att-resume", "att") == b, key
     capsys.readouterr()
@@ -177,6 +186,7 @@ def test_the_builtin_reference_keeps_the_machine_and_the_linear_preset(tmp_path)
     ref = PlanarLinear.preset()
     PlanarLinear(ref.k_matrix, -0.3 * ref.c_matrix, ref.dt).save(tmp_path / "a.npz")
     assert main(["attack", "--env", "rig3", "--model", str(tmp_path / "a.npz"), "--budget", "4",
+                 "--reference", "rubber",
                  "--searchers", "random", "--max-shrink", "0", "--threads", "1", "--no-plots",
                  "--quiet", "--out", str(tmp_path / "o")]) == 0  # fmt: skip
     report = json.loads((tmp_path / "o" / "report.json").read_text())
@@ -218,8 +228,8 @@ def test_the_covered_search_is_the_searchers_own_run():
 
 
 def test_a_model_that_is_no_network_skips_the_hold_stage_and_says_why(attacked):
-    assert attacked["hold_stage"] == {"run": False, "why": "not a planar network (no fixed points)"}
-    assert "cert-holds" not in [s["searcher"] for s in attacked["searchers"]]
+    assert attacked["hold_stage"] == {"run": False, "why": "not a NARX network (no certificate)"}
+    assert "cert-holds" not in attacked["models"]["active3"]["searchers"]
 
 
 @pytest.fixture(scope="module")
@@ -259,7 +269,7 @@ def test_an_attack_on_a_network_runs_the_hold_stage(bushing, network):
     report = _attack(bushing, "att-nn", "--model", str(network), "--searchers", "random")
     stage = report["hold_stage"]
     assert stage["run"] and stage["grid_points"] == 5
-    names = [s["searcher"] for s in report["searchers"]]
+    names = list(report["models"]["nn3"]["searchers"])
     assert names == (["random", "cert-holds"] if stage["listed"] else ["random"])
 
 

@@ -102,7 +102,7 @@ def _across_axes_rows(rows, out):
     assert "broken_of_passed" in summary["mimo_pooled"]
     assert "| teacher-forcing/hybrid | 1 |" in (out / "summary.md").read_text()
     judge = summary["judge"]  # the reference every member was judged by, vetted first
-    assert judge["vetting"]["passed"] is True and judge["vetting"]["reference"] == "reference"
+    assert judge["vetting"]["passed"] is True and judge["vetting"]["reference"] == "rubber"
     assert [c["check"] for c in judge["vetting"]["checks"]][0] == "holds"
     assert "vetted first (holds ok" in (out / "summary.md").read_text()
     assert not (out / "accuracy_vs_robustness.png").exists()

@@ -163,7 +163,7 @@ def test_a_member_trains_checks_single_axes_and_is_attacked_deterministically(tm
 
 def test_only_the_searchers_that_can_be_held_to_one_family_run_the_single_axis_check():
     from bushenv.search.base import SearchError
-    from bushenv.search.campaign_planar import held_to, planar_search
+    from bushenv.search.campaign_search import family_search, held_to
     from bushenv.search.searchers import RandomSearch
 
     assert held_to("random", "one_axis") == {"families": ("one_axis",)}
@@ -171,4 +171,4 @@ def test_only_the_searchers_that_can_be_held_to_one_family_run_the_single_axis_c
     with pytest.raises(SearchError, match="certificate cannot be held"):
         held_to("certificate", "one_axis")
     with pytest.raises(SearchError, match="by name only"):
-        planar_search(None, None, RandomSearch(), 1, 0, family="one_axis")
+        family_search(None, None, RandomSearch(), 1, 0, family="one_axis")

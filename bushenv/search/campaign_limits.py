@@ -1,22 +1,20 @@
-"""What is truly three-coordinate in resolving an attack (``campaign_resolve.resolve`` is the
-one stage): a three-axis model or reference named in an attack or a case (what the attack and
-the corpus's replay of three-axis cases share); the limits the search drives, from the card
-beside a user's file (``search_limits``, ``limits_of_card``: per coordinate, the rotation with
-its own flag), as the one-axis attack takes its scales from its reference's card
-(``judge.judging_scales``); and the reference vetted within those limits (``vetting``).
+"""The limits an attack over several coordinates drives and the reference vetted within them
+(part of the resolve stage, ``campaign_resolve.resolve``): from the card beside a user's file
+(``search_limits``, ``limits_of_card``: per coordinate, the rotation with its own flag), as the
+one-axis attack takes its scales from its reference's card (``judge.judging_scales``); and the
+reference vetted within those limits (``vetted_within``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
+from bushenv.judge import ScaleFlags
 from bushenv.scales import RECORD_MARGIN
 from bushenv.search.base import SearchError
-from bushenv.search.campaign_config import CampaignConfig
 from bushenv.search.campaign_models import card_records
 from bushenv.search.limits import (
     COORDS,
@@ -24,53 +22,6 @@ from bushenv.search.limits import (
     limits_of_records,
     machine_limits,
 )
-
-DEFAULT_REFERENCE = "reference"
-DEFAULT_CONTROL = "linear"
-
-
-def resolve_planar_spec(spec: str, dt: float | None, what: str):
-    """A three-axis model by ``MODELS`` name (with a preset) or ``.npz`` file; ``dt`` None:
-    a file at its own rate (a fit on 500 Hz records runs at 500 Hz), a preset at the papers'."""
-    from bushenv.models import load_model
-    from bushenv.models.base import PAPER_DT
-    from bushenv.rigs.common import resolve_model
-
-    if dt is None and str(spec).endswith(".npz") and Path(spec).is_file():
-        return load_model(spec, coords=3, wanted_by=f"the {what}")
-    dt = PAPER_DT if dt is None else dt
-    return resolve_model(spec, dt=dt, coords=3, what=what, env_id="BushRig3-v0")
-
-
-def resolved_planar(spec: str, dt: float | None, what: str, card: bool = False):
-    """``resolve_planar_spec`` as a ``ResolvedModel`` (its file and sha256, for cases); with
-    ``card``, the planar card beside a file (checked against the file; ``CardError`` when it
-    does not match), read here once."""
-    from bushenv.models import file_hash
-    from bushenv.resolved import ResolvedModel, report_key
-
-    model = resolve_planar_spec(spec, dt, what)
-    path = Path(spec) if str(spec).endswith(".npz") and Path(spec).is_file() else None
-    found = read_planar_card(path) if card and path is not None else None
-    return ResolvedModel(
-        key=report_key(spec),
-        spec=str(spec),
-        model=model,
-        file=path,
-        sha256=None if path is None else file_hash(path),
-        card=None if found is None else found.data,
-        card_file=None if found is None else found.path,
-        registered=path is None,
-    )
-
-
-def read_planar_card(path: Path):
-    """The planar ``ModelCard`` beside model file ``path``, or None when there is none."""
-    from bushenv.identify.card import card_paths, load_card
-
-    if not card_paths(path)[0].is_file():
-        return None
-    return load_card(path)
 
 
 def limits_of_card(resolved) -> Rig3Limits | None:
@@ -100,9 +51,10 @@ def limits_of_card(resolved) -> Rig3Limits | None:
     )
 
 
-def search_limits(config: CampaignConfig, subject, reference) -> Rig3Limits:
-    """What the search drives (see the module doc, step 1)."""
-    c = config
+def search_limits(flags: ScaleFlags, subject, reference) -> Rig3Limits:
+    """What the search drives: a user's reference's card (else the model's) or the machine's,
+    with the flags on top (``--stroke-mm`` and ``--max-velocity`` on the translations,
+    ``--rotation-mrad`` on the rotation)."""
     limits = machine_limits()
     if reference.file is not None:  # a user's reference: its card, else the model's
         for res in (reference, subject):
@@ -112,24 +64,25 @@ def search_limits(config: CampaignConfig, subject, reference) -> Rig3Limits:
                 break
     stroke, rate = list(limits.stroke), list(limits.rate)
     given = []
-    if c.stroke_mm is not None:
-        stroke[:2] = [c.stroke_mm * 1e-3] * 2
-        given.append(f"--stroke-mm {c.stroke_mm:g}")
-    if c.max_velocity_m_per_s is not None:
-        rate[:2] = [c.max_velocity_m_per_s] * 2
-        given.append(f"--max-velocity {c.max_velocity_m_per_s:g}")
-    if not given and c.rotation_mrad is None:
+    if flags.stroke_mm is not None:
+        stroke[:2] = [flags.stroke_mm * 1e-3] * 2
+        given.append(f"--stroke-mm {flags.stroke_mm:g}")
+    if flags.max_velocity_m_per_s is not None:
+        rate[:2] = [flags.max_velocity_m_per_s] * 2
+        given.append(f"--max-velocity {flags.max_velocity_m_per_s:g}")
+    if not given and flags.rotation_mrad is None:
         return limits
     source = f"{' and '.join(given)} on axial and radial" if given else ""
-    if c.rotation_mrad is not None:
-        stroke[2] = c.rotation_mrad * 1e-3
-        source += f"{'; ' if source else ''}--rotation-mrad {c.rotation_mrad:g} on the rotation"
+    if flags.rotation_mrad is not None:
+        stroke[2] = flags.rotation_mrad * 1e-3
+        source += (f"{'; ' if source else ''}--rotation-mrad {flags.rotation_mrad:g} on the "
+                   "rotation")  # fmt: skip
     else:
         source += f" (the rotation: {limits.source})"
     return replace(limits, stroke=tuple(stroke), rate=tuple(rate), source=source)
 
 
-def vetting(
+def vetted_within(
     reference,
     ref_spec: str,
     target,
@@ -172,4 +125,22 @@ def vetting(
         "force_floors": dict(zip(target.coords, floors.tolist(), strict=True)),
         "force_floors_source": floors_source,
         "stroke": dict(zip(target.coords, np.asarray(stroke).tolist(), strict=True)),
+    }
+
+
+def failure_reach(profiles: list[np.ndarray], limits: Rig3Limits | None) -> dict | None:
+    """How far beyond the records the failures sit: per profile the largest over the
+    coordinates of its peak |q| over the records' (``limits.records_peak``); its median,
+    smallest and largest. None when the limits come from no records."""
+    seen = None if limits is None or limits.records_peak is None else np.array(limits.records_peak)
+    if seen is None or not profiles or not np.any(seen > 0):
+        return None
+    moved = seen > 0
+    ratio = [float(np.max(np.max(np.abs(q), axis=0)[moved] / seen[moved])) for q in profiles]
+    return {
+        "failures": len(ratio),
+        "median": round(float(np.median(ratio)), 3),
+        "min": round(min(ratio), 3),
+        "max": round(max(ratio), 3),
+        "of": "each failure's largest peak |q| over the records' peak, per coordinate",
     }
