@@ -38,9 +38,6 @@ from bushenv.scales import (
     static_identified,
 )
 
-# a profile that spends this long in a range where the reference failed its vetting is
-# judged there (a ring or a departure shows in a hold, not in a sweep through)
-UNVETTED_DWELL_S = 0.5
 NO_REFERENCE = "none"  # the spelling of "judged without a reference" in every command
 BUILTIN_REFERENCE = "rubber"
 
@@ -117,21 +114,28 @@ class Judge:
         departs or pulls there); empty when it passed or was not vetted."""
         return () if self.vetting is None else self.vetting.unvetted_ranges_m
 
+    @property
+    def has_unvetted_regions(self) -> bool:
+        """Whether the reference failed its vetting somewhere (ranges over one coordinate,
+        boxes of held vectors over several), so verdicts there are marked unvetted."""
+        return self.vetting is not None and bool(
+            self.vetting.unvetted_ranges_m or self.vetting.unvetted_boxes
+        )
+
     def in_unvetted_range(self, profile, dt: float) -> bool | None:
-        """Whether ``profile`` (deflection, m, at ``dt``) dwells, ``UNVETTED_DWELL_S`` in all,
-        in a range where the reference failed its vetting (it rings, departs or pulls when
-        held there, so a verdict on the profile is unvetted); None without a reference."""
+        """Whether ``profile`` ((T,) deflection, m, or (T, C) over C coordinates, at ``dt``)
+        dwells, ``vetting_check.UNVETTED_DWELL_S`` in all, where the reference failed its
+        vetting (it rings, departs or pulls when held there, so a verdict on the profile is
+        unvetted): one
+        coordinate, its ranges widened by one hold grid step (the vetting saw the holds, not
+        between them); several, its boxes (``vetting_check.enters_unvetted``). None without a
+        reference."""
         if self.reference is None:
             return None
-        import numpy as np
+        from bushenv.vetting_check import enters_unvetted
 
-        x = np.asarray(profile, dtype=np.float64)
-        # one hold grid step about each range: the vetting saw the holds, not between them
-        pad = 2 * self.scales.stroke_m / 200
-        for a, b in self.unvetted_ranges_m:
-            if np.count_nonzero((x >= a - pad) & (x <= b + pad)) * dt >= UNVETTED_DWELL_S:
-                return True
-        return False
+        stroke = getattr(self.scales, "stroke_m", None) or getattr(self.scales, "stroke", None)
+        return enters_unvetted(self.vetting, profile, dt, stroke)
 
     @property
     def unvetted(self) -> bool:

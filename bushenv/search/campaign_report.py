@@ -340,9 +340,16 @@ def _judge_lines(judge: dict | None) -> list[str]:
     if not vet["passed"]:
         state = "FAILED (--trust-reference: verdicts UNVETTED)"
         ranges = judge.get("unvetted_ranges_m") or []
+        boxes = vet.get("unvetted_boxes") or []  # over several coordinates, each in its unit
         if ranges:
             where = ", ".join(f"{a * 1e3:+.3g}..{b * 1e3:+.3g} mm" for a, b in ranges)
             state += f"; it failed at {where}"
+        elif boxes:
+            where = "; ".join(
+                "(" + ", ".join(f"{a * 1e3:+.3g}..{b * 1e3:+.3g}" for a, b in box) + ")"
+                for box in boxes[:4]
+            )
+            state += f"; it failed in {len(boxes)} box(es) of held vectors (mm, mm, mrad): {where}"
     elif all(c["passed"] is True for c in checks):
         state = "passed (every check)"
     else:

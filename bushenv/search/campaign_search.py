@@ -170,7 +170,7 @@ def search_one(
         )
     outside = [judge.in_envelope(c.profile, dt) is False for c in res.failures]
     summary["failures_reference_outside_envelope"] = int(sum(outside))
-    if judge.unvetted_ranges_m:  # trusted despite failing there: those verdicts are unvetted
+    if judge.has_unvetted_regions:  # trusted despite failing there: verdicts there unvetted
         if res.first_failure is not None:
             summary["first_failure"]["reference_unvetted_here"] = judge.in_unvetted_range(
                 res.first_failure.profile, dt

@@ -116,3 +116,32 @@ def test_a_users_three_axis_file_without_a_reference_is_told_to_give_one(tmp_pat
     (err,) = capsys.readouterr().err.strip().splitlines()
     assert "rig3 target judges against a reference and none was given" in err
     assert "--reference NAME|FILE" in err and "rubber, the built-in" in err
+
+
+def test_a_trusted_three_axis_reference_marks_verdicts_where_it_failed(tmp_path, capsys):
+    """A reference that rings when held near -1.25 mm radial (its certificate lists it, the
+    vetting confirms it): trusted, the attack marks every verdict on a profile dwelling there
+    as unvetted, as one axis marks its ranges."""
+    from certify.conftest import ringing3
+
+    from bushenv.search.campaign_config import CampaignConfig
+    from bushenv.search.campaign_resolve import resolve
+
+    ref = ringing3().save(tmp_path / "ring3.npz")
+    model = _rotation_active(tmp_path / "active.npz")
+    config = CampaignConfig(model=str(model), reference=str(ref), target="rig3",
+                            trust_reference=True, out=tmp_path / "r")  # fmt: skip
+    judge = resolve(config).judge
+    assert judge.trusted_by_flag and judge.has_unvetted_regions
+    dt = judge.reference.dt
+    held = np.zeros((int(1.0 / dt), 3))
+    held[:, 1] = -1.25e-3
+    assert judge.in_unvetted_range(held, dt) is True
+    assert judge.in_unvetted_range(np.zeros_like(held), dt) is False
+    argv = ["attack", "--env", "rig3", "--model", str(model), "--reference", str(ref),
+            "--trust-reference", "--budget", "8", "--searchers", "random", "--max-shrink",
+            "0", "--no-plots", "--quiet", "--out", str(tmp_path / "a")]  # fmt: skip
+    assert main(argv) == 0
+    report = json.loads((tmp_path / "a" / "report.json").read_text())
+    assert "failures_in_unvetted_range" in report["models"]["active"]["searchers"]["random"]
+    assert "box(es) of held vectors" in capsys.readouterr().out
