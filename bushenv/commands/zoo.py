@@ -115,8 +115,7 @@ def run(args: argparse.Namespace) -> int:
         refuse_other_kind(config.out / "cells.jsonl", config.coords)
     run_study(config, backend, Progress(quiet=args.quiet))
     print((config.out / "summary.md").read_text())
-    written = ("cells.jsonl", "summary.json", "summary.md")
-    if config.coords == 1:
-        written += ("accuracy_vs_robustness.png",)
+    made = ("cells.jsonl", "summary.json", "summary.md", "accuracy_vs_robustness.png")
+    written = [name for name in made if (config.out / name).is_file()]  # the plot: one axis
     print(f"wrote {config.out}/" + ", ".join(written))
     return 0
