@@ -20,17 +20,22 @@ physical reason and a threshold:
    ``SIGN_FRACTION`` of the stroke), *not finite*, each coordinate against one threshold tied
    to the reference itself (``certify.reached_holds.ring_threshold``: the larger of 3 x its own
    noise in these holds and 1 % of its largest held force), at most that coordinate's force
-   floor.
+   floor. Where it fails: one axis, ranges of x; over C > 1, boxes about the held vectors.
 2. **certificate holds** (NARX references of any C: ``nn``, ``hybrid``, ``nn-axis`` or their
    files): the reference's own certificate (``bushenv certify``, reference-free: wrong sign
-   against the deflection) lists the holds where it oscillates, departs or pulls. One axis:
-   each is reached the way a search reaches it -- a step at the velocity limit, and sines
-   inside the reference's envelope then the hold (``certify.reached_holds.confirm_holds``) --
-   and judged with the same threshold. A confirmed one fails the check; with
-   ``--trust-reference`` every verdict whose profile enters its range is marked unvetted
-   (``Vetting.unvetted_ranges_m``). For C > 1 the certificate runs over the held vectors of
-   check 1; a listed hold is *not checked* (the sines that reach a hold run along one
-   coordinate), none listed passes.
+   against the deflection; one axis over ``CERTIFICATE_HOLDS`` holds, over C > 1 over the held
+   vectors of check 1) lists the holds where it oscillates, departs or pulls. Each is reached
+   the way a search reaches it (``certify.reached_holds.confirm_holds``): a step with every
+   coordinate at its own velocity limit, and sines inside the reference's envelope along each
+   coordinate (and, for a hold off the coordinate axes, along its own direction) then the
+   hold -- and judged per coordinate with check 1's thresholds. A confirmed one fails the
+   check, naming the held vector and the coordinates that show it; with ``--trust-reference``
+   every verdict whose profile dwells in its region is marked unvetted (one axis, its range,
+   ``Vetting.unvetted_ranges_m``; over C > 1, a box about the held vectors,
+   ``Vetting.unvetted_boxes``; ``vetting_check.enters_unvetted`` for any C). The envelope:
+   ``envelope`` when given (one axis: the card's training records' largest |x| and |dx/dt|),
+   else the stroke and ``velocity`` per coordinate (over C with no velocity,
+   ``machine_rate``). A listing the reaching does not confirm passes, saying so.
 3. **records**: the reference's RMS ratio (its worst coordinate's) on the records its model
    card names at most ``RECORD_LIMIT``: 30 % is beyond every fitted model of the papers
    (Tables 2-4) and beyond any model worth judging with. Not checked without a card or without

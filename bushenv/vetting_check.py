@@ -127,24 +127,26 @@ class Vetting:
         return [f"{c.name}: {c.verdict} ({c.detail})" for c in self.checks]
 
 
-def unvetted_regions(vetting: Vetting | None, stroke) -> list[np.ndarray]:
+def unvetted_regions(vetting: Vetting | None, stroke=None) -> list[np.ndarray]:
     """Where ``vetting`` found its reference failing, for any number of coordinates C: (C, 2)
     boxes of per-coordinate (lo, hi) -- one coordinate: its ``unvetted_ranges_m``, widened by
     one step of the certificate's grid over the judged ``stroke`` (m) as the judge does;
     over C > 1 its ``unvetted_boxes`` (``stroke`` unused). Empty without a vetting."""
     if vetting is None:
         return []
-    pad = 2 * float(np.ravel(stroke)[0]) / (CERTIFICATE_HOLDS - 1) if vetting.unvetted_ranges_m \
-        else 0.0  # fmt: skip
-    out = [np.array([[a - pad, b + pad]]) for a, b in vetting.unvetted_ranges_m]
+    ranges = vetting.unvetted_ranges_m
+    if ranges and stroke is None:
+        raise BadInput("one coordinate's unvetted ranges are widened by the judged stroke: give it")
+    pad = 2 * float(np.ravel(stroke)[0]) / (CERTIFICATE_HOLDS - 1) if ranges else 0.0
+    out = [np.array([[a - pad, b + pad]]) for a, b in ranges]
     return out + [np.array(box, dtype=np.float64) for box in vetting.unvetted_boxes]
 
 
-def enters_unvetted(vetting: Vetting | None, profile, dt: float, stroke) -> bool:
+def enters_unvetted(vetting: Vetting | None, profile, dt: float, stroke=None) -> bool:
     """Whether ``profile`` ((T,) for one coordinate, (T, C)) dwells ``UNVETTED_DWELL_S`` in all
     inside one region where ``vetting`` found its reference failing (``unvetted_regions``:
     every coordinate within the box), so a verdict on it is unvetted. One coordinate: the
-    judge's ``in_unvetted_range`` answer."""
+    judge's ``in_unvetted_range`` answer (``stroke``: the judged stroke, m, needed there)."""
     regions = unvetted_regions(vetting, stroke)
     if not regions:
         return False

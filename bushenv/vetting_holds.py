@@ -157,7 +157,6 @@ def _confirmed_vectors(reference, listed, n_held, stroke, envelope, thresholds) 
     )
     if not confirmed:
         return Check("certificate holds", True, f"{said}; none confirmed by {reach}")
-    worst = max(confirmed, key=lambda h: h.ripple_n)
     found = sorted({k for h in confirmed for k in h.kinds})
     names = [reference.coords[i] for i in sorted({i for h in confirmed for i in h.coords})]
     shown = "; ".join(
@@ -166,13 +165,18 @@ def _confirmed_vectors(reference, listed, n_held, stroke, envelope, thresholds) 
         for h in confirmed[:SHOWN]
     )
     more = f"; and {len(confirmed) - SHOWN} more" if len(confirmed) > SHOWN else ""
-    w = worst.worst_coord
-    text = (
-        f"{said}; {len(confirmed)} confirmed ({', '.join(found)}; on {', '.join(names)}): "
-        f"{shown}{more}; by {reach}; worst {worst.ripple_n:.4g} {reference.force_units[w]} "
-        f"p-p on {reference.coords[w]} at {_vector(np.asarray(worst.q), reference)} after "
-        f"{worst.after}"
-    )
+    overall = f" ({', '.join(found)}; on {', '.join(names)})" if more else ""
+    text = f"{said}; {len(confirmed)} confirmed{overall}: {shown}{more}; by {reach}"
+    ringing = [h for h in confirmed if set(h.kinds) & {"oscillating", "not finite"}]
+    if ringing:  # a ripple says something of a ring only
+        worst = max(ringing, key=lambda h: h.ripple_n)
+        w, at = worst.worst_coord, _vector(np.asarray(worst.q), reference)
+        text += (
+            f"; worst {worst.ripple_n:.4g} {reference.force_units[w]} p-p on "
+            f"{reference.coords[w]} at {at} after {worst.after}"
+        )
+    else:
+        text += f"; first after {confirmed[0].after}"
     # the chains of listed vectors holding a confirmed one (not every listed hold is simulated)
     step = 2 * stroke / (HOLDS - 1)
     qs = np.array([h["q"] for h in listed], dtype=np.float64)

@@ -3,15 +3,18 @@
 A certificate's free run steps to each hold from rest; a slow ramp barely excites a hold at all.
 A search reaches a hold after any motion: a network whose hold fixed point is barely unstable
 (spectral radius slightly above 1) stays quiet for seconds after a slow ramp and rings at once
-after a sine. So a listed hold is *confirmed* here from several histories, all inside the
-model's envelope (the largest |x| and |dx/dt| of its card's records, else the judged stroke and
-velocity): the step at the velocity limit (the attack's hold stage), and sines of
+after a sine. So a listed hold -- a deflection x, or over C coordinates a held vector q -- is
+*confirmed* here from several histories, all inside the model's envelope (per coordinate the
+largest |q| and |dq/dt|: of its card's records, else the judged stroke and rate): the step
+with every coordinate at its own velocity limit (the attack's hold stage), and sines of
 ``AMPLITUDE_FRACTIONS`` of the envelope's displacement at ``FREQUENCIES_HZ`` (those within its
-velocity and below a quarter of the sample rate), each from rest, ending at rest position, then
-a move to the hold at the sine's peak speed, then ``HOLD_S`` held (longer for a departure the
-certificate predicts later).
+velocity and below a quarter of the sample rate) along each coordinate, and for a hold off the
+coordinate axes along its own direction (scaled to touch the envelope's box), each from rest,
+ending at rest position, then a move to the hold at the sine's peak speed (as a fraction of
+each coordinate's limit), then ``HOLD_S`` held (longer for a departure the certificate
+predicts later). One coordinate is the case C = 1.
 
-Each hold is judged on its tail (the last ``TAIL_S``), against one threshold
+Each hold is judged on its tail (the last ``TAIL_S``), per coordinate against one threshold
 (:func:`ring_threshold`) tied to the model itself: ``NOISE_FACTOR`` times its own noise (the
 median peak-to-peak of its detrended tails in holds from rest: a few ringing holds do not move
 a median) and ``RING_FRACTION`` of its force scale (its largest settled force over the stroke),
@@ -277,6 +280,8 @@ def confirm_holds(
         hit = cols[np.any(np.stack([flags[k][cols] for k in kinds]), axis=0)]
         worst = int(hit[np.argmax(flags["ripple_n"][hit])])
         shows = np.flatnonzero(flags["coordinates"][hit].any(axis=0))
+        if shows.size == 0:  # a wrong sign of the work alone: the coordinates held
+            shows = np.flatnonzero(_held(h))
         out.append(Confirmed(
             tuple(_held(h).tolist()), found, float(flags["ripple_n"][worst]), how[worst],
             tuple(int(k) for k in shows), int(flags["worst_coordinate"][worst]),
