@@ -98,7 +98,6 @@ def run(args: argparse.Namespace) -> int:
         reference=args.reference,
         allow_failing=args.allow_failing,
     )
-    env = done.facts.envelope
     print(done.path)
     cert = done.certificate
     if cert is not None and cert.fails:
@@ -109,16 +108,27 @@ def run(args: argparse.Namespace) -> int:
             "warning"
         )
     if not args.quiet:
-        if done.coords == 1:
-            io = "deflection in, force out"
-            bounds = f"|x| <= {env.stroke_m * 1e3:.4g} mm, |v| <= {env.velocity_m_per_s:.4g} m/s"
-        else:
-            io = "axial, radial, rotation in; force_axial, force_radial, moment out"
-            bounds = dict(done.facts.lines)["envelope"].split(" (")[0]
-        print(
-            f"FMI {done.fmi_version} FMU (co-simulation and model exchange; {io}) of the "
-            f"{done.model!r} model, compiled with {done.compiler}; envelope {bounds} "
-            f"({env.source}); certificate: {cert.verdict() if cert is not None else 'none'}",
-            file=sys.stderr,
-        )
+        print(summary(done), file=sys.stderr)
     return 0
+
+
+def summary(done) -> str:
+    """One line on the FMU written (``build.Exported``): its ports, in and out, and its
+    envelope per coordinate (mm or mrad; m/s or rad/s), from the FMU's own variables."""
+    from bushenv.export.description import PORTS
+
+    ports = PORTS[done.coords]
+    env = done.facts.envelope
+    strokes, rates = env.limits(done.coords)
+    io = f"{', '.join(p.x for p in ports)} in; {', '.join(p.f for p in ports)} out"
+    bounds = ", ".join(
+        f"|{p.symbol}| <= {s * 1e3:.4g} {'mrad' if p.x_unit == 'rad' else 'mm'}, "
+        f"|d{p.symbol}/dt| <= {r:.4g} {p.v_unit}"
+        for p, s, r in zip(ports, strokes, rates, strict=True)
+    )
+    cert = done.certificate
+    return (
+        f"FMI {done.fmi_version} FMU (co-simulation and model exchange; {io}) of the "
+        f"{done.model!r} model, compiled with {done.compiler}; envelope {bounds} "
+        f"({env.source}); certificate: {cert.verdict() if cert is not None else 'none'}"
+    )

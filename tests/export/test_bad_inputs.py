@@ -137,7 +137,8 @@ def test_export_command_writes_the_fmu_and_names_it(tmp_path, capsys):
     assert main(["export", "linear", "--fmi", "3.0", "--out", str(out), "--stroke-mm", "3"]) == 0
     captured = capsys.readouterr()
     assert captured.out.strip() == str(out)
-    assert "envelope |x| <= 3 mm" in captured.err
+    assert "deflection in; force out" in captured.err
+    assert "envelope |x| <= 3 mm, |dx/dt| <= 1.257 m/s" in captured.err
     assert main(["export", "linear", "--out", str(out), "--stroke-mm", "-1"]) == 2
     assert "--stroke-mm must be positive" in _error(capsys)
 
