@@ -41,7 +41,8 @@ import numpy as np
 from bushenv.errors import ModelRaised
 from bushenv.rigs.common import MODEL_ERRORS, RigError, positive_int, reset_columns
 from bushenv.rigs.coupling import LONG_ARM_M
-from bushenv.rigs.halfcar_batch_kernels import PY, VY, bushing_motion_kernel, substeps_kernel
+from bushenv.rigs.halfcar_batch_kernels import PY, VY, bushing_motion_kernel
+from bushenv.rigs.halfcar_batch_lanes import lanes_kernel
 from bushenv.rigs.halfcar_batch_layout import ROAD, layout
 from bushenv.rigs.halfcar_batch_outputs import RESULT_KEYS, car_outputs, out_of_bounds, result
 from bushenv.rigs.halfcar_inputs import replay_inputs
@@ -70,6 +71,7 @@ class HalfCarBatch:
         cols = n * len(self.groups)
         tables = [layout(p, role) for role, _ in self.groups]
         t = self._table = tables[0]
+        self._kernel = self._compiled()
         self._rest0 = np.repeat(np.stack([x.rest for x in tables]), n, axis=0).T.copy()
         self._stiff = np.repeat(np.stack([x.stiff for x in tables]), n, axis=0).T.copy()
         self._damp = np.repeat(np.stack([x.damp for x in tables]), n, axis=0).T.copy()
@@ -177,26 +179,33 @@ class HalfCarBatch:
         """The sub-steps of every column; with ``threads`` > 1 the columns split in as many
         ranges, each stepped in its own thread (the kernel releases the GIL)."""
         p, t = self.params, self._table
+        if self._kernel is None:  # unpickled
+            self._kernel = self._compiled()
         args = (
             self.state, self.rest, self._stiff, self._damp, self.contact, gx, h_car,
-            p.substeps, ITERATIONS, t.kind, t.ia, t.ib, t.side, t.anchors, t.m_inv, t.i_inv,
-            p.k_t, -p.tyre_static_n, p.c_t, p.k_y, p.c_y,
+            int(p.substeps), t.anchors, t.m_inv, t.i_inv,
+            *(float(x) for x in (p.k_t, -p.tyre_static_n, p.c_t, p.k_y, p.c_y)),
         )  # fmt: skip
         cols = self.state.shape[2]
         parts = min(self.threads, cols // MIN_THREAD_COLUMNS)
         if parts <= 1:
-            substeps_kernel(*args, 0, cols)
+            self._kernel(*args, 0, cols)
             return
         if self._pool is None:
             self._pool = ThreadPoolExecutor(self.threads)
         edges = np.linspace(0, cols, parts + 1).astype(int)
-        jobs = [self._pool.submit(substeps_kernel, *args, lo, hi)
+        jobs = [self._pool.submit(self._kernel, *args, lo, hi)
                 for lo, hi in zip(edges[:-1], edges[1:], strict=True)]  # fmt: skip
         for job in jobs:
             job.result()
 
+    def _compiled(self):
+        """The sub-step kernel compiled for this car's element table."""
+        t = self._table
+        return lanes_kernel(t.kind, t.ia, t.ib, t.side, t.m_inv != 0, ITERATIONS)
+
     def __getstate__(self) -> dict[str, Any]:
-        return {**self.__dict__, "_pool": None}
+        return {**self.__dict__, "_pool": None, "_kernel": None}
 
     def _sample(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every car's (cols, 4, 3) pivot forces at t_k and why they cannot be applied ((cols,)
