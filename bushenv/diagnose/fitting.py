@@ -131,18 +131,40 @@ def fit(
 
 def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
     """The fitted model's force on one record (N), (T,). A per-record block gets the weights
-    the record was fitted with, or, on a judged record, the mean of the fitted records' (its
-    own start is not known before it is judged: fitting it there would give every judged
-    record a spring and damper of its own)."""
+    the record was fitted with; on a judged record, one scale >= 0 of its own along
+    ``start_direction`` (the state it starts in -- a heat -- is the record's, and no other
+    record can tell it; one number, not a spring and damper of its own)."""
     a = store.design(prep, f.blocks)
     out = prep.b0 + a @ f.theta
     if f.nuisance:
         wn = store.design(prep, f.nuisance)
         own = f.nuisance_w.get(prep.uid)
-        if own is None:
-            own = np.mean(list(f.nuisance_w.values()), axis=0)
-        out = out + wn @ own
+        if own is not None:
+            out = out + wn @ own
+        else:
+            d = shift_columns(wn @ start_direction(store, f), f.delay_s, prep.dt)
+            dd = float(d @ d)
+            if dd > 0:
+                res = prep.force - shift_columns(out, f.delay_s, prep.dt)
+                return shift_columns(out, f.delay_s, prep.dt) + max(float(res @ d) / dd, 0.0) * d
     return shift_columns(out, f.delay_s, prep.dt)
+
+
+def start_direction(store: ColumnStore, f: Fit) -> np.ndarray:
+    """The per-record block's weights up to a scale, for a record judged: the effect's own
+    weights where its columns match the per-record ones one to one (a record that starts warm
+    loses stiffness and damping in the ratio heating takes them), else the fitted records'
+    mean start."""
+    mean = np.mean(list(f.nuisance_w.values()), axis=0)
+    if len(f.nuisance) != 1:
+        return mean
+    name, i = f.nuisance[0][0], 0
+    for block in f.blocks:
+        n = store.columns_count(block)
+        if block[0] == name and n == mean.size:
+            return f.theta[i : i + n]
+        i += n
+    return mean
 
 
 def _product(grids: list[list]) -> list[tuple]:

@@ -7,7 +7,9 @@ knots every 10 % and its own growth per side; both heating laws on a finer time-
 a finer delay grid) and must still close a significant share of what that form leaves above
 the noise. A partner that only mends the first effect's usual form where it does not fit the
 true one exactly (a relaxation spectrum of another shape leaving a structured remainder that
-a backbone or a friction soaks up) adds nothing to the richest form and is not named.
+a backbone or a friction soaks up) adds nothing to the richest form and is not named. A pair
+without the best single effect (the *first*) must close the same share of what the first's
+richest form leaves: a pair is an answer only where the first's whole family is not.
 
 The threshold ``BEYOND_RICH_MIN`` is calibrated on single-effect cases whose forms no
 candidate shares (``validation/partner_cases.py``); its false-positive rate is measured there
@@ -57,10 +59,31 @@ def member_beyond_rich(member: str, other: str, row_of: RowOf, ctx: Context, cac
     }
 
 
-def check_partners(pairs: list[dict], row_of: RowOf, ctx: Context) -> None:
+def pair_beyond_rich(pair: dict, first: str, row_of: RowOf, ctx: Context, cache: dict) -> dict:
+    """How much the pair ``pair`` (without ``first``) adds to ``first``'s richest form."""
+    if first not in cache:
+        cache[first] = row_of(Combination((_rich(first),)))
+    base = cache[first]
+    z = float(cut_z(ctx.force, base["_pred"], pair["_pred"], ctx.edges))
+    share = float(ctx.closes(pair["gap_after"], base["gap_after"]))
+    return {
+        "member": pair["effect"],
+        "beside_richest": first,
+        "richest_gap": float(base["gap_after"]),
+        "gap_with_member": float(pair["gap_after"]),
+        "z": z,
+        "share": share,
+        "adds": bool((z >= Z_NAME or share >= CLEAR_CUT) and share >= BEYOND_RICH_MIN),
+    }
+
+
+def check_partners(
+    pairs: list[dict], row_of: RowOf, ctx: Context, first: str | None = None
+) -> None:
     """On ranked ``pairs``: the first ``PAIRS_TRIED`` that would pass keep passing only when
-    each member adds to the other's richest form (``beyond_richest`` in the row); passing
-    pairs further down are not named (``beyond_richest`` None)."""
+    each member adds to the other's richest form and, for a pair without ``first`` (the best
+    single), the pair adds to ``first``'s richest form (``beyond_richest`` in the row);
+    passing pairs further down are not named (``beyond_richest`` None)."""
     cache: dict[str, dict] = {}
     tried = 0
     for r in pairs:
@@ -73,8 +96,12 @@ def check_partners(pairs: list[dict], row_of: RowOf, ctx: Context) -> None:
             continue
         tried += 1
         a, b = r["members"]
-        checks = [member_beyond_rich(b, a, row_of, ctx, cache)]
-        if checks[0]["adds"]:
+        checks = []
+        if first is not None and first not in r["members"]:
+            checks.append(pair_beyond_rich(r, first, row_of, ctx, cache))
+        if all(c["adds"] for c in checks):
+            checks.append(member_beyond_rich(b, a, row_of, ctx, cache))
+        if all(c["adds"] for c in checks):
             checks.append(member_beyond_rich(a, b, row_of, ctx, cache))
         r["beyond_richest"] = checks
         if not all(c["adds"] for c in checks):

@@ -6,8 +6,9 @@ own: a record whose own linear fit (spring and damper fitted on that record alon
 than ``rule.OUTSIDE_NOISE`` x the noise shows behaviour a linear bushing does not have; a
 record that does not (a TRAIN too small or too slow to excite the effect) only says how far
 the effect's fit on the others extrapolates, which is not the question. A candidate that passes
-there is named (``Answer.on_records`` lists those records); if none does, the answer stays
-``outside_candidates``.
+there is named (``Answer.on_records`` lists those records) -- a single, or a pair when a pair
+is what closes those records' gap, by the same rule and partner test as on all records; if
+none does, the answer stays ``outside_candidates``.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import copy
 
 import numpy as np
 
-from bushenv.diagnose import rule
+from bushenv.diagnose import naming, partner, rule
 from bushenv.metrics import rms_ratio
 
 
@@ -55,32 +56,33 @@ def restricted(ctx: rule.Context, keep: list[int]) -> tuple[rule.Context, np.nda
     return sub, idx
 
 
+def _restrict(r: dict, idx: np.ndarray, sub: rule.Context) -> dict:
+    c = copy.copy(r)
+    c["_pred"] = r["_pred"][idx]
+    c["gap_after"] = rms_ratio(sub.force, c["_pred"])
+    return c
+
+
 def answer_on_showing(
-    singles: list[dict], ctx: rule.Context
+    singles: list[dict], pairs: list[dict], ctx: rule.Context, row_of: partner.RowOf
 ) -> tuple[rule.Answer, list[int]] | None:
-    """The best single that passes the rule on the records that show a gap, when some records
-    do not, and those records' indices (else None: the pooled answer stands)."""
+    """The answer of the whole rule -- singles, pairs and each partner beside the other's
+    richest form (``row_of`` judges those) -- on the records that show a gap, when some
+    records do not, and those records' indices (else None: the pooled answer stands). A pair
+    is named there when a pair is what closes those records' gap."""
     keep = showing_records(ctx)
     if not keep or len(keep) == len(ctx.records or []):
         return None
     sub, idx = restricted(ctx, keep)
-    rows = []
-    for r in singles:
-        c = copy.copy(r)
-        c["_pred"] = r["_pred"][idx]
-        c["gap_after"] = rms_ratio(sub.force, c["_pred"])
-        rows.append(c)
-    rule.mark_failed(rows, sub)
-    rule.mark_passes(rows, sub)
-    passing = sorted((c for c in rows if c["passes"]), key=lambda c: c["gap_after"])
-    if not passing:
+    s_rows = [_restrict(r, idx, sub) for r in singles]
+    p_rows = [_restrict(r, idx, sub) for r in pairs]
+    rule.mark_failed(s_rows + p_rows, sub)
+    s_rows, p_rows = naming.apply_rule(
+        s_rows, p_rows, sub, lambda c: _restrict(row_of(c), idx, sub)
+    )
+    ans = rule.answer(s_rows, p_rows, sub)
+    if ans.effect in (rule.OUTSIDE, "none"):
         return None
-    best = next(r for r in singles if r["effect"] == passing[0]["effect"])
-    if len(passing) > 1 and rule.indistinguishable(passing[0], passing[1], sub):
-        between = [passing[0]["effect"], passing[1]["effect"]]
-        return rule.Answer(rule.AMBIGUOUS, best, between, between), keep
-    name = best["effect"]
-    others = [c["effect"] for c in passing[1:]] or [
-        c["effect"] for c in rows if c["effect"] != name
-    ]
-    return rule.Answer(name, best, [name] + others[:1], []), keep
+    full = {frozenset(r["members"]): r for r in singles + pairs}
+    row = full[frozenset(ans.row["members"])]
+    return rule.Answer(ans.effect, row, ans.top_two, ans.between), keep

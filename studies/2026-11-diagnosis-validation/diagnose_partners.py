@@ -2,6 +2,8 @@
 
     python studies/2026-11-diagnosis-validation/diagnose_partners.py --seed 1 --out p1.json
     python studies/2026-11-diagnosis-validation/diagnose_partners.py --summary p1.json p2.json
+    python studies/2026-11-diagnosis-validation/diagnose_partners.py --label thermal+relaxation \
+        --seed 5 --cases 10 --out tr.json
 
 Runs ``diagnose`` (default mode) on ``validation/partner_cases.py`` cases and keeps, per case,
 the answer, the answer the pair rule alone would give (the first pair that passed it, before
@@ -27,11 +29,11 @@ def named_set(named: str) -> set[str]:
     return set() if named in ("none", AMBIGUOUS, OUTSIDE) else set(named.split("+"))
 
 
-def run(seed: int, cases: int, start: int) -> list[dict]:
+def run(seed: int, cases: int, start: int, label: tuple[str, ...] | None = None) -> list[dict]:
     rows = []
     t0 = time.monotonic()
     for n, i in enumerate(range(start, start + cases)):
-        case = make_partner_case(seed, i)
+        case = make_partner_case(seed, i, label=label)
         r = diagnose(case.train, case.tests)
         before = next((p["effect"] for p in r["pairs"] if p.get("passes_pair_rule")), None)
         rows.append(
@@ -81,7 +83,8 @@ def summary(rows: list[dict]) -> str:
         for r, lab in zip(rows, label, strict=True):
             for t in r["tested"]:
                 for c in t["checks"]:
-                    true = c["member"] in lab and c["beside_richest"] in lab
+                    # a pair tested beside the best single's richest form: all three true
+                    true = set(c["member"].split("+")) | {c["beside_richest"]} <= lab
                     if true == (kind == "true"):
                         shares.append(round(c["share"], 2))
         out.append(f"{kind} partners' shares beside the richest form: {sorted(shares)}")
@@ -94,12 +97,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cases", type=int, default=40)
     ap.add_argument("--start", type=int, default=0)
     ap.add_argument("--out", default="partners.json")
+    ap.add_argument("--label", help="every case this effect or pair, e.g. thermal+relaxation")
     ap.add_argument("--summary", nargs="*", help="only summarise these JSON files")
     a = ap.parse_args(argv)
     if a.summary:
         rows = [row for p in a.summary for row in json.load(open(p, encoding="utf-8"))]
     else:
-        rows = run(a.seed, a.cases, a.start)
+        label = tuple(a.label.split("+")) if a.label else None
+        rows = run(a.seed, a.cases, a.start, label)
         with open(a.out, "w", encoding="utf-8") as f:
             json.dump(rows, f, indent=1)
     print(summary(rows))

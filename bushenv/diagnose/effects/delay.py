@@ -7,9 +7,13 @@ from typing import Any
 import numpy as np
 
 from bushenv.diagnose.effects.base import Effect, Scales, Signals
+from bushenv.diagnose.effects.timeshift import shift_columns
 
 DELAY_GRID_S = tuple(float(d) for d in 1e-3 * np.geomspace(0.25, 40.0, 25))
 RICH_DELAY_GRID_S = tuple(float(d) for d in 1e-3 * np.geomspace(0.1, 60.0, 48))
+# The richest form spreads the lag: the spring's and the damper's force also at these shares of
+# d before and after it (a causal lag kernel on [0, 2 d] of mean d, non-negative weights).
+SPREAD_SHARES = (-1.0, -0.5, 0.5, 1.0)
 EXAMPLE_DELAY_S = 6e-3  # between grid values: the shape search must refine it
 
 
@@ -34,6 +38,14 @@ class Delay(Effect):
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         return np.zeros((s.x.size, 0))  # no weights: the shift is all of it
+
+    def rich_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        """A lag spread over [0, 2 d]: the spring's and the damper's force also shifted by
+        each of ``SPREAD_SHARES`` x d around the delay, weights >= 0. A measurement chain lags
+        through a filter (an average, an anti-alias stage), which lowers the gain as the lag
+        spreads (by ``w^2 var / 2``, as a mass would); a pure shift is only its narrowest case."""
+        xv = np.stack([s.x, s.v], axis=1)
+        return np.concatenate([shift_columns(xv, q * shape, s.dt) for q in SPREAD_SHARES], axis=1)
 
     def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
         return EXAMPLE_DELAY_S, np.zeros(0)

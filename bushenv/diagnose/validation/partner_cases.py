@@ -167,13 +167,23 @@ def _poor_train(rng, dt: float, peak: float) -> np.ndarray:
     return peak / 3 * x * np.minimum(1.0, t / 0.5)
 
 
-def make_partner_case(seed: int, index: int, poor_train: bool | None = None) -> Case:
+def make_partner_case(
+    seed: int, index: int, poor_train: bool | None = None, label: tuple[str, ...] | None = None
+) -> Case:
     """Case ``index`` of partner run ``seed`` (deterministic); ``poor_train`` True / False
-    forces the poor TRAIN on or off (None: one single-effect case in four)."""
+    forces the poor TRAIN on or off (None: one single-effect case in four); ``label`` forces
+    the effects (a pair the drawn labels seldom hold, such as thermal + relaxation)."""
     from bushenv.records import Record
 
     rng = np.random.default_rng([seed, index, 41])
-    label = label_of(index, rng)
+    drawn_label = label_of(index, rng)
+    if label is None:
+        label = drawn_label
+    else:
+        unknown = [n for n in label if n not in EFFECTS]
+        if unknown or len(set(label)) != len(label) or not 1 <= len(label) <= 2:
+            raise ValueError(f"label {label!r}: one or two distinct effects of {EFFECTS}")
+        label = tuple(sorted(label, key=EFFECTS.index))
     rate = float(rng.choice(BUSHING_RATES_HZ))
     dt_f = 1.0 / (rate * OVERSAMPLE)
     train_x, test_x, info = bushing_programmes(rng, dt_f, rate)
