@@ -112,8 +112,7 @@ def _span(args: argparse.Namespace, model) -> tuple[tuple[float, ...], str]:
 
 
 def _several(args: argparse.Namespace, model) -> Setup:
-    from bushenv.search.targets import reference_floors
-    from bushenv.vetting import vet_reference
+    from bushenv.search.campaign_limits import vetted_within
 
     span, source = _span(args, model)
     spec = None if args.reference in (None, "none") else str(args.reference)
@@ -123,29 +122,12 @@ def _several(args: argparse.Namespace, model) -> Setup:
         spec, axis=args.axis, dt=model.dt, coords=model.n_coords,
         wanted_by="bushenv certify --reference",
     )  # fmt: skip
-    floors, floors_source = reference_floors(reference)
-    vetting = vet_reference(
-        reference,
-        spec,
-        np.array(span),
-        floors,
-        card_file=spec if spec.endswith(".npz") else None,
-        model=model,
-        model_file=args.model if str(args.model).endswith(".npz") else None,
-    )
-    if not vetting.passed and not args.trust_reference:
-        raise CertifyError(
-            f"the reference {spec} failed its vetting ({vetting.summary()}): it cannot judge; "
-            "give another --reference, or pass --trust-reference to certify against it anyway"
-        )
-    judge = {
-        "reference": spec,
-        "vetting": vetting.describe(),
-        "vetting_verdict": vetting.verdict,
-        "trusted_despite_failed_vetting": bool(not vetting.passed),
-        "force_floors": dict(zip(model.coords, np.asarray(floors).tolist(), strict=True)),
-        "force_floors_source": floors_source,
-    }
+    model_file = args.model if str(args.model).endswith(".npz") else None
+    vetting, judged = vetted_within(
+        reference, spec, None, lambda _: None, model=model, model_file=model_file,
+        trust=args.trust_reference, error=CertifyError, stroke=np.array(span),
+    )  # fmt: skip
+    judge = {"reference": spec, "vetting_verdict": vetting.verdict, **judged}
     line = f"{spec}, vetting {vetting.headline()}"
     return Setup(span, source, _shown(model, span), reference, spec, line, judge, _title(args))
 

@@ -93,9 +93,10 @@ def vetted_within(
     error: type[Exception] = SearchError,
     stroke: np.ndarray | None = None,
 ):
-    """The reference checked before it judges (``bushenv.vetting``) within ``stroke`` (None:
-    the target's): ``error`` when it fails, unless ``trust``; (the ``Vetting``, what judged --
-    the vetting, floors, stroke -- for a report)."""
+    """The reference (over several coordinates) checked before it judges (``bushenv.vetting``)
+    within ``stroke`` (None: the search ``target``'s): ``error`` when it fails, unless
+    ``trust``; (the ``Vetting``, what judged -- the vetting, the force floors per coordinate,
+    the stroke -- for a report). The attack, the zoo and ``bushenv certify`` vet with it."""
     from bushenv.search.targets import reference_floors
     from bushenv.vetting import vet_reference
 
@@ -122,9 +123,9 @@ def vetted_within(
     return vetted, {
         "vetting": vetted.describe(),
         "trusted_despite_failed_vetting": bool(not vetted.passed),
-        "force_floors": dict(zip(target.coords, floors.tolist(), strict=True)),
+        "force_floors": dict(zip(reference.coords, floors.tolist(), strict=True)),
         "force_floors_source": floors_source,
-        "stroke": dict(zip(target.coords, np.asarray(stroke).tolist(), strict=True)),
+        "stroke": dict(zip(reference.coords, np.asarray(stroke).tolist(), strict=True)),
     }
 
 

@@ -37,9 +37,10 @@ VOLATILE = {
 
 
 def relative(obj: Any, out: Path) -> Any:
-    """``obj`` with the run's temporary folder written as ``<out>`` in every string."""
+    """``obj`` with the run's temporary folder written as ``<out>`` in every string (keys
+    too: a case's verdicts are keyed by the model's file)."""
     if isinstance(obj, dict):
-        return {k: relative(v, out) for k, v in obj.items()}
+        return {relative(k, out): relative(v, out) for k, v in obj.items()}
     if isinstance(obj, list):
         return [relative(v, out) for v in obj]
     return obj.replace(str(out), "<out>") if isinstance(obj, str) else obj
