@@ -41,7 +41,7 @@ import numpy as np
 from bushenv.errors import ModelRaised
 from bushenv.rigs.common import MODEL_ERRORS, RigError, positive_int, reset_columns
 from bushenv.rigs.coupling import LONG_ARM_M
-from bushenv.rigs.halfcar_batch_kernels import PY, VY, bushing_motion_kernel
+from bushenv.rigs.halfcar_batch_kernels import PY, VY, bushing_motion_kernel, hold_kernel
 from bushenv.rigs.halfcar_batch_lanes import lanes_kernel
 from bushenv.rigs.halfcar_batch_layout import ROAD, layout
 from bushenv.rigs.halfcar_batch_outputs import RESULT_KEYS, car_outputs, out_of_bounds, result
@@ -77,6 +77,7 @@ class HalfCarBatch:
         self._damp = np.repeat(np.stack([x.damp for x in tables]), n, axis=0).T.copy()
         self._split = np.repeat(np.stack([x.split for x in tables]), n, axis=0)  # (cols, 4, 2, 3)
         self._hold_rows = t.bushing_rows.reshape(-1)  # each pivot's axial, radial, rotary spring
+        self._limits = np.array([p.force_limit, p.force_limit, p.moment_limit], dtype=np.float64)
         self._hold_base = np.array([LONG_ARM_M, LONG_ARM_M, 0.0])
         self._hold_sign = np.stack([-np.ones(len(POSITIONS)), -np.ones(len(POSITIONS)),
                                     t.pivot_sign], axis=1)  # fmt: skip
@@ -144,7 +145,7 @@ class HalfCarBatch:
         p, n = self.params, self.num_cars
         now = np.empty((3, n))
         for i, x in enumerate((road_left, road_right, lateral_accel)):
-            now[i] = np.broadcast_to(np.asarray(x, dtype=np.float64), (n,))
+            now[i] = np.asarray(x, dtype=np.float64)  # a scalar or (B,), as broadcasting allows
         before, self._inputs = self._inputs, now
         bushing_motion_kernel(
             self.state, self._table.pivot_arm, self._table.pivot_sign,
@@ -152,19 +153,19 @@ class HalfCarBatch:
         )  # fmt: skip
         q, v = self._q.copy(), self._v.copy()
         forces, why = self._sample(q, v)
-        g = len(self.groups)
+        g = len(self.groups)  # every column's inputs: a car's, then its twin's
+        inputs = np.concatenate((now,) * g, axis=1)
+        roads, ay = inputs[:2], inputs[2]
+        road_v = np.concatenate(((now[:2] - before[:2]) / p.dt,) * g, axis=1)
         for k, side in enumerate(SIDES):
-            self.state[VY, ROAD[side]] = np.tile((now[k] - before[k]) / p.dt, g)
-        gx = np.tile(-(before[2] + now[2]) / 2, g)
+            self.state[VY, ROAD[side]] = road_v[k]
+        gx = np.concatenate((-(before[2] + now[2]) / 2,) * g)
         self._integrate(gx, np.where(self.active, p.h, 0.0))
         for k, side in enumerate(SIDES):  # the road exactly where the step put it, at rest
             r = ROAD[side]
-            self.state[PY, r] = np.where(self.active, np.tile(now[k], g), self.state[PY, r])
+            self.state[PY, r] = np.where(self.active, roads[k], self.state[PY, r])
             self.state[VY, r] = 0.0
         self._t += 1
-        roads = np.tile(now[:2], g)
-        road_v = np.tile((now[:2] - before[:2]) / p.dt, g)
-        ay = np.tile(now[2], g)
         out = car_outputs(p, self.state, self.contact, roads, road_v, self._prev_v, ay)
         bad = (why | out_of_bounds(p, out, q)) & self.active
         self.active &= ~bad
@@ -210,7 +211,7 @@ class HalfCarBatch:
     def _sample(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every car's (cols, 4, 3) pivot forces at t_k and why they cannot be applied ((cols,)
         bool: raised, not finite, beyond the limits); the others' remainders held."""
-        p, n = self.params, self.num_cars
+        n = self.num_cars
         forces = np.empty_like(q)
         for g, (role, models) in enumerate(self.groups):
             cols = slice(g * n, (g + 1) * n)
@@ -229,16 +230,11 @@ class HalfCarBatch:
                 raise
             except Exception as exc:  # the model's own bug: an error, never a verdict
                 raise ModelRaised(f"{role} (half car pivots)", exc) from exc
-        limits = np.array([p.force_limit, p.force_limit, p.moment_limit])
-        with np.errstate(invalid="ignore"):
-            ok = (np.abs(forces) <= limits).all(axis=(1, 2))  # False where NaN
-        k_in, c_in = self._split[:, :, 0], self._split[:, :, 1]
-        held = forces - (k_in * q + c_in * v)
         # the springs' rest lengths LONG_ARM_M - H / k_in, the rotary's rest angle s H / k_in
         # (chipmunk's own angle: the right side unmirrored), where the forces can be applied
-        rest = (self._hold_base + self._hold_sign * held / k_in).reshape(len(ok), -1).T
-        rows = self._hold_rows
-        self.rest[rows] = np.where(ok, rest, self.rest[rows])
+        ok = np.empty(len(forces), dtype=bool)
+        hold_kernel(forces, q, v, self._split, self._hold_base, self._hold_sign,
+                    self._hold_rows, self._limits, self.rest, ok)  # fmt: skip
         return forces, ~ok
 
     # ----- whole manoeuvres -------------------------------------------------------------------

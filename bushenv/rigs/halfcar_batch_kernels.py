@@ -29,6 +29,8 @@ lateral tyre's here; 2e-7 at x = 0.3).
 
 from __future__ import annotations
 
+import math
+
 import numba as nb
 import numpy as np
 
@@ -69,3 +71,52 @@ def zero_state(n: int) -> np.ndarray:
     S = np.zeros((N_ROWS, 9, n))
     S[COS] = 1.0
     return S
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def hold_kernel(
+    forces, q, v, split, base, sign, rows, limits, rest, ok
+):  # pragma: no cover - compiled
+    """Each column's pivot forces ``forces`` (N, P, 3) at (q, v): ``ok`` (N,) where every
+    one is within ``limits`` (3,) (False where NaN), and there the remainder
+    H = F - (k_in q + c_in v) (``split`` (N, P, 2, 3)) held in the sub-steps' springs: rows
+    ``rows`` (P * 3,) of ``rest`` get ``base + sign H / k_in`` (``base`` (3,), ``sign``
+    (P, 3)); a column not ok keeps its rest lengths."""
+    n_p = forces.shape[1]
+    for b in range(forces.shape[0]):
+        good = True
+        for i in range(n_p):
+            for c in range(3):
+                if not abs(forces[b, i, c]) <= limits[c]:
+                    good = False
+        ok[b] = good
+        if good:
+            for i in range(n_p):
+                for c in range(3):
+                    k_in = split[b, i, 0, c]
+                    held = forces[b, i, c] - (k_in * q[b, i, c] + split[b, i, 1, c] * v[b, i, c])
+                    rest[rows[3 * i + c], b] = base[c] + sign[i, c] * held / k_in
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def bounds_kernel(
+    body, roll, travel, q, max_body, max_roll, max_travel, max_deflection, bad
+):  # pragma: no cover - compiled
+    """``bad`` (N,): a column with a body coordinate ``body`` (K, N) or the roll not finite or
+    beyond ``max_body`` / ``max_roll``, a wheel's ``travel`` (S, N) beyond ``max_travel``, a
+    pivot's deflection ``q`` (N, P, 3) not finite or (its two translations) beyond
+    ``max_deflection``."""
+    for b in range(bad.shape[0]):
+        out = not (math.isfinite(roll[b]) and abs(roll[b]) <= max_roll)
+        for k in range(body.shape[0]):
+            x = body[k, b]
+            out |= not (math.isfinite(x) and abs(x) <= max_body)
+        for s in range(travel.shape[0]):
+            out |= abs(travel[s, b]) > max_travel
+        for i in range(q.shape[1]):
+            for c in range(3):
+                x = q[b, i, c]
+                out |= not math.isfinite(x)
+                if c < 2:
+                    out |= abs(x) > max_deflection
+        bad[b] = out

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.rigs.halfcar_batch_kernels import ANG, PX, PY, VX, VY, W
+from bushenv.rigs.halfcar_batch_kernels import ANG, PX, PY, VX, VY, W, bounds_kernel
 from bushenv.rigs.halfcar_batch_layout import UPRIGHT
 from bushenv.rigs.halfcar_car import SIGN
 from bushenv.rigs.halfcar_outputs import PIVOT_KEYS
@@ -75,14 +75,10 @@ def out_of_bounds(p: HalfCarParameters, out: dict[str, np.ndarray], q: np.ndarra
     pivots' deflections at the step's start)."""
     body = np.stack([out["body_x_m"], out["body_y_m"], out["wheel_left_y_m"],
                      out["wheel_right_y_m"]])  # fmt: skip
-    with np.errstate(invalid="ignore"):
-        bad = ~np.isfinite(body).all(axis=0) | ~np.isfinite(out["roll_rad"])
-        bad |= ~np.isfinite(q).all(axis=(1, 2))
-        bad |= np.abs(q[:, :, :2]).max(axis=(1, 2)) > p.max_deflection
-        bad |= np.abs(out["roll_rad"]) > p.max_roll
-        for side in SIDES:
-            bad |= np.abs(out[f"travel_{side}_m"]) > p.max_travel
-        bad |= np.abs(body).max(axis=0) > p.max_body
+    travel = np.stack([out[f"travel_{side}_m"] for side in SIDES])
+    bad = np.empty(len(q), dtype=bool)
+    bounds_kernel(body, out["roll_rad"], travel, q, p.max_body, p.max_roll, p.max_travel,
+                  p.max_deflection, bad)  # fmt: skip
     return bad
 
 
