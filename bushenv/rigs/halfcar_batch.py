@@ -44,7 +44,13 @@ from bushenv.rigs.coupling import LONG_ARM_M
 from bushenv.rigs.halfcar_batch_kernels import PY, VY, bushing_motion_kernel, hold_kernel
 from bushenv.rigs.halfcar_batch_lanes import lanes_kernel
 from bushenv.rigs.halfcar_batch_layout import ROAD, layout
-from bushenv.rigs.halfcar_batch_outputs import RESULT_KEYS, car_outputs, out_of_bounds, result
+from bushenv.rigs.halfcar_batch_outputs import (
+    MODEL_KEYS,
+    RESULT_KEYS,
+    car_outputs,
+    out_of_bounds,
+    result,
+)
 from bushenv.rigs.halfcar_inputs import replay_inputs
 from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, SIDES, HalfCarParameters
 from bushenv.rigs.specs import spec_kwargs
@@ -142,6 +148,11 @@ class HalfCarBatch:
     def step(self, road_left, road_right, lateral_accel) -> dict[str, np.ndarray]:
         """One model step to the inputs (each (B,) or a scalar: m, m, m/s^2): the env's
         ``step`` for B cars. Returns (B,) arrays under ``RESULT_KEYS``."""
+        return result(self, *self._step(road_left, road_right, lateral_accel))
+
+    def _step(self, road_left, road_right, lateral_accel) -> tuple:
+        """``step``'s work: the inputs (3, B), the columns' outputs, the pivots' deflections
+        and forces (cols, 4, 3), for ``result``."""
         p, n = self.params, self.num_cars
         now = np.empty((3, n))
         for i, x in enumerate((road_left, road_right, lateral_accel)):
@@ -174,7 +185,7 @@ class HalfCarBatch:
             self.diverged |= bad[:n] & ~self.reference_out
         else:
             self.diverged |= bad[:n]
-        return result(self, now, out, q, forces)
+        return now, out, q, forces
 
     def _integrate(self, gx: np.ndarray, h_car: np.ndarray) -> None:
         """The sub-steps of every column; with ``threads`` > 1 the columns split in as many
@@ -242,8 +253,8 @@ class HalfCarBatch:
         self, road_left=None, road_right=None, lateral_accel=None, keys=None
     ) -> dict[str, np.ndarray]:
         """Whole manoeuvres from rest: each input (T,) (every car) or (T, B), the absent ones
-        zero; returns (T, B) arrays of ``keys`` (default ``RESULT_KEYS``) plus ``diverged``,
-        ``divergence_step`` and ``physical_limit`` (B,)."""
+        zero; returns (T, B) arrays of ``keys`` (default every key ``step`` returns) plus
+        ``diverged``, ``divergence_step`` and ``physical_limit`` (B,)."""
         n = self.num_cars
         given = {"road_left": road_left, "road_right": road_right, "lateral_accel": lateral_accel}
         cols = {k: np.asarray(x, dtype=np.float64) for k, x in given.items() if x is not None}
@@ -260,16 +271,17 @@ class HalfCarBatch:
         for j in range(n):  # the env's limits on a replayed manoeuvre, column by column
             replay_inputs(self.params, {k: x[:, j] for k, x in full.items()})
         inputs = [full.get(k, np.zeros((T, n))) for k in given]
-        keys = RESULT_KEYS if keys is None else tuple(keys)
-        unknown = sorted(set(keys) - set(RESULT_KEYS))
+        known = RESULT_KEYS if self.with_reference else MODEL_KEYS
+        keys = known if keys is None else tuple(keys)
+        unknown = sorted(set(keys) - set(known))
         if unknown:
-            raise RigError(f"{ENV_ID}: unknown output key(s) {unknown}; known: {RESULT_KEYS}")
+            raise RigError(f"{ENV_ID}: unknown output key(s) {unknown}; known: {known}")
         self.reset()
         rows = {k: np.empty((T, n)) for k in keys}
         first = np.full(n, -1)
         for t in range(T):
-            out = self.step(inputs[0][t], inputs[1][t], inputs[2][t])
-            first[(first < 0) & out["diverged"]] = t
+            out = result(self, *self._step(inputs[0][t], inputs[1][t], inputs[2][t]), keys)
+            first[(first < 0) & self.diverged] = t
             for k in keys:
                 rows[k][t] = out[k]
         rows["diverged"] = self.diverged.copy()

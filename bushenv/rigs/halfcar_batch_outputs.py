@@ -82,29 +82,55 @@ def out_of_bounds(p: HalfCarParameters, out: dict[str, np.ndarray], q: np.ndarra
     return bad
 
 
-def result(batch: Any, now: np.ndarray, out: dict[str, np.ndarray], q, forces) -> dict:
-    """The step's (B,) arrays under ``RESULT_KEYS`` (the reference keys only with twins)."""
-    n = batch.num_cars
-    res: dict[str, np.ndarray] = dict(zip(INPUT_KEYS, now.copy(), strict=True))
-    twins = batch.with_reference
-    for k, v in out.items():
-        res[k] = v[:n]
-        if twins:
-            res["reference_" + k] = v[n:]
+def _sources() -> dict[str, tuple]:
+    """Where each result key is read, in the order a step's result lists them: ("input", row),
+    ("car", output key, role), ("pivot", array, pivot, coordinate, role) with role 0 the model
+    car and 1 its twin, ("twins",) the keys that compare the two, ("flag", attribute)."""
+    src: dict[str, tuple] = {k: ("input", i) for i, k in enumerate(INPUT_KEYS)}
+    for k in CAR_KEYS:
+        src[k], src["reference_" + k] = ("car", k, 0), ("car", k, 1)
     for i, (force_keys, motion, reference) in enumerate(PIVOT_KEYS):
         for c, (key_m, key_r) in enumerate(force_keys):
-            res[key_m] = forces[:n, i, c]
-            if twins:
-                res[key_r] = forces[n:, i, c]
+            src[key_m], src[key_r] = ("pivot", "forces", i, c, 0), ("pivot", "forces", i, c, 1)
         for c in range(3):
-            res[motion[c]] = q[:n, i, c]
-            if twins:
-                res[reference[c]] = q[n:, i, c]
-    if twins:
-        d = forces[:n, :, :2] - forces[n:, :, :2]
-        res["error_n"] = np.hypot(d[..., 0], d[..., 1]).max(axis=1)
-        res["roll_error_rad"] = res["roll_rad"] - res["reference_roll_rad"]
-        res["reference_outside_range"] = (np.abs(q[n:, :, 2]) > batch.calibrated_rotation).any(1)
-    res["diverged"] = batch.diverged.copy()
-    res["physical_limit"] = batch.reference_out.copy()
+            src[motion[c]], src[reference[c]] = ("pivot", "q", i, c, 0), ("pivot", "q", i, c, 1)
+    for k in ("error_n", "roll_error_rad", "reference_outside_range"):
+        src[k] = ("twins",)
+    src["diverged"], src["physical_limit"] = ("flag", "diverged"), ("flag", "reference_out")
+    return src
+
+
+SOURCES = _sources()
+# a step's keys without twins: none of the twin's nor those that compare the two
+MODEL_KEYS = tuple(
+    k for k, s in SOURCES.items() if s[0] != "twins" and not (s[0] in ("car", "pivot") and s[-1])
+)
+
+
+def result(batch: Any, now: np.ndarray, out: dict[str, np.ndarray], q, forces, keys=None) -> dict:
+    """The step's (B,) arrays under ``keys`` (default every key of ``RESULT_KEYS`` the batch
+    has: the reference keys only with twins)."""
+    n = batch.num_cars
+    if keys is None:
+        keys = SOURCES if batch.with_reference else MODEL_KEYS
+    cols = (slice(None, n), slice(n, None))
+    pivots = {"forces": forces, "q": q}
+    res: dict[str, np.ndarray] = {}
+    for k in keys:
+        s = SOURCES[k]
+        if s[0] == "input":
+            res[k] = now[s[1]].copy()
+        elif s[0] == "car":
+            res[k] = out[s[1]][cols[s[2]]]
+        elif s[0] == "pivot":
+            res[k] = pivots[s[1]][cols[s[4]], s[2], s[3]]
+        elif s[0] == "flag":
+            res[k] = getattr(batch, s[1]).copy()
+        elif k == "error_n":
+            d = forces[:n, :, :2] - forces[n:, :, :2]
+            res[k] = np.hypot(d[..., 0], d[..., 1]).max(axis=1)
+        elif k == "roll_error_rad":
+            res[k] = out["roll_rad"][:n] - out["roll_rad"][n:]
+        else:
+            res[k] = (np.abs(q[n:, :, 2]) > batch.calibrated_rotation).any(1)
     return res
