@@ -239,18 +239,22 @@ COUPLED_EFFORT = {
 
 
 def identification_records(
-    dt: float, seed: int, ident_s: float, identification: str = "programme"
+    dt: float,
+    seed: int,
+    ident_s: float,
+    identification: str = "programme",
+    rotation: str = "cardanic",
 ) -> list:
     """[(q, f)] (T, 3) each of random motion at n = 1, independent and correlated, then
     (``"programme"``) the coupled sine sets at n = 1 of ``ident_s`` / 2 each, measured on the
-    coupled reference, each record its noise seed."""
+    coupled reference (its ``rotation`` parameter set), each record its noise seed."""
     if identification not in IDENTIFICATIONS:
         raise ValueError(f"identification {identification!r}; known: {', '.join(IDENTIFICATIONS)}")
     motions = [drive(1.0, ident_s, dt, seed) for drive in (random_independent, random_correlated)]
     if identification == "programme":
         motions += [q for _, q in coupled_sets(1.0, dt, ident_s / 2)]
     return [
-        (q, PlanarRubber.preset(seed=seed + 50 * k, dt=dt).simulate(q))
+        (q, PlanarRubber.preset(seed=seed + 50 * k, dt=dt, rotation=rotation).simulate(q))
         for k, q in enumerate(motions)
     ]
 

@@ -139,7 +139,7 @@ def _shown(entry: dict, out: Path) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     from bushenv.cli import CliError
-    from bushenv.rigs.halfcar_params import ENV_ID
+    from bushenv.rigs.halfcar_params import ENV_ID, REFERENCE
     from bushenv.rigs.specs import spec_kwargs
     from bushenv.vehicle.bushings import Recipe, check_kinds, vehicle_bushings
     from bushenv.vehicle.manoeuvres import NAMES, standard_manoeuvres
@@ -175,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
     if args.search:
         return _search(args, bushings, out, progress, t0)
     report, runs = run_vehicle(
-        manoeuvres, {k: b.model for k, b in bushings.items()}, "rubber", progress,
+        manoeuvres, {k: b.model for k, b in bushings.items()}, REFERENCE, progress,
         args.identical_pct,
     )  # fmt: skip
     report["bushings"] = {k: _shown(b.describe(), out) for k, b in bushings.items()}

@@ -101,7 +101,7 @@ def get_model(
                 cls = entry.model_class(coords)
             except ModelError as exc:
                 raise ModelError(f"model {text!r}: {exc}") from None
-            return _preset(text, cls, dt, preset, wanted_by)
+            return _preset(text, cls, dt, {**entry.preset, **(preset or {})}, wanted_by)
         if entry.entry_point is None:
             raise ModelError(
                 f"model {text!r} exists for {coordinate_words(entry.coordinate_counts()[0])} "
@@ -116,7 +116,8 @@ def get_model(
                     "run scripts/train_default_models.py"
                 )
             return load_model(path, dt=dt)
-        return entry.model_class().preset(axis=axis, dt=dt or PAPER_DT, **(preset or {}))
+        options = {**entry.preset, **(preset or {})}
+        return entry.model_class().preset(axis=axis, dt=dt or PAPER_DT, **options)
     suffix = Path(text).suffix.lower()
     if suffix in MODEL_FILES:  # e.g. an FMU, run through FMPy
         loader = MODEL_FILES[suffix]

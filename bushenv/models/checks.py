@@ -121,7 +121,7 @@ def example(name: str, coords: int = 1, axis: str = "axial") -> BushingModel:
         return get_model(name, axis=axis)
     cls = entry.model_class(coords)
     if has_preset(cls):
-        return cls.preset(**entry.reference_preset)
+        return cls.preset(**entry.preset, **entry.reference_preset)
     return cls.untrained(seed=0)
 
 

@@ -3,8 +3,9 @@
     f = K q + C v,   q = (axial m, radial m, rotation rad),  f = (N, N, N m)
 
 The constant-matrix element of the vehicle tools (Adams FIELD, Chrono's generic bushing) in
-the plane; seed 000 eq. 1 per axis when K and C are diagonal. ``TABLE1`` gives seed 000
-Table 1 on the diagonal and an assumed rotational stiffness (see ``reference.py``).
+the plane; seed 000 eq. 1 per axis when K and C are diagonal. ``preset`` gives seed 000
+Table 1 on the diagonal and the rotation of one of the reference's named parameter sets
+(``reference/planar.py``: ``"cardanic"`` assumed, ``"torsion"`` from the bush's geometry).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy as np
 from bushenv.models.base import PAPER_DT
 from bushenv.models.planar_base import PlanarModel, PlanarModelError, as_matrix
 from bushenv.models.planar_kernels import planar_linear_kernel
-from bushenv.reference.planar import ROTATION_K_NM_PER_RAD
+from bushenv.reference.planar import ROTATION_K_NM_PER_RAD, ROTATIONS, torsion_per_axial
 
 
 class PlanarLinear(PlanarModel):
@@ -31,13 +32,19 @@ class PlanarLinear(PlanarModel):
         super().__init__(dt)
 
     @classmethod
-    def preset(cls, dt: float = PAPER_DT) -> PlanarLinear:
-        """Seed 000 Table 1 on the diagonal (axial, radial); the rotation: the reference's
-        assumed 3000 N m/rad with Table 1's radial loss time c/k (29.6 N m s/rad); no coupling."""
-        k_t = ROTATION_K_NM_PER_RAD
-        k = np.diag([379.68e3, 1518.73e3, k_t])
-        c = np.diag([4.4e3, 15.0e3, k_t * 15.0e3 / 1518.73e3])
-        return cls(k, c, dt=dt)
+    def preset(cls, dt: float = PAPER_DT, rotation: str = "cardanic") -> PlanarLinear:
+        """Seed 000 Table 1 on the diagonal (axial, radial); no coupling. The rotation
+        (``rotation``, the reference's parameter sets): ``"cardanic"`` the reference's assumed
+        3000 N m/rad with Table 1's radial loss time c/k (29.6 N m s/rad); ``"torsion"`` Table
+        1's axial k and c through the bush's K_t / K_a (52.0 N m/rad, 0.60 N m s/rad)."""
+        if rotation not in ROTATIONS:
+            raise PlanarModelError(f"linear: rotation {rotation!r}; known: {list(ROTATIONS)}")
+        k_a, c_a, k_r, c_r = 379.68e3, 4.4e3, 1518.73e3, 15.0e3
+        if rotation == "cardanic":
+            k_t, c_t = ROTATION_K_NM_PER_RAD, ROTATION_K_NM_PER_RAD * c_r / k_r
+        else:
+            k_t, c_t = k_a * torsion_per_axial(), c_a * torsion_per_axial()
+        return cls(np.diag([k_a, k_r, k_t]), np.diag([c_a, c_r, c_t]), dt=dt)
 
     def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         # compiled: at one sample the two numpy products cost more than the arithmetic

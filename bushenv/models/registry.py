@@ -61,6 +61,10 @@ class ModelEntry:
         Trained defaults ship in the package; the name loads ``<axis>_<name>.npz``.
     reference_preset : dict
         Keyword arguments of ``preset`` when the model is a verdict's reference.
+    preset : dict
+        Keyword arguments of ``preset`` that make this name, always given: a named parameter
+        set of another model's class (``rubber-torsion`` is ``rubber``'s preset with
+        ``rotation="torsion"``; ``kind`` names that class).
     hybrid : str or None
         The hybrid ``bushenv attack`` rechecks and attacks beside this model (default:
         ``hybrid``): the papers' NN goes with the papers' hybrid.
@@ -80,6 +84,7 @@ class ModelEntry:
     options: Any = None
     shipped: bool = False
     reference_preset: dict[str, Any] = field(default_factory=dict)
+    preset: dict[str, Any] = field(default_factory=dict)
     hybrid: str | None = None
     also: tuple[str, ...] = ()
     kind: str | None = None
@@ -271,6 +276,28 @@ MODELS.add(
         "the reference rubber bushing (bushenv/reference); as a reference without its "
         "measurement chain",
         reference_preset={"measurement": False},
+        wider={3: Form("bushenv.reference.planar:PlanarRubber")},
+    ),
+)
+MODELS.add(
+    "linear-torsion",
+    ModelEntry(
+        None,
+        "the linear preset with the rotation a torsion (a car's arm pivot: the bush's geometry)",
+        preset={"rotation": "torsion"},
+        kind="linear",
+        wider={3: Form(M + "planar_linear:PlanarLinear")},
+    ),
+)
+MODELS.add(
+    "rubber-torsion",
+    ModelEntry(
+        None,
+        "the reference rubber with the rotation a torsion (HalfCar-v0's arm pivots); as a "
+        "reference without its measurement chain",
+        reference_preset={"measurement": False},
+        preset={"rotation": "torsion"},
+        kind="rubber",
         wider={3: Form("bushenv.reference.planar:PlanarRubber")},
     ),
 )

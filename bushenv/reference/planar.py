@@ -32,16 +32,36 @@ Not ported from the one-axis reference: thermal softening, load-cell delay and f
 
 Presets (``PlanarRubber.preset()``): axial and radial stiffness, damping, relaxation, friction
 and hardening are the one-axis reference's calibrated presets (which reproduce seed 000
-Table 1 by linear fit); the rotation is ASSUMED, typical of a car's control-arm bushing in its
-cardanic (tilt) mode: k_t = 3000 N m/rad (52 N m/deg), damping with the radial loss time
-c_r / k_r, relaxation weights of the radial axis, friction scaled as the radial one (fmax =
-0.25 k_t theta_1 with theta_1 = 0.05 rad the rotation at amplitude index n = 1, x2 = theta_1 *
-0.15), hardening at 0.3 rad. Coupling (assumed magnitudes, Kadlowec's shape): gamma_a = 0.15,
-dip = 0.15 at theta_m = 0.08 rad, u_c = 2 mm. docs/planar.md tabulates the tangent stiffness.
+Table 1 by linear fit); the rotation is one of two named parameter sets (``ROTATIONS``):
+
+- ``"cardanic"`` (the default; BushRig3-v0's): ASSUMED, typical of a car's control-arm bushing
+  in its cardanic (tilt) mode: k_t = 3000 N m/rad (52 N m/deg), damping with the radial loss
+  time c_r / k_r, relaxation weights of the radial axis, friction scaled as the radial one
+  (fmax = 0.25 k_t theta_1 with theta_1 = 0.05 rad the rotation at amplitude index n = 1, x2 =
+  theta_1 * 0.15), hardening at 0.3 rad.
+- ``"torsion"`` (the half car's: an arm turns its pivot's bush about the bush's own axis):
+  DERIVED from the bush's geometry. For a bonded annulus of radii a < b and length L, axial
+  shear gives K_a = 2 pi G L / ln(b/a) (Adkins & Gent, Br. J. Appl. Phys. 5 (1954) 354) and
+  torsion K_t = 4 pi G L / (1/a^2 - 1/b^2) (as García Tárrago, Kari, Viñolas & Gil-Negrete use
+  it, J. Strain Anal. Eng. Des. 42 (2007) 13), so K_t = K_a * 2 ln(b/a) / (1/a^2 - 1/b^2)
+  whatever G and L. Geometry: seed 002 Table 2's bush (inner steel 15 mm, outer steel 50 mm
+  with a 3 mm wall, length 63 mm): a = 7.5 mm, b = 22 mm, K_t / K_a = 1.370e-4 m^2/rad; seed
+  000 Table 1's axial 379.68 kN/m then gives G = 1.03 MPa (a natural rubber's) and K_t = 52.0
+  N m/rad. Torsion shears the rubber as the axial mode does, so the whole rotation row is the
+  axial row mapped: moment = axial force * (K_t / K_a) / l, rotation = axial deflection / l,
+  with l = 2 mm / theta_1 = 0.04 m/rad (the n = 1 amplitudes): stiffness 27.9 N m/rad (the
+  axial backbone's 203.5 kN/m), damping by the axial loss time, the axial relaxation weights,
+  the axial friction (the same loop width at n = 1), hardening and load-cell noise alike.
+  The coupling's dip scales with k_t (the radial-rotation term's share of the rotation's
+  tangent as in the cardanic set, so the energy stays convex).
+
+Coupling (assumed magnitudes, Kadlowec's shape): gamma_a = 0.15, dip = 0.15 at theta_m = 0.08
+rad (cardanic), u_c = 2 mm. docs/planar.md tabulates the tangent stiffness.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any, ClassVar
 
 import numba as nb
@@ -68,26 +88,61 @@ ROTATION_K_NM_PER_RAD = 3000.0  # assumed: a control-arm bushing, cardanic mode 
 THETA_N1_RAD = 0.05  # rotation peak at amplitude index n = 1 (assumed; 2 mm over a 40 mm arm)
 MAX_ROTATION_RAD = 0.15  # the rotation the planar programmes stay within (assumed)
 FRICTION_YIELDS = ("vector", "axis")
+ROTATIONS = ("cardanic", "torsion")  # the rotation's named parameter sets (module docstring)
+# seed 002 Table 2's bush: inner steel diameter 15 mm, outer 50 mm with a 3 mm wall, length 63 mm
+BUSH_INNER_RADIUS_M = 7.5e-3
+BUSH_OUTER_RADIUS_M = 25.0e-3 - 3.0e-3
+BUSH_LENGTH_M = 63.0e-3
+PEAK_M_AT_N1 = 2.0e-3  # the translations' peak at n = 1 (bushenv.excitation)
 
 
-def default_parameters() -> dict[str, Any]:
-    """The coupled rubber's default parameters, from the one-axis axial and radial presets."""
+def torsion_per_axial(a_m: float = BUSH_INNER_RADIUS_M, b_m: float = BUSH_OUTER_RADIUS_M) -> float:
+    """K_t / K_a of a bonded annulus, m^2/rad: K_a = 2 pi G L / ln(b/a) (Adkins & Gent 1954),
+    K_t = 4 pi G L / (1/a^2 - 1/b^2) (García Tárrago et al. 2007); G and L cancel."""
+    if not 0 < a_m < b_m:
+        raise PlanarModelError(f"bush radii must be 0 < a < b, got a={a_m!r}, b={b_m!r}")
+    return 2.0 * math.log(b_m / a_m) / (1.0 / a_m**2 - 1.0 / b_m**2)
+
+
+def shear_modulus_pa(k_axial_n_per_m: float) -> float:
+    """G of the stated bush from an axial stiffness: K_a ln(b/a) / (2 pi L)."""
+    a, b = BUSH_INNER_RADIUS_M, BUSH_OUTER_RADIUS_M
+    return k_axial_n_per_m * math.log(b / a) / (2.0 * math.pi * BUSH_LENGTH_M)
+
+
+def default_parameters(rotation: str = "cardanic") -> dict[str, Any]:
+    """The coupled rubber's default parameters, from the one-axis axial and radial presets;
+    ``rotation`` names the rotation's parameter set (``ROTATIONS``, module docstring)."""
+    if rotation not in ROTATIONS:
+        raise PlanarModelError(f"reference: rotation {rotation!r}; known: {list(ROTATIONS)}")
     ax, rad = ONE_AXIS["axial"], ONE_AXIS["radial"]
-    k_t = ROTATION_K_NM_PER_RAD
-    loss_s = rad["c_ns_per_m"] / rad["k_n_per_m"]
     w_ax = np.array(ax["relax_k_n_per_m"]) / ax["k_n_per_m"]
     w_rad = np.array(rad["relax_k_n_per_m"]) / rad["k_n_per_m"]
-    fr_scale = rad["friction_x2_m"] / 2.0e-3  # x2 over the radial 2 mm peak at n = 1
+    dip = 0.15
+    if rotation == "cardanic":
+        k_t = ROTATION_K_NM_PER_RAD
+        loss_s = rad["c_ns_per_m"] / rad["k_n_per_m"]
+        fr_scale = rad["friction_x2_m"] / PEAK_M_AT_N1  # x2 over the radial peak at n = 1
+        rot = dict(k=k_t, c=k_t * loss_s, w=w_rad, fmax=0.25 * k_t * THETA_N1_RAD,
+                   x2=fr_scale * THETA_N1_RAD, hard=0.3, noise=0.2)  # fmt: skip
+    else:  # the axial (shear) row mapped to the rotation
+        arm = PEAK_M_AT_N1 / THETA_N1_RAD  # m of axial deflection per rad at n = 1
+        force = torsion_per_axial() / arm  # N m of moment per N of axial force
+        k_t = ax["k_n_per_m"] * force * arm
+        rot = dict(k=k_t, c=ax["c_ns_per_m"] * force * arm, w=w_ax,
+                   fmax=ax["friction_fmax_n"] * force, x2=ax["friction_x2_m"] / arm,
+                   hard=ax["hardening_x_m"] / arm, noise=ax["noise_std_n"] * force)  # fmt: skip
+        dip *= k_t / ROTATION_K_NM_PER_RAD
     return dict(
-        stiffness=(ax["k_n_per_m"], rad["k_n_per_m"], k_t),
-        damping=(ax["c_ns_per_m"], rad["c_ns_per_m"], k_t * loss_s),
-        coupling=(0.15, 0.15, 0.08, 2.0e-3),
-        hardening_m=(ax["hardening_x_m"], rad["hardening_x_m"], 0.3),
-        relax_weight=np.stack([w_ax, w_rad, w_rad], axis=1),
+        stiffness=(ax["k_n_per_m"], rad["k_n_per_m"], rot["k"]),
+        damping=(ax["c_ns_per_m"], rad["c_ns_per_m"], rot["c"]),
+        coupling=(0.15, dip, 0.08, 2.0e-3),
+        hardening_m=(ax["hardening_x_m"], rad["hardening_x_m"], rot["hard"]),
+        relax_weight=np.stack([w_ax, w_rad, rot["w"]], axis=1),
         relax_tau_s=ax["relax_tau_s"],
-        friction_fmax=(ax["friction_fmax_n"], rad["friction_fmax_n"], 0.25 * k_t * THETA_N1_RAD),
-        friction_x2=(ax["friction_x2_m"], rad["friction_x2_m"], fr_scale * THETA_N1_RAD),
-        noise_std=(ax["noise_std_n"], rad["noise_std_n"], 0.2),
+        friction_fmax=(ax["friction_fmax_n"], rad["friction_fmax_n"], rot["fmax"]),
+        friction_x2=(ax["friction_x2_m"], rad["friction_x2_m"], rot["x2"]),
+        noise_std=(ax["noise_std_n"], rad["noise_std_n"], rot["noise"]),
     )
 
 
@@ -312,12 +367,15 @@ class PlanarRubber(PlanarModel):
         measurement: bool = True,
         seed: int = 0,
         dt: float = PAPER_DT,
+        rotation: str = "cardanic",
         **overrides: Any,
     ) -> PlanarRubber:
         """The preset specimen: ``effects=None`` switches on the physical effects, and
-        ``measurement`` adds the load cell's noise; ``overrides`` replace preset parameters
-        (or set ``friction_yield``, ``friction_elements``)."""
-        params = default_parameters()
+        ``measurement`` adds the load cell's noise; ``rotation`` names the rotation's
+        parameter set (``ROTATIONS``: ``"cardanic"`` a tilt, ``"torsion"`` a car's arm pivot);
+        ``overrides`` replace preset parameters (or set ``friction_yield``,
+        ``friction_elements``)."""
+        params = default_parameters(rotation)
         unknown = [
             k
             for k in overrides

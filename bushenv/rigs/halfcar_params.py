@@ -27,6 +27,11 @@ POINTS = (
     "spring_chassis_m", "spring_arm_m", "wheel_centre_m",
 )  # fmt: skip
 SPLIT_K_FLOOR = 1e-3  # a split spring needs a stiffness (N/m, N m/rad); this one is nil
+# An arm turns its inner pivot's bush about the bush's own axis: the rotation is a torsion, the
+# reference's "torsion" parameter set (reference/planar.py), 30-60x softer than a tilt.
+PIVOT_ROTATION = "torsion"
+REFERENCE = "rubber-torsion"  # the registered names of that set: the judge's rubber ...
+LINEAR = "linear-torsion"  # ... and the linear preset (the split's in-sub-step part)
 
 
 def _point(name: str, value: Any) -> np.ndarray:
@@ -188,7 +193,8 @@ class HalfCarParameters:
         self.h_rc = self.geometry.roll_centre_height()
         from bushenv.models.planar_linear import PlanarLinear
 
-        preset = PlanarLinear.preset(dt=self.dt)  # the split coupling's in-sub-step part
+        # the split coupling's in-sub-step part
+        preset = PlanarLinear.preset(dt=self.dt, rotation=PIVOT_ROTATION)
         self.k_in, self.c_in = np.diag(preset.k_matrix).copy(), np.diag(preset.c_matrix).copy()
         self.split = {}  # car role -> (4, 2, 3): each pivot's (k_in, c_in) per coordinate
         if resolve_models:
@@ -202,8 +208,8 @@ class HalfCarParameters:
     def pivot_splits(self, models: Any) -> np.ndarray:
         """(4, 2, 3) (k_in, c_in) of each pivot's split coupling: what a model states (a linear
         model's diagonal K, C: its held remainder is then exactly zero, as in the quarter car's
-        ``car_bushings.rotation_split``), else the planar linear preset's (the reference rubber's
-        tangent at rest)."""
+        ``car_bushings.rotation_split``), else the planar linear torsion preset's (the reference
+        rubber's tangent at rest)."""
         out = np.empty((len(POSITIONS), 2, 3))
         for i, k in enumerate(POSITIONS):
             m = models[k] if isinstance(models, dict) else models
@@ -222,7 +228,7 @@ class HalfCarParameters:
         bushings' rotation stiffness and damping through the arms' angle rates, the lateral
         tyre through the scrub) and the unsprung mass (arms and upright, kinetic energy per
         wheel speed^2). ``k_bushing``, ``c_bushing``: (3,) diagonal of the arm bushings (default
-        the linear preset's)."""
+        the linear torsion preset's, ``LINEAR``)."""
         k_b = self.k_in if k_bushing is None else np.asarray(k_bushing)
         c_b = self.c_in if c_bushing is None else np.asarray(c_bushing)
         g, p = self.geometry, self.pts

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from bushenv.progress import Progress
+from bushenv.rigs.halfcar_params import REFERENCE as CAR_REFERENCE
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.families import FAMILIES
 from bushenv.search.searchers import SEARCHERS
@@ -30,7 +31,7 @@ from bushenv.vehicle.checks import VehicleInputError
 from bushenv.vehicle.manoeuvres import Manoeuvre, standard_manoeuvres
 from bushenv.vehicle.study import IDENTICAL_PCT
 
-REFERENCE = "rubber"  # the judge: the coupled rubber, as in ``bushenv vehicle``
+REFERENCE = CAR_REFERENCE  # the judge: the coupled rubber in torsion, as in ``bushenv vehicle``
 ROAD_FAMILIES = ("car_road", "car_bump", "car_pothole")
 
 

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.rigs.halfcar_params import POSITIONS
+from bushenv.rigs.halfcar_params import POSITIONS, REFERENCE
 from bushenv.vehicle import adversary_space as space
 from bushenv.vehicle.compare import run_car, vehicle_differences
 
@@ -67,7 +67,7 @@ def force_table(run, model, reference: Any) -> dict[str, dict[str, dict[str, flo
     return out
 
 
-def blame(profile: np.ndarray, dt_s: float, model, reference: Any = "rubber") -> dict[str, Any]:
+def blame(profile: np.ndarray, dt_s: float, model, reference: Any = REFERENCE) -> dict[str, Any]:
     """The swap and the force views of ``profile`` (module docstring); the wheel-load
     difference D in % of the reference car's peak, as the search judged it."""
     m = space.as_manoeuvre(profile, dt_s)

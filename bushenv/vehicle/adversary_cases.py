@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from bushenv.models import params_sha
+from bushenv.rigs.halfcar_params import REFERENCE
 from bushenv.search.corpus import make_case, profile_sha, save_case
 
 
@@ -40,7 +41,7 @@ def save_cases(
     rubber the verdicts are judged against."""
     models = {b.file: b.model for b in bushings.values()}
     shas = {b.file: b.sha256 for b in bushings.values()}
-    record = {"spec": "rubber", "file_sha256": None, "params_sha256": params_sha(reference)}
+    record = {"spec": REFERENCE, "file_sha256": None, "params_sha256": params_sha(reference)}
     written, seen = [], set()
     for kind, k in kept.items():
         for why, e in _cases_wanted(kind, k):
@@ -53,7 +54,7 @@ def save_cases(
                 params=e["params"],
                 found_by={"searcher": e["searcher"], "seed": seed, "model": kind,
                           "model_sha256": bushings[kind].sha256, "evaluation": e["evaluation"]},
-                models=models, reference=reference, reference_spec="rubber", shas=shas,
+                models=models, reference=reference, reference_spec=REFERENCE, shas=shas,
                 reference_record=record,
                 notes=f"bushenv vehicle --search: {why} for the {kind} car (D "
                 f"{e['d_pct']:.1f} % of the reference car's peak wheel load)",

@@ -5,7 +5,9 @@ given as model files.
 Identification records: ``bushenv.reproduce.identification_records`` -- random motion
 of all three coordinates at n = 1, independent and correlated (``identification_s`` each), and
 the coupled sine sets at n = 1 (``identification_s`` / 2 each), the reference measured with its
-load cell, each record its own noise seed: what ``bushenv reproduce --planar`` identifies on.
+load cell, each record its own noise seed: what ``bushenv reproduce --planar`` identifies on,
+but of the reference in the car's rotation parameter set (``halfcar_params.PIVOT_ROTATION``:
+torsion), the one the car's twins run.
 Each kind is fitted by ``bushenv.identify.fit`` with its default options and the
 seed, as ``bushenv fit REC... --model KIND --seed SEED`` would.
 """
@@ -21,9 +23,11 @@ from typing import Any
 from bushenv.identify.card import sha256_file
 from bushenv.models import load_model, names_for
 from bushenv.persist import plain, write_json
+from bushenv.rigs.halfcar_params import PIVOT_ROTATION
 from bushenv.vehicle.checks import VehicleInputError
 
-RECIPE_VERSION = 1  # bump when the identification changes: older cached fits are then redone
+RECIPE_VERSION = 2  # bump when the identification changes: older cached fits are then redone
+# 2: the reference's torsion parameter set (1: its cardanic rotation, 30-60x stiffer)
 DEFAULT_KINDS = ("linear", "hybrid", "nn")
 
 
@@ -35,10 +39,12 @@ class Recipe:
     seed: int = 0
     identification_s: float = 40.0
     records: str = "programme"  # identification_records': random and the coupled sets at n = 1
+    rotation: str = PIVOT_ROTATION  # the reference's rotation parameter set measured
 
     def key(self, kind: str) -> dict[str, Any]:
         return {"kind": kind, "seed": self.seed, "identification_s": self.identification_s,
-                "records": self.records, "dt_s": self.dt_s, "options": "defaults",
+                "records": self.records, "rotation": self.rotation, "dt_s": self.dt_s,
+                "options": "defaults",
                 "recipe_version": RECIPE_VERSION}  # fmt: skip
 
 
@@ -114,9 +120,8 @@ def vehicle_bushings(
                 if say:
                     say(f"measuring the reference's identification records "
                         f"({recipe.identification_s:g} s random x 2, coupled sets)")  # fmt: skip
-                histories = identification_records(
-                    recipe.dt_s, recipe.seed, recipe.identification_s, recipe.records
-                )
+                ident = (recipe.dt_s, recipe.seed, recipe.identification_s, recipe.records)
+                histories = identification_records(*ident, recipe.rotation)
             if say:
                 say(f"identifying {kind} (seed {recipe.seed}, default options)")
             result = fit(histories, kind, {}, recipe.seed, say or False, dt=recipe.dt_s)
@@ -133,7 +138,7 @@ def vehicle_bushings(
         out[kind] = VehicleBushing(
             kind, model, str(path), sha256_file(path),
             f"fit({kind!r}, default options, seed {recipe.seed}) on the coupled "
-            f"reference's n = 1 records ({samples}); {how}",
+            f"reference's n = 1 records ({recipe.rotation} rotation; {samples}); {how}",
             meta["fit_seconds"], meta.get("info", {}),
         )  # fmt: skip
     return out

@@ -21,7 +21,7 @@ import numpy as np
 from bushenv.errors import BushenvError
 from bushenv.models.planar_base import COORDS
 from bushenv.rigs.halfcar import HalfCarEnv
-from bushenv.rigs.halfcar_params import POSITIONS, resolve_bushings
+from bushenv.rigs.halfcar_params import POSITIONS, REFERENCE, resolve_bushings
 from bushenv.vehicle.comfort import weighted_rms
 from bushenv.vehicle.manoeuvres import Manoeuvre
 
@@ -112,7 +112,7 @@ COLUMNS = _columns()
 def run_car(
     manoeuvre: Manoeuvre,
     model: Any,
-    reference: Any = "rubber",
+    reference: Any = REFERENCE,
     label: str = "",
     env_kwargs: dict[str, Any] | None = None,
     tick: Callable[[int], None] | None = None,
@@ -217,7 +217,7 @@ def force_errors(error: np.ndarray, base: np.ndarray) -> dict[str, Any]:
     return {c: relative(error[:, :, i], base[:, :, i], 1e-9) for i, c in enumerate(COORDS)}
 
 
-def component_errors(run: CarRun, model: Any, reference: Any = "rubber") -> dict[str, Any]:
+def component_errors(run: CarRun, model: Any, reference: Any = REFERENCE) -> dict[str, Any]:
     """The bushing's error as a component: the model's and the reference's laws driven open loop
     (from rest) by the model car's four pivot deflection histories, their force difference per
     coordinate relative to the reference law's force; and, beside it, the in-car difference

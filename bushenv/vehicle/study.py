@@ -16,7 +16,7 @@ import statistics
 import time
 from typing import Any
 
-from bushenv.rigs.halfcar_params import ENV_ID
+from bushenv.rigs.halfcar_params import ENV_ID, REFERENCE
 from bushenv.rigs.specs import spec_kwargs
 from bushenv.vehicle.compare import (
     OUTPUTS,
@@ -137,7 +137,7 @@ def _samples(report: dict[str, Any], name: str) -> int:
 def run_vehicle(
     manoeuvres: list[Manoeuvre],
     bushings: dict[str, Any],
-    reference: Any = "rubber",
+    reference: Any = REFERENCE,
     progress: Any = None,
     identical_pct: float = IDENTICAL_PCT,
     paper_car: bool = True,

@@ -22,7 +22,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from bushenv.rigs.halfcar_params import POSITIONS
+from bushenv.rigs.halfcar_params import POSITIONS, REFERENCE
 from bushenv.vehicle.comfort import weighted_acceleration
 from bushenv.vehicle.compare import AW_FLOOR_M_PER_S2, OUTPUTS
 from bushenv.vehicle.manoeuvres import NAMES, Manoeuvre, standard_manoeuvres
@@ -140,7 +140,7 @@ def pivot_table(terms: list[ErrorTerm], dt_s: float) -> dict[str, Any]:
         base = table.get(t.pivot) or reference_rubber(dt_s)
         factor = calibrate(t.kind, t.coord, float(t.size_pct), dt_s)
         table[t.pivot] = scaled_rubber(base, t.kind, t.coord, factor)
-    return {p: table.get(p, "rubber") for p in POSITIONS}
+    return {p: table.get(p, REFERENCE) for p in POSITIONS}
 
 
 def combinations(count: int, size_pct: float, seed: int) -> list[list[ErrorTerm]]:
@@ -176,7 +176,7 @@ class Campaign:
         self.samples = sum(m.samples for m in self.manoeuvres)
         self.done = 0
         self.ended: list[dict[str, Any]] = []
-        self.base = [self._run(m, "rubber", "reference") for m in self.manoeuvres]
+        self.base = [self._run(m, REFERENCE, "reference") for m in self.manoeuvres]
         self.base_rms = np.array([baseline_rms(b, config.dt_s) for b in self.base])  # (M, O)
         self.floors = np.array([o.floor for o in MAP_OUTPUTS])
 

@@ -70,10 +70,12 @@ class ErrorTerm:
 
 
 def reference_rubber(dt_s: float) -> Any:
-    """The reference bushing as a car's pivot runs it (``rubber`` without its measurement)."""
+    """The reference bushing as a car's pivot runs it (``rubber-torsion`` without its
+    measurement)."""
     from bushenv.models import get_model
+    from bushenv.rigs.halfcar_params import REFERENCE
 
-    return get_model("rubber", dt=dt_s, preset={"measurement": False}, coords=3)
+    return get_model(REFERENCE, dt=dt_s, preset={"measurement": False}, coords=3)
 
 
 def check_term(coord: str, kind: str) -> int:

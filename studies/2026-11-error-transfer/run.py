@@ -97,7 +97,7 @@ def breakdown(report: dict, name: str) -> dict:
 def symmetric_track() -> dict:
     """The step steer's track change (RMS of the difference to the reference car, m) with the
     lower-left pivot's axial stiffness 10 % stiff, and with both lower pivots' so."""
-    from bushenv.rigs.halfcar_params import ENV_ID
+    from bushenv.rigs.halfcar_params import ENV_ID, REFERENCE
     from bushenv.rigs.specs import spec_kwargs
     from bushenv.vehicle.manoeuvres import standard_manoeuvres
     from bushenv.vehicle.study import env_overrides
@@ -108,7 +108,7 @@ def symmetric_track() -> dict:
     dt = float(spec_kwargs(ENV_ID, {})["dt_s"])
     m = standard_manoeuvres(dt, 0, ["step_steer"])[0]
     ov = env_overrides(standard_manoeuvres(dt, 0))
-    base = single_car_run(m, "rubber", ov)
+    base = single_car_run(m, REFERENCE, ov)
     out = {"reference_rms_m": float((base.outputs["track_change"] ** 2).mean() ** 0.5)}
     for label, pivots in (("lower_left", ["lower_left"]),
                           ("both lower", ["lower_left", "lower_right"])):  # fmt: skip

@@ -82,7 +82,7 @@ def reference_deflections(seed: int = 0) -> dict:
     import numpy as np
 
     from bushenv.motions import PEAK_AT_N1
-    from bushenv.rigs.halfcar_params import ENV_ID
+    from bushenv.rigs.halfcar_params import ENV_ID, REFERENCE
     from bushenv.rigs.specs import spec_kwargs
     from bushenv.vehicle.compare import run_car
     from bushenv.vehicle.manoeuvres import standard_manoeuvres
@@ -93,7 +93,7 @@ def reference_deflections(seed: int = 0) -> dict:
     overrides = env_overrides(manoeuvres)
     out = {}
     for m in manoeuvres:
-        run = run_car(m, "rubber", "rubber", "reference", overrides)
+        run = run_car(m, REFERENCE, REFERENCE, "reference", overrides)
         peak = np.abs(run.deflection).max(axis=(0, 1)) / PEAK_AT_N1
         out[m.name] = {"axial": float(peak[0]), "radial": float(peak[1]),
                        "rotation": float(peak[2]),

@@ -19,7 +19,7 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 import bushenv  # noqa: F401  (registers the ids)
 from bushenv.rigs.common import RigError
 from bushenv.rigs.coupling import LONG_ARM_M
-from bushenv.rigs.halfcar_params import POSITIONS
+from bushenv.rigs.halfcar_params import LINEAR, POSITIONS
 
 DT = 1.0 / 204.8
 
@@ -198,19 +198,15 @@ def test_a_wheel_over_a_deep_pothole_lifts_off_and_lands():
 
 
 # ----- physics ------------------------------------------------------------------------------------
-def test_with_identical_tracks_the_half_car_is_two_quarter_cars_within_5_percent():
-    """QuarterCar-v0 set up as one corner of the half car (its sprung half, the corner's wheel
-    rate and damping at the wheel -- coil, arm bushings' rotation and the lateral tyre through
-    the scrub -- and its unsprung mass, ``equivalent_corner``): wheel load and body
-    displacement on a 50 mm x 400 mm bump at 30 km/h agree within 5 % of their peaks (measured
-    3.9 % and 3.8 %); the geometry differs (a swing arm against a double wishbone with camber
-    gain and scrub), the quarter car's bushings carry no rotation. The body neither rolls nor
-    moves sideways (below 1e-9 rad and m; wheel loads equal within 1 mN)."""
+def corner_as_quarter_car(**hc_kw):
+    """(half car env, QuarterCar-v0 set up as one of its corners, the half car's parameters):
+    the quarter car has the half car's sprung half, the corner's wheel rate and damping at the
+    wheel -- coil, arm bushings' rotation and the lateral tyre through the scrub -- and its
+    unsprung mass (``equivalent_corner``), through its own 0.7 motion ratio."""
     from bushenv.rigs.halfcar_params import HalfCarParameters
     from bushenv.rigs.specs import spec_kwargs
 
-    road = bump(0.05)
-    hc_kw = dict(model="linear", reference="linear", tyre_damping_ns_per_m=0.0)
+    hc_kw = dict(model=LINEAR, reference=LINEAR, tyre_damping_ns_per_m=0.0, **hc_kw)
     p = HalfCarParameters(spec_kwargs("HalfCar-v0", hc_kw))
     eq = p.equivalent_corner()
     k_w = eq["wheel_rate_n_per_m"] + eq["scrub_rate_n_per_m"]
@@ -220,9 +216,23 @@ def test_with_identical_tracks_the_half_car_is_two_quarter_cars_within_5_percent
         "QuarterCar-v0", model="linear", reference="linear", sprung_mass_kg=p.m_s / 2,
         spring_n_per_m=k_w / mount**2, damper_ns_per_m=c_w / mount**2,
         wheel_mass_kg=eq["unsprung_mass_kg"] - arm_kg / 3 - wheel_inertia / arm_m**2,
-        tyre_n_per_m=p.k_t,
+        tyre_n_per_m=p.k_t, max_episode_steps=-1,
     ).unwrapped  # fmt: skip
-    hc = make(**hc_kw).unwrapped
+    return make(**hc_kw, max_episode_steps=-1).unwrapped, qc, p
+
+
+def test_with_identical_tracks_the_half_car_is_two_quarter_cars():
+    """A 50 mm x 400 mm bump at 30 km/h under both wheels: wheel load and body displacement
+    agree with the corner's quarter car (``corner_as_quarter_car``) within 6 % and 9 % of their
+    peaks (measured 5.2 % and 8.0 %; 3.4 % and 5.4 % after the bump, t > 0.2 s). The largest
+    differences are during the impact (body at t = 0.146 s, wheel load at 0.176 s), where the
+    linkage the quarter car lumps carries the load: a swing arm against a double wishbone with
+    camber gain, scrub and the arms' own inertia, the quarter car's bushings carry no rotation.
+    (With the cardanic 3000 N m/rad the bushings were 77 % of the wheel rate and damped the
+    impact: 3.9 % and 3.8 %.) The body neither rolls nor moves sideways (below 1e-9 rad and m;
+    wheel loads equal within 1 mN)."""
+    road = bump(0.05)
+    hc, qc, p = corner_as_quarter_car()
     hc.reset(options={"road_left": road, "road_right": road})
     qc.reset(options={"excitation": road})
     half, quarter = [], []
@@ -232,17 +242,45 @@ def test_with_identical_tracks_the_half_car_is_two_quarter_cars_within_5_percent
                      i["body_x_m"], i["wheel_load_right_n"] - i["wheel_load_left_n"]))  # fmt: skip
         quarter.append((j["tyre_force_n"], j["chassis_y_m"]))
     half, quarter = np.array(half), np.array(quarter)
-    for c in (0, 1):
+    for c, tolerance in ((0, 0.06), (1, 0.09)):
         peak = np.abs(quarter[:, c]).max()
-        assert np.abs(half[:, c] - quarter[:, c]).max() < 0.05 * peak, c
+        assert np.abs(half[:, c] - quarter[:, c]).max() < tolerance * peak, c
     assert np.abs(half[:, 2:4]).max() < 1e-9 and np.abs(half[:, 4]).max() < 1e-3  # rad, m; N
 
 
-def stiff_linear(factor=10.0):
-    """The planar linear preset with its translational stiffness and damping x ``factor``."""
-    from bushenv.models.planar_linear import PlanarLinear
+def test_the_half_cars_body_bounces_at_the_quarter_cars_frequency():
+    """A 10 mm bump, then 5.5 s of free bounce with the coil-over's damper lowered to 300 N s/m
+    (the other dampers off) so that it rings: the body's bounce frequency from its zero
+    crossings equals the corner's quarter car's within 2 % (measured 1.392 against 1.406 Hz,
+    1.0 %) and ``equivalent_corner``'s undamped figure (coil, bushings and the lateral tyre's
+    scrub on the tyre) within 3 % (1.422 Hz, 2.1 %)."""
+    road = bump(0.01, total_s=6.0)
+    hc, qc, p = corner_as_quarter_car(
+        damper_ns_per_m=300.0, tyre_lateral_ns_per_m=0.0, ball_joint_ns_per_m=0.0
+    )
+    hc.reset(options={"road_left": road, "road_right": road})
+    qc.reset(options={"excitation": road})
+    half = np.array([hc.step(None)[4]["body_y_m"] for _ in road])
+    quarter = np.array([qc.step(np.zeros(1, np.float32))[4]["chassis_y_m"] for _ in road])
 
-    pre = PlanarLinear.preset()
+    def hz(y):
+        crossings = np.flatnonzero(np.diff(np.sign(y[int(0.5 / p.dt) :])) != 0)
+        return 1 / (2 * np.diff(crossings).mean() * p.dt)
+
+    eq = p.equivalent_corner()
+    k = eq["wheel_rate_n_per_m"] + eq["scrub_rate_n_per_m"]
+    analytic = math.sqrt(k * p.k_t / (k + p.k_t) / (p.m_s / 2)) / (2 * math.pi)
+    assert hz(half) == pytest.approx(hz(quarter), rel=0.02)
+    assert hz(half) == pytest.approx(analytic, rel=0.03)
+
+
+def stiff_linear(factor=10.0):
+    """The car's planar linear preset (torsion) with its translational stiffness and damping
+    x ``factor``."""
+    from bushenv.models.planar_linear import PlanarLinear
+    from bushenv.rigs.halfcar_params import PIVOT_ROTATION
+
+    pre = PlanarLinear.preset(rotation=PIVOT_ROTATION)
     k, c = pre.k_matrix.copy(), pre.c_matrix.copy()
     for i in (0, 1):
         k[i, i] *= factor
@@ -250,15 +288,17 @@ def stiff_linear(factor=10.0):
     return PlanarLinear(k, c)
 
 
-@pytest.mark.parametrize(("model", "tolerance"), [("stiff", 0.03), ("linear", 0.07)])
+@pytest.mark.parametrize(("model", "tolerance"), [("stiff", 0.05), ("linear", 0.03)])
 def test_the_steady_roll_gradient_is_the_analytic_one(model, tolerance):
     """3 m/s^2 held for 5 s: body roll / a_y against ``HalfCarParameters.roll_gradient`` (the
     springs' and the bushings' rotation through the wheel rate, the kinematic roll centre, the
-    tyres' vertical compliance; no bushing translation). Bushings 10x stiffer in translation:
-    within 3 % (measured +2.0 %); the preset bushings' own translational compliance (the
-    formula has none) makes the car roll 5.3 % less."""
-    m = stiff_linear() if model == "stiff" else "linear"
-    env = make(model=m, reference="linear", max_episode_steps=-1).unwrapped
+    tyres' vertical compliance; no bushing translation; 1.12e-2 rad per m/s^2, 6.3 deg/g).
+    Bushings 10x stiffer in translation: within 5 % (measured +4.0 %, the same at 0.5 and 1
+    m/s^2: linear; +2.0 % when the cardanic rotation made the car 4x stiffer in roll); the
+    preset bushings' lateral (axial) compliance, which the formula omits, takes 4.6 % off,
+    their radial adds 0.6 %: within 3 % (measured 0.0 %)."""
+    m = stiff_linear() if model == "stiff" else LINEAR
+    env = make(model=m, reference=LINEAR, max_episode_steps=-1).unwrapped
     n = 1400
     env.reset(options={"lateral_accel": np.minimum(np.arange(1, n + 1) * 0.05, 3.0)})
     roll = np.array([env.step(None)[4]["roll_rad"] for _ in range(n)])
@@ -312,17 +352,20 @@ def energy_terms(car) -> tuple[float, float, np.ndarray]:
 
 
 def test_the_passive_car_balances_road_work_against_dissipation_and_storage():
-    """W = D + dE within 3 % of the road's work (measured 2.0 %): W = the integral of the tyre
+    """W = D + dE within 3 % of the road's work (measured 1.7 %): W = the integral of the tyre
     forces times the road speeds, D of every damper's c v^2 (bushings, coil-overs, ball joints,
     tyres), E the kinetic and every spring's energy. Sampled at 8 x 204.8 Hz (two sub-steps per
-    step), a bump left and a pothole right, linear bushings."""
+    step), a 20 mm bump left and a 30 mm pothole right, linear bushings. The wheels stay on the
+    road: a landing wheel's lateral spring takes its new contact point and drops what it held
+    (a 40 mm bump over 48 ms lifts the left wheel for 23 ms in this car, and 5.7 % goes
+    missing)."""
     rate = 8
     dt = 1 / 204.8 / rate
     t = np.arange(int(1.5 / dt)) * dt
-    left = np.where((t >= 0.1) & (t < 0.148), 0.02 * (1 - np.cos(2 * np.pi * (t - 0.1) / 0.048)), 0)
+    left = np.where((t >= 0.1) & (t < 0.148), 0.01 * (1 - np.cos(2 * np.pi * (t - 0.1) / 0.048)), 0)
     right = np.where((t >= 0.3) & (t < 0.384), -0.015 * (1 - np.cos(2 * np.pi * (t - 0.3) / 0.084)),
                      0)  # fmt: skip
-    env = make(model="linear", reference="linear", dt_s=dt, physics_substeps=16 // rate,
+    env = make(model=LINEAR, reference=LINEAR, dt_s=dt, physics_substeps=16 // rate,
                max_episode_steps=-1).unwrapped  # fmt: skip
     env.reset(options={"road_left": left, "road_right": right})
     e0, p0, f0 = energy_terms(env.car)
@@ -330,7 +373,8 @@ def test_the_passive_car_balances_road_work_against_dissipation_and_storage():
     prev = np.zeros(2)
     residual = []
     for k in range(len(t)):
-        env.step(None)
+        info = env.step(None)[4]
+        assert not (info["wheel_lift_left"] or info["wheel_lift_right"]), k
         h = np.array([left[k], right[k]])
         v_road, prev = (h - prev) / dt, h
         e, p1, f1 = energy_terms(env.car)
@@ -397,7 +441,7 @@ def test_the_split_coupling_settles_under_the_harshest_inputs_with_linear_bushin
     switching at its rate limit, half periods of 1-20 steps, every bound off: linear bushings
     in both cars (the coupling itself, the remainder zero) stay finite and settle once the
     inputs are back at 0 (the roll mode, 1.9 Hz, has a damping ratio of about 0.1)."""
-    settles(make(model="linear", reference="linear", max_episode_steps=-1, **LOOSE).unwrapped,
+    settles(make(model=LINEAR, reference=LINEAR, max_episode_steps=-1, **LOOSE).unwrapped,
             bang_bang_inputs(half, limits=HARSH))  # fmt: skip
 
 

@@ -14,7 +14,7 @@ from bushenv.rigs.halfcar_params import POSITIONS
 
 DT = 1.0 / 204.8
 # the batch against the env: every compared output within this fraction of its own peak
-# (measured on the manoeuvre below: 3e-3 at most, a radial bushing force; docs/envs.md)
+# (measured on the manoeuvre below: 3.3e-3 at most, a radial bushing force; docs/envs.md)
 AGREEMENT = 0.01
 LOADS = ("wheel_load_left_n", "wheel_load_right_n")
 MOTION = ("roll_rad", "roll_rate_rad_per_s", "body_y_m", "camber_left_rad", "travel_right_m",
@@ -28,12 +28,14 @@ BUSHINGS = tuple(
 
 def manoeuvre(n=600):
     """A bump under the left wheel, a pothole under the right, then a lateral-load step and
-    its release (5 m/s^2 at 0.2 m/s^2 per step)."""
+    its release (2 m/s^2 at 0.2 m/s^2 per step: the twin's upper pivots stay within the
+    reference's calibrated +-0.15 rad, which the torsion-soft car's roll overshoot passes from
+    about 3 m/s^2)."""
     t = np.arange(n) * DT
     left = np.where((t > 0.2) & (t < 0.3), 0.03 * np.sin(np.pi * (t - 0.2) / 0.1), 0.0)
     right = np.where((t > 0.6) & (t < 0.65), -0.02 * np.sin(np.pi * (t - 0.6) / 0.05), 0.0)
     k = np.arange(n)
-    ay = np.clip(np.minimum(0.2 * (k - 200), 0.2 * (450 - k)), 0.0, 5.0)
+    ay = np.clip(np.minimum(0.2 * (k - 200), 0.2 * (450 - k)), 0.0, 2.0)
     return {"road_left": left, "road_right": right, "lateral_accel": ay}
 
 

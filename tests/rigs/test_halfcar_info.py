@@ -6,7 +6,7 @@ import gymnasium as gym
 import numpy as np
 
 import bushenv  # noqa: F401  (registers the ids)
-from bushenv.rigs.halfcar_params import POSITIONS
+from bushenv.rigs.halfcar_params import LINEAR, POSITIONS, REFERENCE
 
 KEYS = tuple(
     (f"deflection_{p}_{c}_m" if c != "rotation" else f"rotation_{p}_rad")
@@ -25,12 +25,12 @@ def run(model: str, n: int = 120) -> list[dict]:
 def test_info_carries_the_reference_bushings_deflections_per_pivot_and_coordinate():
     """With the twin's law in the model car too, the two cars' deflections are one; with a
     linear model car they part, and each is the car's own."""
-    same = run("rubber")
+    same = run(REFERENCE)
     for k in KEYS:
         a = np.array([i[k] for i in same])
         b = np.array([i["reference_" + k] for i in same])
         assert np.abs(a).max() > 0 and np.array_equal(a, b), k
-    other = run("linear")
+    other = run(LINEAR)
     for k in KEYS:
         ref = np.array([i["reference_" + k] for i in other])
         np.testing.assert_array_equal(ref, np.array([i["reference_" + k] for i in same]))

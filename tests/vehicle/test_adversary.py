@@ -10,6 +10,7 @@ import pytest
 
 from bushenv.cli import main
 from bushenv.rigs.common import resolve_model
+from bushenv.rigs.halfcar_params import LINEAR, REFERENCE
 from bushenv.search.evaluate import BatchEvaluator
 from bushenv.search.families import FAMILIES
 from bushenv.search.targets import TARGETS
@@ -26,7 +27,7 @@ BUSHINGS = (
 
 @pytest.fixture(scope="module")
 def rubber():
-    return resolve_model("rubber", dt=DT, coords=3, what="reference", env_id="HalfCar-v0")
+    return resolve_model(REFERENCE, dt=DT, coords=3, what="reference", env_id="HalfCar-v0")
 
 
 def _corners(dim):
@@ -76,13 +77,17 @@ def test_a_car_with_the_reference_bushings_passes_with_zero_difference(rubber):
     assert row["worst_deviation"] == 0.0 and row["robustness"] == 1.0 and not row["diverged"]
 
 
-def test_a_softer_bushing_differs_and_its_robustness_is_the_tolerances_margin(rubber):
+def test_a_wrong_bushing_differs_and_its_robustness_is_the_tolerances_margin(rubber):
+    """The cardanic linear preset (3000 N m/rad, 58x the pivots' torsion) against the torsion
+    one: 47 % on a pothole. (A bushing 2-10x softer differs by 1.7-3.9 % only: in this car the
+    coil carries the wheel rate.)"""
+    from bushenv.models import get_model
     from bushenv.models.planar_linear import PlanarLinear
 
-    ref = PlanarLinear.preset()
-    soft = PlanarLinear(0.5 * ref.k_matrix, ref.c_matrix, ref.dt)
+    ref = get_model(LINEAR, coords=3)
+    wrong = PlanarLinear.preset()
     profile = FAMILIES["car_pothole"].profile([0.5, 0.8, 0.3, 0.5], DT)
-    with BatchEvaluator(soft, ref, "halfcar") as ev:
+    with BatchEvaluator(wrong, ref, "halfcar") as ev:
         row = ev.evaluate([profile]).verdict.row(0)
     d = 100 * row["worst_deviation"]
     assert d > 5 and row["first_criterion"] == "differs" and row["diverged"]
@@ -103,15 +108,16 @@ def test_the_network_car_ends_where_the_reference_car_runs_and_fails_as_terminat
 
 
 def test_blame_swaps_every_pivot_and_names_the_one_whose_return_helps_most():
+    from bushenv.models import get_model
     from bushenv.models.planar_linear import PlanarLinear
 
-    ref = PlanarLinear.preset()
-    soft = PlanarLinear(0.5 * ref.k_matrix, ref.c_matrix, ref.dt)
+    ref = get_model(LINEAR, coords=3)
+    wrong = PlanarLinear.preset()  # cardanic: 58x too stiff in torsion
     profile = FAMILIES["car_pothole"].profile([0.5, 0.8, 0.3, 0.5], DT)
-    b = blame(profile, DT, soft, ref)
+    b = blame(profile, DT, wrong, ref)
     d_all, swap = b["d_pct_all_four"], b["swap"]
     assert d_all > 5 and set(swap) == {"lower_left", "upper_left", "lower_right", "upper_right"}
-    for s in swap.values():  # one soft pivot differs less than four
+    for s in swap.values():  # one wrong pivot differs less than four
         assert 0 < s["d_pct_model_here_only"] < d_all
     drops = {k: d_all - s["d_pct_reference_here"] for k, s in swap.items()}
     assert b["carried_by"]["pivot"] == max(drops, key=drops.get)

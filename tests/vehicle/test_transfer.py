@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bushenv.cli import main
-from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS
+from bushenv.rigs.halfcar_params import ENV_ID, POSITIONS, REFERENCE
 from bushenv.rigs.specs import spec_kwargs
 from bushenv.vehicle.compare import run_car
 from bushenv.vehicle.manoeuvres import standard_manoeuvres
@@ -74,7 +74,7 @@ def test_an_unreachable_or_unknown_error_is_refused_naming_it():
 def test_the_single_car_is_halfcar_v0s_model_car_bit_for_bit():
     m = standard_manoeuvres(DT, 0, ["pothole"], duration_s=1.0)[0]
     table = pivot_table([ErrorTerm("upper_left", "rotation", "hysteresis", 10.0)], DT)
-    env_run = run_car(m, table, "rubber", "x", env_overrides([m]))
+    env_run = run_car(m, table, REFERENCE, "x", env_overrides([m]))
     own = single_car_run(m, table, env_overrides([m]))
     assert own.steps == env_run.steps == m.samples and own.end == ""
     for name, values in env_run.model.items():
@@ -134,7 +134,7 @@ def test_a_campaign_repeats_to_the_last_bit_and_its_cars_ran_to_the_end(campaign
 def test_a_symmetric_error_on_a_symmetric_bump_rolls_nothing_and_a_one_sided_one_does():
     bump = standard_manoeuvres(DT, 0, ["bump"], duration_s=1.2)[0]
     ov = env_overrides([bump])
-    base = single_car_run(bump, "rubber", ov)
+    base = single_car_run(bump, REFERENCE, ov)
     both = [ErrorTerm(p, "axial", "stiffness", 10.0) for p in ("lower_left", "lower_right")]
     roll_both = single_car_run(bump, pivot_table(both, DT), ov).outputs["roll"]
     roll_left = single_car_run(bump, pivot_table(both[:1], DT), ov).outputs["roll"]

@@ -13,7 +13,7 @@ from bushenv.cli import main
 from bushenv.models.base import velocity_of
 from bushenv.models.planar_linear import PlanarLinear, fit_linear
 from bushenv.reproduce import identification_records
-from bushenv.rigs.halfcar_params import ENV_ID
+from bushenv.rigs.halfcar_params import ENV_ID, PIVOT_ROTATION, REFERENCE
 from bushenv.rigs.specs import spec_kwargs
 from bushenv.vehicle.checks import VehicleInputError
 from bushenv.vehicle.compare import OUTPUT_NAMES
@@ -27,8 +27,9 @@ SHORT = ("pothole", "step_steer")
 
 @pytest.fixture(scope="module")
 def linearisation() -> PlanarLinear:
-    """The coupled reference's linearisation: least-squares K, C on its n = 1 records."""
-    hist = identification_records(DT, 0, 10.0)
+    """The coupled reference's linearisation (the car's torsion set): least-squares K, C on
+    its n = 1 records."""
+    hist = identification_records(DT, 0, 10.0, rotation=PIVOT_ROTATION)
     q = np.vstack([h[0] for h in hist])
     v = np.vstack([velocity_of(h[0], DT) for h in hist])
     return fit_linear(q, v, np.vstack([h[1] for h in hist]), DT)
@@ -39,7 +40,7 @@ def short_report(linearisation):
     stiff = PlanarLinear(2 * linearisation.k_matrix, linearisation.c_matrix, dt=DT)
     bushings = {"linear": linearisation, "linear-2x-stiff": stiff}
     manoeuvres = standard_manoeuvres(DT, 0, SHORT, duration_s=1.5)
-    return run_vehicle(manoeuvres, bushings, "rubber")
+    return run_vehicle(manoeuvres, bushings, REFERENCE)
 
 
 def test_every_manoeuvre_is_a_halfcar_input_within_its_limits():
@@ -113,7 +114,7 @@ def test_a_car_that_leaves_its_bounds_is_reported_not_raised():
     k = np.diag([-2.0e5, -1.0e6, -3.0e3])
     bad = PlanarLinear(k, np.zeros((3, 3)), dt=DT)
     manoeuvres = standard_manoeuvres(DT, 0, ["pothole"], duration_s=1.5)
-    report, runs = run_vehicle(manoeuvres, {"negative": bad}, "rubber")
+    report, runs = run_vehicle(manoeuvres, {"negative": bad}, REFERENCE)
     row = report["rows"][0]
     assert row["end"]["reason"] and row["steps"] < row["samples"]
     assert "TERMINATED" in markdown(report)
@@ -126,7 +127,7 @@ def test_two_runs_give_the_same_numbers(short_report, linearisation):
     again, _ = run_vehicle(
         standard_manoeuvres(DT, 0, SHORT, duration_s=1.5),
         {"linear": linearisation, "linear-2x-stiff": stiff},
-        "rubber",
+        REFERENCE,
     )
     first = short_report[0]
     for a, b in zip(first["rows"], again["rows"], strict=True):
@@ -170,7 +171,7 @@ def test_with_hybrid_and_linear_the_finding_is_judged_also_in_seed_000s_car(
 ):
     near = PlanarLinear(scale * linearisation.k_matrix, linearisation.c_matrix, dt=DT)
     manoeuvres = standard_manoeuvres(DT, 0, ["pothole"], duration_s=1.5)
-    report, runs = run_vehicle(manoeuvres, {"linear": linearisation, "hybrid": near}, "rubber")
+    report, runs = run_vehicle(manoeuvres, {"linear": linearisation, "hybrid": near}, REFERENCE)
     assert report["kinds"] == ["linear", "hybrid", "hybrid-upper"]
     assert set(runs) == {("pothole", k) for k in report["kinds"]}
     for finding in (report["finding"], report["finding_upper_only"]):
