@@ -89,8 +89,7 @@ def kernel_source(kind, ia, ib, side, moving, iterations: int, width: int = WIDT
         if kd == ROTARY:
             head.append(f"    moment{e} = ja{a} + ja{b}; nmass{e} = 1.0 / moment{e}")
             pre += [
-                f"h_d = {par(e, 2)} * h",
-                f"{sc(e, 5)} = 1.0 - 1.0 / (1.0 + h_d * moment{e})",
+                f"{sc(e, 5)} = 1.0 - 1.0 / (1.0 + {par(e, 2)} * h * moment{e})",
                 f"{sc(e, 6)} = 0.0",
                 f"j = ((ang{a} - ang{b}) - {par(e, 0)}) * {par(e, 1)} * h",
                 f"w{a} -= j * ja{a}",
