@@ -69,9 +69,12 @@ from bushenv.vetting_check import (  # noqa: F401  (the thresholds and verdicts,
     RAMP_S,
     RECORD_LIMIT,
     SIGN_FRACTION,
+    UNVETTED_DWELL_S,
     VERDICTS,
     Check,
     Vetting,
+    enters_unvetted,
+    unvetted_regions,
 )
 from bushenv.vetting_holds import certificate_check, hold_check, passivity_check
 from bushenv.vetting_records import compatibility_check, records_check

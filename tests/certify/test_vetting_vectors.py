@@ -11,8 +11,7 @@ from bushenv.certify.reached_holds import boxes_of, confirm_holds, reach_profile
 from bushenv.errors import BadInput
 from bushenv.judge import build_judge
 from bushenv.models import get_model
-from bushenv.vetting import HOLDS, machine_rate, vet_reference
-from bushenv.vetting_check import enters_unvetted, unvetted_regions
+from bushenv.vetting import HOLDS, enters_unvetted, machine_rate, unvetted_regions, vet_reference
 
 from .conftest import bistable, ringing3, ringing_hybrid
 
