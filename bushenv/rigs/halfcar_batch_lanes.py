@@ -10,7 +10,8 @@ arithmetic per car is the scheme's, operation for operation and in its order, wi
 fused or reordered (the same numbers, bit for bit, a car alone or in any batch, any vector
 width). The source depends only on the element table's integers
 (kinds, bodies, sides, which bodies move), the sweeps and the chunk width; it is written once
-under ``__pycache__`` so that numba's cache keeps the compiled code between runs.
+to the generated kernels' folder (``narx_kernels.cache_dir``), so that numba's cache keeps the
+compiled code between runs (the first use compiles for some seconds).
 """
 
 from __future__ import annotations
@@ -28,6 +29,8 @@ import numpy as np
 from numba import types
 from numba.core.compiler_lock import global_compiler_lock
 
+from bushenv.models.narx_kernels import cache_dir
+from bushenv.persist import write_text
 from bushenv.rigs.halfcar_batch_kernels import (
     ANG,
     COS,
@@ -263,7 +266,7 @@ def lanes_kernel(kind, ia, ib, side, moving, iterations: int, width: int = WIDTH
     if key in _KERNELS:
         return _KERNELS[key]
     name = f"halfcar_lanes_{key}"
-    path = _write_once(name, source)
+    path = _place(name, source)
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the kernel's globals by module name
@@ -284,19 +287,17 @@ def lanes_kernel(kind, ia, ib, side, moving, iterations: int, width: int = WIDTH
     return kernel
 
 
-def _write_once(name: str, source: str) -> Path:
-    """``source`` as ``name``.py under this package's ``__pycache__`` (a temporary directory if
-    that cannot be written), written only when absent so that numba's cache stays valid."""
-    for folder in (Path(__file__).parent / "__pycache__", Path(tempfile.gettempdir())):
+def _place(name: str, source: str) -> Path:
+    """``source`` as ``name``.py in the generated kernels' folder (``narx_kernels.cache_dir``;
+    a per-user temporary folder if that cannot be written), written only when absent or
+    different, so that numba's cache (keyed by the file's time) stays valid."""
+    user = getattr(os, "getuid", lambda: "user")()
+    for folder in (cache_dir(), Path(tempfile.gettempdir()) / f"bushenv-kernels-{user}"):
         path = folder / f"{name}.py"
-        if path.exists() and path.read_text() == source:
-            return path
         try:
-            folder.mkdir(parents=True, exist_ok=True)
-            tmp = folder / f"{name}.{os.getpid()}.tmp"
-            tmp.write_text(source)
-            os.replace(tmp, path)  # atomic: another process may write the same file
-            return path
+            if path.is_file() and path.read_text() == source:
+                return path
+            return write_text(path, source)  # atomic: another process may write it too
         except OSError:
             continue
-    raise OSError(f"cannot write the half car kernel {name}.py anywhere")
+    raise OSError(f"cannot write the half car kernel {name}.py in {cache_dir()} nor a temp folder")
