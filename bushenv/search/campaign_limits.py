@@ -92,9 +92,11 @@ def vetted_within(
     trust: bool = False,
     error: type[Exception] = SearchError,
     stroke: np.ndarray | None = None,
+    rate: np.ndarray | None = None,
 ):
     """The reference (over several coordinates) checked before it judges (``bushenv.vetting``)
-    within ``stroke`` (None: the search ``target``'s): ``error`` when it fails, unless
+    within ``stroke`` (None: the search ``target``'s) and ``rate`` per coordinate (None: the
+    papers' machine's rule on the stroke, ``vetting.machine_rate``): ``error`` when it fails, unless
     ``trust``; (the ``Vetting``, what judged -- the vetting, the force floors per coordinate,
     the stroke -- for a report). The attack, the zoo and ``bushenv certify`` vet with it."""
     from bushenv.search.targets import reference_floors
@@ -111,6 +113,7 @@ def vetted_within(
         card_file=ref_spec if ref_spec.endswith(".npz") else None,
         model=model,
         model_file=model_file,
+        velocity=None if rate is None else np.asarray(rate, dtype=np.float64),
     )
     for line in vetted.lines():
         say(f"reference {ref_spec}: {line}")

@@ -214,7 +214,7 @@ def coordinate_judge(
     limits = search_limits(flags, subject, ref)
     vetted, judged = vetted_within(
         ref.model, ref.spec, target, say, model=subject.model, model_file=subject.file,
-        trust=trust_reference, stroke=np.array(limits.stroke),
+        trust=trust_reference, stroke=np.array(limits.stroke), rate=np.array(limits.rate),
     )  # fmt: skip
     criteria, why = criteria_of(ref.model, True, target)
     say(f"searching within {limits_text(limits.to_json())}")
