@@ -64,6 +64,19 @@ def _rows(n_body: int, n_el: int) -> dict[str, int]:
             "end": o_par + 3 * n_el + N_SCRATCH * n_el}  # fmt: skip
 
 
+def _impulse(a: int, b: int) -> list[str]:
+    """The lines that apply impulse j along (nx, ny) between bodies a and b (lever arms c1,
+    c2; inverse masses ma, inverse inertias ja)."""
+    return [
+        f"vx{a} -= j * nx * ma{a}",
+        f"vy{a} -= j * ny * ma{a}",
+        f"w{a} -= j * c1 * ja{a}",
+        f"vx{b} += j * nx * ma{b}",
+        f"vy{b} += j * ny * ma{b}",
+        f"w{b} += j * c2 * ja{b}",
+    ]
+
+
 def kernel_source(kind, ia, ib, side, moving, iterations: int, width: int = WIDTH) -> str:
     """The numba source of the sub-step kernel for one element table (``Layout``'s ``kind``,
     ``ia``, ``ib``, ``side``; ``moving`` (bodies,) bool: the bodies the lateral load moves)."""
@@ -159,12 +172,7 @@ def kernel_source(kind, ia, ib, side, moving, iterations: int, width: int = WIDT
             f"{sc(e, 4)} = 1.0 / k",
             f"{sc(e, 5)} = vcoef",
             f"{sc(e, 6)} = 0.0",
-            f"vx{a} -= j * nx * ma{a}",
-            f"vy{a} -= j * ny * ma{a}",
-            f"w{a} -= j * c1 * ja{a}",
-            f"vx{b} += j * nx * ma{b}",
-            f"vy{b} += j * ny * ma{b}",
-            f"w{b} += j * c2 * ja{b}",
+            *_impulse(a, b),
         ]  # fmt: skip
         sweep += [
             f"nx, ny, c1, c2 = {sc(e, 0)}, {sc(e, 1)}, {sc(e, 2)}, {sc(e, 3)}",
@@ -173,12 +181,7 @@ def kernel_source(kind, ia, ib, side, moving, iterations: int, width: int = WIDT
             f"vd = ({sc(e, 6)} - vrn) * {sc(e, 5)}",
             f"{sc(e, 6)} = vrn + vd",
             f"j = vd * {sc(e, 4)}",
-            f"vx{a} -= j * nx * ma{a}",
-            f"vy{a} -= j * ny * ma{a}",
-            f"w{a} -= j * c1 * ja{a}",
-            f"vx{b} += j * nx * ma{b}",
-            f"vy{b} += j * ny * ma{b}",
-            f"w{b} += j * c2 * ja{b}",
+            *_impulse(a, b),
         ]  # fmt: skip
     sides = sorted(landed)
     velocities = [(f"{n}{k}", st(r, k)) for k in range(n_body)
