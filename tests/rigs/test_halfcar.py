@@ -440,7 +440,7 @@ def test_the_split_coupling_settles_under_the_harshest_inputs_with_linear_bushin
     """Bang-bang roads at the rate limit on both sides (out of phase) and a lateral load
     switching at its rate limit, half periods of 1-20 steps, every bound off: linear bushings
     in both cars (the coupling itself, the remainder zero) stay finite and settle once the
-    inputs are back at 0 (the roll mode, 1.9 Hz, has a damping ratio of about 0.1)."""
+    inputs are back at 0 (the roll mode, 1.47 Hz, has a damping ratio of about 0.2)."""
     settles(make(model=LINEAR, reference=LINEAR, max_episode_steps=-1, **LOOSE).unwrapped,
             bang_bang_inputs(half, limits=HARSH))  # fmt: skip
 
