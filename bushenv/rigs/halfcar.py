@@ -54,8 +54,10 @@ class HalfCarEnv(gym.Env):
     reference bushings drives the same roads under the same lateral load. One step is one
     bushing-model sample (204.8 Hz); pymunk takes ``physics_substeps`` steps in between, the
     bushing forces split as QuarterCar-v0's (``coupling.SplitBushing``: the planar linear
-    preset inside every sub-step, the model's remainder held). Geometry and data: Project
-    Chrono's Sedan, cited in ``envs/HalfCar-v0.toml``; docs/envs.md gives the checks.
+    torsion preset, ``linear-torsion``, inside every sub-step, the model's remainder held; the
+    arms turn their pivots' bushes in torsion, ``halfcar_params.PIVOT_ROTATION``). Geometry
+    and data: Project Chrono's Sedan, cited in ``envs/HalfCar-v0.toml``; docs/envs.md gives the
+    checks.
 
     ## Action Space
 
