@@ -156,8 +156,8 @@ class QuarterCarEnv(gym.Env):
         env = gym.make("QuarterCar-v0", model={"radial": "r.npz", "axial": "a.npz"})
         env = gym.make("QuarterCar-v0", arm_bushing="planar.npz")  # one planar model
 
-    ``arm_bushing`` (a ``bushenv.planar.PLANAR_MODELS`` name, a planar ``.npz`` file or a
-    planar model) replaces the two one-axis models by one three-axis bushing that also carries
+    ``arm_bushing`` (a ``MODELS`` name with a three-axis form, a three-axis ``.npz`` file or
+    a three-axis model) replaces the two one-axis models by one three-axis bushing that also carries
     the arm's rotation (a moment, judged by ``arm_moment_limit_nm``; the twin's is
     ``arm_bushing_reference``); info then adds ``arm_rotation_rad``, ``moment_model_nm``,
     ``moment_reference_nm``. docs/planar.md gives its coupling and range.
