@@ -85,6 +85,14 @@ class VectorBoucWenOptions:
         choices=("all", "extrapolation"),
     )
 
+    relaxation_form: str = option(
+        "constant",
+        "constant: the branches relax the deflection (gains in N/m); qlv: they relax the "
+        "elastic force K q + G3(q) (Fung's quasi-linear viscoelasticity: the relaxing force "
+        "follows the hardening and coupled stiffness; the same number of gains)",
+        choices=("constant", "qlv"),
+    )
+
     def taus(self) -> np.ndarray:
         """(M,) the relaxation time constants, s."""
         text = self.relaxation_times.strip()

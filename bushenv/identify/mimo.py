@@ -46,6 +46,7 @@ class HybridBWOptions(MimoOptions):
     )
     relaxation_times: str = option_like(VectorBoucWenOptions, "relaxation_times")
     relaxation_selection: str = option_like(VectorBoucWenOptions, "relaxation_selection")
+    relaxation_form: str = option_like(VectorBoucWenOptions, "relaxation_form")
     network: str = option_like(MimoHybridOptions, "network")
 
     def check(self) -> None:
@@ -63,6 +64,7 @@ class HybridBWOptions(MimoOptions):
             time_limit_s=self.time_limit_s,
             relaxation_times=self.relaxation_times,
             relaxation_selection=self.relaxation_selection,
+            relaxation_form=self.relaxation_form,
         )
 
 

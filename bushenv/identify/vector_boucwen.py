@@ -21,6 +21,12 @@ worse: studies/2026-11-planar-fit-unseen). ``relaxation_selection="extrapolation
 shortest branches when that predicts the training records' largest deflections better
 (``_select``; an option: measured to help on one bushing and hurt on another). The summary warns
 of branches the records cannot tell from the static stiffness (``relaxation.inseparable``).
+``relaxation_form="qlv"``: the branches relax the elastic force F_e,i = K_i q + G_i (q_i q^2)
+(``relaxation.py``), so the force is bilinear in (K, G) and the weights r_m,i; per row, from
+the constant form's fit (r = R_ii / K_ii), ``QLV_ROUNDS`` rounds of alternating least squares:
+(K, C, G, h) given r, then (C, r >= 0, h >= 0) given K and G. Each step is the model's exact
+least squares in its unknowns, so the residual never grows; a fixed count keeps it
+deterministic.
 """
 
 from __future__ import annotations
@@ -46,6 +52,7 @@ START_D_SHARE = (0.05, 0.1, 0.2, 0.4)  # start yield deflections, share of each 
 EXTRAPOLATION_SHARE = 0.1  # the largest deflections held out to choose the relaxation branches
 SELECTION_TIE = 0.01  # scores closer than this (relative) are a tie: the fuller grid kept
 MIN_SAMPLES = 20  # per record
+QLV_ROUNDS = 3  # alternations of the quasi-linear form's least squares, per shape
 
 
 class _OutOfTime(Exception):
@@ -57,8 +64,8 @@ class _Problem:
     hysteretic shape and the relaxation branches kept (indices into ``taus``)."""
 
     def __init__(self, qs: list[np.ndarray], fs: list[np.ndarray], dt: float,
-                 taus: np.ndarray, yield_surface: str) -> None:  # fmt: skip
-        self.qs, self.dt, self.taus, self.surface = qs, dt, taus, yield_surface
+                 taus: np.ndarray, yield_surface: str, form: str = "constant") -> None:  # fmt: skip
+        self.qs, self.dt, self.taus, self.surface, self.form = qs, dt, taus, yield_surface, form
         self.q = np.vstack(qs)
         self.f = np.vstack(fs)
         v = np.vstack([velocity_of(q, dt) for q in qs])
@@ -69,6 +76,21 @@ class _Problem:
         self.col = np.maximum(np.abs(self.lin).max(axis=0), 1e-300)
         self.cub_col = [np.maximum(np.abs(c).max(axis=0), 1e-300) for c in self.cubic]
         self.p_col = np.maximum(np.abs(self.p).max(axis=0), 1e-300)
+        # the quasi-linear form's base columns of row i: q, v, q_i q^2, the branches' filtered
+        # increments of q and of q_i q^2 (``_Columns``), and their QR on every row
+        self.base: list[np.ndarray] = []
+        self.base_scale: list[np.ndarray] = []
+        self.base_qr: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        if form == "qlv":
+            for i in range(3):
+                parts = [relaxation.branch_deflections(q[:, i : i + 1] * q**2, dt, taus)
+                         for q in qs]  # fmt: skip
+                base = np.hstack([self.lin, self.cubic[i], self.p, np.vstack(parts)])
+                scale = np.maximum(np.abs(base).max(axis=0), 1e-300)
+                q0, r0 = np.linalg.qr(base / scale)
+                self.base.append(base)
+                self.base_scale.append(scale)
+                self.base_qr.append((q0, r0, q0.T @ self.f[:, i]))
 
     def hysteretic(self, p: np.ndarray) -> np.ndarray:
         d, beta, eta = np.exp(p[:3]), float(p[3]), float(p[4])
@@ -83,6 +105,15 @@ class _Problem:
         """Coefficients fitted on rows ``fit`` (row i: K_i (3), C_i (3), G_i (3), R_i (3 K),
         h_i for the K branches kept) and the sum over the axes of the RMS ratio on rows
         ``judged`` (default: the fitted ones)."""
+        judged = fit if judged is None else judged
+        if self.form == "qlv" and len(keep):
+            return self.solve_qlv(z, keep, fit, judged)
+        return self.solve_constant(z, keep, fit, judged)
+
+    def solve_constant(
+        self, z: np.ndarray, keep: np.ndarray, fit: Any = slice(None), judged: Any = None
+    ) -> tuple[float, np.ndarray]:
+        """``solve`` for the constant form (the branch columns hold R_m[i, i], N/m ...)."""
         judged = fit if judged is None else judged
         n_p = 3 * len(keep)
         coef = np.zeros((3, 10 + n_p))
@@ -107,6 +138,70 @@ class _Problem:
                 coef[i] = np.concatenate([c[:6] / self.col, c[6:9] / self.cub_col[i], c[9:]])
             score += float(np.linalg.norm(error) / max(np.linalg.norm(y[judged]), 1e-300))
         return score, coef
+
+    def solve_qlv(
+        self, z: np.ndarray, keep: np.ndarray, fit: Any, judged: Any
+    ) -> tuple[float, np.ndarray]:
+        """``solve`` for the quasi-linear form: the constant form's fit, then ``QLV_ROUNDS``
+        alternations; the branch columns of row i hold the weights r_m,i (dimensionless).
+        Every design is a combination of row i's base columns (``base``), so each least
+        squares runs on their triangular factor (as many rows as columns), not on the
+        records."""
+        n_m, n_k = len(self.taus), len(keep)
+        coef = np.zeros((3, 10 + 3 * n_k))
+        score = 0.0
+        for i in range(3):
+            a, y_hat = self.reduced(i, z[:, i], fit)
+            col = _Columns(n_m, keep, a.shape[1])
+            # the constant form: R_m[i, i] on the branch deflections of coordinate i
+            x, rh = _solve_reduced(a, col.unit(col.q + col.v + col.c),
+                                   col.unit([col.pq(m, i) for m in range(n_k)] + [col.z]),
+                                   y_hat)  # fmt: skip
+            k_i, g_i = x[:3], x[6:9]
+            r = np.maximum(rh[:-1] / k_i[i], 0.0) if k_i[i] > 0 else np.zeros(n_k)
+            for _ in range(QLV_ROUNDS):
+                # (K, C, G, h) given r: the elastic columns carry their relaxation along
+                free = np.column_stack(
+                    [col.elastic(j, r, "q") for j in range(3)]
+                    + [col.unit([c])[:, 0] for c in col.v]
+                    + [col.elastic(j, r, "c") for j in range(3)]
+                )
+                x, hr = _solve_reduced(a, free, col.unit([col.z]), y_hat)
+                k_i, g_i, h = x[:3], x[6:9], hr[0]
+                # (C, r, h) given K and G: each branch's elastic-force column, r >= 0
+                held = np.column_stack([col.branch(m, k_i, g_i) for m in range(n_k)]
+                                       + [col.unit([col.z])[:, 0]])  # fmt: skip
+                fixed = col.coefficients(k_i, np.zeros(3), g_i, np.zeros(n_k), 0.0)
+                c_v, rh = _solve_reduced(a, col.unit(col.v), held, y_hat - a @ fixed)
+                r, h = rh[:-1], rh[-1]
+            beta = col.coefficients(k_i, c_v, g_i, r, h)
+            rows = self.base[i][judged]
+            error = rows @ beta[:-1] + z[judged, i] * h - self.f[judged, i]
+            branches = np.zeros(3 * n_k)
+            branches[i::3] = r
+            coef[i] = np.concatenate([k_i, c_v, g_i, branches, [h]])
+            score += float(np.linalg.norm(error) / max(np.linalg.norm(self.f[judged, i]), 1e-300))
+        return score, coef
+
+    def reduced(self, i: int, z: np.ndarray, fit: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(A, y_hat): row i's base columns and z on rows ``fit`` as Q A (Q orthonormal, A
+        square), and y_hat = Q' f_i, so |B beta - f_i| = |A beta - y_hat| + a constant."""
+        y = self.f[:, i]
+        scale = self.base_scale[i]
+        if isinstance(fit, slice) and fit == slice(None):
+            q0, r0, qy = self.base_qr[i]
+            zs = z / max(np.abs(z).max(), 1e-300)
+            w = q0.T @ zs
+            rest = zs - q0 @ w
+            rho = np.linalg.norm(rest)
+            e = rest / rho if rho > 0 else rest
+            r = np.block([[r0, w[:, None]], [np.zeros((1, r0.shape[1])), np.array([[rho]])]])
+            a = r * np.append(scale, max(np.abs(z).max(), 1e-300))[None, :]
+            return a, np.append(qy, e @ y)
+        full = np.column_stack([self.base[i][fit], z[fit]])
+        s = np.maximum(np.abs(full).max(axis=0), 1e-300)
+        q, r = np.linalg.qr(full / s)
+        return r * s[None, :], q.T @ y[fit]
 
     def beyond(self) -> np.ndarray | None:
         """Rows whose deflection vector (each coordinate over its peak) is among the largest
@@ -165,7 +260,7 @@ def fit_vector_boucwen(
                 f"{q.shape} and {f.shape}"
             )
     taus = opt.taus()
-    prob = _Problem(qs, fs, dt, taus, opt.yield_surface)
+    prob = _Problem(qs, fs, dt, taus, opt.yield_surface, opt.relaxation_form)
     lo = np.concatenate([np.log(prob.peak * SEARCH_D_SHARE[0]), [SEARCH_BETA[0], SEARCH_ETA[0]]])
     hi = np.concatenate([np.log(prob.peak * SEARCH_D_SHARE[1]), [SEARCH_BETA[1], SEARCH_ETA[1]]])
     t_start = time.perf_counter()
@@ -226,7 +321,8 @@ def fit_vector_boucwen(
     gain = coef[:, 9:-1].reshape(3, len(kept), 3).transpose(1, 0, 2)  # R_m[i, j]: 3 m + j
     model = PlanarBoucWen(coef[:, :3], coef[:, 3:6], coef[:, -1], np.exp(p[:3]),
                           (p[3], 1.0 - p[3], p[4]), coef[:, 6:9], opt.yield_surface,
-                          dt=dt, relax_tau=kept, relax_gain=gain)  # fmt: skip
+                          dt=dt, relax_tau=kept, relax_gain=gain,
+                          relaxation_form=opt.relaxation_form)  # fmt: skip
     info = {
         "evaluations": count[0],
         "score_sum_rms_ratio": best["score"],
@@ -281,6 +377,62 @@ def _select(prob: _Problem, p: np.ndarray, every: np.ndarray) -> tuple[np.ndarra
         f"kept {kept} (sum of RMS ratios on the largest {EXTRAPOLATION_SHARE:.0%} of "
         f"deflections, fitted on the rest, dropping the shortest branches one by one: {shown})"
     )
+
+
+class _Columns:
+    """Row i's base columns (``_Problem.base`` then z) by index, and the quasi-linear form's
+    designs and coefficients on them: q (3), v (3), c = q_i q^2 (3), P_m[q] (3 M), P_m[c]
+    (3 M), z; ``keep`` the branches used, in the order of their gains."""
+
+    def __init__(self, n_m: int, keep: np.ndarray, width: int) -> None:
+        self.n_m, self.keep, self.width = n_m, keep, width
+        self.q, self.v, self.c = [0, 1, 2], [3, 4, 5], [6, 7, 8]
+        self.z = width - 1
+
+    def pq(self, m: int, j: int) -> int:
+        return 9 + 3 * int(self.keep[m]) + j
+
+    def pc(self, m: int, j: int) -> int:
+        return 9 + 3 * self.n_m + 3 * int(self.keep[m]) + j
+
+    def unit(self, cols: list[int]) -> np.ndarray:
+        t = np.zeros((self.width, len(cols)))
+        t[cols, np.arange(len(cols))] = 1.0
+        return t
+
+    def elastic(self, j: int, r: np.ndarray, kind: str) -> np.ndarray:
+        """Base column q_j (or c_j) with its relaxation r_m P_m[.] added."""
+        t = np.zeros(self.width)
+        t[self.q[j] if kind == "q" else self.c[j]] = 1.0
+        for m, rm in enumerate(r):
+            t[self.pq(m, j) if kind == "q" else self.pc(m, j)] += rm
+        return t
+
+    def branch(self, m: int, k: np.ndarray, g: np.ndarray) -> np.ndarray:
+        """Branch m's elastic-force column: sum_j K_j P_m[q_j] + G_j P_m[c_j]."""
+        t = np.zeros(self.width)
+        for j in range(3):
+            t[self.pq(m, j)] = k[j]
+            t[self.pc(m, j)] = g[j]
+        return t
+
+    def coefficients(self, k, c, g, r, h) -> np.ndarray:
+        """The base coefficients of the model (K, C, G, gains r, h)."""
+        beta = np.zeros(self.width)
+        beta[self.q], beta[self.v], beta[self.c], beta[self.z] = k, c, g, h
+        for m, rm in enumerate(r):
+            beta += rm * self.branch(m, k, g)
+        return beta
+
+
+def _solve_reduced(a: np.ndarray, free: np.ndarray, held: np.ndarray, y_hat: np.ndarray):
+    """``_bounded_lstsq`` on the designs ``a @ free`` and ``a @ held`` (columns scaled to unit
+    norm for the solvers, the coefficients scaled back)."""
+    f, h = a @ free, a @ held
+    fs = np.maximum(np.linalg.norm(f, axis=0), 1e-300)
+    hs = np.maximum(np.linalg.norm(h, axis=0), 1e-300)
+    x, r = _bounded_lstsq(f / fs, h / hs, y_hat)
+    return x / fs, r / hs
 
 
 def _bounded_lstsq(free: np.ndarray, held: np.ndarray, y: np.ndarray):

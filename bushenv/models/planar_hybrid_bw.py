@@ -37,7 +37,10 @@ class PlanarBoucWenHybrid(PlanarNarx):
         dt = params.get("dt", PAPER_DT)
         backbone = {k: params.pop(k) for k in BACKBONE_PARAMS if k in params}
         surface = params.pop("yield_surface", "vector")
-        self.backbone = PlanarBoucWen(**backbone, yield_surface=surface, dt=dt)
+        form = params.pop("relaxation_form", "constant")
+        self.backbone = PlanarBoucWen(
+            **backbone, yield_surface=surface, relaxation_form=form, dt=dt
+        )
         for k in BACKBONE_PARAMS:
             setattr(self, k, getattr(self.backbone, k))
         super().__init__(**params)

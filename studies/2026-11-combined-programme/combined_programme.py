@@ -558,9 +558,7 @@ def run(args: argparse.Namespace) -> dict:
     outside = OutsideBushing(OutsideParams(**VARIANTS[args.variant]), dt_s=dt)
     progress.say("checking the outside bushing: tangent, passivity, stability")
     checks = check_outside(outside, dt, seed)
-    q_id = __import__("bushenv.motions", fromlist=["x"]).random_independent(
-        1.0, 40.0, dt, seed
-    )
+    q_id = __import__("bushenv.motions", fromlist=["x"]).random_independent(1.0, 40.0, dt, seed)
     stiff = {
         "outside": dynamic_stiffness(q_id, outside.simulate(q_id)[0], dt),
         "reference": dynamic_stiffness(q_id, PlanarRubber.preset(dt=dt).simulate(q_id), dt),
@@ -596,8 +594,10 @@ def run(args: argparse.Namespace) -> dict:
             length_s = sum(len(q) for q, _ in hist) * dt
             for kind in kinds:
                 opts = None
-                if kind == "hybrid-bw" and args.evaluations is not None:
-                    opts = {"evaluations": args.evaluations}
+                if kind == "hybrid-bw":
+                    opts = {"relaxation_form": args.relaxation_form}
+                    if args.evaluations is not None:
+                        opts["evaluations"] = args.evaluations
                 key = f"{bushing}/{s}/{kind}"
                 progress.say(f"fitting {key} on {len(hist)} records, {length_s:.0f} s")
                 t0 = time.perf_counter()
@@ -636,6 +636,7 @@ def run(args: argparse.Namespace) -> dict:
                 "random_s": 2 * args.unseen_s,
             },
             "hybrid_bw_evaluations": args.evaluations or "default",
+            "hybrid_bw_relaxation_form": args.relaxation_form,
             "combined_programme": combined_names,
             "wall_s": time.perf_counter() - t_start,
         },
@@ -779,6 +780,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--swept", type=float, default=0.8, help="unseen sweep amplitude / peak")
     p.add_argument("--f-hz", type=float, nargs=2, default=(1.0, 8.0))
     p.add_argument("--evaluations", type=int, default=None, help="hybrid-bw backbone search")
+    p.add_argument(
+        "--relaxation-form",
+        default="constant",
+        choices=["constant", "qlv"],
+        help="hybrid-bw backbone's relaxation: on the deflection, or on the elastic force",
+    )
     p.add_argument("--quick", action="store_true", help="short records, small budgets")
     p.add_argument(
         "--bushings", nargs="+", default=["reference", "outside"], choices=["reference", "outside"]

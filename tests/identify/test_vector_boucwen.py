@@ -136,3 +136,36 @@ def test_branches_slower_than_the_records_are_warned_of_and_a_hold_separates_the
     _, info = fit_vector_boucwen([(q, truth.simulate(q)) for q in [*sep, axial_sweep]],
                                  PAPER_DT, VectorBoucWenOptions(5, time_limit_s=0.0))  # fmt: skip
     assert "relaxation warning" not in info, info
+
+
+def test_a_relaxation_that_follows_the_elastic_stiffness_is_recovered_by_the_qlv_form():
+    """A hardening, coupled bushing whose branches relax its elastic force (the quasi-linear
+    form): the qlv fit recovers it, the constant form (gains on the deflection) cannot follow
+    the stiffer relaxation at large and coupled deflections."""
+    from bushenv.motions import random_correlated
+
+    g = np.array([[5e10, 2e10, 1e5], [2e10, 2e11, 1e8], [1e5, 1e5, 6e5]])
+    ratio = np.stack([np.diag([0.4, 0.3, 0.35]), np.diag([0.15, 0.2, 0.1])])
+    # a light hysteresis, so a short shape search leaves the relaxation's form to tell them apart
+    truth = PlanarBoucWen(K, C, (10.0, 50.0, 4.0), D, (0.5, 0.5, 2.0), g, dt=PAPER_DT,
+                          relax_tau=[0.02, 0.2], relax_gain=ratio,
+                          relaxation_form="qlv")  # fmt: skip
+    q = random_independent(1.0, 6.0, PAPER_DT, 0)
+    f = truth.simulate(q)
+    q_new = random_correlated(1.0, 4.0, PAPER_DT, 7)
+    f_new = truth.simulate(q_new)
+
+    def err(form):
+        opts = VectorBoucWenOptions(
+            evaluations=10, relaxation_times="0.02,0.2", relaxation_form=form
+        )
+        model, _ = fit_vector_boucwen([(q, f)], PAPER_DT, opts)
+        e = model.simulate(q_new) - f_new
+        return model, np.sqrt(np.mean(e**2, axis=0) / np.mean(f_new**2, axis=0))
+
+    qlv, e_qlv = err("qlv")
+    _, e_constant = err("constant")
+    assert qlv.relaxation_form == "qlv"
+    assert np.all(e_qlv < 0.006), e_qlv  # measured 0.42 % at most
+    assert np.max(e_constant) > 2.5 * np.max(e_qlv), (e_constant, e_qlv)  # measured 1.6 %
+    assert np.diag(qlv.relax_gain[0]) == pytest.approx([0.4, 0.3, 0.35], rel=0.1)

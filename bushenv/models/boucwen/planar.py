@@ -30,6 +30,10 @@ model, for measuring what the shared surface is worth.
 
 Optionally a relaxation (``relax_tau`` (M,) s, ``relax_gain`` (M, 3, 3)): the Prony series of
 ``relaxation.py`` on the deflection vector. Files written before it existed have none.
+``relaxation_form="qlv"`` relaxes the elastic force K q + G3(q) instead (the quasi-linear
+form of ``relaxation.py``; ``relax_gain`` then dimensionless): the relaxing force follows the
+hardening and the coupled stiffening. Files without the setting are of the constant form and
+give the forces they always gave.
 
 State (6 + 3 M, B): z (3), the previous deflection (3), the branches' deflections (3 M), at
 rest zero.
@@ -153,8 +157,14 @@ class PlanarBoucWen(PlanarModel):
         dt: float = PAPER_DT,
         relax_tau: Any = None,
         relax_gain: Any = None,
+        relaxation_form: str = "constant",
     ) -> None:
         self.relax_tau, self.relax_gain = relaxation.check(relax_tau, relax_gain)
+        if relaxation_form not in relaxation.FORMS:
+            raise PlanarModelError(
+                f"boucwen: relaxation_form {relaxation_form!r}; known: {list(relaxation.FORMS)}"
+            )
+        self.relaxation_form = relaxation_form
         if yield_surface not in YIELD_SURFACES:
             raise PlanarModelError(
                 f"boucwen: yield_surface {yield_surface!r}; known: {list(YIELD_SURFACES)}"
@@ -201,7 +211,10 @@ class PlanarBoucWen(PlanarModel):
         return 6 + 3 * self.relax_tau.shape[0]
 
     def extra_meta(self) -> dict[str, Any]:
-        return {"yield_surface": self.yield_surface}
+        meta: dict[str, Any] = {"yield_surface": self.yield_surface}
+        if self.relaxation_form != "constant":  # files of the constant form stay as they were
+            meta["relaxation_form"] = self.relaxation_form
+        return meta
 
     def _advance(self, q: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         if self.state.shape[1] != q.shape[1]:
@@ -217,7 +230,13 @@ class PlanarBoucWen(PlanarModel):
         )  # fmt: skip
         if self.relax_tau.shape[0]:
             a, b = relaxation.coefficients(self.relax_tau, self.dt)
-            relaxation.relaxation_kernel(q, q_before, self.state[6:], a, b, self.relax_gain, out)
+            if self.relaxation_form == "qlv":
+                relaxation.qlv_kernel(q, q_before, self.state[6:], a, b, self.relax_gain,
+                                      self.k_matrix, self.g_cubic, out)  # fmt: skip
+            else:
+                relaxation.relaxation_kernel(
+                    q, q_before, self.state[6:], a, b, self.relax_gain, out
+                )
 
     def hysteretic_state(self, q: np.ndarray) -> np.ndarray:
         """z along ``q`` ((T, 3) -> (T, 3)) from rest: the run with K = C = 0 and h = 1."""

@@ -14,6 +14,19 @@ assumes): p_m,t = a_m p_m,t-1 + b_m (q_t - q_t-1), a_m = exp(-dt / tau_m),
 b_m = tau_m (1 - a_m) / dt. With R_m symmetric positive semidefinite (a fit gives diagonal,
 non-negative ones) every branch stores and dissipates energy only: its loss matrix adds
 R_m w tau / (1 + w^2 tau^2) >= 0 at every frequency, so it keeps the element passive.
+
+Quasi-linear form (``FORMS`` "qlv"; Fung 1981, "Biomechanics", ch. 7; the finite-strain
+viscoelasticity of Simo 1987 that finite element codes apply to a hyperelastic rubber): the
+branches relax the *elastic force* instead of the deflection,
+
+    f_relax = sum_m R_m s_m          s_m' = F_e(q)' - s_m / tau_m       (s_m in N, N, N m)
+
+with F_e(q) = K q + G3(q) the backbone's elastic force and R_m dimensionless (the reduced
+relaxation function's weights). In a filled rubber the chains that relax are the ones that
+carry the elastic stress, so the relaxing force scales with the elastic stiffness where the
+bushing is: a hardening or coupled-stiffened state relaxes more. For a linear elastic
+backbone (G3 = 0) F_e' = K q', so s_m = K p_m and the form is the constant one with gains
+R_m K (``qlv_as_constant``). Discrete law as above on the increments of F_e.
 """
 
 from __future__ import annotations
@@ -23,6 +36,8 @@ import numpy as np
 from scipy.signal import lfilter
 
 from bushenv.models.planar_base import PlanarModelError, as_matrix
+
+FORMS = ("constant", "qlv")  # what the branches relax: the deflection, or the elastic force
 
 
 def coefficients(tau: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -72,6 +87,47 @@ def relaxation_kernel(q, q_before, state, a, b, gain, out):  # pragma: no cover 
                     for j in range(3):
                         acc += gain[m, i, j] * state[3 * m + j, b_]
                 out[t, b_, i] += acc
+
+
+@nb.njit(cache=True)
+def _elastic(q0, q1, q2, k, g, i):  # pragma: no cover - compiled
+    """F_e,i = K_i q + sum_j G_ij q_i q_j^2 (the backbone's elastic force on coordinate i)."""
+    qq = (q0, q1, q2)
+    acc = 0.0
+    for j in range(3):
+        acc += k[i, j] * qq[j] + g[i, j] * qq[i] * qq[j] * qq[j]
+    return acc
+
+
+@nb.njit(cache=True)
+def qlv_kernel(q, q_before, state, a, b, gain, k, g, out):  # pragma: no cover - compiled
+    """The quasi-linear form: add sum_m R_m s_m to ``out`` (T, B, 3); ``state`` (3 M, B) the
+    branches' s_m (N, N, N m), updated on the increments of F_e = K q + G3(q)."""
+    T, B, _ = q.shape
+    M = a.shape[0]
+    for b_ in range(B):
+        for t in range(T):
+            for i in range(3):
+                if t == 0:
+                    before = _elastic(q_before[0, b_], q_before[1, b_], q_before[2, b_], k, g, i)
+                else:
+                    before = _elastic(q[t - 1, b_, 0], q[t - 1, b_, 1], q[t - 1, b_, 2], k, g, i)
+                df = _elastic(q[t, b_, 0], q[t, b_, 1], q[t, b_, 2], k, g, i) - before
+                for m in range(M):
+                    r = 3 * m + i
+                    state[r, b_] = a[m] * state[r, b_] + b[m] * df
+            for i in range(3):
+                acc = 0.0
+                for m in range(M):
+                    for j in range(3):
+                        acc += gain[m, i, j] * state[3 * m + j, b_]
+                out[t, b_, i] += acc
+
+
+def qlv_as_constant(gain: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """The constant-form gains R_m K that a quasi-linear relaxation with weights ``gain``
+    (M, 3, 3) on a linear elastic backbone of stiffness ``k`` (3, 3) equals."""
+    return gain @ k
 
 
 SEPARABLE_INFLATION = 1e4  # a column the others explain to 1 part in 10^4 (R^2 0.9999)
