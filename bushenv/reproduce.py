@@ -47,8 +47,10 @@ from bushenv.metrics import esr, max_error, max_error_ratio, rms_ratio
 from bushenv.models import MODELS, get_model
 from bushenv.models.planar_base import COORDS
 from bushenv.motions import (
+    CORRELATION,
     N_VERIFY,
     coupled_sets,
+    preload_sweep,
     random_correlated,
     random_independent,
     verification_motions,
@@ -56,7 +58,7 @@ from bushenv.motions import (
 from bushenv.programmes import IDENTIFICATIONS
 from bushenv.progress import Progress
 from bushenv.records import Record
-from bushenv.reference.planar import PlanarRubber
+from bushenv.reference.planar import TORSION_MAX_ROTATION_RAD, PlanarRubber
 from bushenv.reproduce_report import PAPER, TABLE3, write_report
 
 # Identification time relative to the linear least squares, for the time-left estimate only.
@@ -238,6 +240,40 @@ COUPLED_EFFORT = {
 }
 
 
+# The torsion set's records also reach its calibrated range (a car's pivots turn to 0.3-0.4 rad
+# in its steering events, at its body's frequencies): the peaks (axial, radial, rotation) of the
+# wide records -- the translations' stroke in axial (the car's lower pivots reach 10 mm under
+# lateral load), twice the n = 1 radial (they reach 2.4 mm), the calibrated rotation -- driven
+# in the band of the body's modes (bounce 1.3 Hz, roll 1.5 Hz) and the steering inputs, where a
+# car's large deflections are; the coupled sets sweep the same band.
+WIDE_PEAKS = {"torsion": np.array([12.5e-3, 4.0e-3, TORSION_MAX_ROTATION_RAD])}
+WIDE_BAND_HZ = (0.5, 5.0)
+
+
+def wide_random(peaks: np.ndarray, duration_s: float, dt: float, seed: int) -> list[np.ndarray]:
+    """(T, 3) random motions in ``WIDE_BAND_HZ`` at ``peaks``: independent, then correlated (as
+    ``motions.random_correlated``: a common drive of weight 0.8, the rotation's sign reversed)."""
+    from bushenv.excitation import random_rpc
+
+    def drive(s: int, peak: float) -> np.ndarray:
+        return random_rpc(1.0, duration_s, dt, s, band_hz=WIDE_BAND_HZ, peak_m_at_n1=peak)
+
+    own = np.stack([drive(20_000 + 3 * seed + i, 1.0) for i in range(3)], axis=1)
+    common = drive(30_000 + seed, 1.0)[:, None] * np.array([1.0, 1.0, -1.0])
+    mix = CORRELATION * common + np.sqrt(1 - CORRELATION**2) * own
+    return [own * peaks, mix / np.abs(mix).max(axis=0) * peaks]
+
+
+def wide_coupled(peaks: np.ndarray, duration_s: float, dt: float) -> list[np.ndarray]:
+    """``motions.coupled_sets``' three held sweeps at ``peaks`` instead of the n = 1 ones."""
+    axial, radial, theta = peaks
+    return [
+        preload_sweep(1, radial, theta, duration_s, dt),
+        preload_sweep(2, theta, radial, duration_s, dt),
+        preload_sweep(0, axial, radial, duration_s, dt),
+    ]
+
+
 def identification_records(
     dt: float,
     seed: int,
@@ -247,12 +283,19 @@ def identification_records(
 ) -> list:
     """[(q, f)] (T, 3) each of random motion at n = 1, independent and correlated, then
     (``"programme"``) the coupled sine sets at n = 1 of ``ident_s`` / 2 each, measured on the
-    coupled reference (its ``rotation`` parameter set), each record its noise seed."""
+    coupled reference (its ``rotation`` parameter set), each record its noise seed. For a set
+    with ``WIDE_PEAKS`` (torsion) the same again at those peaks, random ``ident_s`` / 2 and the
+    sets ``ident_s`` / 2 each (as the n = 1 sets: their sweep starts at 1.5 s), so the records
+    reach the set's calibrated range."""
     if identification not in IDENTIFICATIONS:
         raise ValueError(f"identification {identification!r}; known: {', '.join(IDENTIFICATIONS)}")
     motions = [drive(1.0, ident_s, dt, seed) for drive in (random_independent, random_correlated)]
     if identification == "programme":
         motions += [q for _, q in coupled_sets(1.0, dt, ident_s / 2)]
+    if rotation in WIDE_PEAKS:
+        motions += wide_random(WIDE_PEAKS[rotation], ident_s / 2, dt, seed)
+        if identification == "programme":
+            motions += wide_coupled(WIDE_PEAKS[rotation], ident_s / 2, dt)
     return [
         (q, PlanarRubber.preset(seed=seed + 50 * k, dt=dt, rotation=rotation).simulate(q))
         for k, q in enumerate(motions)

@@ -51,9 +51,17 @@ Table 1 by linear fit); the rotation is one of two named parameter sets (``ROTAT
   axial row mapped: moment = axial force * (K_t / K_a) / l, rotation = axial deflection / l,
   with l = 2 mm / theta_1 = 0.04 m/rad (the n = 1 amplitudes): stiffness 27.9 N m/rad (the
   axial backbone's 203.5 kN/m), damping by the axial loss time, the axial relaxation weights,
-  the axial friction (the same loop width at n = 1), hardening and load-cell noise alike.
-  The coupling's dip scales with k_t (the radial-rotation term's share of the rotation's
-  tangent as in the cardanic set, so the energy stays convex).
+  the axial friction (the same loop width at n = 1) and load-cell noise alike.
+  **Calibrated range** (``calibrated_rotation_rad``): torsion shears the annulus with strain
+  gamma(r) = T / (2 pi G L r^2), largest at the inner radius, gamma_a = 2 theta / (1 - a^2/b^2)
+  = 2.26 theta; filled rubber stays near-linear in shear up to gamma ~ 0.5-1, so the set holds
+  to gamma_a = 1: +-0.442 rad (the cardanic set's 0.15 rad stays an assumption). Hardening is
+  the rubber's at a strain, so it is mapped by strain, not by the n = 1 amplitudes: the axial
+  16 mm (gamma_a = u / (a ln(b/a)) = 1.98) is 0.876 rad, +25 % secant stiffness at the range's
+  end as the axial row at gamma_a = 1 (the amplitude mapping put 0.4 rad, +122 % there). The
+  coupling keeps its shape over the range: theta_m = 0.08 rad x 0.442 / 0.15 (0.236 rad), and
+  the dip scales with k_t theta_m^2 (the radial-rotation term's share of the rotation's
+  tangent as in the cardanic set, so the energy stays convex; tested over the range).
 
 Coupling (assumed magnitudes, Kadlowec's shape): gamma_a = 0.15, dip = 0.15 at theta_m = 0.08
 rad (cardanic), u_c = 2 mm. docs/planar.md tabulates the tangent stiffness.
@@ -94,6 +102,34 @@ BUSH_INNER_RADIUS_M = 7.5e-3
 BUSH_OUTER_RADIUS_M = 25.0e-3 - 3.0e-3
 BUSH_LENGTH_M = 63.0e-3
 PEAK_M_AT_N1 = 2.0e-3  # the translations' peak at n = 1 (bushenv.excitation)
+# Filled rubber stays near-linear in shear up to a strain of about 0.5-1 (rubber design
+# practice, e.g. Gent, Engineering with Rubber, Hanser 2012); the torsion set is calibrated to
+# the upper end, where the hardening mapped by strain from the axial row adds 25 % (docstring)
+TORSION_MAX_SHEAR_STRAIN = 1.0
+THETA_M_RAD = 0.08  # the coupling's dip rotation in the cardanic set
+
+
+def torsion_strain_per_rad(
+    a_m: float = BUSH_INNER_RADIUS_M, b_m: float = BUSH_OUTER_RADIUS_M
+) -> float:
+    """Shear strain at the inner radius per rad of torsion of a bonded annulus: the moment's
+    shear stress T / (2 pi r^2 L) integrated over r gives gamma_a = 2 theta / (1 - a^2/b^2)."""
+    if not 0 < a_m < b_m:
+        raise PlanarModelError(f"bush radii must be 0 < a < b, got a={a_m!r}, b={b_m!r}")
+    return 2.0 / (1.0 - (a_m / b_m) ** 2)
+
+
+def axial_strain_per_m(a_m: float = BUSH_INNER_RADIUS_M, b_m: float = BUSH_OUTER_RADIUS_M) -> float:
+    """Shear strain at the inner radius per m of axial deflection: gamma_a = u / (a ln(b/a))."""
+    if not 0 < a_m < b_m:
+        raise PlanarModelError(f"bush radii must be 0 < a < b, got a={a_m!r}, b={b_m!r}")
+    return 1.0 / (a_m * math.log(b_m / a_m))
+
+
+# the torsion set's calibrated rotation: its inner radius at TORSION_MAX_SHEAR_STRAIN (0.442 rad)
+TORSION_MAX_ROTATION_RAD = TORSION_MAX_SHEAR_STRAIN / torsion_strain_per_rad()
+# each rotation set's calibrated range (PlanarRubber.calibrated_rotation_rad), rad
+CALIBRATED_ROTATION_RAD = {"cardanic": MAX_ROTATION_RAD, "torsion": TORSION_MAX_ROTATION_RAD}
 
 
 def torsion_per_axial(a_m: float = BUSH_INNER_RADIUS_M, b_m: float = BUSH_OUTER_RADIUS_M) -> float:
@@ -118,7 +154,7 @@ def default_parameters(rotation: str = "cardanic") -> dict[str, Any]:
     ax, rad = ONE_AXIS["axial"], ONE_AXIS["radial"]
     w_ax = np.array(ax["relax_k_n_per_m"]) / ax["k_n_per_m"]
     w_rad = np.array(rad["relax_k_n_per_m"]) / rad["k_n_per_m"]
-    dip = 0.15
+    dip, theta_m = 0.15, THETA_M_RAD
     if rotation == "cardanic":
         k_t = ROTATION_K_NM_PER_RAD
         loss_s = rad["c_ns_per_m"] / rad["k_n_per_m"]
@@ -129,14 +165,20 @@ def default_parameters(rotation: str = "cardanic") -> dict[str, Any]:
         arm = PEAK_M_AT_N1 / THETA_N1_RAD  # m of axial deflection per rad at n = 1
         force = torsion_per_axial() / arm  # N m of moment per N of axial force
         k_t = ax["k_n_per_m"] * force * arm
+        # hardening is the rubber's, at a strain: the axial scale at the same inner strain
+        hard = ax["hardening_x_m"] * axial_strain_per_m() / torsion_strain_per_rad()
         rot = dict(k=k_t, c=ax["c_ns_per_m"] * force * arm, w=w_ax,
                    fmax=ax["friction_fmax_n"] * force, x2=ax["friction_x2_m"] / arm,
-                   hard=ax["hardening_x_m"] / arm, noise=ax["noise_std_n"] * force)  # fmt: skip
-        dip *= k_t / ROTATION_K_NM_PER_RAD
+                   hard=hard, noise=ax["noise_std_n"] * force)  # fmt: skip
+        # the coupling's shape over the calibrated range as the cardanic set's over its own
+        theta_m = THETA_M_RAD * TORSION_MAX_ROTATION_RAD / MAX_ROTATION_RAD
+    # the radial-rotation term's share of the rotation's tangent (4 d k_r e / theta_m^2 against
+    # k_t) as in the cardanic set, so the energy stays convex
+    dip *= k_t / ROTATION_K_NM_PER_RAD * (theta_m / THETA_M_RAD) ** 2
     return dict(
         stiffness=(ax["k_n_per_m"], rad["k_n_per_m"], rot["k"]),
         damping=(ax["c_ns_per_m"], rad["c_ns_per_m"], rot["c"]),
-        coupling=(0.15, dip, 0.08, 2.0e-3),
+        coupling=(0.15, dip, theta_m, 2.0e-3),
         hardening_m=(ax["hardening_x_m"], rad["hardening_x_m"], rot["hard"]),
         relax_weight=np.stack([w_ax, w_rad, rot["w"]], axis=1),
         relax_tau_s=ax["relax_tau_s"],
@@ -189,8 +231,6 @@ class PlanarRubber(PlanarModel):
 
     name = "rubber"  # files written as "reference" before load through MODELS' alias
     EFFECTS: ClassVar[tuple[str, ...]] = EFFECTS
-    # beyond it the quartic coupling is an extrapolation (docs/planar.md): a judge out of range
-    calibrated_rotation_rad: ClassVar[float] = MAX_ROTATION_RAD
     param_names = (
         "stiffness",
         "damping",
@@ -219,7 +259,14 @@ class PlanarRubber(PlanarModel):
         seed: int = 0,
         effects: Any = None,
         dt: float = PAPER_DT,
+        calibrated_rotation_rad: float = MAX_ROTATION_RAD,
     ) -> None:
+        # beyond it the law is an extrapolation (docs/planar.md): a judge out of range
+        self.calibrated_rotation_rad = float(calibrated_rotation_rad)
+        if not self.calibrated_rotation_rad > 0:
+            raise PlanarModelError(
+                f"reference: calibrated_rotation_rad must be > 0, got {calibrated_rotation_rad!r}"
+            )
         vec = {"stiffness": stiffness, "damping": damping, "hardening_m": hardening_m}
         vec |= {"friction_fmax": friction_fmax, "friction_x2": friction_x2, "noise_std": noise_std}
         for key, value in vec.items():
@@ -353,12 +400,15 @@ class PlanarRubber(PlanarModel):
         )
 
     def extra_meta(self) -> dict[str, Any]:
-        return {
+        meta = {
             "friction_elements": self.friction_elements,
             "friction_yield": self.friction_yield,
             "seed": self.seed,
             "effects": list(self.effects),
         }
+        if self.calibrated_rotation_rad != MAX_ROTATION_RAD:  # the cardanic files as before
+            meta["calibrated_rotation_rad"] = self.calibrated_rotation_rad
+        return meta
 
     @classmethod
     def preset(
@@ -389,7 +439,8 @@ class PlanarRubber(PlanarModel):
         chosen = ((chosen,) if isinstance(chosen, str) else tuple(chosen)) + (
             ("noise",) if measurement else ()
         )
-        return cls(dt=dt, seed=seed, effects=chosen, **{**params, **overrides})
+        return cls(dt=dt, seed=seed, effects=chosen, **{**params, **overrides},
+                   calibrated_rotation_rad=CALIBRATED_ROTATION_RAD[rotation])  # fmt: skip
 
     def __repr__(self) -> str:
         return f"PlanarRubber(effects={list(self.effects)}, friction_yield={self.friction_yield!r})"

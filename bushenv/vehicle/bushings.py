@@ -7,7 +7,10 @@ of all three coordinates at n = 1, independent and correlated (``identification_
 the coupled sine sets at n = 1 (``identification_s`` / 2 each), the reference measured with its
 load cell, each record its own noise seed: what ``bushenv reproduce --planar`` identifies on,
 but of the reference in the car's rotation parameter set (``halfcar_params.PIVOT_ROTATION``:
-torsion), the one the car's twins run.
+torsion), the one the car's twins run; for that set the same again at the wide peaks
+(``reproduce.WIDE_PEAKS``: 12.5 mm, 4 mm and the set's calibrated 0.442 rad, in 0.5-5 Hz;
+random ``identification_s`` / 2, the sets / 2 each), so the fits cover the rotation and
+translations the car's manoeuvres reach.
 Each kind is fitted by ``bushenv.identify.fit`` with its default options and the
 seed, as ``bushenv fit REC... --model KIND --seed SEED`` would.
 """
@@ -26,8 +29,9 @@ from bushenv.persist import plain, write_json
 from bushenv.rigs.halfcar_params import PIVOT_ROTATION
 from bushenv.vehicle.checks import VehicleInputError
 
-RECIPE_VERSION = 2  # bump when the identification changes: older cached fits are then redone
-# 2: the reference's torsion parameter set (1: its cardanic rotation, 30-60x stiffer)
+RECIPE_VERSION = 3  # bump when the identification changes: older cached fits are then redone
+# 3: the torsion set's calibrated range (0.442 rad), strain-mapped hardening, and the records
+# at the wide peaks; 2: the reference's torsion parameter set (1: its cardanic rotation)
 DEFAULT_KINDS = ("linear", "hybrid", "nn")
 
 
@@ -98,7 +102,7 @@ def vehicle_bushings(
     if its key matches ``recipe``, else identified now and saved there. Every model is the one
     read back from its file, so a first run and a rerun use the same numbers."""
     from bushenv.identify import fit
-    from bushenv.reproduce import identification_records
+    from bushenv.reproduce import WIDE_PEAKS, identification_records
 
     kinds = check_kinds(kinds)
     files = files or {}
@@ -135,10 +139,13 @@ def vehicle_bushings(
         model = load_model(path, dt=recipe.dt_s, coords=3)
         ident = recipe.identification_s
         samples = f"random {ident:g} s x 2, coupled sets {ident / 2:g} s x 3"
+        if recipe.rotation in WIDE_PEAKS:
+            samples += (f"; at the wide peaks random {ident / 2:g} s x 2, "
+                        f"coupled sets {ident / 2:g} s x 3")  # fmt: skip
         out[kind] = VehicleBushing(
             kind, model, str(path), sha256_file(path),
             f"fit({kind!r}, default options, seed {recipe.seed}) on the coupled "
-            f"reference's n = 1 records ({recipe.rotation} rotation; {samples}); {how}",
+            f"reference's records ({recipe.rotation} rotation; {samples}); {how}",
             meta["fit_seconds"], meta.get("info", {}),
         )  # fmt: skip
     return out

@@ -75,15 +75,28 @@ def test_the_batch_agrees_with_the_pymunk_env_on_loads_roll_and_bushing_forces(k
 
 
 def test_the_twin_beyond_its_calibrated_rotation_is_flagged_as_the_env_flags_it():
-    """A 100 mm road rise at the rate limit: the upper arms turn past +-0.15 rad; the batch's
-    flag is the env's ``reference_outside_range`` being said, step by step."""
+    """A 100 mm road rise at the rate limit: the upper arms turn past the torsion preset's
+    calibrated +-0.442 rad; the env says so exactly where a twin pivot's rotation is beyond the
+    preset's own range (not the cardanic 0.15 rad), and the batch's flag is the env's
+    ``reference_outside_range`` being said, step by step."""
+    from bushenv.reference.planar import MAX_ROTATION_RAD, TORSION_MAX_ROTATION_RAD
+
     road = np.minimum(0.05 * np.arange(60), 0.1)
     inputs = {"road_left": road, "road_right": road}
     env = gym.make("HalfCar-v0", max_episode_steps=-1).unwrapped
     env.reset(seed=0, options=inputs)
-    said = [env.step(None)[4]["reference_outside_range"] != "" for _ in range(60)]
+    said, theta = [], []
+    for _ in range(60):
+        info = env.step(None)[4]
+        said.append(info["reference_outside_range"] != "")
+        theta.append(max(abs(info[f"reference_rotation_{k}_rad"]) for k in POSITIONS))
+    theta = np.array(theta)
+    assert env.params.references.calibrated_rotation_rad == TORSION_MAX_ROTATION_RAD
+    assert any(said) and said == list(theta > TORSION_MAX_ROTATION_RAD)
+    assert np.any((theta > MAX_ROTATION_RAD) & ~np.array(said))  # beyond 0.15 rad: not flagged
     flag = HalfCarBatch(1).simulate(**inputs, keys=("reference_outside_range",))
-    assert any(said) and list(flag["reference_outside_range"][:, 0].astype(bool)) == said
+    np.testing.assert_array_equal(flag["reference_outside_range"][:, 0].astype(bool), said)
+    np.testing.assert_array_equal(HalfCarBatch(1).calibrated_rotation, TORSION_MAX_ROTATION_RAD)
 
 
 def test_each_car_of_a_batch_is_the_car_alone_bit_for_bit():

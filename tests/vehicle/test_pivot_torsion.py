@@ -14,11 +14,16 @@ from bushenv.reference.planar import (
     BUSH_INNER_RADIUS_M,
     BUSH_LENGTH_M,
     BUSH_OUTER_RADIUS_M,
+    MAX_ROTATION_RAD,
     ROTATION_K_NM_PER_RAD,
+    TORSION_MAX_ROTATION_RAD,
+    TORSION_MAX_SHEAR_STRAIN,
     PlanarRubber,
+    axial_strain_per_m,
     default_parameters,
     shear_modulus_pa,
     torsion_per_axial,
+    torsion_strain_per_rad,
 )
 from bushenv.reference.planar_elastic import tangent_stiffness
 from bushenv.reference.rubber import PRESETS as ONE_AXIS
@@ -91,8 +96,58 @@ def test_the_torsion_sets_energy_stays_convex_over_the_stroke_and_rotation_range
     p = PlanarRubber.preset(rotation="torsion").elastic_params()
     for ua in np.linspace(-12.5e-3, 12.5e-3, 5):
         for ur in np.linspace(-12.5e-3, 12.5e-3, 9):
-            for th in np.linspace(-0.15, 0.15, 9):
+            for th in np.linspace(-TORSION_MAX_ROTATION_RAD, TORSION_MAX_ROTATION_RAD, 13):
                 assert np.linalg.eigvalsh(tangent_stiffness(np.array([ua, ur, th]), p)).min() > 0
+
+
+def test_the_torsion_range_is_the_rotation_that_shears_the_inner_radius_to_strain_one():
+    """Torsion of a bonded annulus: shear stress T / (2 pi r^2 L), strain gamma(r) = T / (2 pi
+    G L r^2), the twist the integral of gamma / r from a to b; gamma at a over the twist is
+    2 / (1 - a^2/b^2). Filled rubber stays near-linear in shear to gamma ~ 1: 0.442 rad."""
+    a, b = BUSH_INNER_RADIUS_M, BUSH_OUTER_RADIUS_M
+    r = np.linspace(a, b, 200_001)
+    gamma = (a / r) ** 2  # per unit strain at a
+    theta = float(np.sum((gamma / r)[:-1] + (gamma / r)[1:]) * (r[1] - r[0]) / 2)
+    assert torsion_strain_per_rad() == pytest.approx(1 / theta, rel=1e-8)
+    assert torsion_strain_per_rad() == pytest.approx(2.263, abs=1e-3)  # the brief's 2.26
+    assert TORSION_MAX_SHEAR_STRAIN == 1.0
+    assert TORSION_MAX_ROTATION_RAD == pytest.approx((1 - (a / b) ** 2) / 2, rel=1e-12)
+    assert TORSION_MAX_ROTATION_RAD == pytest.approx(0.442, abs=1e-3)
+    # each set its own range: the torsion preset's, the cardanic one's 0.15 rad unchanged
+    torsion = get_reference(REFERENCE, coords=3)
+    assert torsion.calibrated_rotation_rad == TORSION_MAX_ROTATION_RAD
+    assert PlanarRubber.preset().calibrated_rotation_rad == MAX_ROTATION_RAD == 0.15
+    assert torsion.copy().calibrated_rotation_rad == TORSION_MAX_ROTATION_RAD
+    assert torsion.only_effects("coupling").calibrated_rotation_rad == TORSION_MAX_ROTATION_RAD
+    with pytest.raises(PlanarModelError, match="calibrated_rotation_rad"):
+        PlanarRubber((1.0, 1.0, 1.0), (0.0, 0.0, 0.0), calibrated_rotation_rad=0.0)
+
+
+def test_a_saved_torsion_reference_keeps_its_range_and_a_cardanic_file_is_as_before(tmp_path):
+    from bushenv.models import load_model
+
+    torsion = PlanarRubber.preset(rotation="torsion", measurement=False)
+    back = load_model(torsion.save(tmp_path / "t.npz"), coords=3)
+    assert back.calibrated_rotation_rad == TORSION_MAX_ROTATION_RAD
+    assert "calibrated_rotation_rad" not in PlanarRubber.preset().extra_meta()
+
+
+def test_the_torsion_hardening_is_the_axial_rows_at_the_same_inner_strain():
+    """Hardening is the rubber's at a strain: at the torsion range's end (strain 1 at the inner
+    radius) the secant stiffening k theta^3 / L^2 over k theta is the axial row's at strain 1
+    (an axial deflection u shears the inner radius by u / (a ln(b/a))): +25 %."""
+    a, b = BUSH_INNER_RADIUS_M, BUSH_OUTER_RADIUS_M
+    p = default_parameters("torsion")
+    assert axial_strain_per_m() == pytest.approx(1 / (a * math.log(b / a)))
+    u = TORSION_MAX_SHEAR_STRAIN / axial_strain_per_m()  # axial deflection at strain 1, m
+    axial = (u / p["hardening_m"][0]) ** 2
+    torsion = (TORSION_MAX_ROTATION_RAD / p["hardening_m"][2]) ** 2
+    assert torsion == pytest.approx(axial, rel=1e-12)
+    assert 0.2 < torsion < 0.3  # near-linear at the range's end, stiffening beyond
+    # the coupling keeps its shape over the range: its dip at the cardanic share of the range
+    theta_m = p["coupling"][2]
+    cardanic = default_parameters("cardanic")["coupling"][2]
+    assert theta_m / TORSION_MAX_ROTATION_RAD == pytest.approx(cardanic / MAX_ROTATION_RAD)
 
 
 def test_in_the_half_car_the_spring_carries_the_wheel_rate_and_the_bushings_a_minority():

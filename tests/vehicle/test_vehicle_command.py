@@ -28,7 +28,7 @@ SHORT = ("pothole", "step_steer")
 @pytest.fixture(scope="module")
 def linearisation() -> PlanarLinear:
     """The coupled reference's linearisation (the car's torsion set): least-squares K, C on
-    its n = 1 records."""
+    its identification records (n = 1 and the wide peaks)."""
     hist = identification_records(DT, 0, 10.0, rotation=PIVOT_ROTATION)
     q = np.vstack([h[0] for h in hist])
     v = np.vstack([velocity_of(h[0], DT) for h in hist])
@@ -165,7 +165,9 @@ def test_command_refuses_an_unknown_kind_and_a_file_for_a_kind_not_run(tmp_path,
     assert "--nn FILE given" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize(("scale", "status"), [(1.01, "reproduced"), (2.0, "refuted")])
+# 3x: in seed 000's car (the upper pivots only) a 2x stiff copy of the linearisation on the
+# records with the wide peaks differs by 4.95 % in camber, at the threshold; 3x by 6.8 %
+@pytest.mark.parametrize(("scale", "status"), [(1.01, "reproduced"), (3.0, "refuted")])
 def test_with_hybrid_and_linear_the_finding_is_judged_also_in_seed_000s_car(
     linearisation, scale, status
 ):
