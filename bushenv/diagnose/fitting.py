@@ -131,9 +131,10 @@ def fit(
 
 def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
     """The fitted model's force on one record (N), (T,). A per-record block gets the weights
-    the record was fitted with; on a judged record, one scale >= 0 of its own along
-    ``start_direction`` (the state it starts in -- a heat -- is the record's, and no other
-    record can tell it; one number, not a spring and damper of its own)."""
+    the record was fitted with; on a judged record, one scale of its own along
+    ``start_direction``, from 0 to the warmest fitted record's (the state it starts in -- a
+    heat -- is the record's, and no other record can tell it; one bounded number, not a
+    spring and damper of its own: a judged record starts no warmer than a record fitted)."""
     a = store.design(prep, f.blocks)
     out = prep.b0 + a @ f.theta
     if f.nuisance:
@@ -142,12 +143,23 @@ def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
         if own is not None:
             out = out + wn @ own
         else:
-            d = shift_columns(wn @ start_direction(store, f), f.delay_s, prep.dt)
+            direction = start_direction(store, f)
+            d = shift_columns(wn @ direction, f.delay_s, prep.dt)
             dd = float(d @ d)
             if dd > 0:
-                res = prep.force - shift_columns(out, f.delay_s, prep.dt)
-                return shift_columns(out, f.delay_s, prep.dt) + max(float(res @ d) / dd, 0.0) * d
+                shifted = shift_columns(out, f.delay_s, prep.dt)
+                scale = float((prep.force - shifted) @ d) / dd
+                return shifted + min(max(scale, 0.0), warmest_start(f, direction)) * d
     return shift_columns(out, f.delay_s, prep.dt)
+
+
+def warmest_start(f: Fit, direction: np.ndarray) -> float:
+    """The largest fitted record's start along ``direction`` (a scale): a judged record starts
+    no warmer than the warmest record fitted."""
+    dd = float(direction @ direction)
+    if dd <= 0:
+        return 0.0
+    return max(max(float(w @ direction) / dd for w in f.nuisance_w.values()), 0.0)
 
 
 def start_direction(store: ColumnStore, f: Fit) -> np.ndarray:

@@ -1,6 +1,5 @@
-"""The naming rule applied to judged rows, in its order: which pass (an effect that starts per
-record for what it shares, ``starts.py``), the ranking, the pairs' rule and each partner
-beside the other's richest form (``rule.py``, ``partner.py``). Used on
+"""The naming rule applied to judged rows, in its order: which pass, the ranking, the pairs'
+rule and each partner beside the other's richest form (``rule.py``, ``partner.py``). Used on
 all judged records together (``fit.py``) and on the records that show the gap
 (``showing.py``)."""
 
@@ -8,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from bushenv.diagnose import partner, rule, starts
+from bushenv.diagnose import partner, rule
 
 
 def apply_rule(
@@ -20,7 +19,6 @@ def apply_rule(
     """``singles`` and ``pairs`` (``failed_to_fit`` marked) ranked best first, each marked
     ``passes``; a pair's members are put the better single first."""
     rule.mark_passes(singles + pairs, ctx)
-    starts.check_beyond_starts(singles + pairs, row_of, ctx)
     singles = rule.rank(singles, [r["effect"] for r in singles], ctx)
     order = [r["effect"] for r in singles]
     for r in pairs:  # the better single first

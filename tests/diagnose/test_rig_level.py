@@ -46,8 +46,8 @@ def test_bushrig_with_withheld_relaxation_names_relaxation_on_the_force_channel(
     assert r["channels"][0]["gap"] > 0.05 and r["channels"][0]["share"] == pytest.approx(1.0)
     assert r["effect"] == "relaxation"
     assert r["shrink"] > 0.2
-    # the best row that passes: a thermal row may fit the step's hold better by each judged
-    # record's own start, and is refused for adding nothing beyond those starts
+    # the best row that passes; thermal, whose judged record may start warm (no warmer than
+    # the warmest record fitted), must not take the step's relaxation under the hold
     assert next(x for x in r["ranking"] if x["passes"])["effect"] == "relaxation"
     thermal = next(x for x in r["ranking"] if x["effect"] == "thermal")
     assert thermal["passes"] is False

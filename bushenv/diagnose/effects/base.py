@@ -123,10 +123,7 @@ class Effect(ABC):
     the energy it dissipates (a hysteresis loop): it is named only when the records show the
     dissipation it claims (``rule.dissipation_evidence``). ``holds_its_law``: the effect is a
     force law of the deflection alone (elastic): it is named only when that law holds through
-    each record (``rule.law_drift``). ``starts_per_record``: each record may start in a
-    state of its own (``nuisance_columns``: a heat); the effect is named only for what its
-    shared weights add beyond those starts (``starts.check_beyond_starts``).
-    ``replaces_spring``: the columns
+    each record (``rule.law_drift``). ``replaces_spring``: the columns
     replace the linear spring ``k x`` (a backbone of its own); ``continuous_shape``: the best
     grid shape is refined by a 1-D search on the fitting error.
 
@@ -145,7 +142,6 @@ class Effect(ABC):
     telling_test: ClassVar[str] = "a programme that excites it alone"
     shows_dissipation: ClassVar[bool] = False
     holds_its_law: ClassVar[bool] = False
-    starts_per_record: ClassVar[bool] = False
     replaces_spring: ClassVar[bool] = False
     continuous_shape: ClassVar[bool] = False
 
@@ -200,14 +196,11 @@ class Effect(ABC):
         return {}
 
     def block_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
-        """``columns``; ``rich_columns`` for a ``Richest`` shape, none for a ``StartOnly`` one,
-        ``nuisance_columns`` for a ``Nuisance`` one (of those shapes too): what the fits call."""
+        """``columns``; ``rich_columns`` for a ``Richest`` shape, ``nuisance_columns`` for a
+        ``Nuisance`` one (of the rich shape too): what the fits call."""
         if isinstance(shape, Nuisance):
-            marked = isinstance(shape.inner, Richest | StartOnly)
-            inner = shape.inner.inner if marked else shape.inner
+            inner = shape.inner.inner if isinstance(shape.inner, Richest) else shape.inner
             return self.nuisance_columns(s, inner, scales)
-        if isinstance(shape, StartOnly):
-            return np.zeros((s.x.size, 0))
         if isinstance(shape, Richest):
             return self.rich_columns(s, shape.inner, scales)
         return self.columns(s, shape, scales)
@@ -245,14 +238,6 @@ PROBE_SAMPLES = 16
 class Richest:
     """A shape marker: the effect's richest admissible form at shape ``inner``
     (``Effect.rich_columns``), used only to test whether a partner adds to it."""
-
-    inner: Any
-
-
-@dataclass(frozen=True)
-class StartOnly:
-    """A shape marker: the effect's per-record starts alone at shape ``inner``, its shared
-    columns left out (what the starts explain without the effect itself)."""
 
     inner: Any
 

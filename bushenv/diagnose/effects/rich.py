@@ -3,8 +3,7 @@
 ``RichForm(Relaxation())`` fits the relaxation's ``rich_columns`` (a wider, denser spectrum)
 under the same name; the ``Richest`` shape marker tells the column store which columns to
 build. Used by ``bushenv.diagnose.partner``: a second effect is named beside a first only when
-it adds to the first's whole family, not merely to its usual form. ``StartsAlone(Thermal())``
-keeps only the effect's per-record starts (``bushenv.diagnose.starts``).
+it adds to the first's whole family, not merely to its usual form.
 """
 
 from __future__ import annotations
@@ -13,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose.effects.base import Effect, Richest, Scales, Signals, StartOnly
+from bushenv.diagnose.effects.base import Effect, Richest, Scales, Signals
 
 
 class RichForm(Effect):
@@ -45,31 +44,3 @@ class RichForm(Effect):
 
     def __repr__(self) -> str:
         return f"RichForm({self.inner!r})"
-
-
-class StartsAlone(Effect):
-    """``inner``'s per-record starts without its shared columns (never registered)."""
-
-    def __init__(self, inner: Effect) -> None:
-        self.inner = inner
-        self.name = inner.name
-        self.replaces_spring = inner.replaces_spring
-        self.continuous_shape = False
-
-    def shapes(self, scales: Scales) -> list:
-        return [StartOnly(s) for s in self.inner.shapes(scales)]
-
-    def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
-        return self.inner.block_columns(s, shape, scales)
-
-    def columns_count(self, shape: Any, scales: Scales) -> int:
-        return self.inner.columns_count(shape, scales)
-
-    def example(self, scales: Scales, k_n_per_m: float) -> tuple[Any, np.ndarray]:
-        raise NotImplementedError("the starts alone are a comparator, not a candidate")
-
-    def describe(self, shape: Any) -> str:
-        return f"{self.inner.describe(shape.inner)}, its starts alone"
-
-    def __repr__(self) -> str:
-        return f"StartsAlone({self.inner!r})"

@@ -45,7 +45,6 @@ class Thermal(Effect):
     """
 
     name = "thermal"
-    starts_per_record = True
     form = (
         "-theta (b_k x + b_c v) - exp(-t / tau_th) (s_k x + s_c v), theta' = P - theta / tau_th, "
         "P = v^2 or abs(v) v_rms (s_k, s_c: lost at the start of a record that starts warm, "
