@@ -35,8 +35,8 @@ form of ``relaxation.py``; ``relax_gain`` then dimensionless): the relaxing forc
 hardening and the coupled stiffening. Files without the setting are of the constant form and
 give the forces they always gave.
 
-State (6 + 3 M, B): z (3), the previous deflection (3), the branches' deflections (3 M), at
-rest zero.
+State (6 + 3 M, B): z (3), the previous deflection (3), the branches' deflections (3 M; their
+elastic forces in the quasi-linear form), at rest zero.
 """
 
 from __future__ import annotations
