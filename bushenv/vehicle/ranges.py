@@ -2,9 +2,10 @@
 the reference twin beyond its calibrated rotation (``reference_outside_range``) and each fitted
 model car beyond the deflections its identification records reached, per coordinate.
 
-    python -m bushenv.vehicle.ranges --bushings DIR [--seed 0] [--out FILE.json]
+    python studies/2026-11-vehicle-manoeuvres/ranges.py --bushings DIR [--seed 0] [--out F.json]
 
-``DIR`` holds ``linear.npz``, ``hybrid.npz``, ``nn.npz`` as ``bushenv vehicle`` caches them
+(``measure``; the script is the study's.) ``DIR`` holds ``linear.npz``, ``hybrid.npz``,
+``nn.npz`` as ``bushenv vehicle`` caches them
 (``DIR/<kind>.fit.json`` names the records' recipe); the records are measured again from that
 recipe (``bushenv.reproduce.identification_records``) for their peaks. Prints one line per
 manoeuvre and car on stderr, and writes the table as JSON when ``--out`` is given.
@@ -12,9 +13,7 @@ manoeuvre and car on stderr, and writes the table as JSON when ``--out`` is give
 
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -93,18 +92,3 @@ def measure(bushings: Path, seed: int = 0, say=None) -> dict[str, Any]:
                 f"its calibrated rotation (peak {ref['peak'][2]:.3f} rad); beyond the records: "
                 f"{kinds}")  # fmt: skip
     return out
-
-
-def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--bushings", type=Path, required=True)
-    ap.add_argument("--seed", type=int, default=0, help="the manoeuvres' seed (the road)")
-    ap.add_argument("--out", type=Path)
-    args = ap.parse_args(argv)
-    result = measure(args.bushings, args.seed, say=lambda s: print(s, file=sys.stderr, flush=True))
-    if args.out:
-        args.out.write_text(json.dumps(result, indent=1) + "\n")
-
-
-if __name__ == "__main__":
-    main()
