@@ -150,7 +150,9 @@ def main(argv: list[str] | None = None) -> int:
             rows += one_cell(axis, seed, args.models.split(","), args.recipes.split(","))
             if args.json:
                 args.json.write_text(json.dumps(rows, indent=1))
-    command = "python studies/2026-11-training-recipes/fit_recipes.py " + " ".join(argv or sys.argv[1:])
+    command = "python studies/2026-11-training-recipes/fit_recipes.py " + " ".join(
+        argv or sys.argv[1:]
+    )
     text = markdown(rows, command.strip(), time.perf_counter() - t0)
     print(text)
     if args.md:

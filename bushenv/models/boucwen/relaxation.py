@@ -68,6 +68,17 @@ def branch_deflections(q: np.ndarray, dt: float, tau: np.ndarray) -> np.ndarray:
 
 
 @nb.njit(cache=True)
+def _add_branches(gain, state, b_, out_tb):  # pragma: no cover - compiled
+    """out_tb[i] += sum_m sum_j gain[m, i, j] s_m,j: the branches' force on each coordinate."""
+    for i in range(3):
+        acc = 0.0
+        for m in range(gain.shape[0]):
+            for j in range(3):
+                acc += gain[m, i, j] * state[3 * m + j, b_]
+        out_tb[i] += acc
+
+
+@nb.njit(cache=True)
 def relaxation_kernel(q, q_before, state, a, b, gain, out):  # pragma: no cover - compiled
     """Add sum_m R_m p_m to ``out`` (T, B, 3); ``state`` (3 M, B) the branches' p_m, updated;
     ``q_before`` (3, B) the deflection before the first sample."""
@@ -81,12 +92,7 @@ def relaxation_kernel(q, q_before, state, a, b, gain, out):  # pragma: no cover 
                 for m in range(M):
                     r = 3 * m + i
                     state[r, b_] = a[m] * state[r, b_] + b[m] * dq
-            for i in range(3):
-                acc = 0.0
-                for m in range(M):
-                    for j in range(3):
-                        acc += gain[m, i, j] * state[3 * m + j, b_]
-                out[t, b_, i] += acc
+            _add_branches(gain, state, b_, out[t, b_])
 
 
 @nb.njit(cache=True)
@@ -116,12 +122,7 @@ def qlv_kernel(q, q_before, state, a, b, gain, k, g, out):  # pragma: no cover -
                 for m in range(M):
                     r = 3 * m + i
                     state[r, b_] = a[m] * state[r, b_] + b[m] * df
-            for i in range(3):
-                acc = 0.0
-                for m in range(M):
-                    for j in range(3):
-                        acc += gain[m, i, j] * state[3 * m + j, b_]
-                out[t, b_, i] += acc
+            _add_branches(gain, state, b_, out[t, b_])
 
 
 def qlv_as_constant(gain: np.ndarray, k: np.ndarray) -> np.ndarray:
