@@ -12,7 +12,14 @@ import os
 from importlib import resources
 from pathlib import Path
 
-from bushenv.models.base import AXES, DT_TOLERANCE, PAPER_DT, BushingModel, ModelError
+from bushenv.models.base import (
+    AXES,
+    DT_TOLERANCE,
+    PAPER_DT,
+    BushingModel,
+    ModelError,
+    has_preset,
+)
 from bushenv.models.files import file_hash, load_model, params_sha, wrong_coordinates
 from bushenv.models.registry import MODELS, Form, ModelEntry, coordinate_words, names_for
 from bushenv.registry import Registry, load_entry_point
@@ -125,11 +132,6 @@ def get_model(
     if text.endswith(".npz") or Path(text).exists():
         return load_model(text, dt=dt, coords=coords, wanted_by=wanted_by)
     raise ModelError(f"{MODELS.unknown_message(text)} or a .npz model file")
-
-
-def has_preset(cls: type) -> bool:
-    """Whether a model class builds itself without files (its own ``preset``)."""
-    return getattr(cls.preset, "__func__", None) is not BushingModel.preset.__func__
 
 
 def _preset(name: str, cls: type, dt: float | None, options: dict | None, wanted_by: str):

@@ -290,3 +290,8 @@ def velocity_of(x: np.ndarray, dt: float) -> np.ndarray:
     if x.shape[0] < 2:
         return np.zeros_like(x)
     return np.gradient(x, dt, axis=0)
+
+
+def has_preset(cls: type) -> bool:
+    """Whether a model class builds itself without files (its own ``preset``)."""
+    return getattr(cls.preset, "__func__", None) is not BushingModel.preset.__func__

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from bushenv.models.base import ModelError
+from bushenv.models.base import ModelError, has_preset
 from bushenv.registry import Registry, load_entry_point
 
 
@@ -123,8 +123,6 @@ class ModelEntry:
             return False
         if coords == 1 and self.shipped:
             return True
-        from bushenv.models import has_preset
-
         return has_preset(self.model_class(coords))
 
     def fits(self, coords: int = 1) -> bool:
