@@ -73,7 +73,7 @@ def fitted_linear(source, scales, displacements: list | None = None, seed: int =
     ...) scaled to the bushing's stroke (the papers' n = 1 peak is 2 mm of a 12.5 mm stroke)
     and kept within its rate. ``scales``: one coordinate's ``BushingScales`` (``stroke_m``,
     ``velocity_m_per_s``), or limits per coordinate (``stroke``, ``rate``: sequences of C, as
-    ``search.limits.Rig3Limits``). A ``LinearBushing``, or the linear model over C."""
+    ``search.limits.CoordinateLimits``). A ``LinearBushing``, or the linear model over C."""
     dt, c = source.dt, source.n_coords
     if c == 1:
         stroke, rate = [scales.stroke_m], [scales.velocity_m_per_s]

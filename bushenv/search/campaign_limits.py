@@ -17,68 +17,113 @@ from bushenv.scales import RECORD_MARGIN
 from bushenv.search.base import SearchError
 from bushenv.search.campaign_models import card_records
 from bushenv.search.limits import (
-    COORDS,
-    Rig3Limits,
+    CoordinateLimits,
     limits_of_records,
     machine_limits,
+    machine_of,
 )
+from bushenv.vetting import machine_rate
 
 
-def limits_of_card(resolved) -> Rig3Limits | None:
-    """The limits of the bushing ``resolved``'s card describes: from its training records
-    (``limits_of_records``: 1.5 x their peak |q| and |dq/dt| per coordinate); when the records
-    are gone, the stroke from the card's peak deflections and the machine's rates; None
-    without a card (or one without training records)."""
+def limits_of_card(resolved) -> CoordinateLimits | None:
+    """The limits of the bushing ``resolved``'s card describes, over its model's coordinates:
+    from its training records (``limits_of_records``: 1.5 x their peak |q| and |dq/dt| per
+    coordinate); when the records are gone, the stroke from the card's peak deflections and
+    the rates of the machine (``machine_of``; none: ``vetting.machine_rate``, the papers'
+    rule on the stroke); None without a card (or one without training records)."""
     if resolved is None or resolved.card is None:
         return None
+    coords, units = tuple(resolved.model.coords), tuple(resolved.model.units)
     name = f"the training records of {resolved.card_file}"
     records = card_records(resolved)
     if records is not None:
-        return limits_of_records([r.q for r in records], records[0].dt, name)
+        return limits_of_records([r.q for r in records], records[0].dt, name, coords, units)
     train = [r for r in resolved.card.get("records", []) if r.get("role") == "train"]
     peaks = [r.get("peak_deflection") for r in train]
     if not peaks or not all(isinstance(p, dict) for p in peaks):
         return None
-    peak = np.array([max(float(p[c]) for p in peaks) for c in COORDS])
-    machine = machine_limits()
-    stroke = np.where(peak > 0, np.minimum(RECORD_MARGIN * peak, machine.stroke), machine.stroke)
-    return Rig3Limits(
+    peak = np.array([max(float(p[c]) for p in peaks) for c in coords])
+    if machine_of(coords) is None:
+        if not np.all(peak > 0):
+            return None
+        stroke, rate, whose = RECORD_MARGIN * peak, machine_rate(RECORD_MARGIN * peak), "rule"
+    else:
+        machine = machine_limits()
+        top = np.array(machine.stroke)
+        stroke = np.where(peak > 0, np.minimum(RECORD_MARGIN * peak, top), top)
+        rate, whose = np.array(machine.rate), "rates"
+    return CoordinateLimits(
         tuple(stroke.tolist()),
-        machine.rate,
+        tuple(rate.tolist()),
         f"{RECORD_MARGIN:g} x the peak deflection {name} state (the records are not there: "
-        "the machine's rates)",
+        f"the machine's {whose})",
         tuple(peak.tolist()),
+        coords,
+        units,
     )
 
 
-def search_limits(flags: ScaleFlags, subject, reference) -> Rig3Limits:
-    """What the search drives: a user's reference's card (else the model's) or the machine's,
-    with the flags on top (``--stroke-mm`` and ``--max-velocity`` on the translations,
-    ``--rotation-mrad`` on the rotation)."""
-    limits = machine_limits()
-    if reference.file is not None:  # a user's reference: its card, else the model's
+def _listed(names: list[str]) -> str:
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
+
+
+def search_limits(flags: ScaleFlags, subject, reference) -> CoordinateLimits:
+    """What the search drives over the model's coordinates: a user's reference's card (else
+    the model's; with no reference, the model's) or the machine's (``machine_of``), with the
+    flags on top (``--stroke-mm`` and ``--max-velocity`` on the translations, ``--rotation-mrad``
+    on the rotations). ``SearchError`` when a coordinate has none of these."""
+    coords, units = tuple(subject.model.coords), tuple(subject.model.units)
+    limits = machine_limits() if machine_of(coords) is not None else None
+    if reference is None or reference.file is not None:  # a user's: its card, else the model's
         for res in (reference, subject):
             found = limits_of_card(res)
             if found is not None:
                 limits = found
                 break
+    flag = {"m": (flags.stroke_mm, flags.max_velocity_m_per_s), "rad": (flags.rotation_mrad, None)}
+    named = {"m": [c for c, u in zip(coords, units, strict=True) if u == "m"],
+             "rad": [c for c, u in zip(coords, units, strict=True) if u == "rad"]}  # fmt: skip
+    if limits is None:
+        missing = [f for f, u in (("--stroke-mm", "m"), ("--rotation-mrad", "rad"))
+                   if named[u] and flag[u][0] is None]  # fmt: skip
+        if missing:
+            raise SearchError(
+                f"{subject.spec}: no model card with training records to take the range of "
+                f"{', '.join(coords)} from, and no machine over them; give {' and '.join(missing)} "
+                "(the deflections the bushing is used at)"
+            )
+        stroke = [flag[u][0] * 1e-3 for u in units]
+        v = flags.max_velocity_m_per_s
+        rate = [machine_rate(s) if u == "rad" or v is None else v
+                for s, u in zip(stroke, units, strict=True)]  # fmt: skip
+        given = " and ".join(f for f, u in (("--stroke-mm", "m"), ("--rotation-mrad", "rad"))
+                             if named[u])  # fmt: skip
+        return CoordinateLimits(tuple(stroke), tuple(float(r) for r in rate),
+                                f"{given} (the rates the papers' machine's rule)", None,
+                                coords, units)  # fmt: skip
     stroke, rate = list(limits.stroke), list(limits.rate)
-    given = []
-    if flags.stroke_mm is not None:
-        stroke[:2] = [flags.stroke_mm * 1e-3] * 2
-        given.append(f"--stroke-mm {flags.stroke_mm:g}")
-    if flags.max_velocity_m_per_s is not None:
-        rate[:2] = [flags.max_velocity_m_per_s] * 2
-        given.append(f"--max-velocity {flags.max_velocity_m_per_s:g}")
-    if not given and flags.rotation_mrad is None:
+    parts = []
+    for u in ("m", "rad"):
+        s, v = flag[u]
+        if not named[u] or (s is None and v is None):
+            continue
+        idx = [i for i, x in enumerate(units) if x == u]
+        given = []
+        if s is not None:
+            given.append(f"--{'stroke-mm' if u == 'm' else 'rotation-mrad'} {s:g}")
+            for i in idx:
+                stroke[i] = s * 1e-3
+        if v is not None:
+            given.append(f"--max-velocity {v:g}")
+            for i in idx:
+                rate[i] = v
+        where = _listed(named[u]) if u == "m" else "the " + _listed(named[u])
+        parts.append((u, f"{' and '.join(given)} on {where}"))
+    if not parts:
         return limits
-    source = f"{' and '.join(given)} on axial and radial" if given else ""
-    if flags.rotation_mrad is not None:
-        stroke[2] = flags.rotation_mrad * 1e-3
-        source += (f"{'; ' if source else ''}--rotation-mrad {flags.rotation_mrad:g} on the "
-                   "rotation")  # fmt: skip
-    else:
-        source += f" (the rotation: {limits.source})"
+    source = "; ".join(text for _, text in parts)
+    if [u for u, _ in parts] == ["m"] and named["rad"]:
+        source += f" (the {_listed(named['rad'])}: {limits.source})"
     return replace(limits, stroke=tuple(stroke), rate=tuple(rate), source=source)
 
 
@@ -132,7 +177,7 @@ def vetted_within(
     }
 
 
-def failure_reach(profiles: list[np.ndarray], limits: Rig3Limits | None) -> dict | None:
+def failure_reach(profiles: list[np.ndarray], limits: CoordinateLimits | None) -> dict | None:
     """How far beyond the records the failures sit: per profile the largest over the
     coordinates of its peak |q| over the records' (``limits.records_peak``); its median,
     smallest and largest. None when the limits come from no records."""

@@ -14,7 +14,7 @@
      "shrunk": [...], "corpus": [...], "complete": bool, "seconds": float}
 
 Over C > 1 coordinates the same layout: ``scales`` are the limits searched, per coordinate with
-its unit in the key (``search.limits.Rig3Limits.to_json``); ``judged`` the force floors per
+its unit in the key (``search.limits.CoordinateLimits.to_json``); ``judged`` the force floors per
 coordinate and the stroke the reference was vetted within; each search's ``coverage`` is per
 family and coordinate and its ``failures`` tallied by family, coordinate and criterion; the
 recheck counts failures ``by_axis``; ``failure_reach`` says how far beyond the records' peak the

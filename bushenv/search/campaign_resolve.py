@@ -38,7 +38,7 @@ from bushenv.search.campaign_models import (
     roles,
 )
 from bushenv.search.evaluate import BatchEvaluator
-from bushenv.search.limits import Rig3Limits, limits_text
+from bushenv.search.limits import CoordinateLimits, limits_text
 from bushenv.search.targets import Target, get_target
 
 Say = Callable[[str], None]
@@ -68,10 +68,10 @@ class Resolved:
     judged: Mapping[str, Any] | None = None
 
     @property
-    def limits(self) -> Rig3Limits | None:
+    def limits(self) -> CoordinateLimits | None:
         """The limits the search drives over several coordinates (the judge's scales); None
         over one, where ``judge.scales`` (a ``BushingScales``) are the bushing's limits."""
-        return self.judge.scales if isinstance(self.judge.scales, Rig3Limits) else None
+        return self.judge.scales if isinstance(self.judge.scales, CoordinateLimits) else None
 
     @property
     def case_axis(self) -> str:

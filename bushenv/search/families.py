@@ -30,7 +30,7 @@ input stops is judged, seed 000 §5.2) and lasts at most ``max_s`` seconds. Road
 |             |   | inside QuarterCar-v0's 0.05 m per step)                                      |
 
 The rig over three coordinates (target ``rig3``, ``families_rig.py``): a (T, 3) profile (axial m,
-radial m, rotation rad) within a stroke and rate per coordinate (``limits.Rig3Limits``: the
+radial m, rotation rad) within a stroke and rate per coordinate (``limits.CoordinateLimits``: the
 rig's, or a user's bushing's from its records):
 
 | family         | d  | parameters                                                               |

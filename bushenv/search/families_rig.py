@@ -5,7 +5,7 @@ One coordinate (target ``rig``, a (T,) profile in m): steps, ramps, pulses, sine
 random beyond the training band, sequences of those, and ``any`` (CMA-ES over them), within the
 bushing's ``BushingScales`` (stroke, velocity: the papers' machine by default). Several
 coordinates (target ``rig3``, a (T, 3) profile: axial m, radial m, rotation rad) within a stroke
-and rate per coordinate (``limits.Rig3Limits``): a preload in one coordinate with a step in
+and rate per coordinate (``limits.CoordinateLimits``): a preload in one coordinate with a step in
 another, a rotation sweep under a radial preload, an axial-radial orbit, one random drive
 phase-shifted into all three, ``any3`` (CMA-ES over them), and ``one_axis`` (the one-coordinate
 ``any`` in one coordinate, the others at rest: what a single-axis rig drives). Directions,
@@ -33,7 +33,7 @@ from bushenv.search.family_base import (
     _move,
     _n,
 )
-from bushenv.search.limits import COORDS, TARGET, finish3, limits3, rig3_limits
+from bushenv.search.limits import COORDS, TARGET, finish_coords, limits_arrays, rig3_limits
 
 FADE_S = 0.25  # orbits fade in and out over this long, so they start and end at rest
 
@@ -222,7 +222,7 @@ ONE_COORDINATE: list[Family] = [
 
 # ----- several coordinates: u -> (q (T, 3), params) ----------------------------------------------
 def _strokes_speeds(lim) -> tuple[np.ndarray, np.ndarray]:
-    stroke, rate = limits3(lim)
+    stroke, rate = limits_arrays(lim)
     return stroke, rate * SPEED_MARGIN
 
 
@@ -362,7 +362,7 @@ def _one_axis(u, dt, max_s, lim):
     the one-axis machine's stroke, at the chosen coordinate's rate in that proportion (at
     most the machine's), and scaled to the coordinate's stroke; its parameters are the
     one-axis profile's, before that scaling."""
-    stroke, rate = limits3(lim)
+    stroke, rate = limits_arrays(lim)
     i = _pick(u[0], 3)
     scale = stroke[i] / MACHINE.stroke_m
     one = MACHINE
@@ -394,7 +394,10 @@ def _any3(u, dt, max_s, lim):
 
 ONE_AXIS_DIM = 1 + ANY.dim
 COMBINED: list[Family] = [
-    *(Family(name, d, TARGET, build, finish=finish3) for name, (d, build) in _COMBINED.items()),
-    Family("any3", _ANY_DIM, TARGET, _any3, random=False, finish=finish3),
-    Family("one_axis", ONE_AXIS_DIM, TARGET, _one_axis, random=False, finish=finish3),
+    *(
+        Family(name, d, TARGET, build, finish=finish_coords)
+        for name, (d, build) in _COMBINED.items()
+    ),
+    Family("any3", _ANY_DIM, TARGET, _any3, random=False, finish=finish_coords),
+    Family("one_axis", ONE_AXIS_DIM, TARGET, _one_axis, random=False, finish=finish_coords),
 ]

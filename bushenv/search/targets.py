@@ -8,7 +8,7 @@ evaluator, shrinking, campaigns and the corpus ask the target; none of them comp
 ``bushenv/search/checks.py`` holds the contract as checks every ``TARGETS`` entry passes.
 
 The rig target over three coordinates (``rig3``): a profile is (T, 3) (axial m, radial m,
-rotation rad) within a stroke and rate per coordinate (``limits.Rig3Limits``: the
+rotation rad) within a stroke and rate per coordinate (``limits.CoordinateLimits``: the
 rig's, or a user's bushing's, passed as the evaluator's ``scales``); each coordinate's force
 (or moment) is judged by ``divergence.judge`` on its own scale: the env's force limit there and
 a force floor per coordinate (``reference_floors``: the papers' bushing's -- the one-axis
@@ -41,7 +41,7 @@ from bushenv.identify.static_estimate import coordinate_stiffness
 from bushenv.registry import Registry
 from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
 from bushenv.search.base import SearchError
-from bushenv.search.limits import COORDS, UNITS, clip3, limits3
+from bushenv.search.limits import COORDS, UNITS, clip_coords, limits_arrays
 from bushenv.search.roads import quarter_car_responses
 from bushenv.search.target_base import (  # noqa: F401 (simulate_or_nan: the evaluator's)
     Responses,
@@ -176,7 +176,7 @@ class Rig3Target(Target):
     shown_units = UNITS
 
     def finish(self, x: np.ndarray, dt: float, limits=MACHINE) -> np.ndarray:
-        return clip3(x, dt, limits)
+        return clip_coords(x, dt, limits)
 
     def judging_facts(self, reference) -> dict[str, dict[str, float]]:
         floors = reference_floors(reference)[0]
@@ -184,8 +184,9 @@ class Rig3Target(Target):
 
     def profile_bounds(self, limits=MACHINE) -> tuple[np.ndarray, np.ndarray]:
         """Per coordinate (3,) arrays: the stroke and rate of ``limits`` when they are
-        ``Rig3Limits``, else BushRig3-v0's (a one-axis bushing's ``BushingScales`` do not apply)."""
-        return limits3(limits)
+        ``CoordinateLimits``, else BushRig3-v0's (a one-axis bushing's ``BushingScales`` do not
+        apply)."""
+        return limits_arrays(limits)
 
     def responses(
         self, model, reference, x, lengths, dt, axis, dtype="float64", scales=MACHINE

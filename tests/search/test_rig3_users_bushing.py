@@ -13,7 +13,7 @@ from bushenv.models.planar_linear import PlanarLinear, fit_linear
 from bushenv.persist import load_profiles
 from bushenv.record_files import load_record
 from bushenv.search.families import FAMILIES
-from bushenv.search.limits import COORDS, Rig3Limits, machine_limits
+from bushenv.search.limits import COORDS, CoordinateLimits, machine_limits
 from bushenv.search.targets import TARGETS
 
 TRAIN = "random_independent_n1_8s_seed0.csv"
@@ -197,7 +197,7 @@ def test_the_builtin_reference_keeps_the_machine_and_the_linear_preset(tmp_path)
 
 @pytest.mark.parametrize("name", TARGETS["rig3"].family_names())
 def test_every_family_stays_within_small_limits_of_a_users_bushing(name):
-    lim = Rig3Limits((2e-3, 1e-3, 0.02), (0.05, 0.2, 0.5))
+    lim = CoordinateLimits((2e-3, 1e-3, 0.02), (0.05, 0.2, 0.5))
     fam = FAMILIES[name]
     rng = np.random.default_rng(4)
     dt = PlanarLinear.preset().dt
@@ -248,7 +248,7 @@ def test_the_hold_stage_steps_to_each_suspect_hold_within_the_limits_and_judges_
     from bushenv.search.target_base import covered_search
 
     model = load_model(network, coords=3)
-    lim = Rig3Limits((3e-3, 3e-3, 0.075), (0.2, 0.2, 5.0))
+    lim = CoordinateLimits((3e-3, 3e-3, 0.075), (0.2, 0.2, 5.0))
     holds = listed_vectors(model, lim.stroke, floors=np.zeros(3))  # no floor: every push counts
     assert holds, "a network with no floor to its pushes lists some hold"
     for h in holds:
