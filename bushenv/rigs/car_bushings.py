@@ -69,8 +69,9 @@ def carried(key: str, model: BushingModel) -> tuple[int, ...]:
 
 def rotation_split(model: BushingModel) -> tuple[float, float]:
     """(k_in N m/rad, c_in N m s/rad) of an arm bushing's rotation inside the sub-steps: what
-    the model states (a linear model's K_tt, C_tt; a hybrid's backbone), else the three-axis
-    linear preset's (the reference's tangent at rest, 3000 N m/rad). Matching the model makes
+    the model states (a linear model's K_tt, C_tt; a hybrid's backbone), else the linear
+    torsion preset's (52.0 N m/rad: the arm turns its pivot's bush about the bush's axis, as
+    in HalfCar-v0). Matching the model makes
     its held remainder small: a linear model's is exactly zero, as in the one-axis split.
     Held explicitly, even 3000 N m/rad on the arm (about 1.1 kg m^2 about its centre of mass)
     is omega dt = 0.26: the rotation is not where the coupling trap lies; accuracy is."""
@@ -78,7 +79,7 @@ def rotation_split(model: BushingModel) -> tuple[float, float]:
 
     k = getattr(model, "k_matrix", None)
     if k is None:
-        lin = PlanarLinear.preset(dt=model.dt)
+        lin = PlanarLinear.preset(dt=model.dt, rotation="torsion")
         return float(lin.k_matrix[2, 2]), float(lin.c_matrix[2, 2])
     return max(float(k[2, 2]), ROTATION_K_IN_FLOOR), max(float(model.c_matrix[2, 2]), 0.0)
 
@@ -90,15 +91,16 @@ def arm_models(p, kwargs: dict[str, Any]) -> None:
     from bushenv.rigs.common import resolve_model
 
     arm = resolve_model(p.arm_bushing, dt=p.dt, coords=3, what="arm_bushing", env_id=CAR.name)
+    twin_spec = kwargs.get("arm_bushing_reference", "rubber-torsion")
     twin = resolve_model(
-        kwargs.get("arm_bushing_reference", "reference"), dt=p.dt, coords=3,
-        what="arm_bushing_reference", env_id=CAR.name,
-    )  # fmt: skip
+        twin_spec, dt=p.dt, coords=3, what="arm_bushing_reference", env_id=CAR.name
+    )
     p.models, p.references = {"arm": arm}, {"arm": twin}
     p.rotation_in = {"model": rotation_split(arm), "reference": rotation_split(twin)}
     label = p.arm_bushing if isinstance(p.arm_bushing, str | Path) else arm.name
     p.model_name = f"planar {Path(str(label)).name}"
-    p.reference_name = f"planar {twin.name}"
+    twin_label = twin_spec if isinstance(twin_spec, str | Path) else twin.name
+    p.reference_name = f"planar {Path(str(twin_label)).name}"
 
 
 def axis_label(models: dict[str, BushingModel], spec: Any) -> str:

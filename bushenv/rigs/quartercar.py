@@ -159,7 +159,8 @@ class QuarterCarEnv(gym.Env):
     ``arm_bushing`` (a ``MODELS`` name with a three-axis form, a three-axis ``.npz`` file or
     a three-axis model) replaces the two one-axis models by one three-axis bushing that also carries
     the arm's rotation (a moment, judged by ``arm_moment_limit_nm``; the twin's is
-    ``arm_bushing_reference``); info then adds ``arm_rotation_rad``, ``moment_model_nm``,
+    ``arm_bushing_reference``, by default the torsion preset ``rubber-torsion``); info then
+    adds ``arm_rotation_rad``, ``moment_model_nm``,
     ``moment_reference_nm``. docs/planar.md gives its coupling and range.
         obs, info = env.reset(options={"excitation": road})  # replay road heights exactly
 
@@ -198,7 +199,9 @@ class QuarterCarEnv(gym.Env):
       ``max_episode_steps`` (Gymnasium's ``TimeLimit``; the kwarg ``episode_steps`` is gone),
       ``render_fps`` is 1 / ``dt_s``, the env pickles and deep-copies, a vector entry point
       exists, and the id is also registered as ``bushenv/QuarterCar-v0``. The dynamics and
-      every number an episode gives are unchanged.
+      every number an episode gives are unchanged. With ``arm_bushing`` set, the twin's
+      default is the torsion preset ``rubber-torsion`` since 2026-11-29 (the arm turns its
+      pivot's bush about the bush's axis; before: the tilt preset ``reference``).
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 204.8}

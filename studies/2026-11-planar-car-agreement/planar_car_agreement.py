@@ -4,7 +4,7 @@ planar arm bushing: the largest difference of each signal over a road, relative 
     python studies/2026-11-planar-car-agreement/planar_car_agreement.py [--arms linear reference] [--harsh] [--quiet]
 
 Replays each road in the pymunk env and in column 0 of the vector env (arm_bushing = each
-planar preset, the twin the default ``reference``) and prints one markdown row per arm and
+planar preset, the twin ``reference``, the default when measured) and prints one markdown row per arm and
 road (docs/planar.md quotes them). Roads: the papers' 400 mm x 100 mm bump at 30 km/h then a
 rough road (2048 steps, tests/rigs/test_quartercar_vector.py), a pothole 60 mm deep, a random
 rough road and a square wave at the rate limit through the wheel hop (+-30 mm, 9-step half
@@ -71,6 +71,7 @@ def harsh_roads() -> tuple[dict[str, np.ndarray], dict]:
 
 def differences(arm: str, road: np.ndarray, **kw) -> tuple[dict[str, float], int, str]:
     """(signal -> max |pymunk - vector| / peak, steps run, how the episodes ended)."""
+    kw = {"arm_bushing_reference": "reference", **kw}  # the twin as measured (the tilt set)
     env = gym.make("QuarterCar-v0", arm_bushing=arm, **kw)
     venv = gym.make_vec(
         "QuarterCar-v0", num_envs=2, vectorization_mode="vector_entry_point", arm_bushing=arm,

@@ -110,7 +110,7 @@ def test_an_unknown_arm_bushing_name_lists_the_planar_models():
         make(arm_bushing="nope")
 
 
-@pytest.mark.parametrize("arm", ["linear", "reference"])
+@pytest.mark.parametrize("arm", ["linear", "reference", "rubber-torsion"])
 def test_the_coupling_keeps_linear_and_reference_stable_on_the_worst_roads_within_travel(arm):
     """DESIGN-NOTES' trap: held forces are an explicit scheme. The rate-limit square waves of
     test_quartercar (through wheel hop) and a random bang-bang road, within the car's travel
@@ -147,3 +147,19 @@ def test_info_says_when_the_reference_arm_bushing_judges_beyond_its_calibrated_r
     assert "calibrated +-0.15 rad" in first and "extrapolation" in first
     lin = replay(make(arm_bushing="linear", arm_bushing_reference="linear", **loose), roads[:, 15])
     assert not any(r[4]["reference_outside_range"] for r in lin)  # a law with no stated range
+
+
+def test_the_default_twin_is_the_torsion_preset_and_judges_within_its_range():
+    """The arm turns its pivot's bush about the bush's own axis: the twin is the torsion
+    preset (+-0.442 rad), so on the worst roads within travel it judges inside its range,
+    where the tilt preset (+-0.15 rad) extrapolates."""
+    from test_quartercar import LOOSE, worst_roads
+
+    env = make(arm_bushing="linear")
+    assert env.unwrapped.params.reference_name == "planar rubber-torsion"
+    roads = worst_roads(600, np.random.default_rng(0))
+    loose = dict(LOOSE, arm_moment_limit_nm=1e12)
+    rows = replay(make(arm_bushing="linear", **loose), roads[:, 15])
+    theta = np.abs([r[4]["reference_arm_rotation_rad"] for r in rows])
+    assert 0.15 < theta.max() < 0.442  # beyond the tilt's range, within the torsion's
+    assert not any(r[4]["reference_outside_range"] for r in rows)

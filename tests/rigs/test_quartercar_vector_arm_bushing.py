@@ -283,7 +283,8 @@ def test_info_says_where_the_reference_judges_beyond_its_calibrated_rotation():
     from bushenv.reference.planar import MAX_ROTATION_RAD
 
     road = worst_roads(600, np.random.default_rng(0))[:, 15]
-    _, vector = run_both(road, arm_bushing="linear", arm_moment_limit_nm=1e12, **LOOSE)
+    kw = dict(LOOSE, arm_bushing="linear", arm_bushing_reference="reference")  # the tilt set
+    _, vector = run_both(road, arm_moment_limit_nm=1e12, **kw)
     theta = np.array([o[4]["reference_arm_rotation_rad"] for o in vector])
     said = np.array([[bool(s) for s in o[4]["reference_outside_range"]] for o in vector])
     assert np.abs(theta).max() > MAX_ROTATION_RAD
