@@ -334,6 +334,15 @@ def test_binary_regression_case_is_refused_naming_the_file(tmp_path):
         load_case(path)
 
 
+def test_a_model_file_given_to_replay_is_named_a_model_file(tmp_path):
+    from bushenv.models import get_model
+    from bushenv.search.corpus import CorpusError, load_case
+
+    path = get_model("linear", coords=3).save(tmp_path / "lin3.npz")
+    with pytest.raises(CorpusError, match=r"lin3\.npz: a model file, not a divergence case"):
+        load_case(path)
+
+
 ATTACK = ["attack", "--model", "linear", "--hybrid", "linear", "--control", "linear"]
 
 

@@ -216,6 +216,11 @@ def _kept(
 
 def load_case(path: str | os.PathLike) -> Case:
     path = Path(path)
+    if path.suffix in (".npz", ".fmu"):
+        raise CorpusError(
+            f"{path}: a model file, not a divergence case; replay takes corpus folders or "
+            "case files (CASE.json, as bushenv attack writes them)"
+        )
     try:
         d = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
