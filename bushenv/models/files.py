@@ -89,10 +89,11 @@ def load_model(
 
 # What takes a model of C coordinates, for the message that refuses it elsewhere.
 TAKES = {
-    1: "bushenv attack (--env rig or quartercar), certify, export, diagnose, replay, zoo, and "
+    1: "bushenv attack (--env rig or quartercar), certify, export, card, measure, and "
     "gym.make('BushRig-v0' or 'QuarterCar-v0', model=FILE)",
     3: "bushenv attack --env rig3, certify, export, card, measure --axes 3, and "
-    "gym.make('BushRig3-v0', model=FILE)",
+    "gym.make('BushRig3-v0' or 'HalfCar-v0', model=FILE) or "
+    "gym.make('QuarterCar-v0', arm_bushing=FILE)",
 }
 
 
