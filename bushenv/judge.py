@@ -8,9 +8,13 @@ inputs give the same judge everywhere:
   built-in ``rubber`` when the model under test is a registered name (the shipped models are
   models of it), none for a model file; ``"none"``: judged without one, by the criteria that
   need no reference -- the same meaning in every command.
-- **scales** (``bushenv.scales``): the reference's static stiffness sets the force floor, its
-  model card's records the stroke and velocity (without a reference: the model's card), flags
-  on top.
+- **scales** (``bushenv.scales``): the reference's static stiffness sets the force floor; the
+  range (stroke and velocity, per coordinate over several) is 1.5 x the training records' peak
+  |q| and |dq/dt| (``scales.record_range``, within the machine) on the first model card of
+  ``range_sources`` -- the reference's; a user's reference without one, or no reference, the
+  model's; a registered reference (the built-in specimen, the shipped presets) the papers'
+  machine's --, flags on top. Over several coordinates the range is a
+  ``search.limits.CoordinateLimits`` (``search.campaign_limits.search_limits``, the same rule).
 - **criteria**: all of ``divergence.CRITERIA`` against a reference; without one, those that
   need none; ``static`` only where the target has holds and the reference's card shows static
   behaviour (``scales.static_identified``).
@@ -33,6 +37,7 @@ from bushenv.resolved import ResolvedModel, resolve_model, resolved
 from bushenv.scales import (
     BushingScales,
     ScaleError,
+    has_range,
     scales_of_card,
     scales_of_reference,
     static_identified,
@@ -109,6 +114,13 @@ class Judge:
         return bool(np.max(np.abs(x)) <= x_max * (1 + 1e-9) and rate <= v_max * (1 + 1e-9))
 
     @property
+    def span(self) -> tuple[float, ...]:
+        """The largest |q| per coordinate the judge's range allows (m or rad): one coordinate's
+        ``BushingScales.stroke_m``, each of several coordinates' ``CoordinateLimits.stroke``."""
+        stroke = getattr(self.scales, "stroke", None)
+        return (self.scales.stroke_m,) if stroke is None else tuple(stroke)
+
+    @property
     def unvetted_ranges_m(self) -> tuple[tuple[float, float], ...]:
         """Displacement ranges (lo, hi), m, where the reference failed its vetting (it rings,
         departs or pulls there); empty when it passed or was not vetted."""
@@ -183,6 +195,19 @@ def check_reference_needed(spec: Any, target: Any) -> None:
             f"--reference NAME|FILE (a model of your bushing, or {BUILTIN_REFERENCE}, the "
             "built-in)"
         )
+
+
+def range_sources(model: Any, reference: Any) -> tuple:
+    """Whose model card gives the judged range, first choice first (``bushenv.resolved``
+    values): the reference's; a user's reference (a file) without a usable card leaves it to the
+    model's, and so does no reference; a registered reference (the built-in specimen, the
+    shipped presets, models of the papers' bushing) has no card and leaves the machine's. The
+    one rule for any number of coordinates."""
+    if reference is None:
+        return () if model is None else (model,)
+    if reference.registered or model is None:
+        return (reference,)
+    return (reference, model)
 
 
 def judging_scales(
@@ -282,7 +307,8 @@ def judge_of(
     builtin = reference is not None and reference.registered and reference.spec == BUILTIN_REFERENCE
     ref_card = None if reference is None else reference.card
     model_card = None if model is None else model.card
-    card = ref_card if ref is not None else model_card
+    cards = [r.card for r in range_sources(model, reference) if has_range(r.card)]
+    card = cards[0] if cards else None
     scale_problem = None
     try:
         scales = judging_scales(ref, builtin, card, flags)

@@ -136,16 +136,27 @@ def scales_of_reference(reference, builtin: bool) -> BushingScales:
     )
 
 
+def record_range(peak, speed, top_stroke=np.inf, top_rate=np.inf) -> tuple[np.ndarray, np.ndarray]:
+    """The range a search drives and a certificate holds over, from records' largest |q| and
+    |dq/dt| (numbers, or one per coordinate): ``RECORD_MARGIN`` times each, within the
+    machine's ``top_stroke`` and ``top_rate`` (none: no bound). The one rule for any number of
+    coordinates (``scales_of_card``, ``search.limits.limits_of_records``)."""
+    stroke = np.minimum(RECORD_MARGIN * np.asarray(peak, dtype=np.float64), top_stroke)
+    rate = np.minimum(RECORD_MARGIN * np.asarray(speed, dtype=np.float64), top_rate)
+    return stroke, rate
+
+
 def scales_of_records(scales: BushingScales, x_m, dt: float) -> BushingScales:
     """``scales`` with stroke and velocity from measured displacement ``x_m`` (one or several
     arrays): their largest |x| and |dx/dt| times ``RECORD_MARGIN``, within the machine."""
     xs = [np.asarray(a, dtype=np.float64) for a in (x_m if isinstance(x_m, list) else [x_m])]
     peak = max(float(np.max(np.abs(a))) for a in xs)
     speed = max(float(np.max(np.abs(np.diff(a)))) / dt for a in xs if a.size > 1)
+    stroke, rate = record_range(peak, speed, ex.MAX_DISPLACEMENT_M, ex.MAX_VELOCITY_M_PER_S)
     return replace(
         scales,
-        stroke_m=min(RECORD_MARGIN * peak, ex.MAX_DISPLACEMENT_M),
-        velocity_m_per_s=min(RECORD_MARGIN * speed, ex.MAX_VELOCITY_M_PER_S),
+        stroke_m=float(stroke),
+        velocity_m_per_s=float(rate),
         source=scales.source + f"; stroke and velocity 1.5 x the records' ({peak * 1e3:.3g} mm)",
     )
 
@@ -172,16 +183,23 @@ def static_identified(card: dict) -> bool:
 FLOOR_FRACTION = FLOOR_AMPLITUDE_M / ex.MAX_DISPLACEMENT_M  # 0.5 of 12.5 mm: 4 %
 
 
+def has_range(card: dict | None) -> bool:
+    """Whether a one-axis model card's training records state their range (older cards and
+    cards of several coordinates do not: ``scales_of_card`` leaves the scales as they are)."""
+    train = [r for r in (card or {}).get("records", []) if r.get("role") == "train"]
+    return bool(train) and all("max_abs_displacement_m" in r for r in train)
+
+
 def scales_of_card(scales: BushingScales, card: dict) -> BushingScales:
     """``scales`` from a model card's training records: stroke and velocity their largest |x|
-    and |dx/dt| times ``RECORD_MARGIN`` (within the machine), their peak force the typical
-    force, and -- when they do not show static behaviour (``static_identified``), so the
-    static stiffness is an extrapolation -- the floor at ``FLOOR_FRACTION`` of that peak (the
-    papers' rule, 0.5 mm of a 12.5 mm stroke, as a share of force). A card without those
-    figures leaves ``scales`` as they are."""
-    train = [r for r in card.get("records", []) if r.get("role") == "train"]
-    if not train or any("max_abs_displacement_m" not in r for r in train):
+    and |dx/dt| times ``RECORD_MARGIN`` (``record_range``, within the machine), their peak
+    force the typical force, and -- when they do not show static behaviour
+    (``static_identified``), so the static stiffness is an extrapolation -- the floor at
+    ``FLOOR_FRACTION`` of that peak (the papers' rule, 0.5 mm of a 12.5 mm stroke, as a share
+    of force). A card without those figures leaves ``scales`` as they are."""
+    if not has_range(card):
         return scales
+    train = [r for r in card.get("records", []) if r.get("role") == "train"]
     peak = max(r["max_abs_displacement_m"] for r in train)
     speed = max(r["max_abs_velocity_m_per_s"] for r in train)
     force = max(r["max_abs_force_n"] for r in train)
@@ -189,10 +207,11 @@ def scales_of_card(scales: BushingScales, card: dict) -> BushingScales:
     if not static_identified(card):
         floor = FLOOR_FRACTION * force
         source = f"4 % of the card's training records' peak force ({force:.4g} N) as the floor"
+    stroke, rate = record_range(peak, speed, ex.MAX_DISPLACEMENT_M, ex.MAX_VELOCITY_M_PER_S)
     return replace(
         scales,
-        stroke_m=min(RECORD_MARGIN * peak, ex.MAX_DISPLACEMENT_M),
-        velocity_m_per_s=min(RECORD_MARGIN * speed, ex.MAX_VELOCITY_M_PER_S),
+        stroke_m=float(stroke),
+        velocity_m_per_s=float(rate),
         force_scale_n=force,
         force_floor_n=floor,
         source=source + f"; stroke and velocity 1.5 x the card's training records "

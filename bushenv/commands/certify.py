@@ -4,10 +4,11 @@ number of coordinates (``bushenv.certify``: holds on a grid of deflection vector
 Writes DIR/certificate.json and the plots that apply (static force, spectral radius, its map
 over each pair of coordinates, the least loss eigenvalue); prints a summary on stdout and
 progress on stderr. Exits as a test runner does: 0 when the certificate passes (holds and
-passivity), 1 when it fails, 2 on bad input. The span of the holds is the model card's (1.5 x
-its records' per coordinate), the papers' +-12.5 mm only for the shipped models,
-``--stroke-mm`` / ``--rotation-mrad`` on top; without a reference only the reference-free parts
-run, and the summary says what needs one.
+passivity), 1 when it fails, 2 on bad input. The span of the holds is the judge's range, by
+the attack's rule for any number of coordinates (``certify_setup``: 1.5 x the training records'
+peak on the reference's card, else the model's, within the machine), the machine's only for the
+shipped models, ``--stroke-mm`` / ``--rotation-mrad`` on top; without a reference only the
+reference-free parts run, and the summary says what needs one.
 """
 
 from __future__ import annotations
@@ -77,13 +78,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=float,
         default=None,
         help="holds span -S..+S mm in every translation (default: the model card's stroke, 1.5 x "
-        f"its records'; {DEFAULTS.stroke_m * 1e3:g}, the machine's, for the shipped models)",
+        "its records' -- the reference's card, else the model's -- within the machine; "
+        f"{DEFAULTS.stroke_m * 1e3:g}, the machine's, for the shipped models)",
     )
     parser.add_argument(
         "--rotation-mrad",
         type=float,
         default=None,
-        help="holds span -R..+R mrad in every rotation (default: 1.5 x the card's training range)",
+        help="holds span -R..+R mrad in every rotation (default: as --stroke-mm's)",
     )
     parser.add_argument(
         "--at-mm",

@@ -1,26 +1,32 @@
-"""What ``bushenv certify`` judges with: the holds' span and the reference, resolved once.
+"""What ``bushenv certify`` judges with: the holds' span and the reference, resolved once, for a
+model of any number of coordinates C by the attack's resolve stage
+(``search.campaign_resolve.resolve_target`` at the rig, ``judge.RIG``: reference-free, static
+judged).
 
-One coordinate: the one judging setup (``bushenv.judge``: the reference resolved and vetted,
-the stroke the model card's, the machine's for the shipped models, ``--stroke-mm`` on top).
-Several coordinates: the span per coordinate 1.5 x the card's training range (the one-axis
-stroke rule), ``--stroke-mm`` for translations and ``--rotation-mrad`` for rotations on top;
-the reference a model of as many coordinates (a registered name or a file), vetted over the
-span (``vetting.vet_reference``; ``--trust-reference`` certifies against one that
-failed), the judging setup being one coordinate's.
+The span per coordinate is the judge's range (``Judge.span``): 1.5 x the training records' peak
+|q| on the first model card of ``judge.range_sources`` (the reference's; a user's reference
+without one, or no reference, the model's), within the machine of those coordinates; the
+machine's for a registered reference (the shipped models); ``--stroke-mm`` on the translations
+and ``--rotation-mrad`` on the rotations on top. A model file whose span would be the machine's
+by default is refused: that span is the shipped models' only. The reference is a model of as
+many coordinates (a registered name or a file), vetted within the span (``--trust-reference``
+certifies against one that failed).
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from bushenv.certify.network import CertifyError
-from bushenv.models import MODELS, get_model
+from bushenv.judge import RIG, ScaleFlags
+from bushenv.models import MODELS
+from bushenv.resolved import resolved
+from bushenv.search.campaign_resolve import resolve_target
+
+FLAGS = {"m": "--stroke-mm", "rad": "--rotation-mrad"}  # the span's flag per unit
 
 
 @dataclass(frozen=True)
@@ -38,99 +44,56 @@ class Setup:
     title: str
 
 
-def _shown(model, span) -> str:
-    return ", ".join(
-        f"{c} +-{v * 1e3:.4g} {'mrad' if u == 'rad' else 'mm'}"
-        for c, u, v in zip(model.coords, model.units, span, strict=True)
-    )
+def shown(coords, units, span) -> str:
+    """``+-3 mm`` for one coordinate, ``axial +-3 mm, ..., rotation +-75 mrad`` over several."""
+    parts = [
+        f"+-{v * 1e3:.4g} {'mrad' if u == 'rad' else 'mm'}"
+        for u, v in zip(units, span, strict=True)
+    ]
+    if len(parts) == 1:  # a lone coordinate needs no name
+        return parts[0]
+    return ", ".join(f"{c} {p}" for c, p in zip(coords, parts, strict=True))
 
 
 def setup(args: argparse.Namespace, model) -> Setup:
     """The span and the reference of ``args`` for ``model`` (see the module doc)."""
-    if model.n_coords == 1:
-        return _judged(args, model)
-    return _several(args, model)
-
-
-def _judged(args: argparse.Namespace, model) -> Setup:
-    from bushenv.judge import ScaleFlags, build_judge
-
-    judge = build_judge(
-        args.model,
-        args.reference,
-        axis=args.axis,
-        dt=model.dt,
-        flags=ScaleFlags(stroke_mm=args.stroke_mm),
-        trust_reference=args.trust_reference,
-        model_object=model,
-    )
-    if args.stroke_mm is None and args.model not in MODELS and "card" not in judge.scales.source:
+    subject = resolved(args.model, model, args.axis, card=True)
+    flags = ScaleFlags(stroke_mm=args.stroke_mm, rotation_mrad=args.rotation_mrad)
+    one = resolve_target(subject, args.reference, axis=args.axis, target=RIG, flags=flags,
+                         trust_reference=args.trust_reference)  # fmt: skip
+    judge = one.judge
+    source = judge.scales.source
+    given = {"m": args.stroke_mm, "rad": args.rotation_mrad}
+    missing = [FLAGS[u] for u in dict.fromkeys(model.units) if given[u] is None]
+    if missing and args.model not in MODELS and "card" not in source:
+        ref = one.reference
+        why = (
+            f"the registered reference {ref.spec} has no model card and leaves the holds' span "
+            "to the machine"
+            if ref is not None and ref.registered
+            else "no model card (the reference's or the model's) to take the holds' span from"
+        )
         raise CertifyError(
-            f"{args.model}: no model card to take the stroke from (and the papers' +-12.5 mm "
-            "is the shipped models' only); give --stroke-mm S, the stroke the model is for"
+            f"{args.model}: {why}, and the machine's span is the shipped models' only; give "
+            f"{' and '.join(missing)} (the deflections the bushing is used at)"
         )
     line = (judge.reference_spec or "none") + (
         "" if judge.vetting is None else f", vetting {judge.vetting.headline()}"
     )
-    stroke = judge.scales.stroke_m
+    span = judge.span
     return Setup(
-        (stroke,),
-        judge.scales.source,
-        f"+-{stroke * 1e3:.4g} mm",
+        span,
+        source,
+        shown(model.coords, model.units, span),
         judge.reference,
         judge.reference_spec,
         line,
-        judge.describe(),
-        f"{Path(args.model).name} ({args.axis})",
+        {**judge.describe(), **(one.judged or {})},
+        title(Path(args.model).name, args.axis, model.coords),
     )
 
 
-def _span(args: argparse.Namespace, model) -> tuple[tuple[float, ...], str]:
-    """The holds' half-width per coordinate: 1.5 x the card's training range, else
-    --stroke-mm for translations and --rotation-mrad for rotations."""
-    from bushenv.identify.card import card_paths
-
-    given = {"m": args.stroke_mm, "rad": args.rotation_mrad}
-    if all(given[u] is not None for u in model.units):
-        return tuple(given[u] * 1e-3 for u in model.units), "--stroke-mm/--rotation-mrad"
-    card = card_paths(args.model)[0]
-    if Path(args.model).suffix == ".npz" and card.is_file():
-        span = json.loads(card.read_text()).get("training_range")
-        if span:
-            out = [
-                1.5 * span[c] if given[u] is None else given[u] * 1e-3
-                for c, u in zip(model.coords, model.units, strict=True)
-            ]
-            return tuple(out), f"1.5 x the training range of {card.name}"
-    missing = " and ".join(
-        f for f, u in (("--stroke-mm", "m"), ("--rotation-mrad", "rad")) if given[u] is None
-    )
-    raise CertifyError(
-        f"{args.model}: no model card with a training range beside it to take the holds' span "
-        f"from; give {missing} (the deflections the bushing is used at)"
-    )
-
-
-def _several(args: argparse.Namespace, model) -> Setup:
-    from bushenv.search.campaign_limits import vetted_within
-
-    span, source = _span(args, model)
-    spec = None if args.reference in (None, "none") else str(args.reference)
-    if spec is None:
-        return Setup(span, source, _shown(model, span), None, None, "none", None, _title(args))
-    reference = get_model(
-        spec, axis=args.axis, dt=model.dt, coords=model.n_coords,
-        wanted_by="bushenv certify --reference",
-    )  # fmt: skip
-    model_file = args.model if str(args.model).endswith(".npz") else None
-    vetting, judged = vetted_within(
-        reference, spec, None, lambda _: None, model=model, model_file=model_file,
-        trust=args.trust_reference, error=CertifyError, stroke=np.array(span),
-    )  # fmt: skip
-    judge = {"reference": spec, "vetting_verdict": vetting.verdict, **judged}
-    line = f"{spec}, vetting {vetting.headline()}"
-    return Setup(span, source, _shown(model, span), reference, spec, line, judge, _title(args))
-
-
-def _title(args: argparse.Namespace) -> str:
-    return Path(args.model).name
+def title(name: str, axis: str, coords) -> str:
+    """The plots' title: the model's name, with the axis (``--axis``) a one-coordinate model
+    stands for (the coordinates of several are on the plots' own axes)."""
+    return name if len(coords) > 1 else f"{name} ({axis})"

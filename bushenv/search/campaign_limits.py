@@ -12,8 +12,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from bushenv.judge import ScaleFlags
-from bushenv.scales import RECORD_MARGIN
+from bushenv.judge import ScaleFlags, range_sources
+from bushenv.scales import RECORD_MARGIN, record_range
 from bushenv.search.base import SearchError
 from bushenv.search.campaign_models import card_records
 from bushenv.search.limits import (
@@ -46,11 +46,12 @@ def limits_of_card(resolved) -> CoordinateLimits | None:
     if machine_of(coords) is None:
         if not np.all(peak > 0):
             return None
-        stroke, rate, whose = RECORD_MARGIN * peak, machine_rate(RECORD_MARGIN * peak), "rule"
+        stroke = record_range(peak, 0.0)[0]
+        rate, whose = machine_rate(stroke), "rule"
     else:
         machine = machine_limits()
         top = np.array(machine.stroke)
-        stroke = np.where(peak > 0, np.minimum(RECORD_MARGIN * peak, top), top)
+        stroke = np.where(peak > 0, record_range(peak, 0.0, top)[0], top)
         rate, whose = np.array(machine.rate), "rates"
     return CoordinateLimits(
         tuple(stroke.tolist()),
@@ -68,18 +69,18 @@ def _listed(names: list[str]) -> str:
 
 
 def search_limits(flags: ScaleFlags, subject, reference) -> CoordinateLimits:
-    """What the search drives over the model's coordinates: a user's reference's card (else
-    the model's; with no reference, the model's) or the machine's (``machine_of``), with the
-    flags on top (``--stroke-mm`` and ``--max-velocity`` on the translations, ``--rotation-mrad``
-    on the rotations). ``SearchError`` when a coordinate has none of these."""
+    """What the search drives over the model's coordinates: the range of the first card of
+    ``judge.range_sources`` (the reference's; a user's reference without one, or none, the
+    model's) or the machine's (``machine_of``), with the flags on top (``--stroke-mm`` and
+    ``--max-velocity`` on the translations, ``--rotation-mrad`` on the rotations).
+    ``SearchError`` when a coordinate has none of these."""
     coords, units = tuple(subject.model.coords), tuple(subject.model.units)
     limits = machine_limits() if machine_of(coords) is not None else None
-    if reference is None or reference.file is not None:  # a user's: its card, else the model's
-        for res in (reference, subject):
-            found = limits_of_card(res)
-            if found is not None:
-                limits = found
-                break
+    for res in range_sources(subject, reference):
+        found = limits_of_card(res)
+        if found is not None:
+            limits = found
+            break
     flag = {"m": (flags.stroke_mm, flags.max_velocity_m_per_s), "rad": (flags.rotation_mrad, None)}
     named = {"m": [c for c, u in zip(coords, units, strict=True) if u == "m"],
              "rad": [c for c, u in zip(coords, units, strict=True) if u == "rad"]}  # fmt: skip

@@ -3,10 +3,11 @@ hybrid, the control and the models rechecked beside them, each resolved once
 (``bushenv.resolved``) into one ``Resolved``, whatever the number of coordinates C of the target.
 
 ``resolve_target`` is the stage for one model (a cell of ``bushenv campaign``, a member of the
-zoo); ``resolve`` adds the roles of a whole attack (``campaign_models.roles``). Over one
-coordinate the judge's scales come from the reference's card (``judge.judge_of``); over several
-they are the limits the search drives, per coordinate in its unit, scaled to the user's card
-(``campaign_limits.search_limits``), and the reference is vetted within them.
+zoo, the model ``bushenv certify`` certifies); ``resolve`` adds the roles of a whole attack
+(``campaign_models.roles``). ``judge_over`` is the judge for any C: its range from the same cards
+by the same rule (``judge.range_sources``, ``scales.record_range``); over one coordinate the
+judge's scales (``judge.judge_of``), over several the limits per coordinate in its unit
+(``campaign_limits.search_limits``) with the reference vetted within them.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import numpy as np
 from bushenv.judge import (
     Judge,
     ScaleFlags,
+    Where,
     check_reference_needed,
     criteria_of,
     judge_of,
@@ -76,12 +78,12 @@ class Resolved:
     @property
     def case_axis(self) -> str:
         """The axis a corpus case of this attack records (``planar`` over several)."""
-        return self.axis if not self.target.coords else "planar"
+        return self.axis if self.n_coords == 1 else "planar"
 
     @property
     def n_coords(self) -> int:
-        """The number of coordinates C of the bushing searched."""
-        return max(1, len(self.target.coords))
+        """The number of coordinates C of the bushing searched (the target model's)."""
+        return self.models[self.target_key].model.n_coords
 
     @property
     def dt(self) -> float:
@@ -159,34 +161,32 @@ def resolve_target(
     reference: Any,
     *,
     axis: str,
-    target: str | Target = "rig",
+    target: str | Target | Where = "rig",
     flags: ScaleFlags | None = None,
     trust_reference: bool = False,
     say: Say = _quiet,
 ) -> Resolved:
     """The stage for one model (a name, file, object, or resolved already, with its card)
     against ``reference`` (a name, file, object, ``"none"``, or None: see
-    ``judge.reference_spec_for``), over the target's coordinates: both resolved, the reference
-    vetted. Raises ``JudgeError`` as ``judge_of`` does (``SearchError`` over several
-    coordinates)."""
-    tgt = get_target(target)
-    n = max(1, len(tgt.coords))
+    ``judge.reference_spec_for``): both resolved over the target's coordinates (a ``judge.Where``
+    has none: the model's, any number), the judge built (``judge_over``), the reference vetted.
+    Raises ``JudgeError`` as ``judge_of`` does (``SearchError`` over several coordinates)."""
+    tgt = target if isinstance(target, Where) else get_target(target)
+    coords = getattr(tgt, "coords", None)  # a ``Where``: the model's, however many
     flags = flags or ScaleFlags()
     wanted = f"the {tgt.name} target"
     subject = model
     if not isinstance(model, ResolvedModel):
+        n = None if coords is None else max(1, len(coords))
         subject = resolve_model(model, axis, card=True, coords=n, wanted_by=f"{wanted}'s model")
     spec = reference_spec_for(subject.spec if subject.registered else None, reference)
     check_reference_needed(spec, tgt)
     ref = None
     if spec is not None:
-        ref = resolve_model(spec, axis, subject.model.dt, reference=True, card=True, coords=n,
+        ref = resolve_model(spec, axis, subject.model.dt, reference=True, card=True,
+                            coords=subject.model.n_coords,
                             wanted_by=f"{wanted}'s reference")  # fmt: skip
-    judged = None
-    if n == 1:
-        judge = judge_of(subject, ref, target=tgt, flags=flags, trust_reference=trust_reference)
-    else:
-        judge, judged = coordinate_judge(subject, ref, tgt, flags, trust_reference, say)
+    judge, judged = judge_over(subject, ref, tgt, flags, trust_reference, say)
     return Resolved(
         axis=axis,
         target=tgt,
@@ -195,34 +195,58 @@ def resolve_target(
         models=_frozen({subject.key: subject}),
         roles=_frozen({subject.key: "target"}),
         keys=_frozen({"target": subject.key}),
-        notes=tuple(judge_notes(judge, tgt, say if n == 1 else _quiet)),
+        notes=tuple(judge_notes(judge, tgt, say)),
         judged=judged,
     )
 
 
-def coordinate_judge(
+def judge_over(
     subject: ResolvedModel,
-    ref: ResolvedModel,
-    target: Target,
+    ref: ResolvedModel | None,
+    target: Target | Where,
     flags: ScaleFlags,
     trust_reference: bool,
-    say: Say,
-) -> tuple[Judge, dict]:
+    say: Say = _quiet,
+) -> tuple[Judge, dict | None]:
+    """The judge of ``subject`` against ``ref`` (None: without one) over the model's C
+    coordinates, and what judged for the report (None over one coordinate, where the judge's
+    record says it all). The range is the one rule's either way (``judge.range_sources``); the
+    kind of it is C's: one coordinate's ``BushingScales`` (force floor, limit and scale with the
+    stroke, as the one-axis verdicts and their records always had) or ``CoordinateLimits``
+    with a force floor per coordinate (``targets.reference_floors``)."""
+    if subject.model.n_coords == 1:
+        judge = judge_of(subject, ref, target=target, flags=flags, trust_reference=trust_reference)
+        return judge, None
+    return coordinate_judge(subject, ref, target, flags, trust_reference, say)
+
+
+def coordinate_judge(
+    subject: ResolvedModel,
+    ref: ResolvedModel | None,
+    target: Target | Where,
+    flags: ScaleFlags,
+    trust_reference: bool,
+    say: Say = _quiet,
+) -> tuple[Judge, dict | None]:
     """The judge over several coordinates: the limits searched (``search_limits``), the
     reference vetted within them, every criterion on each coordinate (``judge_coordinates``);
-    and what judged, for the report."""
+    and what judged, for the report (None without a reference)."""
     limits = search_limits(flags, subject, ref)
+    say(f"searching within {limits_text(limits.to_json())}")
+    criteria, why = criteria_of(None if ref is None else ref.model, True, target)
+    why = f"{why}, on each coordinate (target_base.judge_coordinates)"
+    if ref is None:
+        judge = Judge(reference_spec=None, builtin=False, scales=limits, static=False,
+                      criteria=criteria, why=why)  # fmt: skip
+        return judge, None
     vetted, judged = vetted_within(
-        ref.model, ref.spec, target, say, model=subject.model, model_file=subject.file,
+        ref.model, ref.spec, target, _quiet, model=subject.model, model_file=subject.file,
         trust=trust_reference, stroke=np.array(limits.stroke), rate=np.array(limits.rate),
     )  # fmt: skip
-    criteria, why = criteria_of(ref.model, True, target)
-    say(f"searching within {limits_text(limits.to_json())}")
     judge = Judge(
         reference_spec=ref.spec, builtin=ref.registered, scales=limits, static=True,
-        criteria=criteria, why=f"{why}, on each coordinate (target_base.judge_coordinates)",
-        vetting=vetted, trusted_by_flag=bool(trust_reference and not vetted.passed),
-        reference=ref.model,
+        criteria=criteria, why=why, vetting=vetted,
+        trusted_by_flag=bool(trust_reference and not vetted.passed), reference=ref.model,
     )  # fmt: skip
     return judge, judged
 

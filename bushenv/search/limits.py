@@ -15,7 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from bushenv import excitation as ex
-from bushenv.scales import RECORD_MARGIN
+from bushenv.scales import RECORD_MARGIN, record_range
 from bushenv.search.base import SearchError
 from bushenv.search.family_base import MIN_HOLD_S, _n
 
@@ -170,8 +170,8 @@ def limits_of_records(
     if tops is None and not moved.all():
         still = ", ".join(c for c, m in zip(coords, moved, strict=True) if not m)
         raise SearchError(f"{what} never move {still} and no machine bounds it: give its range")
-    stroke = np.where(moved, np.minimum(RECORD_MARGIN * peak, top_stroke), top_stroke)
-    rate = np.where(moved, np.minimum(RECORD_MARGIN * speed, top_rate), top_rate)
+    stroke, rate = record_range(peak, speed, top_stroke, top_rate)
+    stroke, rate = np.where(moved, stroke, top_stroke), np.where(moved, rate, top_rate)
     seen = ", ".join(
         f"{c} {1e3 * p:.4g} {SHOWN[u]} at {v:.4g} {u}/s"
         for c, u, p, v in zip(coords, units, peak, speed, strict=True)
