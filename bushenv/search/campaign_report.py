@@ -374,9 +374,13 @@ def _limits_lines(report: dict[str, Any]) -> list[str]:
     if judged:
         from bushenv.search.limits import limits_text
 
-        floors = ", ".join(f"{k} {x:.4g}" for k, x in judged["force_floors"].items())
-        lines.append(f"searched within {limits_text(report['scales'])}")
-        lines.append(f"  force floors {floors} (N, N, N m): {judged['force_floors_source']}")
+        scales = report["scales"]
+        floors = ", ".join(
+            f"{k} {x:.4g} {'N m' if 'stroke_mrad' in scales.get(k, {}) else 'N'}"
+            for k, x in judged["force_floors"].items()
+        )  # a rotation's floor is a moment
+        lines.append(f"searched within {limits_text(scales)}")
+        lines.append(f"  force floors {floors}: {judged['force_floors_source']}")
     ctl = report.get("control")
     if ctl:
         lines.append(f"control: {ctl['label']} ({ctl['how']})")

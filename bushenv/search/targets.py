@@ -37,9 +37,9 @@ import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.divergence import judge
-from bushenv.identify.static_estimate import coordinate_stiffness
+from bushenv.identify.static_estimate import STIFFNESS_LEVER_M, coordinate_stiffness
 from bushenv.registry import Registry
-from bushenv.scales import FORCE_FLOOR_N, MACHINE, BushingScales
+from bushenv.scales import FLOOR_AMPLITUDE_M, FORCE_FLOOR_N, MACHINE, BushingScales
 from bushenv.search.base import SearchError
 from bushenv.search.limits import COORDS, UNITS, clip_coords, limits_arrays
 from bushenv.search.roads import quarter_car_responses
@@ -80,10 +80,16 @@ def _builtin_stiffness(dt: float) -> np.ndarray:
 
 
 def reference_floors(reference) -> tuple[np.ndarray, str]:
-    """(floors (3,) N, N, N m; where they come from): ``MACHINE_FLOORS`` times the reference's
-    static stiffness over the built-in reference's, per coordinate. A coordinate whose
-    stiffness is not a positive number keeps the machine's floor (the vetting's holds then
-    say why the reference cannot judge)."""
+    """(floors (C,) N or N m; where they come from): over BushRig3-v0's coordinates
+    ``MACHINE_FLOORS`` times the reference's static stiffness over the built-in reference's, per
+    coordinate. A coordinate whose stiffness is not a positive number keeps the machine's floor
+    (the vetting's holds then say why the reference cannot judge). Over other coordinates, with
+    no built-in reference of them, the one-axis rule (``scales.scales_of_reference``) on each:
+    its static force at the papers' smallest amplitude, 0.5 mm (a rotation: 0.5 mm at the
+    stiffness lever, ``static_estimate.STIFFNESS_LEVER_M``)."""
+    coords = tuple(getattr(reference, "coords", ()))
+    if coords != COORDS:
+        return _floors_without_builtin(reference, coords)
     k, k0 = coordinate_stiffness(reference), _builtin_stiffness(reference.dt)
     ratio = np.where(np.isfinite(k) & (k > 0), k / k0, 1.0)
     floors = MACHINE_FLOORS * ratio
@@ -91,6 +97,26 @@ def reference_floors(reference) -> tuple[np.ndarray, str]:
     return (
         floors,
         f"the papers' floors times the reference's static stiffness over the built-in's ({text})",
+    )
+
+
+def _floors_without_builtin(reference, coords: tuple[str, ...]) -> tuple[np.ndarray, str]:
+    k = coordinate_stiffness(reference)
+    amplitude = np.array(
+        [FLOOR_AMPLITUDE_M / (STIFFNESS_LEVER_M if u == "rad" else 1.0) for u in reference.units]
+    )
+    bad = [c for c, v in zip(coords, k, strict=True) if not (np.isfinite(v) and v > 0)]
+    if bad:
+        raise SearchError(
+            f"the reference's static stiffness in {', '.join(bad)} is not a positive number: "
+            "it cannot set the force floor there (a bushing pushes back)"
+        )
+    floors = k * amplitude
+    text = ", ".join(f"{c} {v:.4g}" for c, v in zip(coords, k, strict=True))
+    return floors, (
+        f"the reference's static stiffness per coordinate ({text}; N/m, N m/rad) x the papers' "
+        f"smallest amplitude, {FLOOR_AMPLITUDE_M * 1e3:g} mm (a rotation: at the "
+        f"{STIFFNESS_LEVER_M:g} m lever)"
     )
 
 

@@ -87,3 +87,29 @@ def test_limits_of_records_over_a_coordinate_set_without_machine():
     still = [np.column_stack([np.linspace(0, 2e-3, 100), np.zeros(100)])]
     with pytest.raises(SearchError, match="never move b"):
         limits_of_records(still, 1e-3, "the records", ("a", "b"), ("m", "rad"))
+
+
+class _Spring:
+    """A linear spring over any coordinates, f = K q (the static-stiffness probe's view)."""
+
+    def __init__(self, k, coords, units):
+        self.k, self.coords, self.units = np.asarray(k, dtype=float), coords, units
+        self.n_coords, self.dt = len(coords), 1e-3
+
+    def copy(self):
+        return self
+
+    def simulate(self, q):
+        return np.asarray(q) * self.k
+
+
+def test_force_floors_over_coordinates_without_a_builtin_reference_follow_the_one_axis_rule():
+    from bushenv.scales import FLOOR_AMPLITUDE_M
+    from bushenv.search.targets import reference_floors
+
+    spring = _Spring([4e5, 2e3], ("x", "rz"), ("m", "rad"))
+    floors, source = reference_floors(spring)
+    assert floors == pytest.approx([4e5 * FLOOR_AMPLITUDE_M, 2e3 * FLOOR_AMPLITUDE_M / 0.04])
+    assert "x 4e+05, rz 2000" in source and "0.5 mm" in source
+    with pytest.raises(SearchError, match="static stiffness in rz is not a positive number"):
+        reference_floors(_Spring([4e5, -1.0], ("x", "rz"), ("m", "rad")))
