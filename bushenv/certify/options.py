@@ -83,3 +83,15 @@ def passivity_holds(opts: CertifyOptions, coords: int) -> np.ndarray:
             q[i] = sign * opts.passivity_fraction * s
             out.append(q)
     return np.array(out)
+
+
+def span_text(coords, units, span) -> str:
+    """``+-3 mm`` for one coordinate, ``axial +-3 mm, ..., rotation +-75 mrad`` over several
+    (what ``bushenv certify`` and an FMU's certificate say of the holds' span)."""
+    parts = [
+        f"+-{v * 1e3:.4g} {'mrad' if u == 'rad' else 'mm'}"
+        for u, v in zip(units, span, strict=True)
+    ]
+    if len(parts) == 1:  # a lone coordinate needs no name
+        return parts[0]
+    return ", ".join(f"{c} {p}" for c, p in zip(coords, parts, strict=True))

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from bushenv.certify.network import CertifyError
+from bushenv.certify.options import span_text
 from bushenv.judge import RIG, ScaleFlags
 from bushenv.models import MODELS
 from bushenv.resolved import resolved
@@ -42,17 +43,6 @@ class Setup:
     reference_line: str
     judge: dict | None
     title: str
-
-
-def shown(coords, units, span) -> str:
-    """``+-3 mm`` for one coordinate, ``axial +-3 mm, ..., rotation +-75 mrad`` over several."""
-    parts = [
-        f"+-{v * 1e3:.4g} {'mrad' if u == 'rad' else 'mm'}"
-        for u, v in zip(units, span, strict=True)
-    ]
-    if len(parts) == 1:  # a lone coordinate needs no name
-        return parts[0]
-    return ", ".join(f"{c} {p}" for c, p in zip(coords, parts, strict=True))
 
 
 def setup(args: argparse.Namespace, model) -> Setup:
@@ -84,7 +74,7 @@ def setup(args: argparse.Namespace, model) -> Setup:
     return Setup(
         span,
         source,
-        shown(model.coords, model.units, span),
+        span_text(model.coords, model.units, span),
         judge.reference,
         judge.reference_spec,
         line,

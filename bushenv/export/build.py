@@ -33,7 +33,6 @@ from bushenv.export.description import (
     model_description,
 )
 from bushenv.export.facts import (
-    THREE_AXIS_STROKES,
     Facts,
     facts_of,
     find_card,
@@ -222,7 +221,6 @@ def export_fmu(
         path=certificate,
         reference=reference,
         stroke_m=stroke_m,
-        spans=THREE_AXIS_STROKES,
     )
     if cert.fails and not allow_failing:
         label = str(spec) if isinstance(spec, str | os.PathLike) else f"the {model.name!r} model"

@@ -124,14 +124,14 @@ def carried_certificate(
     path: str | os.PathLike | None = None,
     reference: Any = None,
     stroke_m: float | None = None,
-    spans: tuple[float, ...] = (),
 ) -> Carried:
     """The certificate the FMU of ``model`` carries. ``path``: a ``certificate.json`` to read
     (checked to be ``model``'s); else run as ``bushenv certify`` runs it, against
     ``reference`` (None: none, wrong sign judged against the deflection) over the span
-    ``bushenv certify`` takes (one coordinate: the card's stroke, the machine's; ``stroke_m``
-    on top; several: ``spans``, the test machine's). A kind without a recurrence (linear,
-    Bouc-Wen) has none: a ``Carried`` that says so (a ``path`` given for one is refused)."""
+    ``bushenv certify`` takes for any number of coordinates (``Judge.span``: the card's
+    records' range, the machine's; ``stroke_m`` on the translations on top). A kind without
+    a recurrence (linear, Bouc-Wen) has none: a ``Carried`` that says so (a ``path`` given
+    for one is refused)."""
     units = tuple(getattr(model, "units", ("m",)))
     if not is_narx(model):
         if path is not None:
@@ -159,7 +159,7 @@ def carried_certificate(
         check_belongs(doc, model, path)
         source = f"{Path(path).name}, given"
     else:
-        doc, source = _run(model, spec, axis, reference, stroke_m, spans)
+        doc, source = _run(model, spec, axis, reference, stroke_m)
     s = doc["summary"]
     return Carried(
         source,
@@ -172,36 +172,26 @@ def carried_certificate(
     )
 
 
-def _judged(model, spec, axis, reference, stroke_m) -> tuple[Any, float, str, str]:
-    """One coordinate: (reference, stroke, where the stroke comes from, the reference's
-    description) from the judging setup (``bushenv.judge``, one coordinate's)."""
-    from bushenv.judge import NO_REFERENCE, ScaleFlags, build_judge
-
-    judge = build_judge(
-        spec if isinstance(spec, str | os.PathLike) else None,
-        NO_REFERENCE if reference is None else reference,
-        axis=axis,
-        dt=model.dt,
-        flags=ScaleFlags(stroke_mm=None if stroke_m is None else stroke_m * 1e3),
-        model_object=model,
-    )
-    return judge.reference, judge.scales.stroke_m, judge.scales.source, judge.reference_spec
-
-
-def _run(model, spec, axis, reference, stroke_m, spans) -> tuple[dict, str]:
+def _run(model, spec, axis, reference, stroke_m) -> tuple[dict, str]:
+    """The certificate as ``bushenv certify`` runs it: the judge of the attack's resolve stage
+    at the rig (``resolve_target`` at ``judge.RIG``, the same for any number of coordinates)
+    gives the holds' span (``Judge.span``) and the vetted reference."""
     from bushenv.certify.certificate import certify
-    from bushenv.certify.options import CertifyOptions, per_coordinate
-    from bushenv.models import get_model
+    from bushenv.certify.options import CertifyOptions, per_coordinate, span_text
+    from bushenv.judge import NO_REFERENCE, RIG, ScaleFlags
+    from bushenv.resolved import resolved
+    from bushenv.search.campaign_resolve import resolve_target
 
-    if model.n_coords == 1:
-        ref, stroke, span_source, ref_spec = _judged(model, spec, axis, reference, stroke_m)
-        span = (stroke,)
-    else:
-        span, span_source, ref_spec = tuple(spans), "the three-axis test machine's", reference
-        ref = None
-        if reference is not None:
-            ref = get_model(reference, axis=axis, dt=model.dt, coords=model.n_coords,
-                            wanted_by="bushenv export --reference")  # fmt: skip
+    given = spec if isinstance(spec, str | os.PathLike) else model
+    flags = ScaleFlags(stroke_mm=None if stroke_m is None else stroke_m * 1e3)
+    one = resolve_target(
+        resolved(given, model, axis, card=True), NO_REFERENCE if reference is None else reference,
+        axis=axis, target=RIG, flags=flags,
+    )  # fmt: skip
+    judge = one.judge
+    ref, ref_spec, span, span_source = (
+        judge.reference, judge.reference_spec, judge.span, judge.scales.source
+    )  # fmt: skip
     opts = CertifyOptions(span=span)
     doc = certify(model, ref, opts).document
     against = (
@@ -209,10 +199,7 @@ def _run(model, spec, axis, reference, stroke_m, spans) -> tuple[dict, str]:
         if ref is None
         else f"reference {ref_spec}"
     )
-    shown = ", ".join(
-        f"{c} +-{s * 1e3:.4g} {'mrad' if u == 'rad' else 'mm'}"
-        for c, u, s in zip(model.coords, model.units, span, strict=True)
-    )
+    shown = span_text(model.coords, model.units, span)
     n = per_coordinate(opts.holds, model.n_coords)
     grid = f"{n} holds" if model.n_coords == 1 else f"{n}^{model.n_coords} hold vectors"
     return doc, f"certified at export, {grid} over {shown} ({span_source}), {against}"

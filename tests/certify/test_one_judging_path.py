@@ -123,3 +123,16 @@ def test_the_command_builds_no_judge_of_its_own():
     names = {a.name for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) for a in n.names}
     assert "resolve_target" in names
     assert not names & {"build_judge", "judge_of", "vetted_within", "get_model", "search_limits"}
+
+
+def test_an_fmus_certificate_is_run_over_the_span_certify_takes(tmp_path):
+    """``bushenv export`` certifies as ``bushenv certify`` does: over several coordinates the
+    same judge's span, not the test machine's."""
+    from bushenv.export.certificate import carried_certificate
+
+    path = network().save(tmp_path / "nn3.npz")
+    model = network()
+    judged = resolve_target(str(path), "none", axis="axial", target=RIG)
+    carried = carried_certificate(model, str(path), "axial")
+    assert carried.document["settings"]["span"] == pytest.approx(list(judged.judge.span))
+    assert judged.judge.scales.source in carried.source
