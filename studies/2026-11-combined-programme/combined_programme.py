@@ -588,6 +588,8 @@ def run(args: argparse.Namespace) -> dict:
     traces: dict = {}
     seconds: dict = {}
     notes: dict = {}
+    forms: dict = {}
+    free_run: dict = {}
     for bushing in args.bushings:
         for s in args.sets:
             hist = sets[bushing][s]
@@ -595,14 +597,21 @@ def run(args: argparse.Namespace) -> dict:
             for kind in kinds:
                 opts = None
                 if kind == "hybrid-bw":
-                    opts = {"relaxation_form": args.relaxation_form}
+                    opts = {}
+                    if args.relaxation_form is not None:  # else the library's default
+                        opts["relaxation_form"] = args.relaxation_form
                     if args.evaluations is not None:
                         opts["evaluations"] = args.evaluations
+                    if args.free_run_steps is not None:
+                        opts["free_run_steps"] = args.free_run_steps
                 key = f"{bushing}/{s}/{kind}"
                 progress.say(f"fitting {key} on {len(hist)} records, {length_s:.0f} s")
                 t0 = time.perf_counter()
                 fit = fit_model(hist, kind, opts, seed, progress=False, dt=dt)
                 seconds[key] = time.perf_counter() - t0
+                if kind == "hybrid-bw":
+                    forms[key] = fit.model.backbone.relaxation_form
+                    free_run[key] = fit.options.free_run_steps
                 notes[key] = [f"{k}: {v}" for k, v in fit.info.items() if "warning" in k]
                 traces[key] = {}
                 results[key] = judge(fit.model, unseen, measured[bushing], moving, traces[key])
@@ -636,7 +645,8 @@ def run(args: argparse.Namespace) -> dict:
                 "random_s": 2 * args.unseen_s,
             },
             "hybrid_bw_evaluations": args.evaluations or "default",
-            "hybrid_bw_relaxation_form": args.relaxation_form,
+            "hybrid_bw_relaxation_form": forms,
+            "hybrid_bw_free_run_steps": free_run,
             "combined_programme": combined_names,
             "wall_s": time.perf_counter() - t_start,
         },
@@ -732,7 +742,7 @@ def figure(report: dict, arrays: dict, path: Path) -> None:
         ax.set_ylabel("worst RMS ratio, %")
         ax.grid(axis="y", alpha=0.3)
         ax.legend(loc="upper right", fontsize=8)
-    key = "outside/B/hybrid"
+    key = "outside/B/hybrid" if "outside/B/hybrid" in res else "outside/B/hybrid-bw"
     ax = fig.add_subplot(grid[1, :])
     if key in res:
         _, rec, coord = worst(res[key])
@@ -756,7 +766,8 @@ def figure(report: dict, arrays: dict, path: Path) -> None:
                     label=f"{name} (RMS {r:.1f} %)",
                 )
         ax.set_title(
-            f"outside bushing, unseen '{rec}': {coord} force where hybrid on B is worst",
+            f"outside bushing, unseen '{rec}': {coord} force where {key.split('/')[2]} on B "
+            "is worst",
             fontsize=10,
         )
         ax.set_xlabel("time, s")
@@ -782,9 +793,17 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--evaluations", type=int, default=None, help="hybrid-bw backbone search")
     p.add_argument(
         "--relaxation-form",
-        default="constant",
+        default=None,
         choices=["constant", "qlv"],
-        help="hybrid-bw backbone's relaxation: on the deflection, or on the elastic force",
+        help="hybrid-bw backbone's relaxation: on the deflection, or on the elastic force "
+        "(default: the library's, qlv since the remainder re-measure)",
+    )
+    p.add_argument(
+        "--free-run-steps",
+        type=int,
+        default=None,
+        help="hybrid-bw network's free-run steps (default: the library's, 1000 since the "
+        "remainder re-measure; the first two runs had 200)",
     )
     p.add_argument("--quick", action="store_true", help="short records, small budgets")
     p.add_argument(

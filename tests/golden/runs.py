@@ -189,7 +189,10 @@ def planar_fit_run(out: Path) -> dict[str, Any]:
     return {
         "linear": _planar_fit(out, "linear", []),
         "nn": _planar_fit(out, "nn", PLANAR_NET),
-        "hybrid-bw": _planar_fit(out, "hybrid-bw", ["--evaluations", "12", *PLANAR_NET]),
+        # the form recorded (hybrid-bw's default is qlv since studies/2026-11-combined-programme)
+        "hybrid-bw": _planar_fit(
+            out, "hybrid-bw", ["--evaluations", "12", "--relaxation-form", "constant", *PLANAR_NET]
+        ),
     }
 
 

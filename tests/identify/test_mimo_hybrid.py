@@ -6,6 +6,7 @@ import pytest
 
 from bushenv.excitation import random_rpc
 from bushenv.identify import options_class
+from bushenv.identify.mimo import HYBRID_BW_FREE_RUN_STEPS
 from bushenv.identify.mimo_options import NOISY_FEEDBACK_TRAINING, default_options
 from bushenv.identify.mimo_options import MimoOptions as TrainOptions
 from bushenv.identify.mimo_train import fit_mimo
@@ -63,7 +64,9 @@ def test_every_network_gets_the_plain_training_unless_the_hybrid_asks_for_noisy_
     for kind in ("nn", "nn-axis", "hybrid"):
         assert default_options(kind) == TrainOptions()
         assert options_class(kind, 3)().train_options() == TrainOptions()
-    assert options_class("hybrid-bw", 3)().train_options() == TrainOptions()
+    # hybrid-bw's remainder: the plain training with a longer free run (test_hybrid_bw_options)
+    bw = options_class("hybrid-bw", 3)().train_options()
+    assert bw == TrainOptions(free_run_steps=HYBRID_BW_FREE_RUN_STEPS)
     noisy = options_of(options_class("hybrid", 3), {"training": "noisy-feedback"}, "hybrid")
     assert noisy.train_options() == TrainOptions(**NOISY_FEEDBACK_TRAINING)
     assert NOISY_FEEDBACK_TRAINING["hidden"] == 54 and NOISY_FEEDBACK_TRAINING["feedback_noise"]
