@@ -64,7 +64,7 @@ def test_every_network_gets_the_plain_training_unless_the_hybrid_asks_for_noisy_
     for kind in ("nn", "nn-axis", "hybrid"):
         assert default_options(kind) == TrainOptions()
         assert options_class(kind, 3)().train_options() == TrainOptions()
-    # hybrid-bw's remainder: the plain training with a longer free run (test_hybrid_bw_options)
+    # hybrid-bw's remainder: the plain training with a longer free run (test_hybrid_bw_defaults.py)
     bw = options_class("hybrid-bw", 3)().train_options()
     assert bw == TrainOptions(free_run_steps=HYBRID_BW_FREE_RUN_STEPS)
     noisy = options_of(options_class("hybrid", 3), {"training": "noisy-feedback"}, "hybrid")
