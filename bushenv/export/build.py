@@ -36,7 +36,6 @@ from bushenv.export.facts import (
     Facts,
     facts_of,
     find_card,
-    refuse_three_axis_overrides,
 )
 from bushenv.export.flagged import Carried
 from bushenv.export.model_c import BOUCWEN_SUBSTEPS, EXPORTABLE_BY_COORDS, model_source
@@ -208,12 +207,10 @@ def export_fmu(
     compiler = c_compiler()
     path = model_file(spec, axis)
     card_path = Path(card) if card is not None else None
-    if card_path is None and model.n_coords == 1:
+    if card_path is None:
         card_path = find_card(spec, axis)
     if card_path is not None and not card_path.is_file():
         raise ExportError(f"{card_path}: no such model card")
-    if model.n_coords != 1:
-        refuse_three_axis_overrides(card_path, stroke_m, velocity_m_per_s)
     cert = carried_certificate(
         model,
         spec,

@@ -1,8 +1,9 @@
 """What an exported FMU carries besides the model: its validity envelope and the card's facts.
 
-The envelope is the stroke and velocity the model was fitted on: the largest |x| and |dx/dt| of
-its card's training records (as ``identify.card.record_entry`` measures them), else the papers'
-test machine (12.5 mm, 1.257 m/s), else flags; plus the deflection boxes its certificate flags
+The envelope is the stroke and velocity the model was fitted on, per coordinate: the largest
+|q| and |dq/dt| of its card's training records (as ``identify.card.record_entry`` measures
+them), else the test machine of its coordinates (the papers' 12.5 mm, 1.257 m/s; BushRig3-v0's
+over three), flags on the translations on top; plus the deflection boxes its certificate flags
 (``export.certificate``: the holds that fail it). The facts are one line each (model file
 hash, each record's hash, held-out errors, the certificate's verdicts and boxes), written into
 modelDescription.xml as string constants and as an annotation.
@@ -18,16 +19,6 @@ from bushenv import excitation as ex
 from bushenv.export.flagged import Carried, Flagged
 from bushenv.identify.card import CardError, card_paths, load_card
 from bushenv.models import BushingModel, ModelError, model_file
-
-# The three-axis test machine (envs/BushRig3-v0.toml): seed 002 Table 1's stroke and rate on
-# the two translations, the assumed +-0.15 rad rotation at the same rate rule.
-MAX_ROTATION_RAD = 0.15
-THREE_AXIS_STROKES = (ex.MAX_DISPLACEMENT_M, ex.MAX_DISPLACEMENT_M, MAX_ROTATION_RAD)
-THREE_AXIS_RATES = (
-    ex.MAX_VELOCITY_M_PER_S,
-    ex.MAX_VELOCITY_M_PER_S,
-    ex.MAX_VELOCITY_M_PER_S / ex.MAX_DISPLACEMENT_M * MAX_ROTATION_RAD,
-)
 
 
 @dataclass(frozen=True)
@@ -77,41 +68,88 @@ def facts_of(
     stroke_m: float | None = None,
     velocity_m_per_s: float | None = None,
 ) -> Facts:
-    """The envelope and facts of ``model`` from its card and certificate (either optional);
-    ``stroke_m`` and ``velocity_m_per_s`` override the card's."""
+    """The envelope and facts of ``model`` (any number of coordinates) from its card and
+    certificate (either optional); ``stroke_m`` and ``velocity_m_per_s`` override the card's
+    on the translations (a rotation keeps its card's or machine's range)."""
     lines = [("model", model.name), ("sample_rate_hz", f"{1 / model.dt:.10g}")]
     lines.append(("model_sha256", model_sha256 or "none (a preset, not a file)"))
-    if model.n_coords != 1:
-        return _three_axis(model, lines, card_path, certificate, stroke_m, velocity_m_per_s)
-    env = Envelope()
+    if model.n_coords > 1:
+        lines.append(("coordinates", ", ".join(model.coords)))
+    strokes, rates, source = machine_range(model)
     if card_path is not None:
-        env, card_lines = _from_card(card_path, model_sha256)
+        ranged, card_lines = _from_card(card_path, model_sha256, model)
         lines += card_lines
+        if ranged is not None:
+            strokes, rates, source = _card_range(ranged, rates, card_path, model)
+        else:
+            source = f"{source} ({card_path.name} has no ranges)"
     else:
         lines.append(("card", "none: no MODEL.card.json beside the model file"))
+    if stroke_m is not None or velocity_m_per_s is not None:
+        moved = [u == "m" for u in model.units]
+        strokes = tuple(stroke_m if m and stroke_m is not None else s
+                        for m, s in zip(moved, strokes, strict=True))  # fmt: skip
+        rates = tuple(velocity_m_per_s if m and velocity_m_per_s is not None else r
+                      for m, r in zip(moved, rates, strict=True))  # fmt: skip
+        source += "; overridden by --stroke-mm / --velocity-m-per-s"
     flagged = () if certificate is None else certificate.flagged
     lines += [("certificate", "none")] if certificate is None else certificate.lines()
-    source = env.source
-    if stroke_m is not None or velocity_m_per_s is not None:
-        source += "; overridden by --stroke-mm / --velocity-m-per-s"
-    env = Envelope(
-        stroke_m if stroke_m is not None else env.stroke_m,
-        velocity_m_per_s if velocity_m_per_s is not None else env.velocity_m_per_s,
-        flagged,
-        source,
-    )
-    ranges = [[b.lo[0], b.hi[0]] for b in env.flagged]
-    lines.append(
-        (
-            "envelope",
-            f"|x| <= {env.stroke_m:.6g} m, |v| <= {env.velocity_m_per_s:.6g}"
-            f" m/s, flagged x ranges {ranges} ({env.source})",
-        )
-    )
+    env = Envelope(strokes[0], rates[0], flagged, source, strokes, rates)
+    lines.append(("envelope", _envelope_text(model, env)))
     return Facts(env, tuple(lines), certificate)
 
 
-def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, list]:
+def machine_range(model: BushingModel) -> tuple[tuple, tuple, str]:
+    """(strokes, rates, source): the test machine of the model's coordinates -- the papers'
+    for one, BushRig3-v0 for its three (``search.limits.machine_of``)."""
+    if model.n_coords == 1:
+        return (
+            (ex.MAX_DISPLACEMENT_M,),
+            (ex.MAX_VELOCITY_M_PER_S,),
+            "the papers' test machine (no model card)",
+        )
+    from bushenv.search.limits import machine_of, rig3_limits
+
+    if machine_of(model.coords) is None:
+        raise ModelError(
+            f"no test machine over {', '.join(model.coords)} to take an FMU's envelope from; "
+            "give the model's card (--card) with its training records' ranges"
+        )
+    stroke, rate = rig3_limits()
+    return (
+        tuple(stroke.tolist()),
+        tuple(rate.tolist()),
+        "the three-axis test machine (BushRig3-v0's stroke and rate; no model card)",
+    )
+
+
+def _card_range(ranged, machine_rates, card_path, model) -> tuple[tuple, tuple, str]:
+    """The card's training records' largest |q| per coordinate, and their |dq/dt| where the
+    card states it (cards written before did not over several: then the machine's)."""
+    peaks, speeds = ranged
+    source = f"the training records of {card_path.name}"
+    if speeds is None:
+        return peaks, machine_rates, source + " (the rates the machine's: the card has none)"
+    return peaks, speeds, source
+
+
+def _envelope_text(model: BushingModel, env: Envelope) -> str:
+    if model.n_coords == 1:
+        ranges = [[b.lo[0], b.hi[0]] for b in env.flagged]
+        return (
+            f"|x| <= {env.stroke_m:.6g} m, |v| <= {env.velocity_m_per_s:.6g}"
+            f" m/s, flagged x ranges {ranges} ({env.source})"
+        )
+    bounds = ", ".join(
+        f"|{c}| <= {s:.6g} {u}, rate <= {r:.6g} {u}/s"
+        for c, u, s, r in zip(model.coords, model.units, env.strokes, env.rates, strict=True)
+    )
+    return f"{bounds} ({env.source})"
+
+
+def _from_card(card_path: Path, model_sha256: str | None, model: BushingModel):
+    """((peaks, speeds or None) per coordinate, or None when the card states no ranges; the
+    card's lines)."""
     try:
         card = load_card(card_path, check_model=True)
     except CardError as exc:
@@ -127,60 +165,47 @@ def _from_card(card_path: Path, model_sha256: str | None) -> tuple[Envelope, lis
     ]
     for i, r in enumerate(card.records):
         digest = r.get("sha256") or r.get("data_sha256")
-        m = r.get("metrics") or {}
-        errors = ""
-        if m:
-            errors = (
-                f"; rms_ratio={m.get('rms_ratio', float('nan')):.4g}, "
-                f"esr={m.get('esr', float('nan')):.4g}, "
-                f"max_error_n={m.get('max_error', float('nan')):.4g}, "
-                f"nrmse={m.get('nrmse', float('nan')):.4g}"
-            )
+        errors = _errors(r.get("metrics") or {})
         name = Path(str(r.get("file") or r.get("name"))).name
         # numbered: a record's name is no variable name (spaces, quotes, a role's hyphen)
         lines.append((f"record_{i + 1}", f"{r['role']} {name}: sha256={digest}{errors}"))
-    train = [r for r in card.records if r["role"] == "train" and "max_abs_displacement_m" in r]
-    if not train:
-        return Envelope(source=f"the papers' test machine ({card_path.name} has no ranges)"), lines
-    stroke = max(r["max_abs_displacement_m"] for r in train)
-    speed = max(r["max_abs_velocity_m_per_s"] for r in train)
-    return Envelope(stroke, speed, (), f"the training records of {card_path.name}"), lines
+    return train_range(card.records, model.coords), lines
 
 
-def refuse_three_axis_overrides(card_path, stroke_m, velocity_m_per_s) -> None:
-    """A three-axis FMU carries the machine's envelope: a card or envelope override is refused
-    (checked before the export certifies the model, so it fails fast)."""
-    given = [
-        name
-        for name, value in (
-            ("--card", card_path),
-            ("--stroke-mm", stroke_m),
-            ("--velocity-m-per-s", velocity_m_per_s),
-        )
-        if value is not None
-    ]
-    if given:
-        raise ModelError(
-            f"{' and '.join(given)}: a three-axis FMU carries the three-axis test machine's "
-            "envelope; cards and envelope overrides go into one-axis FMUs only"
+def _errors(m: dict) -> str:
+    """A record's held-out errors: the one coordinate's, or each coordinate's RMS ratio and
+    largest error over several (``card_records.coordinate_metrics``; None: no ratio)."""
+    if not m:
+        return ""
+    if not all(isinstance(v, dict) for v in m.values()):
+        return (
+            f"; rms_ratio={m.get('rms_ratio', float('nan')):.4g}, "
+            f"esr={m.get('esr', float('nan')):.4g}, "
+            f"max_error_n={m.get('max_error', float('nan')):.4g}, "
+            f"nrmse={m.get('nrmse', float('nan')):.4g}"
         )
 
+    def ratio(v):
+        return "none" if v is None else f"{v:.4g}"
 
-def _three_axis(model, lines, card_path, certificate, stroke_m, velocity_m_per_s) -> Facts:
-    """A model over several coordinates carries the three-axis test machine's envelope and the
-    boxes of its certificate (``bushenv.certify``); its card is not read into the FMU yet."""
-    refuse_three_axis_overrides(card_path, stroke_m, velocity_m_per_s)
-    source = "the three-axis test machine (BushRig3-v0's stroke and rate; no model card)"
-    flagged = () if certificate is None else certificate.flagged
-    env = Envelope(
-        flagged=flagged, source=source, strokes=THREE_AXIS_STROKES, rates=THREE_AXIS_RATES
+    return "; " + ", ".join(
+        f"{c}: rms_ratio={ratio(v.get('rms_ratio'))}, max_error={ratio(v.get('max_error'))}"
+        for c, v in m.items()
     )
-    lines.append(("coordinates", ", ".join(model.coords)))
-    lines.append(("card", "none: three-axis cards are not read into FMUs"))
-    lines += [("certificate", "none")] if certificate is None else certificate.lines()
-    bounds = ", ".join(
-        f"|{c}| <= {s:.6g} {u}, rate <= {r:.6g} {u}/s"
-        for c, u, s, r in zip(model.coords, model.units, env.strokes, env.rates, strict=True)
-    )
-    lines.append(("envelope", f"{bounds} ({source})"))
-    return Facts(env, tuple(lines), certificate)
+
+
+def train_range(records: list[dict], coords) -> tuple[tuple, tuple | None] | None:
+    """The training records' largest |q| and |dq/dt| per coordinate (the one-axis keys, or
+    ``peak_deflection`` and ``peak_rate`` over several); None when they are not stated."""
+    train = [r for r in records if r.get("role") == "train"]
+    if train and all("max_abs_displacement_m" in r for r in train):
+        return (
+            (max(r["max_abs_displacement_m"] for r in train),),
+            (max(r["max_abs_velocity_m_per_s"] for r in train),),
+        )
+    if not train or not all(isinstance(r.get("peak_deflection"), dict) for r in train):
+        return None
+    peaks = tuple(max(float(r["peak_deflection"][c]) for r in train) for c in coords)
+    if not all(isinstance(r.get("peak_rate"), dict) for r in train):
+        return peaks, None
+    return peaks, tuple(max(float(r["peak_rate"][c]) for r in train) for c in coords)

@@ -76,7 +76,7 @@ def record_entry(
     Over one coordinate the range is ``max_abs_displacement_m``, ``max_abs_velocity_m_per_s``,
     ``max_abs_force_n`` and what it says about static behaviour (``quasi_static_share``,
     ``longest_hold_s``; attacks scale their search to these, ``bushenv.scales``); over several,
-    ``peak_deflection`` and ``max_abs`` (force) per coordinate."""
+    ``peak_deflection``, ``peak_rate`` (|dq/dt|) and ``max_abs`` (force) per coordinate."""
     path = getattr(record, "path", None)
     file = os.fspath(path) if path is not None else None
     if path is not None and card_dir is not None:
@@ -109,6 +109,8 @@ def record_entry(
         entry["peak_deflection"] = {
             c: float(v) for c, v in zip(record.coords, peaks_q, strict=True)
         }
+        rates = np.abs(np.diff(record.q, axis=0)).max(axis=0) * record.sample_rate_hz
+        entry["peak_rate"] = {c: float(v) for c, v in zip(record.coords, rates, strict=True)}
     if model is not None:
         entry["metrics"] = free_run_metrics(model, record)
     return entry

@@ -28,9 +28,9 @@ from bushenv.vetting import machine_rate
 def limits_of_card(resolved) -> CoordinateLimits | None:
     """The limits of the bushing ``resolved``'s card describes, over its model's coordinates:
     from its training records (``limits_of_records``: 1.5 x their peak |q| and |dq/dt| per
-    coordinate); when the records are gone, the stroke from the card's peak deflections and
-    the rates of the machine (``machine_of``; none: ``vetting.machine_rate``, the papers'
-    rule on the stroke); None without a card (or one without training records)."""
+    coordinate); when the records are gone, the card's peak deflections and rates (cards
+    written before state no rates: the machine's, ``machine_of``; none: ``vetting.machine_rate``,
+    the papers' rule on the stroke); None without a card (or one without training records)."""
     if resolved is None or resolved.card is None:
         return None
     coords, units = tuple(resolved.model.coords), tuple(resolved.model.units)
@@ -43,6 +43,17 @@ def limits_of_card(resolved) -> CoordinateLimits | None:
     if not peaks or not all(isinstance(p, dict) for p in peaks):
         return None
     peak = np.array([max(float(p[c]) for p in peaks) for c in coords])
+    speeds = [r.get("peak_rate") for r in train]
+    if all(isinstance(v, dict) for v in speeds):  # cards state |dq/dt| since 2026-11-29
+        speed = np.array([max(float(v[c]) for v in speeds) for c in coords])
+        machine = machine_limits() if machine_of(coords) is not None else None
+        top_s, top_r = (np.inf, np.inf) if machine is None else (machine.stroke, machine.rate)
+        stroke, rate = record_range(peak, speed, np.array(top_s), np.array(top_r))
+        return CoordinateLimits(
+            tuple(stroke.tolist()), tuple(rate.tolist()),
+            f"{RECORD_MARGIN:g} x the peak deflection and rate {name} state (the records are "
+            "not there)", tuple(peak.tolist()), coords, units,
+        )  # fmt: skip
     if machine_of(coords) is None:
         if not np.all(peak > 0):
             return None

@@ -280,8 +280,9 @@ def _drive_q(fmu_path, q):
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_a_three_axis_network_that_fails_is_refused_and_flags_its_boxes(tmp_path, version):
-    from bushenv.export.facts import THREE_AXIS_STROKES
+    from bushenv.search.limits import rig3_limits
 
+    THREE_AXIS_STROKES = tuple(rig3_limits()[0])  # no card, no reference: the machine's span
     model = _three_axis_network(pushing=False)
     with pytest.raises(FailingCertificate, match="wrong-sign holds") as refused:
         export_fmu(model, tmp_path / "n3.fmu", version)

@@ -126,15 +126,35 @@ def test_the_cli_exports_a_three_axis_preset_and_refuses_a_kind_without_c(tmp_pa
     assert "exportable kinds over 3 coordinates: linear, nn, nn-axis, hybrid" in err
 
 
-def test_a_three_axis_file_with_a_card_is_refused_naming_why(tmp_path, capsys):
+def test_a_three_axis_file_carries_its_cards_envelope_and_the_flags_move_its_translations(
+    tmp_path,
+):
+    """As for one axis: the card's training records' largest |q| and |dq/dt| per coordinate;
+    --stroke-mm and --velocity-m-per-s replace the translations' (a rotation keeps its
+    card's)."""
     from bushenv.cli import main
+    from bushenv.export import export_fmu
+    from bushenv.identify.card import load_card
 
-    model = tmp_path / "h3.npz"
-    _model("nn-axis").save(model)
-    argv = ["export", str(model), "--card", str(model), "--allow-failing", "--out",
-            str(tmp_path / "h.fmu")]  # fmt: skip
-    assert main(argv) == 2
-    assert "cards and envelope overrides go into one-axis FMUs only" in capsys.readouterr().err
+    rec = tmp_path / "rec"
+    assert main(["measure", "--axes", "3", "--programme", "random", "--duration", "6",
+                 "--out", str(rec), "--quiet"]) == 0  # fmt: skip
+    model = tmp_path / "lin3.npz"
+    assert main(["fit", str(sorted(rec.glob("*.csv"))[0]), "--model", "linear", "--out",
+                 str(model), "--no-plots", "--quiet"]) == 0  # fmt: skip
+    train = [r for r in load_card(model).data["records"] if r["role"] == "train"]
+    coords = ("axial", "radial", "rotation")
+    peak = [max(r["peak_deflection"][c] for r in train) for c in coords]
+    rate = [max(r["peak_rate"][c] for r in train) for c in coords]
+    assert 0 < peak[2] < 0.15 and 0 < peak[0] < 12.5e-3  # inside the machine's, not it
+
+    env = export_fmu(str(model), tmp_path / "a.fmu").facts.envelope
+    assert env.limits(3) == (pytest.approx(peak), pytest.approx(rate))
+    assert "training records of lin3.card.json" in env.source
+    env = export_fmu(str(model), tmp_path / "b.fmu", stroke_m=2e-3, velocity_m_per_s=0.1)
+    strokes, rates = env.facts.envelope.limits(3)
+    assert strokes == pytest.approx([2e-3, 2e-3, peak[2]])
+    assert rates == pytest.approx([0.1, 0.1, rate[2]])
 
 
 def test_a_rotation_beyond_the_machines_range_is_flagged_and_logged_naming_it(fmu3):
