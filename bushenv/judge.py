@@ -41,6 +41,7 @@ from bushenv.scales import (
     scales_of_card,
     scales_of_reference,
     static_identified,
+    train_range,
 )
 
 NO_REFERENCE = "none"  # the spelling of "judged without a reference" in every command
@@ -357,11 +358,7 @@ def judge_of(
 
 def envelope_of(card: dict | None, scales: BushingScales) -> tuple[float, float, str]:
     """The reference's envelope (see ``Judge.envelope``)."""
-    train = [r for r in (card or {}).get("records", []) if r.get("role") == "train"]
-    if train and all("max_abs_displacement_m" in r for r in train):
-        return (
-            max(r["max_abs_displacement_m"] for r in train),
-            max(r["max_abs_velocity_m_per_s"] for r in train),
-            "the reference's card's training records",
-        )
+    if has_range(card):
+        (peak,), (speed,) = train_range(card["records"], ())
+        return peak, speed, "the reference's card's training records"
     return scales.stroke_m, scales.velocity_m_per_s, "the judged stroke and velocity"

@@ -190,6 +190,23 @@ def has_range(card: dict | None) -> bool:
     return bool(train) and all("max_abs_displacement_m" in r for r in train)
 
 
+def train_range(records: list[dict], coords) -> tuple[tuple, tuple | None] | None:
+    """The training records' largest |q| and |dq/dt| per coordinate (the one-axis keys, or
+    ``peak_deflection`` and ``peak_rate`` over several); None when they are not stated."""
+    train = [r for r in records if r.get("role") == "train"]
+    if train and all("max_abs_displacement_m" in r for r in train):
+        return (
+            (max(r["max_abs_displacement_m"] for r in train),),
+            (max(r["max_abs_velocity_m_per_s"] for r in train),),
+        )
+    if not train or not all(isinstance(r.get("peak_deflection"), dict) for r in train):
+        return None
+    peaks = tuple(max(float(r["peak_deflection"][c]) for r in train) for c in coords)
+    if not all(isinstance(r.get("peak_rate"), dict) for r in train):
+        return peaks, None
+    return peaks, tuple(max(float(r["peak_rate"][c]) for r in train) for c in coords)
+
+
 def scales_of_card(scales: BushingScales, card: dict) -> BushingScales:
     """``scales`` from a model card's training records: stroke and velocity their largest |x|
     and |dx/dt| times ``RECORD_MARGIN`` (``record_range``, within the machine), their peak
@@ -200,8 +217,7 @@ def scales_of_card(scales: BushingScales, card: dict) -> BushingScales:
     if not has_range(card):
         return scales
     train = [r for r in card.get("records", []) if r.get("role") == "train"]
-    peak = max(r["max_abs_displacement_m"] for r in train)
-    speed = max(r["max_abs_velocity_m_per_s"] for r in train)
+    (peak,), (speed,) = train_range(train, ())
     force = max(r["max_abs_force_n"] for r in train)
     floor, source = scales.force_floor_n, scales.source
     if not static_identified(card):

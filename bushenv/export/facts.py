@@ -19,6 +19,7 @@ from bushenv import excitation as ex
 from bushenv.export.flagged import Carried, Flagged
 from bushenv.identify.card import CardError, card_paths, load_card
 from bushenv.models import BushingModel, ModelError, model_file
+from bushenv.scales import train_range
 
 
 @dataclass(frozen=True)
@@ -192,20 +193,3 @@ def _errors(m: dict) -> str:
         f"{c}: rms_ratio={ratio(v.get('rms_ratio'))}, max_error={ratio(v.get('max_error'))}"
         for c, v in m.items()
     )
-
-
-def train_range(records: list[dict], coords) -> tuple[tuple, tuple | None] | None:
-    """The training records' largest |q| and |dq/dt| per coordinate (the one-axis keys, or
-    ``peak_deflection`` and ``peak_rate`` over several); None when they are not stated."""
-    train = [r for r in records if r.get("role") == "train"]
-    if train and all("max_abs_displacement_m" in r for r in train):
-        return (
-            (max(r["max_abs_displacement_m"] for r in train),),
-            (max(r["max_abs_velocity_m_per_s"] for r in train),),
-        )
-    if not train or not all(isinstance(r.get("peak_deflection"), dict) for r in train):
-        return None
-    peaks = tuple(max(float(r["peak_deflection"][c]) for r in train) for c in coords)
-    if not all(isinstance(r.get("peak_rate"), dict) for r in train):
-        return peaks, None
-    return peaks, tuple(max(float(r["peak_rate"][c]) for r in train) for c in coords)

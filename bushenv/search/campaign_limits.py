@@ -13,7 +13,7 @@ from dataclasses import replace
 import numpy as np
 
 from bushenv.judge import ScaleFlags, range_sources
-from bushenv.scales import RECORD_MARGIN, record_range
+from bushenv.scales import RECORD_MARGIN, record_range, train_range
 from bushenv.search.base import SearchError
 from bushenv.search.campaign_models import card_records
 from bushenv.search.limits import (
@@ -39,13 +39,12 @@ def limits_of_card(resolved) -> CoordinateLimits | None:
     if records is not None:
         return limits_of_records([r.q for r in records], records[0].dt, name, coords, units)
     train = [r for r in resolved.card.get("records", []) if r.get("role") == "train"]
-    peaks = [r.get("peak_deflection") for r in train]
-    if not peaks or not all(isinstance(p, dict) for p in peaks):
+    if not train or not all(isinstance(r.get("peak_deflection"), dict) for r in train):
         return None
-    peak = np.array([max(float(p[c]) for p in peaks) for c in coords])
-    speeds = [r.get("peak_rate") for r in train]
-    if all(isinstance(v, dict) for v in speeds):  # cards state |dq/dt| since 2026-11-29
-        speed = np.array([max(float(v[c]) for v in speeds) for c in coords])
+    peaks, speeds = train_range(train, coords)
+    peak = np.array(peaks)
+    if speeds is not None:  # cards state |dq/dt| since 2026-11-29
+        speed = np.array(speeds)
         machine = machine_limits() if machine_of(coords) is not None else None
         top_s, top_r = (np.inf, np.inf) if machine is None else (machine.stroke, machine.rate)
         stroke, rate = record_range(peak, speed, np.array(top_s), np.array(top_r))
