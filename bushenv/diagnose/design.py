@@ -28,6 +28,8 @@ DAMPER = ("spring", "v")  # the damper alone, when a backbone replaces the sprin
 Block = tuple[str, Any]
 EDGE_FACTOR = 2.0  # the low-pass edge over the top of the displacement's signal band
 TARGETS_KEPT = 256  # force targets (one per record and delay) kept
+COLUMNS_KEPT_BYTES = 512 * 2**20  # columns kept, least recently used out (a refined leak
+# visits many shapes once)
 
 
 @dataclass
@@ -120,22 +122,29 @@ class ColumnStore:
     def __init__(self, scales: Scales, admissible: bool = True) -> None:
         self.scales = scales
         self.admissible = admissible
-        self._cols: dict[tuple, np.ndarray] = {}
+        self._cols: OrderedDict[tuple, np.ndarray] = OrderedDict()
+        self._cols_bytes = 0
         self._gram: dict[tuple, np.ndarray] = {}
         self._rhs: dict[tuple, np.ndarray] = {}
         self._targets: OrderedDict[tuple, tuple[np.ndarray, float]] = OrderedDict()
 
     def columns(self, prep: Prepared, block: Block) -> np.ndarray:
         key = (prep.uid, block)
-        if key not in self._cols:
-            if block == SPRING:
-                cols = np.stack([prep.signals.x, prep.signals.v], axis=1)
-            elif block == DAMPER:
-                cols = prep.signals.v[:, None].copy()
-            else:
-                cols = get_effect(block[0]).block_columns(prep.signals, block[1], self.scales)
-            self._cols[key] = np.ascontiguousarray(cols)
-        return self._cols[key]
+        if key in self._cols:
+            self._cols.move_to_end(key)
+            return self._cols[key]
+        if block == SPRING:
+            cols = np.stack([prep.signals.x, prep.signals.v], axis=1)
+        elif block == DAMPER:
+            cols = prep.signals.v[:, None].copy()
+        else:
+            cols = get_effect(block[0]).block_columns(prep.signals, block[1], self.scales)
+        cols = np.ascontiguousarray(cols)
+        while self._cols and self._cols_bytes + cols.nbytes > COLUMNS_KEPT_BYTES:
+            self._cols_bytes -= self._cols.popitem(last=False)[1].nbytes
+        self._cols[key] = cols
+        self._cols_bytes += cols.nbytes
+        return cols
 
     def design(self, prep: Prepared, blocks: tuple[Block, ...]):
         """(T, p) columns of ``blocks`` side by side."""
@@ -197,6 +206,7 @@ class ColumnStore:
 
     def clear(self) -> None:
         self._cols.clear()
+        self._cols_bytes = 0
         self._gram.clear()
         self._rhs.clear()
         self._targets.clear()

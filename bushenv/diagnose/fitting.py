@@ -132,9 +132,10 @@ def fit(
 def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
     """The fitted model's force on one record (N), (T,). A per-record block gets the weights
     the record was fitted with; on a judged record, one scale of its own along
-    ``start_direction``, from 0 to the warmest fitted record's (the state it starts in -- a
-    heat -- is the record's, and no other record can tell it; one bounded number, not a
-    spring and damper of its own: a judged record starts no warmer than a record fitted)."""
+    ``start_direction``, read from its cooling (``cooling_scale``), from 0 to the warmest
+    fitted record's (the state it starts in -- a heat -- is the record's, and no other record
+    can tell it; one bounded number, not a spring and damper of its own: a judged record
+    starts no warmer than a record fitted)."""
     a = store.design(prep, f.blocks)
     out = prep.b0 + a @ f.theta
     if f.nuisance:
@@ -148,9 +149,21 @@ def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
             dd = float(d @ d)
             if dd > 0:
                 shifted = shift_columns(out, f.delay_s, prep.dt)
-                scale = float((prep.force - shifted) @ d) / dd
+                own_spring = shift_columns(store.design(prep, (SPRING,)), f.delay_s, prep.dt)
+                scale = cooling_scale(prep.force - shifted, d, own_spring)
                 return shifted + min(max(scale, 0.0), warmest_start(f, direction)) * d
     return shift_columns(out, f.delay_s, prep.dt)
+
+
+def cooling_scale(residual: np.ndarray, d: np.ndarray, spring: np.ndarray) -> float:
+    """The scale of a judged record's start ``d`` read from its cooling alone: ``d`` less what
+    the record's own spring and damper (``spring``, (T, 2)) give of it. A start whose leak is
+    long beside the record hardly cools: its level is a stiffness of the record's own, which
+    any effect whose secant changes from record to record gives as well (a friction, a
+    backbone at a larger amplitude); only its fall through the record is thermal's."""
+    part = d - spring @ np.linalg.lstsq(spring, d, rcond=None)[0]
+    pp = float(part @ part)
+    return float(residual @ part) / pp if pp > 1e-12 * float(d @ d) else 0.0
 
 
 def warmest_start(f: Fit, direction: np.ndarray) -> float:
@@ -189,40 +202,66 @@ def _product(grids: list[list]) -> list[tuple]:
 def best_shapes(
     store: ColumnStore, combo: Combination, records: tuple[Prepared, ...], linear_base: bool
 ) -> Fit:
-    """The shapes with the lowest fitting error over the product of the members' grids."""
+    """The shapes with the lowest fitting error over the product of the members' grids, a
+    continuous shape refined from the best of each of its families (a thermal leak under each
+    heating law: the coarse grid can rank the laws wrong)."""
     grids = [m.shapes(store.scales) for m in combo.members]
 
     def delay_of(shapes: tuple) -> float:
         return sum(m.delay_s(s) for m, s in zip(combo.members, shapes, strict=True))
 
     # by delay, so that the shifted force targets of one delay are used together
-    combos = sorted(_product(grids), key=delay_of)
-    best = min((fit(store, combo, c, records, linear_base) for c in combos), key=lambda f: f.mse)
+    fits = [
+        fit(store, combo, c, records, linear_base) for c in sorted(_product(grids), key=delay_of)
+    ]
+    best = min(fits, key=lambda f: f.mse)
     for i, member in enumerate(combo.members):
-        if member.continuous_shape and len(grids[i]) >= 3:
-            best = _refine(store, combo, grids, i, best, records, linear_base)
+        if not (member.continuous_shape and len(grids[i]) >= 3):
+            continue
+        families: dict = {}
+        for f in fits:
+            families.setdefault(member.with_shape_value(f.shapes[i], 1.0), []).append(f)
+        mine = member.with_shape_value(best.shapes[i], 1.0)
+        starts = [
+            best if fam == mine else min(fs, key=lambda f: f.mse) for fam, fs in families.items()
+        ]
+        refined = [_refine(store, combo, grids, i, f, records, linear_base) for f in starts]
+        best = min([best, *refined], key=lambda f: f.mse)
     return best
 
 
 def _refine(store, combo, grids, i: int, best: Fit, records, linear_base: bool) -> Fit:
-    """Refine shape ``i`` between its grid neighbours, then choose the others again."""
-    grid = grids[i]
-    k = grid.index(best.shapes[i])
-    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+    """Refine shape ``i``'s continuous part between its finite grid neighbours, then choose
+    the others again."""
+    member = combo.members[i]
+    here = best.shapes[i]
+    values = sorted(
+        member.shape_value(s)
+        for s in grids[i]
+        if member.with_shape_value(s, 1.0) == member.with_shape_value(here, 1.0)
+    )
+    v = member.shape_value(here)
+    if len(values) < 2 or not np.isfinite(v):
+        return best
+    k = values.index(v)
+    lo, hi = values[max(k - 1, 0)], values[min(k + 1, len(values) - 1)]
+    if not np.isfinite(hi):  # beyond the last finite value: the cumulative heat, no start
+        hi = v
+
+    def shaped(log_s: float) -> tuple:
+        combo_s = list(best.shapes)
+        combo_s[i] = member.with_shape_value(here, float(np.exp(log_s)))
+        return tuple(combo_s)
 
     def mse(log_s: float) -> float:
-        combo_s = list(best.shapes)
-        combo_s[i] = float(np.exp(log_s))
-        return fit(store, combo, tuple(combo_s), records, linear_base).mse
+        return fit(store, combo, shaped(log_s), records, linear_base).mse
 
     res = minimize_scalar(
         mse, bounds=(np.log(lo), np.log(hi)), method="bounded", options={"xatol": 0.01}
     )
     if res.fun >= best.mse:
         return best
-    shapes = list(best.shapes)
-    shapes[i] = float(np.exp(res.x))
-    best = fit(store, combo, tuple(shapes), records, linear_base)
+    best = fit(store, combo, shaped(res.x), records, linear_base)
     for j in range(len(grids)):
         if j == i or len(grids[j]) < 2:
             continue

@@ -290,7 +290,7 @@ def test_records_that_start_warm_are_named_thermal():
     result = diagnose(recs[0], recs[1:])
     assert result["effect"] == "thermal", result["effect"]
     p = result["parameters"]["thermal"]
-    assert p["time_constant_s"] == tau
+    assert p["time_constant_s"] == pytest.approx(tau, rel=0.05)  # refined between grid values
     assert p["stiffness_lost_at_start_n_per_m"] == pytest.approx(0.12 * K, rel=0.25)
 
 

@@ -101,3 +101,34 @@ def test_a_memory_of_the_deflection_is_named_relaxation_not_thermal(order):
     r = _diagnose(_relaxing_forces(progs), progs, ORDERS[order])
     assert r["effect"] == "relaxation", (r["effect"], r["top_two"])
     assert "thermal" not in r["effect"].split("+")
+
+
+def test_a_warm_session_gives_back_its_cold_spring_and_its_leak():
+    """Every record after the first starts warm; the leak (60 s) lies between the grid's
+    values. Read between them, the leak and the cold spring come back: a leak held at a grid
+    value makes the warm starts take part of the spring (10 % high before)."""
+    progs = _programmes()
+    order = ORDERS["hot first"]
+    r = _diagnose(_thermal_forces(progs, order, True), progs, order)
+    p = r["parameters"]
+    assert r["effect"] == "thermal", r["effect"]
+    assert abs(p["k_n_per_m"] / K - 1.0) < 0.02, p["k_n_per_m"]
+    assert abs(p["thermal"]["time_constant_s"] / TAU_S - 1.0) < 0.1, p["thermal"]
+    assert p["thermal"]["heating"] == "viscous"
+
+
+def test_a_judged_start_is_read_from_its_cooling_not_from_the_records_level():
+    """A record that is only stiffer or softer than the fit (a level, as a friction's secant at
+    another amplitude gives) gets no start; one whose stiffness recovers as it cools gets the
+    start it cooled from."""
+    from bushenv.diagnose.fitting import cooling_scale
+
+    t = np.arange(int(20.0 / DT)) * DT
+    x = 2e-3 * np.sin(2 * np.pi * 1.3 * t) * (1.0 + 0.5 * np.sin(2 * np.pi * 0.11 * t))
+    v = np.gradient(x, DT)
+    spring = np.stack([x, v], axis=1)
+    start = -np.exp(-t / 8.0)[:, None] * spring @ np.array([2e4, 200.0])  # a warm start, N
+    softer = -0.1 * (K * x + C * v)  # 10 % softer through the whole record
+    assert cooling_scale(softer, start, spring) == pytest.approx(0.0, abs=0.02)
+    assert cooling_scale(0.7 * start, start, spring) == pytest.approx(0.7, rel=1e-6)
+    assert cooling_scale(softer + 0.7 * start, start, spring) == pytest.approx(0.7, rel=1e-3)

@@ -175,6 +175,14 @@ class Effect(ABC):
         """Time shift of the whole predicted force (only the delay has one)."""
         return 0.0
 
+    def shape_value(self, shape: Any) -> float:
+        """The part of ``shape`` a ``continuous_shape`` effect refines (default: all of it)."""
+        return float(shape)
+
+    def with_shape_value(self, shape: Any, value: float) -> Any:
+        """``shape`` with its refined part set to ``value``."""
+        return value
+
     def rich_shapes(self, scales: Scales) -> list:
         """The shapes of the richest admissible form (default: the usual ones)."""
         return self.shapes(scales)

@@ -55,10 +55,20 @@ class Thermal(Effect):
         "a long constant-amplitude sine with rests (a stiffness that falls while it runs "
         "and recovers in the rests)"
     )
-    shape_text = "tau_th in {10, 30, 100, 300, inf} s x heating {viscous, hysteretic}"
+    shape_text = (
+        "tau_th in {10, 30, 100, 300, inf} s x heating {viscous, hysteretic}, tau_th refined "
+        "between the finite values by a bounded 1-D search"
+    )
+    continuous_shape = True  # the leak: a start's cooling is read through it
 
     def shapes(self, scales: Scales) -> list:
         return [(h, t) for h in HEATING for t in TIME_CONSTANTS_S]
+
+    def shape_value(self, shape: Any) -> float:
+        return float(shape[1])
+
+    def with_shape_value(self, shape: Any, value: float) -> Any:
+        return (shape[0], float(value))
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         heating, tau = shape
