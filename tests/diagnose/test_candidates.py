@@ -182,3 +182,25 @@ def test_the_runner_up_is_another_candidate_than_the_answer():
     result = diagnose(train, [record(2, "relaxation", noise=0.002, duration_s=24.0, name="t")])
     assert result["effect"] == "relaxation"
     assert result["runner_up"] not in (None, "relaxation")
+
+
+def test_the_column_store_keeps_its_budget_and_gives_the_same_columns_after_eviction(monkeypatch):
+    """A refined leak visits many shapes once: columns beyond the budget go, least recently
+    used first, and come back identical when asked again."""
+    from bushenv.diagnose import design
+    from bushenv.diagnose.design import ColumnStore, Prepared
+
+    dt = 1 / 200.0
+    x = 2e-3 * np.sin(2 * np.pi * 1.5 * np.arange(4000) * dt)
+    s = Signals(x, dt)
+    prep = Prepared("r", "train", np.arange(x.size) * dt, s, x * 1e5, np.zeros(x.size))
+    store = ColumnStore(Scales.of([s]))
+    blocks = [("thermal", ("viscous", float(tau))) for tau in (20, 30, 40, 50, 60)]
+    monkeypatch.setattr(design, "COLUMNS_KEPT_BYTES", 3 * x.size * 2 * 8)  # three blocks
+    first = store.columns(prep, blocks[0]).copy()
+    for b in blocks[1:]:
+        store.columns(prep, b)
+    assert store._cols_bytes <= design.COLUMNS_KEPT_BYTES
+    assert (prep.uid, blocks[0]) not in store._cols  # the oldest went first
+    assert (prep.uid, blocks[-1]) in store._cols
+    assert np.array_equal(store.columns(prep, blocks[0]), first)
