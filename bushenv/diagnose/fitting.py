@@ -132,10 +132,10 @@ def fit(
 def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
     """The fitted model's force on one record (N), (T,). A per-record block gets the weights
     the record was fitted with; on a judged record, one scale of its own along
-    ``start_direction``, read from its cooling (``cooling_scale``), from 0 to the warmest
-    fitted record's (the state it starts in -- a heat -- is the record's, and no other record
-    can tell it; one bounded number, not a spring and damper of its own: a judged record
-    starts no warmer than a record fitted)."""
+    ``start_direction``, read from its cooling and its level (``judged_start``), from 0 to
+    the warmest fitted record's (the state it starts in -- a heat -- is the record's, and no
+    other record can tell it; one bounded number, not a spring and damper of its own: a
+    judged record starts no warmer than a record fitted)."""
     a = store.design(prep, f.blocks)
     out = prep.b0 + a @ f.theta
     if f.nuisance:
@@ -150,9 +150,19 @@ def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
             if dd > 0:
                 shifted = shift_columns(out, f.delay_s, prep.dt)
                 own_spring = shift_columns(store.design(prep, (SPRING,)), f.delay_s, prep.dt)
-                scale = cooling_scale(prep.force - shifted, d, own_spring)
+                scale = judged_start(prep.force - shifted, d, own_spring)
                 return shifted + min(max(scale, 0.0), warmest_start(f, direction)) * d
     return shift_columns(out, f.delay_s, prep.dt)
+
+
+def judged_start(residual: np.ndarray, d: np.ndarray, spring: np.ndarray) -> float:
+    """A judged record's start along ``d``: the smaller of what its cooling shows
+    (``cooling_scale``) and what its level shows (the least-squares scale of ``d`` on the
+    residual). Neither reading may claim more than the other: a level without its cooling is
+    a stiffness of the record's own (any effect whose secant changes from record to record),
+    and a cooling read through a leak long beside the record is noisy where its level is not."""
+    level = float(residual @ d) / float(d @ d)
+    return min(cooling_scale(residual, d, spring), level)
 
 
 def cooling_scale(residual: np.ndarray, d: np.ndarray, spring: np.ndarray) -> float:

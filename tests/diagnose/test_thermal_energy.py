@@ -132,3 +132,22 @@ def test_a_judged_start_is_read_from_its_cooling_not_from_the_records_level():
     assert cooling_scale(softer, start, spring) == pytest.approx(0.0, abs=0.02)
     assert cooling_scale(0.7 * start, start, spring) == pytest.approx(0.7, rel=1e-6)
     assert cooling_scale(softer + 0.7 * start, start, spring) == pytest.approx(0.7, rel=1e-3)
+
+
+def test_a_judged_start_claims_no_more_than_its_cooling_nor_its_level_shows():
+    """The start is the smaller reading: a level without a cooling gets none, and a cooling
+    whose record is stiffer than the start would make it gets only what the level shows."""
+    from bushenv.diagnose.fitting import judged_start
+
+    t = np.arange(int(20.0 / DT)) * DT
+    x = 2e-3 * np.sin(2 * np.pi * 1.3 * t) * (1.0 + 0.5 * np.sin(2 * np.pi * 0.11 * t))
+    v = np.gradient(x, DT)
+    spring = np.stack([x, v], axis=1)
+    start = -np.exp(-t / 8.0)[:, None] * spring @ np.array([2e4, 200.0])
+    softer, stiffer = -0.1 * (K * x + C * v), 0.1 * (K * x + C * v)
+    assert judged_start(softer, start, spring) == pytest.approx(0.0, abs=0.02)
+    assert judged_start(0.7 * start, start, spring) == pytest.approx(0.7, rel=1e-6)
+    assert judged_start(softer + 0.7 * start, start, spring) == pytest.approx(0.7, rel=1e-3)
+    level = float((stiffer + 0.7 * start) @ start) / float(start @ start)
+    assert level < 0.5  # the stiffer record's level shows less than its cooling
+    assert judged_start(stiffer + 0.7 * start, start, spring) == pytest.approx(level, rel=1e-9)
