@@ -34,7 +34,8 @@ above the noise: ``excess(g) = sqrt(max(g^2 - gap_noise^2, 0))``.
    better (gap within ``TIE_GAP``) and fails only because its lag is not seen: then
    ``"ambiguous"`` (the same for a pair answer and a pair with a delay); if nothing passes,
    ``"outside_candidates"`` when the null's gap stands clear of the noise (excess above
-   ``OUTSIDE_NOISE`` x the noise gap), else ``"none"``.
+   ``OUTSIDE_NOISE`` x the noise gap), else ``"none"``; the two effects ranked first are then
+   the best pair's when it fits clearly better than the best single (``closest_two``).
 
 Ranking: by judged gap; of two rows the judged errors cannot tell apart (z within ``Z_TIE``,
 gaps within ``TIE_GAP``), the one with fewer parameters first.
@@ -326,7 +327,6 @@ class Answer:
 def answer(singles: list[dict], pairs: list[dict], ctx: Context) -> Answer:
     """The answer from ranked ``singles`` and ``pairs`` (rules 4)."""
     ok = [r for r in singles if not r["failed_to_fit"]]
-    best_two = [r["effect"] for r in ok[:2]]
     winners = [r for r in pairs if r["passes"]]
     if winners:
         best = winners[0]
@@ -361,9 +361,26 @@ def answer(singles: list[dict], pairs: list[dict], ctx: Context) -> Answer:
             between = [name, rival["effect"]]
             return Answer(AMBIGUOUS, first, between, between)
         return Answer(name, first, top_two, [])
+    closest = closest_two(ok, pairs, ctx)
     if ctx.excess(ctx.gap_null) > OUTSIDE_NOISE * ctx.gap_noise:
-        return Answer(OUTSIDE, None, best_two, [])
-    return Answer("none", None, best_two, [])
+        return Answer(OUTSIDE, None, closest, [])
+    return Answer("none", None, closest, [])
+
+
+def closest_two(singles: list[dict], pairs: list[dict], ctx: Context) -> list[str]:
+    """When nothing passes, the two candidates that come closest: the best pair's members when
+    that pair fits better than the best single by more than the judged errors' spread (two
+    effects at once, none of which explains the gap alone), else the two best singles (ranked,
+    those that failed to fit left out)."""
+    names = [r["effect"] for r in singles]
+    fitted = [r for r in pairs if not r["failed_to_fit"]]
+    if not singles or not fitted:
+        return names[:2]
+    best, single = fitted[0], singles[0]
+    if best["gap_after"] < single["gap_after"] and not indistinguishable(best, single, ctx):
+        order = names + [m for m in best["members"] if m not in names]
+        return sorted(best["members"], key=order.index)
+    return names[:2]
 
 
 def unexplained(ans: Answer, rows: list[dict], gap_before: float, ctx: Context) -> dict:

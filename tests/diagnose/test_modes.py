@@ -359,3 +359,26 @@ def test_a_real_loop_beside_another_unexplained_dissipation_is_still_named_frict
     assert r["dissipation_left"] > rule.DISSIPATION_LEFT_MAX  # the other dissipation is left
     assert r["dissipation_shown"] >= rule.DISSIPATION_SHOWN_MIN  # but the loop is there
     assert r["passes"]
+
+
+def test_an_abstention_ranks_first_the_two_effects_whose_pair_comes_clearly_closest():
+    ctx, _, _, row, r1, r2 = _rows_for_pair_rule()
+    singles = [
+        row("friction", ["friction"], 0.05 * r1, 8),
+        row("delay", ["delay"], 0.04 * r1, 1),
+        row("inertia", ["inertia"], 0.03 * r2, 1),
+    ]
+    rule.mark_failed(singles, ctx)
+    rule.mark_passes(singles, ctx)
+    assert not any(r["passes"] for r in singles)
+    close = row("friction+inertia", ["friction", "inertia"], r1 + r2, 9)
+    close.update(failed_to_fit=False, passes=False)  # refused by the richest-form test
+    ans = rule.answer(singles, [close], ctx)
+    assert ans.effect == rule.OUTSIDE and ans.top_two == ["friction", "inertia"]
+    # a pair a little better than the best single, by less than the judged errors' spread
+    # (better in 6 of 11 blocks, worse in 5): the two best singles
+    signs = np.repeat(np.resize([1.0] * 6 + [-1.0] * 5, len(ctx.edges)), 200)
+    twin = row("inertia+delay", ["inertia", "delay"], 0.05 * r1 + 0.05 * r2 * signs, 2)
+    twin.update(failed_to_fit=False, passes=False)
+    assert twin["gap_after"] < singles[0]["gap_after"]
+    assert rule.answer(singles, [twin], ctx).top_two == ["friction", "delay"]
