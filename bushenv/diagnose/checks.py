@@ -130,8 +130,8 @@ def check_bounds_admissible(name: str) -> None:
     assert np.any(w != 0) or effect.delay_s(shape) > 0, f"{name}: the example adds nothing"
     grid = effect.shapes(scales)
     if effect.continuous_shape:
-        family = effect.with_shape_value(shape, 1.0)
-        values = [effect.shape_value(g) for g in grid if effect.with_shape_value(g, 1.0) == family]
+        family = effect.shape_family(shape)
+        values = [effect.shape_value(g) for g in grid if effect.shape_family(g) == family]
         v = effect.shape_value(shape)
         assert values and min(values) <= v <= max(values), f"{name}: example {shape} off the grid"
     else:

@@ -230,8 +230,8 @@ def best_shapes(
             continue
         families: dict = {}
         for f in fits:
-            families.setdefault(member.with_shape_value(f.shapes[i], 1.0), []).append(f)
-        mine = member.with_shape_value(best.shapes[i], 1.0)
+            families.setdefault(member.shape_family(f.shapes[i]), []).append(f)
+        mine = member.shape_family(best.shapes[i])
         starts = [
             best if fam == mine else min(fs, key=lambda f: f.mse) for fam, fs in families.items()
         ]
@@ -248,7 +248,7 @@ def _refine(store, combo, grids, i: int, best: Fit, records, linear_base: bool) 
     values = sorted(
         member.shape_value(s)
         for s in grids[i]
-        if member.with_shape_value(s, 1.0) == member.with_shape_value(here, 1.0)
+        if member.shape_family(s) == member.shape_family(here)
     )
     v = member.shape_value(here)
     if len(values) < 2 or not np.isfinite(v):

@@ -183,6 +183,11 @@ class Effect(ABC):
         """``shape`` with its refined part set to ``value``."""
         return value
 
+    def shape_family(self, shape: Any) -> Any:
+        """What of ``shape`` the refinement keeps (a thermal leak's heating law): shapes of one
+        family differ only in their ``shape_value``."""
+        return self.with_shape_value(shape, 1.0)
+
     def rich_shapes(self, scales: Scales) -> list:
         """The shapes of the richest admissible form (default: the usual ones)."""
         return self.shapes(scales)
