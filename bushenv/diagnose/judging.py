@@ -63,7 +63,7 @@ class Run:
             "shrink_vs_null": 1.0 - gap / self.gap_null if self.gap_null > 0 else 0.0,
             "n_extra_parameters": j.n_extra,
             "_dissipative": any(get_effect(n).shows_dissipation for n in j.combo.names),
-            "_elastic": any(get_effect(n).holds_its_law for n in j.combo.names),
+            "_holds_law": any(get_effect(n).holds_its_law for n in j.combo.names),
             "shape": describe_shapes(j.fits[0]),
             "gap_train": j.gap_train,
             "_mse": j.mse,

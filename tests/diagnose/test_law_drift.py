@@ -1,10 +1,12 @@
-"""An elastic effect is named only when its force law of the deflection holds through each
-record (``rule.law_drift``): a load-cell zero drifting in time, or a stiffness lost for good at
-the largest deflection, is not a hardening however much error a hardening fit cuts."""
+"""A law of the deflection (a backbone, a friction) is named only when it holds through each
+record (``rule.law_drift``): a load-cell zero drifting in time, a stiffness lost for good at
+the largest deflection or a stiffness lost to heat is not a hardening nor a friction however
+much error their fit cuts."""
 
 import numpy as np
 
 from bushenv.diagnose import rule
+from bushenv.diagnose.candidates import effect_names, get_effect
 from bushenv.diagnose.lag import lag_evidence
 from bushenv.metrics import rms_ratio
 
@@ -27,8 +29,8 @@ def _law_fit(x, y):
     return a @ w
 
 
-def _row(ctx, pred):
-    r = {"effect": "hardening", "members": ["hardening"], "_pred": pred, "_elastic": True}
+def _row(ctx, pred, effect="hardening"):
+    r = {"effect": effect, "members": [effect], "_pred": pred, "_holds_law": True}
     r.update(n_extra_parameters=6, gap_after=rms_ratio(ctx.force, pred), gap_train=0.0)
     rule.mark_failed([r], ctx)
     rule.mark_passes([r], ctx)
@@ -80,9 +82,36 @@ def test_a_stiffness_lost_for_good_at_the_largest_deflection_is_refused_as_harde
     assert r["closes_excess"] > rule.SHRINK_MIN
     assert r["law_drift"] > rule.LAW_DRIFT_MAX
     assert not r["passes"]
-    r.pop("_elastic")  # an effect that is no law of the deflection is not asked
+    r.pop("_holds_law")  # an effect that is no law of the deflection is not asked
     rule.mark_passes([r], ctx)
     assert r["passes"]
+
+
+def _friction_fit(x, y):
+    """The least-squares friction (a smooth sign of the velocity) and spring: one law of the
+    deflection's history for the whole record."""
+    v = np.gradient(x, DT)
+    a = np.stack([np.tanh(v / (0.05 * np.std(v))), x], axis=1)
+    w, *_ = np.linalg.lstsq(a, y, rcond=None)
+    return a @ w
+
+
+def test_a_friction_whose_loop_holds_passes_and_one_that_softens_with_heat_is_refused():
+    assert {n for n in effect_names() if get_effect(n).holds_its_law} == {"hardening", "friction"}
+    rng = np.random.default_rng(3)
+    x = _motion(rng)
+    v = np.gradient(x, DT)
+    loop = 40.0 * np.tanh(v / (0.05 * np.std(v)))  # N: a friction force
+    ctx = _ctx(x, loop, noise_n=0.05 * float(np.std(loop)), rng=rng)
+    r = _row(ctx, _friction_fit(x, ctx.force), "friction")
+    assert r["law_drift"] < rule.LAW_DRIFT_MAX and r["passes"]
+    heat = np.cumsum(v * v) * DT / (np.sum(v * v) * DT)  # dissipated energy, 0 to 1
+    y = loop - 1.5e5 * heat * x  # N: the same loop on a spring that softens as it heats
+    ctx = _ctx(x, y)
+    r = _row(ctx, _friction_fit(x, y), "friction")
+    assert r["closes_excess"] > rule.SHRINK_MIN and r["significant"]  # it does cut the error
+    assert r["law_drift"] > rule.LAW_DRIFT_MAX
+    assert not r["passes"]
 
 
 def test_record_edges_cover_the_stacked_samples_in_order():

@@ -122,8 +122,9 @@ class Effect(ABC):
     answer cannot tell two effects apart). ``shows_dissipation``: the effect's own evidence is
     the energy it dissipates (a hysteresis loop): it is named only when the records show the
     dissipation it claims (``rule.dissipation_evidence``). ``holds_its_law``: the effect is a
-    force law of the deflection alone (elastic): it is named only when that law holds through
-    each record (``rule.law_drift``). ``replaces_spring``: the columns
+    force law of the deflection and its history, the same at every moment (a backbone, a
+    friction; not a heat that builds up): it is named only when that law holds through each
+    record (``rule.law_drift``). ``replaces_spring``: the columns
     replace the linear spring ``k x`` (a backbone of its own); ``continuous_shape``: the best
     grid shape is refined by a 1-D search on the fitting error.
 

@@ -70,6 +70,7 @@ class Friction(Effect):
 
     name = "friction"
     shows_dissipation = True
+    holds_its_law = True  # a law of the deflection's history: the same at every moment
     form = (
         "sum_j F_j z_j, dz_j/dx = (sgn dx - z_j)/x_j, x_j = sigma_x {0.003..1}; "
         "- sum_m q_m x A_m / sigma_x, A_m = envelope of abs(x) (2 s, 20 s)"
