@@ -201,7 +201,7 @@ class ColumnStore:
             if b[0] == "spring":
                 out.append(np.full(len(b[1].split(",")), 0.0 if self.admissible else -np.inf))
             else:
-                out.append(get_effect(b[0]).lower(b[1], self.scales))
+                out.append(get_effect(b[0]).block_lower(b[1], self.scales))
         return np.concatenate(out)
 
     def clear(self) -> None:

@@ -23,7 +23,10 @@ above the noise: ``excess(g) = sqrt(max(g^2 - gap_noise^2, 0))``.
    hardening, friction) is refused when that law does not hold through the records: a smooth
    law refitted on each third of every record explains more than ``LAW_DRIFT_MAX`` of its cut
    beyond one law per record (``law_drift``: a zero drifting in time, a stiffness lost for
-   good, a stiffness lost to heat, fitted as a backbone or a friction).
+   good, a stiffness lost to heat, fitted as a backbone or a friction). Any row is refused
+   where a stiffness lost for good at the largest deflection, fitted beside it, explains most
+   of what it leaves and a part of the gap that counts (``lasting.py``: a Mullins softening
+   is no candidate).
 3. A **pair** ``{A, B}`` passes when it passes as a single would, the best single leaves more
    than ``PAIR_TRY_IF_LEFT`` of the null's gap (or none passes), the pair closes at least
    ``PAIR_GAIN_MIN`` of the best single's gap, and **each member passes given the other**:
@@ -103,7 +106,10 @@ RULE_TEXT = (
     f"{100 * DISSIPATION_SHOWN_MIN:.0f} % of the dissipation it claims), and hardening and "
     f"friction must hold their law (refused when a law of the deflection refitted on each "
     f"third of every record explains more than {100 * LAW_DRIFT_MAX:.0f} % of its cut beyond "
-    f"one law per record). A pair passes when it "
+    f"one law per record); any candidate is refused where a stiffness lost for good at the "
+    f"largest deflection, fitted beside it, cuts significantly and closes at least half of "
+    f"what it leaves above the noise and {100 * SHRINK_MIN:.0f} % of the null's. A pair "
+    f"passes when it "
     f"passes so, "
     f"closes at least {100 * PAIR_GAIN_MIN:.0f} % of what the best single leaves, and each of "
     f"its effects passes the same test given the other, closing at least "

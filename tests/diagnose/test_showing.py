@@ -3,6 +3,7 @@
 import numpy as np
 
 from bushenv.diagnose import rule, showing
+from bushenv.diagnose.effects.rich import LastingForm
 from bushenv.diagnose.evidence import block_edges
 from bushenv.diagnose.lag import LagEvidence
 from bushenv.metrics import rms_ratio
@@ -45,7 +46,7 @@ def test_a_candidate_right_on_the_records_showing_the_gap_is_named_there():
     assert not cand["passes"]  # pooled, TRAIN's bad extrapolation sinks it
     assert rule.answer([cand], [], ctx).effect == rule.OUTSIDE
     assert showing.showing_records(ctx) == [1]  # TRAIN's own linear fit leaves only noise
-    ans, keep = showing.answer_on_showing([cand], [], ctx, _no_rich_form)
+    ans, keep = showing.answer_on_showing([cand], [], ctx, _no_rich_form(cand))
     assert ans.effect == "hardening" and keep == [1]
 
 
@@ -54,11 +55,19 @@ def test_when_every_record_shows_the_gap_the_pooled_answer_stands():
     rule.mark_failed([cand], ctx)
     rule.mark_passes([cand], ctx)
     assert showing.showing_records(ctx) == [0, 1]
-    assert showing.answer_on_showing([cand], [], ctx, _no_rich_form) is None
+    assert showing.answer_on_showing([cand], [], ctx, _no_rich_form(cand)) is None
 
 
-def _no_rich_form(combo):
-    raise AssertionError(f"no pair here, so no richest form of {combo.name} is asked for")
+def _no_rich_form(cand):
+    """A row_of that gives ``cand`` back beside a stiffness lost for good (nothing is lost
+    here) and refuses any richest form (no pair here)."""
+
+    def row_of(combo):
+        if any(isinstance(m, LastingForm) for m in combo.members):
+            return cand
+        raise AssertionError(f"no pair here, so no richest form of {combo.name} is asked for")
+
+    return row_of
 
 
 def _row(name, pred, force):

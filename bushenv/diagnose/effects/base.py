@@ -199,6 +199,15 @@ class Effect(ABC):
         A partner is named beside this effect only when it adds to this form."""
         return self.columns(s, shape, scales)
 
+    def lasting_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
+        """The usual columns and a stiffness lost for good, a saturating function of the
+        largest deflection so far (``-x (1 - exp(-max|x| / (a sigma_x)))``, ``a`` in
+        ``LOST_SATURATION``, weights >= 0; never recovered): what a row is compared with
+        (``lasting.py``; no candidate is such a softening)."""
+        peak = np.maximum.accumulate(np.abs(s.x)) / scales.sigma_x
+        lost = [-s.x * (1.0 - np.exp(-peak / a)) for a in LOST_SATURATION]
+        return np.concatenate([self.columns(s, shape, scales), np.stack(lost, axis=1)], axis=1)
+
     def nuisance_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         """(T, q) columns whose weights (>= 0) each record has of its own, fitted on that
         record even when it is judged (a state the record starts in that no other record
@@ -210,14 +219,25 @@ class Effect(ABC):
         return {}
 
     def block_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
-        """``columns``; ``rich_columns`` for a ``Richest`` shape, ``nuisance_columns`` for a
-        ``Nuisance`` one (of the rich shape too): what the fits call."""
+        """``columns``; ``rich_columns`` for a ``Richest`` shape, ``lasting_columns`` for a
+        ``Lasting`` one, ``nuisance_columns`` for a ``Nuisance`` one (of those shapes too):
+        what the fits call."""
         if isinstance(shape, Nuisance):
-            inner = shape.inner.inner if isinstance(shape.inner, Richest) else shape.inner
-            return self.nuisance_columns(s, inner, scales)
+            marked = isinstance(shape.inner, Richest | Lasting)
+            return self.nuisance_columns(s, shape.inner.inner if marked else shape.inner, scales)
         if isinstance(shape, Richest):
             return self.rich_columns(s, shape.inner, scales)
+        if isinstance(shape, Lasting):
+            return self.lasting_columns(s, shape.inner, scales)
         return self.columns(s, shape, scales)
+
+    def block_lower(self, shape: Any, scales: Scales) -> np.ndarray:
+        """``lower`` of ``block_columns``: a ``Lasting`` shape's lost stiffness >= 0 after the
+        effect's own bounds (an effect's ``lower`` knows its own columns only)."""
+        if isinstance(shape, Lasting):
+            lost = np.zeros(len(LOST_SATURATION))
+            return np.concatenate([self.lower(shape.inner, scales), lost])
+        return self.lower(shape, scales)
 
     def forward(
         self, s: Signals, force: np.ndarray, shape: Any, w: np.ndarray, scales: Scales
@@ -246,12 +266,22 @@ class Effect(ABC):
 
 
 PROBE_SAMPLES = 16
+LOST_SATURATION = (0.5, 1.5, 5.0)  # peak deflections (x sigma_x) at which a lost stiffness
+# saturates: from a loss set by the first excursions to one growing with the peak
 
 
 @dataclass(frozen=True)
 class Richest:
     """A shape marker: the effect's richest admissible form at shape ``inner``
     (``Effect.rich_columns``), used only to test whether a partner adds to it."""
+
+    inner: Any
+
+
+@dataclass(frozen=True)
+class Lasting:
+    """A shape marker: the effect at shape ``inner`` with a stiffness lost for good beside it
+    (``Effect.lasting_columns``), used only to test whether that explains what it leaves."""
 
     inner: Any
 

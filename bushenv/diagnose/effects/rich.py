@@ -1,9 +1,12 @@
-"""An effect in its richest admissible form, as a member of a combination.
+"""An effect in another form, as a member of a combination: its richest admissible form, or
+its usual form with a stiffness lost for good beside it.
 
 ``RichForm(Relaxation())`` fits the relaxation's ``rich_columns`` (a wider, denser spectrum)
 under the same name; the ``Richest`` shape marker tells the column store which columns to
 build. Used by ``bushenv.diagnose.partner``: a second effect is named beside a first only when
-it adds to the first's whole family, not merely to its usual form.
+it adds to the first's whole family, not merely to its usual form. ``LastingForm(Friction())``
+fits ``lasting_columns`` (``Lasting`` marker: a stiffness lost for good beside the usual
+columns), used by ``bushenv.diagnose.lasting``.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose.effects.base import Effect, Richest, Scales, Signals
+from bushenv.diagnose.effects.base import Effect, Lasting, Richest, Scales, Signals
 
 
 class RichForm(Effect):
@@ -44,3 +47,16 @@ class RichForm(Effect):
 
     def __repr__(self) -> str:
         return f"RichForm({self.inner!r})"
+
+
+class LastingForm(RichForm):
+    """``inner`` with its shapes wrapped in ``Lasting`` (never registered)."""
+
+    def shapes(self, scales: Scales) -> list:
+        return [Lasting(s) for s in self.inner.shapes(scales)]
+
+    def describe(self, shape: Any) -> str:
+        return f"{self.inner.describe(shape.inner)}, and a stiffness lost for good"
+
+    def __repr__(self) -> str:
+        return f"LastingForm({self.inner!r})"
