@@ -10,7 +10,8 @@ neither the candidates, the widened set nor the reference rubber use:
   (2 x_y)) d`` from the last reversal ``(x_r, F_r)`` in direction ``d``;
 - hardening: a **tangent** law ``k_h (x_l tan(x / x_l) - x)``, its limit ``x_l`` drawn per side;
 - thermal: a heat node fed by the specimen's own dissipated power, its leak faster with speed
-  (forced convection), stiffness lost linearly and damping exponentially with the heat; the
+  (forced convection), stiffness lost linearly and damping exponentially with the heat, at
+  most a third of the stiffness anywhere in the session (a partner's dissipation heats too); the
   records run as **one session** in a drawn order, the heat carried over rests of 30-300 s, so
   TRAIN may start warm;
 - delay: a **boxcar** average of the force channel over a few samples (linear phase);
@@ -41,6 +42,7 @@ from bushenv.diagnose.validation.widened_programmes import bushing_programmes
 EFFECTS = ("relaxation", "friction", "hardening", "thermal", "delay", "inertia")
 SINGLES = ("none",) + EFFECTS
 PAIR_EVERY = 4  # one case in four is a pair
+MAX_LOSS = 0.33  # the most stiffness heat takes, anywhere in a session
 
 
 @njit(cache=True)
@@ -109,8 +111,14 @@ def effect_force(name: str, p: dict, x: np.ndarray, dt: float) -> np.ndarray:
 
 def specimen_forces(label, p: dict, k, c, progs, order, rests_s) -> list[np.ndarray]:
     """Noise-free forces of every record (sampled), the thermal heat carried in ``order``."""
+    return _session(label, p, k, c, progs, order, rests_s)[0]
+
+
+def _session(label, p: dict, k, c, progs, order, rests_s) -> tuple[list[np.ndarray], float]:
+    """The forces and the highest heat (J) the session reaches (0 without thermal)."""
     out: list[np.ndarray | None] = [None] * len(progs)
     heat = p.get("thermal", {}).get("warm", 0.0)
+    top = 0.0
     for j, i in enumerate(order):
         x, dt = progs[i]
         v = np.gradient(x, dt)
@@ -119,6 +127,7 @@ def specimen_forces(label, p: dict, k, c, progs, order, rests_s) -> list[np.ndar
         if "thermal" in label:
             q = p["thermal"]
             theta = _heat(c * v * v + np.abs(extra * v), v, dt, q, heat)
+            top = max(top, float(np.max(theta)))
             soft = q["scale"] * theta
             f = (1 - soft) * (elastic + extra) + np.exp(-q["damping_ratio"] * soft) * viscous
             heat = float(theta[-1]) * np.exp(-rests_s[j] / q["tau_s"])
@@ -128,7 +137,7 @@ def specimen_forces(label, p: dict, k, c, progs, order, rests_s) -> list[np.ndar
             n = p["delay"]["width"]
             f = np.convolve(f, np.ones(n) / n)[: f.size]
         out[i] = f[::OVERSAMPLE]
-    return out
+    return out, top
 
 
 def _draw(name: str, rng, k: float, c: float, x_peak: float, band_hz: float, dt: float) -> dict:
@@ -209,10 +218,12 @@ def make_partner_case(
             if gap <= 0 or n == "delay":
                 break
             p[n]["scale"] *= target / gap
-        if n == "thermal":  # at most a third of the stiffness lost
-            p[n]["scale"] = min(p[n]["scale"], 0.33 / _peak_heat(p[n], c, progs))
     if "thermal" in label and rng.random() < 0.5:  # the specimen ran warm before the session
         p["thermal"]["warm"] = 0.5 * _peak_heat(p["thermal"], c, progs)
+    if "thermal" in label:  # at most a third of the stiffness lost, all through the session:
+        # a partner's own dissipation heats too, as do a warm start and the heat carried over
+        top = _session(label, p, k, c, progs, order, rests)[1]
+        p["thermal"]["scale"] = min(p["thermal"]["scale"], MAX_LOSS / max(top, 1e-300))
     forces = specimen_forces(label, p, k, c, progs, order, rests)
     drawn = {"rate_hz": rate, **info, "poor_train": poor, "order": [int(i) for i in order],
              "k_n_per_m": round(k, 3), "c_ns_per_m": round(c, 4),
