@@ -30,5 +30,5 @@ def apply_rule(
     lasting.check_lasting(pairs, row_of, ctx)
     pairs = rule.rank(pairs, order, ctx)
     first = next((r["effect"] for r in singles if not r["failed_to_fit"]), None)
-    partner.check_partners(pairs, row_of, ctx, first)
+    partner.check_partners(pairs, row_of, ctx, first, singles)
     return singles, pairs

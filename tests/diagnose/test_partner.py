@@ -1,0 +1,78 @@
+"""A partner is weighed against the other member's whole family at its best judged form: the
+richest form or the usual one, whichever predicts the judged records better."""
+
+import numpy as np
+
+from bushenv.diagnose import partner, rule
+from bushenv.diagnose.effects.rich import RichForm
+from bushenv.diagnose.evidence import block_edges
+from bushenv.diagnose.lag import LagEvidence
+from bushenv.metrics import rms_ratio
+
+N, DT = 4000, 0.01
+NO_LAG = LagEvidence(False, False, 0.0, 0.0, 1.0, [], "no lag")
+
+
+def _setup():
+    """A specimen whose force holds a first effect (a slow wave) and a partner (a drift);
+    the noise is 0.2 % of the force."""
+    rng = np.random.default_rng(5)
+    t = np.arange(N) * DT
+    base = np.sin(2 * np.pi * 0.9 * t)
+    first = 0.3 * np.sin(2 * np.pi * 0.13 * t + 0.4)
+    drift = 0.2 * (t / t[-1]) * np.sin(2 * np.pi * 0.9 * t)
+    force = base + first + drift + 0.002 * rng.normal(size=N)
+    ctx = rule.Context(force, base, block_edges([N], [DT]), rms_ratio(force, base), 0.002, NO_LAG)
+    return ctx, base, first, drift
+
+
+def _row(name, pred, force):
+    return {"effect": name, "members": name.split("+"), "_pred": pred,
+            "gap_after": rms_ratio(force, pred)}  # fmt: skip
+
+
+def _row_of(rows):
+    """Rows by what is asked: the first's richest form alone, or beside the partner."""
+
+    def row_of(combo):
+        rich = any(isinstance(m, RichForm) for m in combo.members)
+        assert rich, f"only richest forms are asked for, not {combo.name}"
+        return rows["rich+partner" if len(combo.members) == 2 else "rich"]
+
+    return row_of
+
+
+def test_a_partner_the_usual_pair_needs_is_kept_when_the_richest_form_extrapolates_badly():
+    ctx, base, first, drift = _setup()
+    wild = 0.25 * np.sin(2 * np.pi * 2.3 * np.arange(N) * DT)  # the richer form's misfit
+    rows = {
+        "rich": _row("relaxation", base + first + wild, ctx.force),
+        "rich+partner": _row("relaxation+thermal", base + first + drift + wild, ctx.force),
+    }
+    alone = _row("relaxation", base + first, ctx.force)
+    pair = _row("relaxation+thermal", base + first + drift, ctx.force)
+    before = partner.member_beyond_rich("thermal", "relaxation", _row_of(rows), ctx, {})
+    assert not before["adds"]  # beside the badly extrapolating richest form alone
+    got = partner.member_beyond_rich(
+        "thermal", "relaxation", _row_of(rows), ctx, {}, pair=pair, alone=alone
+    )
+    assert got["adds"] and got["forms"] == ["usual", "usual"], got
+    assert got["share"] > 0.9
+    assert np.isclose(got["richest_gap"], alone["gap_after"])
+
+
+def test_a_partner_that_only_mends_the_usual_form_is_still_refused():
+    """The richest form explains the whole first effect; the usual form leaves a part of it
+    that the partner soaks up: the usual pair is no better than the richest form alone."""
+    ctx, base, first, _ = _setup()
+    rows = {
+        "rich": _row("relaxation", base + first, ctx.force),
+        "rich+partner": _row("relaxation+hardening", base + first, ctx.force),
+    }
+    alone = _row("relaxation", base + 0.6 * first, ctx.force)
+    pair = _row("relaxation+hardening", base + first, ctx.force)
+    got = partner.member_beyond_rich(
+        "hardening", "relaxation", _row_of(rows), ctx, {}, pair=pair, alone=alone
+    )
+    assert not got["adds"] and got["forms"][0] == "richest", got
+    assert abs(got["share"]) < 0.05
