@@ -42,7 +42,6 @@ class Fit:
     force_ms: float  # mean square of the force fitted (for a relative fitting error)
     nuisance: tuple[Block, ...] = ()  # per-record blocks (a warm start), fitted per record
     nuisance_w: dict = field(default_factory=dict)  # record uid -> its own weights
-    nuisance_p: dict = field(default_factory=dict)  # uid -> its spring part, one-record fold
 
     @property
     def delay_s(self) -> float:
@@ -103,8 +102,7 @@ def fit(
     linear_base: bool,
 ) -> Fit:
     """Weights of ``combo`` at ``shapes`` by bounded least squares on ``records``; per-record
-    blocks (``nuisance_of``) get weights of their own on each record, fitted jointly -- on a
-    fold of one record, by the block's cooling only (``cooling``)."""
+    blocks (``nuisance_of``) get weights of their own on each record, fitted jointly."""
     blocks = blocks_of(store, combo, shapes, linear_base)
     nuis = nuisance_of(store, combo, shapes)
     delay = sum(m.delay_s(s) for m, s in zip(combo.members, shapes, strict=True))
@@ -112,21 +110,14 @@ def fit(
     q = sum(store.columns_count(b) for b in nuis)
     size = p_ + q * len(records)
     g, b, yy = np.zeros((size, size)), np.zeros(size), 0.0
-    parts = {}
-    alone = len(records) == 1
-    full = blocks + ((SPRING,) if q and alone else ()) + nuis
     for i, p in enumerate(records):
-        gp = store.gram(p, full)
-        bp, yp = store.rhs(p, full, delay)
+        gp = store.gram(p, blocks + nuis)
+        bp, yp = store.rhs(p, blocks + nuis, delay)
         o = p_ + i * q
         g[:p_, :p_] += gp[:p_, :p_]
         b[:p_] += bp[:p_]
         yy += yp
-        if q and alone:
-            gbn, gnn, bn, parts[p.uid] = cooling(gp, bp, p_)
-            g[:p_, o : o + q], g[o : o + q, :p_] = gbn, gbn.T
-            g[o : o + q, o : o + q], b[o : o + q] = gnn, bn
-        elif q:
+        if q:
             g[:p_, o : o + q], g[o : o + q, :p_] = gp[:p_, p_:], gp[p_:, :p_]
             g[o : o + q, o : o + q], b[o : o + q] = gp[p_:, p_:], bp[p_:]
     n = sum(p.n for p in records)
@@ -135,28 +126,7 @@ def fit(
     mse = max(float(yy - 2 * w @ b + w @ g @ w) / n, 0.0)
     force_ms = float(sum(np.sum(p.force**2) for p in records)) / n
     own = {p.uid: w[p_ + i * q : p_ + (i + 1) * q] for i, p in enumerate(records)} if q else {}
-    return Fit(combo, tuple(shapes), blocks, w[:p_], mse, n, force_ms, nuis, own, parts)
-
-
-def cooling(gp: np.ndarray, bp: np.ndarray, p_: int) -> tuple:
-    """The per-record block of the one record a fold fits, less what its own spring and
-    damper give of it.
-
-    ``gp``, ``bp``: the record's Gram products of [the shared blocks (``p_`` columns), a
-    spring and damper, the per-record block]. Returns the shared-by-own Gram, the own Gram,
-    the own right-hand side and the spring part ``P`` (the block is ``N - [x v] P``).
-
-    A start is a record's heat beside the session's other records. On one record its level
-    is the spring: a start whose leak is long beside the record hardly cools, and it trades
-    freely with the shared spring (a spring four times too stiff and a start as warm, which
-    the judged record then inherits); only its fall through the record can be told, as for a
-    judged record (``cooling_scale``). With several records fitted, each start's level is
-    told against the others' and is kept whole."""
-    s, o = slice(p_, p_ + 2), slice(p_ + 2, None)
-    part = np.linalg.lstsq(gp[s, s], gp[s, o], rcond=None)[0]
-    gbn = gp[:p_, o] - gp[:p_, s] @ part
-    gnn = gp[o, o] - gp[o, s] @ part
-    return gbn, gnn, bp[o] - part.T @ bp[s], part
+    return Fit(combo, tuple(shapes), blocks, w[:p_], mse, n, force_ms, nuis, own)
 
 
 def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
@@ -172,9 +142,6 @@ def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
         wn = store.design(prep, f.nuisance)
         own = f.nuisance_w.get(prep.uid)
         if own is not None:
-            part = f.nuisance_p.get(prep.uid)
-            if part is not None:
-                wn = wn - store.design(prep, (SPRING,)) @ part
             out = out + wn @ own
         else:
             direction = start_direction(store, f)
