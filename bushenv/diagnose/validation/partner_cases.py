@@ -9,7 +9,8 @@ neither the candidates, the widened set nor the reference rubber use:
 - friction: a **Masing** hysteresis on a tanh backbone, ``F = F_r + 2 F_y tanh((x - x_r) d /
   (2 x_y)) d`` from the last reversal ``(x_r, F_r)`` in direction ``d``;
 - hardening: a **tangent** law ``k_h (x_l tan(x / x_l) - x)``, its limit ``x_l`` drawn per side;
-- thermal: a heat node fed by the specimen's own dissipated power, its leak faster with speed
+- thermal: a heat node fed by the power the specimen dissipates (its damper's, a relaxation
+  arm's dashpot's, a friction's slip; a spring or a mass gives none), its leak faster with speed
   (forced convection), stiffness lost linearly and damping exponentially with the heat, at
   most a third of the stiffness anywhere in the session (a partner's dissipation heats too); the
   records run as **one session** in a drawn order, the heat carried over rests of 30-300 s, so
@@ -109,6 +110,20 @@ def effect_force(name: str, p: dict, x: np.ndarray, dt: float) -> np.ndarray:
     return np.zeros_like(x)
 
 
+def dissipated_power(name: str, p: dict, force: np.ndarray, x: np.ndarray, dt: float):
+    """The power (W) effect ``name`` dissipates, its force ``force`` on the motion ``x``: the
+    relaxation arm's dashpot, the friction's slip (its force times the velocity less the
+    elastic part it stores, ``F F' / k_0``); a spring's or a mass's energy comes back (0)."""
+    v = np.gradient(x, dt)
+    if name == "relaxation":  # the arm's force times its dashpot's rate v - h'
+        h = force / (p["scale"] * p["k_a"])
+        return np.maximum(force * (v - np.gradient(h, dt)), 0.0)
+    if name == "friction":
+        k0 = p["scale"] * p["f_y"] / p["x_y"]
+        return np.maximum(force * v - force * np.gradient(force, dt) / k0, 0.0)
+    return np.zeros_like(x)
+
+
 def specimen_forces(label, p: dict, k, c, progs, order, rests_s) -> list[np.ndarray]:
     """Noise-free forces of every record (sampled), the thermal heat carried in ``order``."""
     return _session(label, p, k, c, progs, order, rests_s)[0]
@@ -123,10 +138,12 @@ def _session(label, p: dict, k, c, progs, order, rests_s) -> tuple[list[np.ndarr
         x, dt = progs[i]
         v = np.gradient(x, dt)
         elastic, viscous = k * x, c * v
-        extra = sum((effect_force(n, p[n], x, dt) for n in label), np.zeros_like(x))
+        own = {n: effect_force(n, p[n], x, dt) for n in label}
+        extra = sum(own.values(), np.zeros_like(x))
         if "thermal" in label:
             q = p["thermal"]
-            theta = _heat(c * v * v + np.abs(extra * v), v, dt, q, heat)
+            partner = sum(dissipated_power(n, p[n], f, x, dt) for n, f in own.items())
+            theta = _heat(c * v * v + partner, v, dt, q, heat)
             top = max(top, float(np.max(theta)))
             soft = q["scale"] * theta
             f = (1 - soft) * (elastic + extra) + np.exp(-q["damping_ratio"] * soft) * viscous
