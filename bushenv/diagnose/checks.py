@@ -19,7 +19,15 @@ from scipy import signal
 from scipy.optimize import lsq_linear
 
 from bushenv.diagnose.candidates import EFFECTS, get_effect
-from bushenv.diagnose.effects.base import Effect, Scales, Signals, contract_problem
+from bushenv.diagnose.effects.base import (
+    Effect,
+    Lasting,
+    Nuisance,
+    Richest,
+    Scales,
+    Signals,
+    contract_problem,
+)
 from bushenv.diagnose.effects.timeshift import shift_columns
 
 K_N_PER_M = 380e3  # the probe bushing: seed 000's axial Table 1
@@ -140,6 +148,33 @@ def check_bounds_admissible(name: str) -> None:
     assert np.isfinite(d) and d >= 0, f"{name}: delay {d} s"
 
 
+def check_other_forms(name: str) -> None:
+    """The forms the diagnosis compares an effect in -- its richest form (``rich_columns``,
+    bounded by ``rich_lower``), with a stiffness lost for good beside it and its per-record
+    columns -- give finite columns of the count declared, one lower bound per column."""
+    effect = get_effect(name)
+    records, scales = probes()
+    rich = effect.rich_shapes(scales)
+    picks = list(dict.fromkeys([rich[0], rich[len(rich) // 2], rich[-1]])) if rich else []
+    forms = [Richest(sh) for sh in picks]
+    forms += [m(sh) for sh in _shapes_to_check(effect, scales) for m in (Lasting, Nuisance)]
+    for form in forms:
+        p = effect.columns_count(form, scales)
+        for s in records:
+            cols = effect.block_columns(s, form, scales)
+            assert cols.ndim == 2 and cols.shape == (s.x.size, p), (
+                f"{name} at {form!r}: columns {cols.shape} on a record of {s.x.size} samples; "
+                f"columns_count says {p}"
+            )
+            assert np.all(np.isfinite(cols)), f"{name} at {form!r}: columns not finite"
+        lower = np.asarray(effect.block_lower(form, scales), dtype=float)
+        assert lower.shape == (p,), (
+            f"{name} at {form!r}: {lower.shape} bounds for {p} columns (an effect whose "
+            "rich_columns differ from its columns declares their bounds in rich_lower)"
+        )
+        assert not np.any(np.isnan(lower)) and np.all(lower < np.inf), f"{name}: bad bounds"
+
+
 def check_forward_recovers_its_parameters(name: str) -> None:
     """The forward form's output, fitted back with the effect's own regressors, gives back the
     spring, damper and weights it was made with, and the example's shape fits best."""
@@ -193,6 +228,7 @@ CHECKS: dict[str, Check] = {
     "name_declared_once": check_name_declared_once,
     "columns_shape_and_finite": check_columns_shape_and_finite,
     "bounds_admissible": check_bounds_admissible,
+    "other_forms": check_other_forms,
     "forward_recovers_its_parameters": check_forward_recovers_its_parameters,
     "deterministic": check_deterministic,
     "report_is_plain": check_report_is_plain,

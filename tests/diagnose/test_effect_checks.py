@@ -114,3 +114,70 @@ def test_a_forward_form_its_regressors_cannot_reproduce_fails_the_checks():
     with EFFECTS.temporarily("lagless", Lagless):
         with pytest.raises(AssertionError, match="lagless: its regressors leave"):
             CHECKS["forward_recovers_its_parameters"]("lagless")
+
+
+class DriftingPreload(Preload):
+    """A preload whose richest form lets it drift linearly through a record; both weights of
+    either sign, declared for the richest form in ``rich_lower`` (a test effect)."""
+
+    name = "driftingpreload"
+
+    def rich_columns(self, s, shape, scales):
+        ramp = np.arange(s.x.size) / s.x.size
+        return np.stack([np.ones(s.x.size), ramp], axis=1)
+
+    def rich_lower(self, shape, scales):
+        return np.full(2, -np.inf)
+
+
+def test_the_richest_form_is_bounded_by_rich_lower_and_a_miscount_fails_the_checks():
+    from bushenv.diagnose.candidates import get_effect
+    from bushenv.diagnose.checks import probes
+    from bushenv.diagnose.effects.base import Lasting, Nuisance, Richest
+
+    scales = probes()[1]
+    with EFFECTS.temporarily("driftingpreload", DriftingPreload):
+        check_effect("driftingpreload")
+        effect = get_effect("driftingpreload")
+        assert list(effect.block_lower(Richest(None), scales)) == [-np.inf, -np.inf]
+        assert list(effect.block_lower(Lasting(None), scales)) == [-np.inf, 0.0, 0.0, 0.0]
+        assert effect.block_lower(Nuisance(None), scales).shape == (0,)
+
+    class Miscounted(DriftingPreload):
+        name = "miscounted"
+
+        def rich_lower(self, shape, scales):
+            return np.full(1, -np.inf)  # the usual form's count
+
+    with EFFECTS.temporarily("miscounted", Miscounted):
+        with pytest.raises(AssertionError, match=r"miscounted at Richest.*\(1,\) bounds for 2"):
+            CHECKS["other_forms"]("miscounted")
+
+
+def test_an_effect_lower_is_asked_about_its_usual_shapes_only():
+    """A ``lower`` that reads its shape (a tuple here) never sees the diagnosis's markers."""
+    from bushenv.diagnose.candidates import get_effect
+    from bushenv.diagnose.checks import probes
+    from bushenv.diagnose.effects.base import Lasting, Nuisance, Richest
+
+    class Tupled(Preload):
+        name = "tupled"
+
+        def shapes(self, scales):
+            return [("free", 1.0), ("signed", 2.0)]
+
+        def lower(self, shape, scales):
+            kind, _ = shape  # a marker here would raise
+            return np.full(1, -np.inf if kind == "free" else 0.0)
+
+        def example(self, scales, k_n_per_m):
+            return ("free", 1.0), np.array([0.5 * k_n_per_m * scales.sigma_x])
+
+    scales = probes()[1]
+    with EFFECTS.temporarily("tupled", Tupled):
+        CHECKS["other_forms"]("tupled")
+        CHECKS["bounds_admissible"]("tupled")
+        effect = get_effect("tupled")
+        for marker in (Richest, Lasting):
+            assert effect.block_lower(marker(("signed", 2.0)), scales)[0] == 0.0
+        assert effect.block_lower(Nuisance(("free", 1.0)), scales).shape == (0,)

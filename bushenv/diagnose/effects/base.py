@@ -199,6 +199,14 @@ class Effect(ABC):
         A partner is named beside this effect only when it adds to this form."""
         return self.columns(s, shape, scales)
 
+    def rich_lower(self, shape: Any, scales: Scales) -> np.ndarray:
+        """Lower bounds of ``rich_columns`` at ``shape`` (a ``rich_shapes`` entry): ``lower``
+        where the richest form is the usual one, else 0 for each of its columns. An effect
+        whose ``rich_columns`` add columns of free sign says so here."""
+        if type(self).rich_columns is Effect.rich_columns:
+            return self.lower(shape, scales)
+        return np.zeros(self.columns_count(Richest(shape), scales))
+
     def lasting_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         """The usual columns and a stiffness lost for good, a saturating function of the
         largest deflection so far (``-x (1 - exp(-max|x| / (a sigma_x)))``, ``a`` in
@@ -232,8 +240,13 @@ class Effect(ABC):
         return self.columns(s, shape, scales)
 
     def block_lower(self, shape: Any, scales: Scales) -> np.ndarray:
-        """``lower`` of ``block_columns``: a ``Lasting`` shape's lost stiffness >= 0 after the
-        effect's own bounds (an effect's ``lower`` knows its own columns only)."""
+        """``lower`` of ``block_columns``: ``rich_lower`` for a ``Richest`` shape, a
+        ``Lasting`` shape's lost stiffness >= 0 after the effect's own bounds, 0 for a
+        ``Nuisance`` one (an effect's ``lower`` is only ever asked about its usual shapes)."""
+        if isinstance(shape, Nuisance):
+            return np.zeros(self.columns_count(shape, scales))
+        if isinstance(shape, Richest):
+            return self.rich_lower(shape.inner, scales)
         if isinstance(shape, Lasting):
             lost = np.zeros(len(LOST_SATURATION))
             return np.concatenate([self.lower(shape.inner, scales), lost])
