@@ -9,8 +9,11 @@ Runs ``diagnose`` (default mode) on ``validation/partner_cases.py`` cases and ke
 the answer, the answer the pair rule alone would give (the first pair that passed it, before
 the richest-form test) and every tested pair's figures (``beyond_richest``). The summary: the
 answers naming an effect that is not there, with and without the richest-form test, singles
-named exactly, pairs both in the top two, poor-TRAIN cases, and the partners' shares beside the
-richest form on true pairs and on invented ones (what ``partner.BEYOND_RICH_MIN`` is set from).
+named exactly, pairs both in the top two (also split by whether each effect shows, above three
+times the noise, in at least two records: a judge held out confirms an effect only where it
+shows in a record fitted and in one judged), poor-TRAIN cases, and the partners' shares beside
+the richest form on true pairs and on invented ones (what ``partner.BEYOND_RICH_MIN`` is set
+from).
 """
 
 from __future__ import annotations
@@ -45,6 +48,8 @@ def run(seed: int, cases: int, start: int, label: tuple[str, ...] | None = None)
                 "top_two": r["top_two"],
                 "poor_train": case.drawn["poor_train"],
                 "visible": case.drawn["visible"],
+                "visible_by_record": case.drawn["visible_by_record"],
+                "noise_fraction": case.drawn["noise_fraction"],
                 "tested": [
                     {"pair": p["effect"], "checks": p["beyond_richest"]}
                     for p in r["pairs"]
@@ -57,6 +62,16 @@ def run(seed: int, cases: int, start: int, label: tuple[str, ...] | None = None)
         print(f"case {done}/{cases} {case.label_text:<22} -> {r['effect']:<22} "
               f"(about {eta:.0f} s left)", file=sys.stderr)  # fmt: skip
     return rows
+
+
+SHOWS = 3.0  # an effect shows in a record where its share of the force is 3 x the noise's
+
+
+def shown_in(row: dict) -> int:
+    """The fewest records any effect of the case shows in (a judge held out needs two)."""
+    counts = [sum(v >= SHOWS * row["noise_fraction"] for v in shares)
+              for shares in row.get("visible_by_record", {}).values()]  # fmt: skip
+    return min(counts) if counts else 0
 
 
 def summary(rows: list[dict]) -> str:
@@ -78,6 +93,14 @@ def summary(rows: list[dict]) -> str:
               for r in pairs)  # fmt: skip
     exact_p = sum(named_set(r["named"]) == set(r["label"].split("+")) for r in pairs)
     out.append(f"pairs both in top two {hit} of {len(pairs)}; named exactly {exact_p}")
+    if pairs and all("visible_by_record" in r for r in pairs):
+        for seen, part in (("in two records or more", [r for r in pairs if shown_in(r) >= 2]),
+                           ("in one record or none", [r for r in pairs if shown_in(r) < 2])):  # fmt: skip
+            hit = sum(set(r["top_two"]) == set(r["label"].split("+")) and r["named"] != "none"
+                      for r in part)  # fmt: skip
+            exact_p = sum(named_set(r["named"]) == set(r["label"].split("+")) for r in part)
+            out.append(f"  pairs whose effects each show {seen}: {len(part)}; both in top two "
+                       f"{hit}, named exactly {exact_p}")  # fmt: skip
     for kind in ("true", "invented"):
         shares = []
         for r, lab in zip(rows, label, strict=True):

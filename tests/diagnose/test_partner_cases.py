@@ -63,3 +63,24 @@ def test_a_partner_heats_by_the_work_its_loop_dissipates(name, p):
         assert heat == 0.0 and abs(work) < 1e-9
     else:
         assert work > 0.1 and heat == pytest.approx(work, rel=2e-3)
+
+
+def test_each_effects_records_are_told_a_heat_seen_in_one_record_only():
+    """Seed 5 case 8 (two records, the steps run first and cold): the relaxation shows in both
+    records, the heat in the sine blocks alone -- no fit on the other record can learn it."""
+    case = pc.make_partner_case(5, 8, label=("relaxation", "thermal"))
+    seen = case.drawn["visible_by_record"]
+    noise = case.drawn["noise_fraction"]
+    assert set(seen) == {"relaxation", "thermal"}
+    assert all(len(v) == len(case.train) + len(case.tests) for v in seen.values())
+    assert min(seen["relaxation"]) > 3 * noise
+    assert seen["thermal"][0] > 10 * noise and seen["thermal"][1] < noise
+
+
+def test_a_single_effect_shows_where_it_is_drawn_and_a_case_without_one_shows_none():
+    one = pc.make_partner_case(1, 1)
+    assert list(one.drawn["visible_by_record"]) == list(one.label)
+    assert max(one.drawn["visible_by_record"][one.label[0]]) > 0
+    cases = (pc.make_partner_case(1, i) for i in range(8))
+    none = next(c for c in cases if c.label == ())
+    assert none.drawn["visible_by_record"] == {}

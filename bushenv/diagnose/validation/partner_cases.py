@@ -157,6 +157,27 @@ def _session(label, p: dict, k, c, progs, order, rests_s) -> tuple[list[np.ndarr
     return out, top
 
 
+def member_visibility(label, p: dict, k, c, progs, order, rests_s) -> dict[str, list[float]]:
+    """Per effect of ``label``, per record: the share of the record's force (noise-free, RMS)
+    that the effect adds and the record's own spring, damper and offset cannot take. A record
+    where an effect stays below the noise cannot show it: a held-out judge confirms an effect
+    only where it shows in a record fitted and in one judged."""
+    full = specimen_forces(label, p, k, c, progs, order, rests_s)
+    out = {}
+    for m in label:
+        rest = tuple(n for n in label if n != m)
+        without = specimen_forces(rest, {n: p[n] for n in rest}, k, c, progs, order, rests_s)
+        shares = []
+        for f, g, (x, dt) in zip(full, without, progs, strict=True):
+            xs = x[::OVERSAMPLE]
+            a = np.stack([xs, np.gradient(xs, dt * OVERSAMPLE), np.ones_like(xs)], axis=1)
+            d = f - g
+            r = d - a @ np.linalg.lstsq(a, d, rcond=None)[0]
+            shares.append(round(float(np.sqrt(np.mean(r**2) / np.mean(f**2))), 4))
+        out[m] = shares
+    return out
+
+
 def _draw(name: str, rng, k: float, c: float, x_peak: float, band_hz: float, dt: float) -> dict:
     if name == "relaxation":
         return {"scale": 1.0, "k_a": k * _logu(rng, 0.3, 1.0), "tau_s": _logu(rng, 0.05, 3.0),
@@ -241,10 +262,12 @@ def make_partner_case(
         # a partner's own dissipation heats too, as do a warm start and the heat carried over
         top = _session(label, p, k, c, progs, order, rests)[1]
         p["thermal"]["scale"] = min(p["thermal"]["scale"], MAX_LOSS / max(top, 1e-300))
+    by_record = member_visibility(label, p, k, c, progs, order, rests)
     forces = specimen_forces(label, p, k, c, progs, order, rests)
     drawn = {"rate_hz": rate, **info, "poor_train": poor, "order": [int(i) for i in order],
              "k_n_per_m": round(k, 3), "c_ns_per_m": round(c, 4),
-             "visible": round(visible_gap(forces, progs, judged), 4)}  # fmt: skip
+             "visible": round(visible_gap(forces, progs, judged), 4),
+             "visible_by_record": by_record}  # fmt: skip
     noise = {"fraction": _logu(rng, *NOISE_FRACTION), "pink": False, "quantum": 0.0,
              "x_fraction": 0.0}  # fmt: skip
     drawn["noise_fraction"] = round(noise["fraction"], 5)
