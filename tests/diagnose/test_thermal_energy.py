@@ -103,6 +103,20 @@ def test_a_memory_of_the_deflection_is_named_relaxation_not_thermal(order):
     assert "thermal" not in r["effect"].split("+")
 
 
+@pytest.mark.parametrize(
+    "order,warm",
+    [(("slow", "hot"), False), (("mixed", "hot"), True), (("hot", "broad"), True)],
+)
+def test_a_session_of_two_records_is_named_thermal(order, warm):
+    """Each record is judged by a fit on the other alone. A lone record keeps a warm start only
+    where it needs one: under a steady power its heat is affine in the start's cooling, and a
+    start fitted whole traded with the spring and the heating law (the first two were
+    ``outside_candidates`` and ``hardening+thermal``); the third starts warm and needs it."""
+    progs = _programmes()
+    r = _diagnose(_thermal_forces(progs, order, warm), progs, order)
+    assert r["effect"] == "thermal", (r["effect"], r["top_two"])
+
+
 def test_a_warm_session_gives_back_its_cold_spring_and_its_leak():
     """Every record after the first starts warm; the leak (60 s) lies between the grid's
     values. Read between them, the leak and the cold spring come back: a leak held at a grid
@@ -151,4 +165,3 @@ def test_a_judged_start_claims_no_more_than_its_cooling_nor_its_level_shows():
     level = float((stiffer + 0.7 * start) @ start) / float(start @ start)
     assert level < 0.5  # the stiffer record's level shows less than its cooling
     assert judged_start(stiffer + 0.7 * start, start, spring) == pytest.approx(level, rel=1e-9)
-
