@@ -104,6 +104,13 @@ def check_name_declared_once(name: str) -> None:
     assert get_effect(name).name == name, f"{name}: an instance answers {get_effect(name).name}"
 
 
+def _assert_columns(where: str, cols: np.ndarray, samples: int, p: int) -> None:
+    assert cols.ndim == 2 and cols.shape == (samples, p), (
+        f"{where}: columns {cols.shape} on a record of {samples} samples; columns_count says {p}"
+    )
+    assert np.all(np.isfinite(cols)), f"{where}: columns not finite"
+
+
 def check_columns_shape_and_finite(name: str) -> None:
     effect = get_effect(name)
     records, scales = probes()
@@ -111,12 +118,8 @@ def check_columns_shape_and_finite(name: str) -> None:
         p = effect.columns_count(shape, scales)
         for s in records:
             cols = effect.columns(s, shape, scales)
-            assert cols.ndim == 2 and cols.shape == (s.x.size, p), (
-                f"{name} at {shape!r}: columns {cols.shape} on a record of {s.x.size} samples; "
-                f"columns_count says {p}"
-            )
+            _assert_columns(f"{name} at {shape!r}", cols, s.x.size, p)
             assert cols.dtype == np.float64, f"{name} at {shape!r}: columns are {cols.dtype}"
-            assert np.all(np.isfinite(cols)), f"{name} at {shape!r}: columns not finite"
             if p:
                 assert np.all(np.any(cols != 0, axis=0)), f"{name} at {shape!r}: a zero column"
 
@@ -162,11 +165,7 @@ def check_other_forms(name: str) -> None:
         p = effect.columns_count(form, scales)
         for s in records:
             cols = effect.block_columns(s, form, scales)
-            assert cols.ndim == 2 and cols.shape == (s.x.size, p), (
-                f"{name} at {form!r}: columns {cols.shape} on a record of {s.x.size} samples; "
-                f"columns_count says {p}"
-            )
-            assert np.all(np.isfinite(cols)), f"{name} at {form!r}: columns not finite"
+            _assert_columns(f"{name} at {form!r}", cols, s.x.size, p)
         lower = np.asarray(effect.block_lower(form, scales), dtype=float)
         assert lower.shape == (p,), (
             f"{name} at {form!r}: {lower.shape} bounds for {p} columns (an effect whose "
