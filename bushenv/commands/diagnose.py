@@ -1,11 +1,12 @@
 """``bushenv diagnose``: a baseline's sim-to-real gap, where it lies, which effect closes it.
 
     bushenv diagnose TRAIN_CSV TEST_CSV [TEST_CSV ...] --out DIR [--train CSV ...]
-                     [--cross | --held-out]
+                     [--cross | --held-out] [--run-order CSV]
 
 Every record is used: each record, TRAIN or TEST, is judged by a fit on all the others (the
 default with the linear baseline, ``--cross``); ``--held-out`` fits on TRAIN only and judges
-the TESTs. Writes
+the TESTs. ``--run-order`` gives the order the rig ran the records in and the rests between
+(``bushenv.diagnose.session``): a heat is carried from record to record. Writes
 
 - ``DIR/report.json``: effect named, ranking, pairs, unexplained share, shift warnings, where
   the gap lies, parameters (docs/diagnose.md)
@@ -36,7 +37,7 @@ from bushenv.progress import Progress
 
 EXAMPLE = (
     "bushenv diagnose train.csv test_random.csv test_steps.csv --out diag/ "
-    "[--train more.csv] [--held-out] [--max-displacement 0.5]"
+    "[--train more.csv] [--held-out] [--run-order order.csv] [--max-displacement 0.5]"
 )
 
 
@@ -101,6 +102,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="write into an existing DIR (replaces only the report's own files)",
     )
+    parser.add_argument(
+        "--run-order",
+        type=Path,
+        default=None,
+        metavar="CSV",
+        help="the order the rig ran the records in: a CSV 'record,rest_before_s', one row per "
+        "record (its file stem), the rest in s since the row before ended; an empty rest (or "
+        "'cold') begins a session. A heat is then carried from record to record",
+    )
     parser.add_argument("--seed", type=int, default=0, help="seed for baseline identification")
     add_resample_option(parser, keep=True)
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
@@ -130,6 +140,7 @@ def config_from(args: argparse.Namespace) -> DiagnoseConfig:
         force=args.force,
         seed=args.seed,
         resample=args.resample,
+        run_order=args.run_order,
     )
 
 

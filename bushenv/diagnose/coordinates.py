@@ -211,6 +211,7 @@ def diagnose_coordinates(
     effects: Sequence[str] | None = None,
     train_names: Sequence[str] | None = None,
     engine: Callable[..., dict[str, Any]],
+    run_order: Sequence[tuple[str, Any]] | None = None,
 ) -> dict[str, Any]:
     """Which coordinate carries the gap, which effect closes it there, how far (module doc).
     ``engine`` is the one-axis diagnosis run on each coordinate (``bushenv.diagnose.fit.
@@ -272,6 +273,7 @@ def diagnose_coordinates(
             train_names=tr,
             cross=cross,
             effects=effects,
+            run_order=run_order,
         )
         d["coordinate"] = name
         diagnoses[name] = d

@@ -48,6 +48,12 @@ class Prepared:
     b0: np.ndarray
     band_edge_hz: float | None = None
     uid: int = field(default_factory=lambda: next(_UIDS))
+    start_of: int | None = None  # the uid of its session's first record (they share a start)
+
+    @property
+    def start_key(self) -> int:
+        """Whose per-record block (a warm start) this record's is: its session's, else its own."""
+        return self.uid if self.start_of is None else self.start_of
 
     @property
     def dt(self) -> float:

@@ -44,6 +44,7 @@ from bushenv.diagnose.inputs import (
 from bushenv.diagnose.judging import Run, judge_all, test_only_hint
 from bushenv.diagnose.lag import lag_evidence
 from bushenv.diagnose.outcome import notes_of, result_of
+from bushenv.diagnose.session import Order, link
 from bushenv.diagnose.shift import shift_warnings
 
 __all__ = ["DiagnoseError", "diagnose", "baseline_names"]
@@ -61,6 +62,7 @@ def diagnose(
     cross: bool | None = None,
     effects: Sequence[str] | None = None,
     train_names: Sequence[str] | None = None,
+    run_order: Order | None = None,
 ) -> dict[str, Any]:
     """Where the gap lies, which candidate effect closes it, and by how much.
 
@@ -71,6 +73,10 @@ def diagnose(
     (docs/diagnose.md) plus ``"predictions"``: one dict per judged record with ``name``,
     ``role`` and (T,) arrays ``time``, ``displacement``, ``force_measured``,
     ``force_baseline``, ``force_augmented`` (the answer's held-out prediction).
+
+    ``run_order``: the records in the order the rig ran them, ``[(name, rest_s), ...]``
+    (``bushenv.diagnose.session``): a heat is carried from record to record and a session has
+    one start. Without it every record may start warm, each at its own heat.
 
     Records of C > 1 coordinates (``.q``, ``.f`` (T, C)) go to
     ``bushenv.diagnose.coordinates.diagnose_coordinates``: which coordinate carries the gap,
@@ -89,6 +95,7 @@ def diagnose(
             effects=effects,
             train_names=train_names,
             engine=diagnose,
+            run_order=run_order,
         )
     say = progress or (lambda msg: None)
     if not trains:
@@ -109,6 +116,9 @@ def diagnose(
     say(f"identifying baseline {baseline!r} on TRAIN ({n_train} samples)")
     model = None if linear_base else fit_nonlinear_baseline(baseline, trains[0], seed, say)
     tr, te, stencil = prepare_records(trains, tests, t_names, names, model, cross, say)
+    sessions = link(tr + te, run_order) if run_order else []
+    for names_run in sessions:
+        say("run in one session, heat carried over: " + " -> ".join(names_run))
     fitting = tr + (te if cross else [])
     store = ColumnStore(Scales.of([p.signals for p in fitting]), admissible=linear_base)
     run = Run(store, make_folds(tr, te, cross), linear_base)
@@ -155,6 +165,7 @@ def diagnose(
             for f in run.folds
         ],
     }
+    result["records"]["sessions"] = sessions  # the run order given (empty: none)
     result["derivative_stencil"] = stencil
     result["displacement_band_hz"] = {
         p.name: p.band_edge_hz for p in tr + te if p.band_edge_hz is not None

@@ -43,7 +43,8 @@ class Fit:
     n: int  # samples fitted
     force_ms: float  # mean square of the force fitted (for a relative fitting error)
     nuisance: tuple[Block, ...] = ()  # per-record blocks (a warm start), fitted per record
-    nuisance_w: dict = field(default_factory=dict)  # record uid -> its own weights
+    nuisance_w: dict = field(default_factory=dict)  # start key (record or session) -> weights
+    start_seen_s: dict = field(default_factory=dict)  # start key -> its earliest record fitted
 
     @property
     def delay_s(self) -> float:
@@ -133,40 +134,46 @@ def _fit(
     delay = sum(m.delay_s(s) for m, s in zip(combo.members, shapes, strict=True))
     p_ = sum(store.columns_count(b) for b in blocks)
     q = sum(store.columns_count(b) for b in nuis)
-    size = p_ + q * len(records)
+    starts = list(dict.fromkeys(p.start_key for p in records))  # a session's records share one
+    size = p_ + q * len(starts)
     g, b, yy = np.zeros((size, size)), np.zeros(size), 0.0
-    for i, p in enumerate(records):
+    for p in records:
         gp = store.gram(p, blocks + nuis)
         bp, yp = store.rhs(p, blocks + nuis, delay)
-        o = p_ + i * q
+        o = p_ + starts.index(p.start_key) * q
         g[:p_, :p_] += gp[:p_, :p_]
         b[:p_] += bp[:p_]
         yy += yp
         if q:
-            g[:p_, o : o + q], g[o : o + q, :p_] = gp[:p_, p_:], gp[p_:, :p_]
-            g[o : o + q, o : o + q], b[o : o + q] = gp[p_:, p_:], bp[p_:]
+            g[:p_, o : o + q] += gp[:p_, p_:]
+            g[o : o + q, :p_] += gp[p_:, :p_]
+            g[o : o + q, o : o + q] += gp[p_:, p_:]
+            b[o : o + q] += bp[p_:]
     n = sum(p.n for p in records)
     lower = np.concatenate([store.lower(blocks), np.zeros(size - p_)])
     w = bounded_lstsq(g, b, lower, n)
     mse = max(float(yy - 2 * w @ b + w @ g @ w) / n, 0.0)
     force_ms = float(sum(np.sum(p.force**2) for p in records)) / n
-    own = {p.uid: w[p_ + i * q : p_ + (i + 1) * q] for i, p in enumerate(records)} if q else {}
-    return Fit(combo, tuple(shapes), blocks, w[:p_], mse, n, force_ms, nuis, own)
+    own = {k: w[p_ + i * q : p_ + (i + 1) * q] for i, k in enumerate(starts)} if q else {}
+    seen = {k: min(p.signals.session_time_s for p in records if p.start_key == k) for k in own}
+    return Fit(combo, tuple(shapes), blocks, w[:p_], mse, n, force_ms, nuis, own, seen)
 
 
 def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
     """The fitted model's force on one record (N), (T,). A per-record block gets the weights
-    the record was fitted with; on a judged record, one scale of its own along
+    the record was fitted with, or its session's where a record of the session run before it
+    was fitted (the start has only cooled since). Else one scale of its own along
     ``start_direction``, read from its cooling and its level (``judged_start``), from 0 to
-    the warmest fitted record's (the state it starts in -- a heat -- is the record's, and no
-    other record can tell it; one bounded number, not a spring and damper of its own: a
-    judged record starts no warmer than a record fitted)."""
+    the warmest fitted record's, or to its session's fitted start (the state it starts in --
+    a heat -- is the record's: one bounded number, not a spring and damper of its own; a
+    session's start fitted on records run after it, where it has cooled, is read through
+    a cooling that may have left little of it)."""
     a = store.design(prep, f.blocks)
     out = prep.b0 + a @ f.theta
     if f.nuisance:
         wn = store.design(prep, f.nuisance)
-        own = f.nuisance_w.get(prep.uid)
-        if own is not None:
+        own = f.nuisance_w.get(prep.start_key)
+        if own is not None and prep.signals.session_time_s >= f.start_seen_s[prep.start_key]:
             out = out + wn @ own
         else:
             direction = start_direction(store, f)
@@ -176,7 +183,8 @@ def predict(store: ColumnStore, f: Fit, prep: Prepared) -> np.ndarray:
                 shifted = shift_columns(out, f.delay_s, prep.dt)
                 own_spring = shift_columns(store.design(prep, (SPRING,)), f.delay_s, prep.dt)
                 scale = judged_start(prep.force - shifted, d, own_spring)
-                return shifted + min(max(scale, 0.0), warmest_start(f, direction)) * d
+                top = warmest_start(f, direction, own)
+                return shifted + min(max(scale, 0.0), top) * d
     return shift_columns(out, f.delay_s, prep.dt)
 
 
@@ -201,13 +209,14 @@ def cooling_scale(residual: np.ndarray, d: np.ndarray, spring: np.ndarray) -> fl
     return float(residual @ part) / pp if pp > 1e-12 * float(d @ d) else 0.0
 
 
-def warmest_start(f: Fit, direction: np.ndarray) -> float:
-    """The largest fitted record's start along ``direction`` (a scale): a judged record starts
-    no warmer than the warmest record fitted."""
+def warmest_start(f: Fit, direction: np.ndarray, own: np.ndarray | None = None) -> float:
+    """The largest fitted record's start along ``direction`` (a scale), or the record's
+    session's start (``own``) where it was fitted: a judged record starts no warmer."""
     dd = float(direction @ direction)
     if dd <= 0:
         return 0.0
-    return max(max(float(w @ direction) / dd for w in f.nuisance_w.values()), 0.0)
+    starts = [own] if own is not None else list(f.nuisance_w.values())
+    return max(max(float(w @ direction) / dd for w in starts), 0.0)
 
 
 def start_direction(store: ColumnStore, f: Fit) -> np.ndarray:

@@ -44,6 +44,8 @@ def _header(data: dict[str, Any]) -> list[str]:
         lines.append(f"- TRAIN: `{t['name']}` ({t['samples']} samples at {t['rate_hz']:.6g} Hz)")
     for t in recs["tests"]:
         lines.append(f"- TEST: `{t['name']}` ({t['samples']} samples at {t['rate_hz']:.6g} Hz)")
+    for names in recs.get("sessions", []):
+        lines.append(f"- run in one session, heat carried over: {' -> '.join(names)}")
     lines += [f"- judged: {', '.join(recs['judged'])}", f"- baseline: `{data['baseline']}`", ""]
     return lines
 

@@ -18,6 +18,7 @@ from typing import Any
 from bushenv.diagnose.errors import DiagnoseError
 from bushenv.diagnose.fit import diagnose
 from bushenv.diagnose.report_files import write_report
+from bushenv.diagnose.session import read_order
 from bushenv.record_files import record_coordinates
 from bushenv.record_rates import one_rate
 
@@ -31,7 +32,8 @@ class DiagnoseConfig:
     ``cross``: None is the default mode (every record judged with the linear baseline, the
     TESTs held out with another), True / False ask for cross / held-out. ``max_displacement_m``
     and ``max_force_n``: plausibility limits of the records (None: the loader's defaults).
-    ``resample``: ``--resample``'s value (None refuses mixed rates).
+    ``resample``: ``--resample``'s value (None refuses mixed rates). ``run_order``: the order
+    the records ran in and the rests between, read before any record is loaded.
     """
 
     train: tuple[str, ...]
@@ -45,6 +47,7 @@ class DiagnoseConfig:
     force: bool = False
     seed: int = 0
     resample: float | str | None = None
+    run_order: Path | None = None  # a CSV ``record,rest_before_s`` (bushenv.diagnose.session)
 
 
 def _load(paths: tuple[str, ...], config: DiagnoseConfig, say: Say) -> list:
@@ -75,6 +78,7 @@ def run_diagnosis(config: DiagnoseConfig, say: Say | None = None) -> dict[str, A
             f"judged files need distinct file names (stems {judged}): each one's predictions "
             "go to predictions/<stem>.csv"
         )
+    order = read_order(config.run_order) if config.run_order is not None else None
     if three_axis_files(config.train + config.tests):
         trains, tests = _load_three_axis(config, say)
     else:
@@ -91,6 +95,7 @@ def run_diagnosis(config: DiagnoseConfig, say: Say | None = None) -> dict[str, A
         train_names=[Path(p).stem for p in config.train],
         cross=config.cross,
         effects=config.effects,
+        run_order=order,
     )
     result["files"] = {"train": [str(p) for p in config.train], "tests": list(config.tests)}
     say(f"writing {out}")

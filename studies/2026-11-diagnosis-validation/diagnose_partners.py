@@ -32,12 +32,22 @@ def named_set(named: str) -> set[str]:
     return set() if named in ("none", AMBIGUOUS, OUTSIDE) else set(named.split("+"))
 
 
-def run(seed: int, cases: int, start: int, label: tuple[str, ...] | None = None) -> list[dict]:
+def run_order(case) -> list[tuple[str, float | None]]:
+    """The case's records in the order its session ran them, the rests between (its start
+    unknown: the specimen may have run warm before)."""
+    names = [r.name for r in case.train + case.tests]
+    order, rests = case.drawn["order"], case.drawn["rests_s"]
+    return [(names[i], None if j == 0 else rests[j - 1]) for j, i in enumerate(order)]
+
+
+def run(
+    seed: int, cases: int, start: int, label: tuple[str, ...] | None = None, order: bool = False
+) -> list[dict]:
     rows = []
     t0 = time.monotonic()
     for n, i in enumerate(range(start, start + cases)):
         case = make_partner_case(seed, i, label=label)
-        r = diagnose(case.train, case.tests)
+        r = diagnose(case.train, case.tests, run_order=run_order(case) if order else None)
         before = next((p["effect"] for p in r["pairs"] if p.get("passes_pair_rule")), None)
         rows.append(
             {
@@ -122,12 +132,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default="partners.json")
     ap.add_argument("--label", help="every case this effect or pair, e.g. thermal+relaxation")
     ap.add_argument("--summary", nargs="*", help="only summarise these JSON files")
+    ap.add_argument(
+        "--run-order", action="store_true", help="give the diagnosis the order the records ran"
+    )
     a = ap.parse_args(argv)
     if a.summary:
         rows = [row for p in a.summary for row in json.load(open(p, encoding="utf-8"))]
     else:
         label = tuple(a.label.split("+")) if a.label else None
-        rows = run(a.seed, a.cases, a.start, label)
+        rows = run(a.seed, a.cases, a.start, label, a.run_order)
         with open(a.out, "w", encoding="utf-8") as f:
             json.dump(rows, f, indent=1)
     print(summary(rows))

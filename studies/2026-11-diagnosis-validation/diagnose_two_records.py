@@ -1,7 +1,8 @@
 """Sessions of two records: how often a thermal drift is named when each record is judged by a
 fit on the other alone (the default mode with one TEST).
 
-    python studies/2026-11-diagnosis-validation/diagnose_two_records.py [--out two.json]
+    python studies/2026-11-diagnosis-validation/diagnose_two_records.py [--out two.json] \
+        [--run-order]
 
 The specimen of ``tests/diagnose/test_thermal_energy.py`` (heat fed by ``c v^2``, a 60 s leak,
 a quarter of the stiffness and damping lost at the session's hottest; and the relaxing one,
@@ -30,7 +31,7 @@ from tests.diagnose.test_thermal_energy import (  # noqa: E402
 )
 
 
-def run() -> list[dict]:
+def run(run_order: bool = False) -> list[dict]:
     progs = _programmes()
     sessions = [(a, b, w) for a, b in itertools.permutations(progs, 2) for w in (False, True)]
     sessions += [(a, b, None) for a, b in itertools.permutations(progs, 2)]
@@ -41,7 +42,7 @@ def run() -> list[dict]:
             forces, label = _relaxing_forces(progs), "relaxation"
         else:
             forces, label = _thermal_forces(progs, order, warm), "thermal"
-        r = _diagnose(forces, progs, order)
+        r = _diagnose(forces, progs, order, run_order)
         rows.append({"label": label, "order": list(order), "warm": warm,
                      "named": r["effect"], "top_two": r["top_two"]})  # fmt: skip
         eta = (time.monotonic() - t0) / (n + 1) * (len(sessions) - n - 1)
@@ -68,8 +69,11 @@ def summary(rows: list[dict]) -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="two_records.json")
+    ap.add_argument(
+        "--run-order", action="store_true", help="tell the diagnosis the order and the rests"
+    )
     a = ap.parse_args(argv)
-    rows = run()
+    rows = run(a.run_order)
     Path(a.out).write_text(json.dumps(rows, indent=1), encoding="utf-8")
     for r in rows:
         print(f"{r['label']:<10} {' then '.join(r['order']):<16} "

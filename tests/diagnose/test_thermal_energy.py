@@ -44,21 +44,23 @@ def _programmes() -> dict[str, np.ndarray]:
     }
 
 
-def _heat(v: np.ndarray, start: float) -> np.ndarray:
-    """theta' = c v^2 - theta / tau from ``start`` (J)."""
+def _heat(v: np.ndarray, start: float, law: str = "viscous") -> np.ndarray:
+    """theta' = P - theta / tau from ``start`` (J): P = c v^2 (viscous), or a friction's
+    F0 |v| with F0 = c x 0.1 m/s (hysteretic)."""
     a = np.exp(-DT / TAU_S)
-    return signal.lfilter([DT], [1.0, -a], C * v * v, zi=[a * start])[0]
+    power = C * v * v if law == "viscous" else C * 0.1 * np.abs(v)
+    return signal.lfilter([DT], [1.0, -a], power, zi=[a * start])[0]
 
 
-def _thermal_forces(progs, order, warm: bool) -> dict[str, np.ndarray]:
+def _thermal_forces(progs, order, warm: bool, law: str = "viscous") -> dict[str, np.ndarray]:
     """The session's forces: the heat follows the dissipated energy through ``order``."""
-    top = max(float(np.max(_heat(np.gradient(x, DT), 0.0))) for x in progs.values())
-    heat = float(_heat(np.gradient(progs["hot"], DT), 0.0)[-1]) if warm else 0.0
+    top = max(float(np.max(_heat(np.gradient(x, DT), 0.0, law))) for x in progs.values())
+    heat = float(_heat(np.gradient(progs["hot"], DT), 0.0, law)[-1]) if warm else 0.0
     out = {}
     for name in order:
         x = progs[name]
         v = np.gradient(x, DT)
-        theta = _heat(v, heat)
+        theta = _heat(v, heat, law)
         soft = LOSS * theta / top
         out[name] = (1.0 - soft) * (K * x + C * v)
         heat = float(theta[-1]) * np.exp(-REST_S / TAU_S)
@@ -76,13 +78,15 @@ def _relaxing_forces(progs) -> dict[str, np.ndarray]:
     return out
 
 
-def _diagnose(forces, progs, order) -> dict:
+def _diagnose(forces, progs, order, run_order: bool = False) -> dict:
+    """``run_order``: the diagnosis is told the order and the rests (not the start)."""
     rng = np.random.default_rng(7)
     recs = []
     for name in order:
         f = forces[name] + 0.005 * np.std(forces[name]) * rng.normal(size=forces[name].size)
         recs.append(Record.from_arrays(progs[name], f, DT, name=name))
-    return diagnose(recs[0], recs[1:])
+    given = [(order[0], None)] + [(n, REST_S) for n in order[1:]] if run_order else None
+    return diagnose(recs[0], recs[1:], run_order=given)
 
 
 @pytest.mark.parametrize(
@@ -115,6 +119,29 @@ def test_a_session_of_two_records_is_named_thermal(order, warm):
     progs = _programmes()
     r = _diagnose(_thermal_forces(progs, order, warm), progs, order)
     assert r["effect"] == "thermal", (r["effect"], r["top_two"])
+
+
+@pytest.mark.parametrize("order", list(ORDERS))
+def test_a_heat_fed_by_friction_is_read_as_hysteretic(order):
+    """A heat fed by ``|v|`` (a friction's dissipation) over a session of four programmes is
+    named thermal with the hysteretic heating law."""
+    progs = _programmes()
+    r = _diagnose(_thermal_forces(progs, ORDERS[order], False, "hysteretic"), progs, ORDERS[order])
+    assert r["effect"] == "thermal", (r["effect"], r["top_two"])
+    assert r["parameters"]["thermal"]["heating"] == "hysteretic"
+
+
+@pytest.mark.parametrize(
+    "order,warm", [(("broad", "slow"), False), (("hot", "slow"), False), (("mixed", "broad"), True)]
+)
+def test_a_run_order_carries_the_heat_from_record_to_record(order, warm):
+    """Told the order and the rest, a record's start is what the one before left, cooled over
+    the rest: no start of its own to trade with the spring. These sessions answered
+    ``outside_candidates`` without the order."""
+    progs = _programmes()
+    r = _diagnose(_thermal_forces(progs, order, warm), progs, order, run_order=True)
+    assert r["effect"] == "thermal", (r["effect"], r["top_two"])
+    assert r["records"]["sessions"] == [list(order)]
 
 
 def test_a_warm_session_gives_back_its_cold_spring_and_its_leak():

@@ -33,6 +33,12 @@ class Signals:
     acceleration), what every bushenv model uses, so simulated records match it exactly;
     ``"five_point"`` is the fourth-order stencil, closer to the derivative of a continuous
     motion near Nyquist. The diagnosis picks the one that fits TRAIN better.
+
+    A record run in a session (``bushenv.diagnose.session``) knows what ran before it:
+    ``before`` is the record run just before and the rest between (s), ``session_time_s`` the
+    time from the session's first sample to this record's, ``session_cold`` whether the
+    session began with the specimen at rest (else it may have started warm). An effect with a
+    state (a heat) carries it over; the others ignore it.
     """
 
     x: np.ndarray
@@ -40,6 +46,10 @@ class Signals:
     stencil: str = "central"
     v: np.ndarray = field(init=False)
     a: np.ndarray = field(init=False)
+    before: tuple[Signals, float] | None = None
+    session_time_s: float = 0.0
+    session_cold: bool = False
+    memo: dict = field(default_factory=dict, repr=False, compare=False)  # states carried over
 
     def __post_init__(self) -> None:
         self.x = np.ascontiguousarray(self.x, dtype=np.float64)

@@ -29,6 +29,31 @@ def heating_state(v: np.ndarray, dt: float, tau: float, heating: str, v_rms: flo
     return signal.lfilter([dt], [1.0, -a], p)
 
 
+def cooling(s: Signals, tau: float, offset_s: float = 0.0) -> np.ndarray:
+    """exp(-(t + offset) / tau) over the record (1 throughout without a leak)."""
+    if np.isinf(tau):
+        return np.ones(s.x.size)
+    return np.exp(-(np.arange(s.x.size) * s.dt + offset_s) / tau)
+
+
+def session_heat(s: Signals, tau: float, heating: str, v_rms: float) -> np.ndarray:
+    """The record's heat with what the session's records run before it left: their heat at
+    their end, cooled over the rest, cools on through this record (a session's unknown start
+    is the per-record block's)."""
+    theta = heating_state(s.v, s.dt, tau, heating, v_rms)
+    if s.before is None:
+        return theta
+    return theta + end_heat(*s.before, tau, heating, v_rms) * cooling(s, tau)
+
+
+def end_heat(s: Signals, rest_s: float, tau: float, heating: str, v_rms: float) -> float:
+    """The heat a record leaves after ``rest_s`` of rest (remembered per record)."""
+    key = ("thermal_end", tau, heating, v_rms)
+    if key not in s.memo:
+        s.memo[key] = float(session_heat(s, tau, heating, v_rms)[-1])
+    return s.memo[key] * (1.0 if np.isinf(tau) else np.exp(-rest_s / tau))
+
+
 def warm_heat(tau: float, scales: Scales) -> float:
     """The steady heat (m^2/s) at TRAIN's RMS velocity with a leak of ``tau``: the unit of a
     warm start (a record that starts at this heat has run long enough to settle)."""
@@ -48,7 +73,8 @@ class Thermal(Effect):
     form = (
         "-theta (b_k x + b_c v) - exp(-t / tau_th) (s_k x + s_c v), theta' = P - theta / tau_th, "
         "P = v^2 or abs(v) v_rms (s_k, s_c: lost at the start of a record that starts warm, "
-        "each record its own)"
+        "each record its own; with a run order theta is carried over the rests and a session "
+        "has one start)"
     )
     weights = "b_k, b_c >= 0; s_k, s_c >= 0 per record"
     telling_test = (
@@ -72,16 +98,20 @@ class Thermal(Effect):
 
     def columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         heating, tau = shape
-        theta = heating_state(s.v, s.dt, tau, heating, scales.v_rms)
+        theta = session_heat(s, tau, heating, scales.v_rms)
         return np.stack([-theta * s.x, -theta * s.v], axis=1)
 
     def nuisance_columns(self, s: Signals, shape: Any, scales: Scales) -> np.ndarray:
         """A record that starts warm cools with the same leak: its stiffness and damping lost
-        at the start, its own (records run in any order start at different heats)."""
+        at the start, its own (records run in any order start at different heats). In a
+        session the start is the session's, cooled until the record begins; none if the
+        session began cold."""
         tau = shape[1] if isinstance(shape, tuple) else shape
         if not np.isfinite(tau):
             return np.zeros((s.x.size, 0))
-        warm = np.exp(-np.arange(s.x.size) * s.dt / tau) * warm_heat(tau, scales)
+        warm = cooling(s, tau, s.session_time_s) * warm_heat(tau, scales)
+        if s.session_cold:
+            warm = np.zeros_like(warm)
         return np.stack([-warm * s.x, -warm * s.v], axis=1)
 
     def rich_shapes(self, scales: Scales) -> list:

@@ -265,6 +265,7 @@ def make_partner_case(
     by_record = member_visibility(label, p, k, c, progs, order, rests)
     forces = specimen_forces(label, p, k, c, progs, order, rests)
     drawn = {"rate_hz": rate, **info, "poor_train": poor, "order": [int(i) for i in order],
+             "rests_s": [round(r, 3) for r in rests],
              "k_n_per_m": round(k, 3), "c_ns_per_m": round(c, 4),
              "visible": round(visible_gap(forces, progs, judged), 4),
              "visible_by_record": by_record}  # fmt: skip
