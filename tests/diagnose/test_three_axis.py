@@ -175,3 +175,13 @@ def test_mixed_record_files_are_refused_naming_both(files, capsys):
     assert code == 2
     assert "train3.csv is a three-axis record but" in err and "one_axis.csv is a one-axis" in err
     assert not (files / "mixed").exists()
+
+
+def test_a_run_order_reaches_every_coordinates_diagnosis():
+    train, test = make_case(FAST[0], 0)
+    order = [(train.name, None), (test.name, 60.0)]
+    result = diagnose(train, [test], run_order=order)
+    for d in result["diagnoses"].values():
+        assert d["records"]["sessions"] == [[train.name, test.name]]
+    with pytest.raises(DiagnoseError, match="run order row 1: no record named 'nope'"):
+        diagnose(train, [test], run_order=[("nope", None)])
