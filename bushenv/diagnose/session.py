@@ -68,7 +68,11 @@ def link(preps: Sequence[Prepared], order: Order) -> list[list[str]]:
     time and start); returns the sessions as lists of names."""
     by_name = {p.name: p for p in preps}
     if len(by_name) != len(preps):
-        raise DiagnoseError("a run order needs every record's name (file stem) distinct")
+        twice = sorted({p.name for p in preps if sum(q.name == p.name for q in preps) > 1})
+        raise DiagnoseError(
+            f"a run order needs every record's name (file stem) distinct; {', '.join(twice)} "
+            "name more than one record: rename the files"
+        )
     seen: set[str] = set()
     sessions: list[list[str]] = []
     first: Prepared | None = None

@@ -76,6 +76,12 @@ def test_a_bad_order_is_refused_by_row(order, message):
         link(preps, order)
 
 
+def test_records_of_one_name_cannot_be_ordered():
+    preps = [_prep("a", _signals(1, 2.0)), _prep("a", _signals(2, 2.0))]
+    with pytest.raises(DiagnoseError, match="distinct; a name more than one record"):
+        link(preps, [("a", None)])
+
+
 def test_an_order_file_is_read_and_a_bad_line_named(tmp_path):
     path = tmp_path / "order.csv"
     path.write_text("record,rest_before_s\ntrain,\n\ntest_a,120\ntest_b,cold\ntest_c,30.5\n")
