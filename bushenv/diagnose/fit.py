@@ -166,6 +166,9 @@ def diagnose(
         ],
     }
     result["records"]["sessions"] = sessions  # the run order given (empty: none)
+    result["records"]["session_time_s"] = {  # each ordered record's start in its session
+        p.name: p.signals.session_time_s for p in tr + te if any(p.name in s for s in sessions)
+    }
     result["derivative_stencil"] = stencil
     result["displacement_band_hz"] = {
         p.name: p.band_edge_hz for p in tr + te if p.band_edge_hz is not None

@@ -119,6 +119,8 @@ def _where(data: dict[str, Any]) -> list[str]:
     ]
     for p in ("where_regimes.png", "where_spectrum.png", "where_time.png"):
         lines += [f"![{p}]({p})", ""]
+    if data["records"].get("sessions"):
+        lines += ["![where_session.png](where_session.png)", ""]
     return lines
 
 

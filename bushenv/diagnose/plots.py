@@ -116,6 +116,36 @@ def time_plot(result: dict[str, Any], out: Path, names: list[str]) -> None:
     _save(fig, out, "where_time.png", names)
 
 
+def session_plot(result: dict[str, Any], out: Path, names: list[str]) -> None:
+    """The gap through each session given by a run order: every judged record at its start
+    in the session, the rests between left blank (a drift across records shows here)."""
+    recs = result["records"]
+    if not recs.get("sessions"):
+        return
+    plt = _plt()
+    preds = {p["name"]: p for p in result["predictions"]}
+    fig, axes = plt.subplots(
+        len(recs["sessions"]), 1, figsize=(8, 2.5 + 1.5 * len(recs["sessions"])), squeeze=False
+    )
+    for ax, session in zip(axes[:, 0], recs["sessions"], strict=True):
+        for name in session:
+            if name not in preds:
+                continue
+            pred, t0 = preds[name], recs["session_time_s"][name]
+            t = np.asarray(pred["time"]) - pred["time"][0] + t0
+            w = max(int(round(1.0 / pred["dt"])), 1)
+            step = max(t.size // MAX_POINTS, 1)
+            for key, ls in (("force_baseline", "-"), ("force_augmented", "--")):
+                r = np.asarray(pred["force_measured"]) - np.asarray(pred[key])
+                run = np.sqrt(np.convolve(r * r, np.ones(w) / w, mode="same"))
+                ax.plot(t[::step], run[::step], ls=ls, label=f"{name} {key[6:]}")
+        ax.set_ylabel(f"1 s RMS gap, {units_of(result)[2]}")
+        ax.legend(fontsize=7, ncol=2)
+    axes[-1, 0].set_xlabel("time in the session, s (rests between records left blank)")
+    axes[0, 0].set_title("where: the gap through the session, records in the order run")
+    _save(fig, out, "where_session.png", names)
+
+
 def _window(t: np.ndarray, r: np.ndarray, dt: float) -> tuple[slice, str]:
     """The whole record up to 30 s; else the window of max(10 s, 1/10) with the largest gap."""
     if t.size * dt <= 30.0:
@@ -184,6 +214,7 @@ def make_plots(result: dict[str, Any], out: Path) -> list[str]:
     regimes_plot(result, out, names)
     spectrum_plot(result, out, names)
     time_plot(result, out, names)
+    session_plot(result, out, names)
     units = units_of(result)
     for pred in result["predictions"]:
         force_plot(pred, out, names, units[2])
