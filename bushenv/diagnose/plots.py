@@ -98,17 +98,21 @@ def spectrum_plot(result: dict[str, Any], out: Path, names: list[str]) -> None:
     _save(fig, out, "where_spectrum.png", names)
 
 
+def _plot_running_gap(ax, pred: dict[str, Any], t: np.ndarray) -> None:
+    """The 1 s running RMS of the baseline's and the augmented model's gap at times ``t``."""
+    w = max(int(round(1.0 / pred["dt"])), 1)
+    step = max(t.size // MAX_POINTS, 1)
+    for key, ls in (("force_baseline", "-"), ("force_augmented", "--")):
+        r = np.asarray(pred["force_measured"]) - np.asarray(pred[key])
+        run = np.sqrt(np.convolve(r * r, np.ones(w) / w, mode="same"))
+        ax.plot(t[::step], run[::step], ls=ls, label=f"{pred['name']} {key[6:]}")
+
+
 def time_plot(result: dict[str, Any], out: Path, names: list[str]) -> None:
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7, 3.5))
     for pred in result["predictions"]:
-        t = np.asarray(pred["time"])
-        w = max(int(round(1.0 / pred["dt"])), 1)
-        for key, ls in (("force_baseline", "-"), ("force_augmented", "--")):
-            r = np.asarray(pred["force_measured"]) - np.asarray(pred[key])
-            run = np.sqrt(np.convolve(r * r, np.ones(w) / w, mode="same"))
-            step = max(t.size // MAX_POINTS, 1)
-            ax.plot(t[::step], run[::step], ls=ls, label=f"{pred['name']} {key[6:]}")
+        _plot_running_gap(ax, pred, np.asarray(pred["time"]))
     ax.set_xlabel("time, s")
     ax.set_ylabel(f"1 s running RMS of the gap, {units_of(result)[2]}")
     ax.legend(fontsize=7)
@@ -132,13 +136,7 @@ def session_plot(result: dict[str, Any], out: Path, names: list[str]) -> None:
             if name not in preds:
                 continue
             pred, t0 = preds[name], recs["session_time_s"][name]
-            t = np.asarray(pred["time"]) - pred["time"][0] + t0
-            w = max(int(round(1.0 / pred["dt"])), 1)
-            step = max(t.size // MAX_POINTS, 1)
-            for key, ls in (("force_baseline", "-"), ("force_augmented", "--")):
-                r = np.asarray(pred["force_measured"]) - np.asarray(pred[key])
-                run = np.sqrt(np.convolve(r * r, np.ones(w) / w, mode="same"))
-                ax.plot(t[::step], run[::step], ls=ls, label=f"{name} {key[6:]}")
+            _plot_running_gap(ax, pred, np.asarray(pred["time"]) - pred["time"][0] + t0)
         ax.set_ylabel(f"1 s RMS gap, {units_of(result)[2]}")
         ax.legend(fontsize=7, ncol=2)
     axes[-1, 0].set_xlabel("time in the session, s (rests between records left blank)")
