@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from bushenv.diagnose import rule, showing
+from bushenv.diagnose import halves, rule, showing
 from bushenv.diagnose.coordinates import coordinate_count, diagnose_coordinates
 from bushenv.diagnose.design import ColumnStore
 from bushenv.diagnose.effects.base import Scales
@@ -97,9 +97,30 @@ def diagnose(
             engine=diagnose,
             run_order=run_order,
         )
-    say = progress or (lambda msg: None)
     if not trains:
         raise DiagnoseError("no TRAIN record given")
+    return _diagnose_axis(
+        trains, list(tests), baseline, progress, seed, test_names, cross, effects, train_names,
+        run_order, halve=True,
+    )  # fmt: skip
+
+
+def _diagnose_axis(
+    trains: list[Any],
+    tests: list[Any],
+    baseline: str,
+    progress: Progress | None,
+    seed: int,
+    test_names: Sequence[str] | None,
+    cross: bool | None,
+    effects: Sequence[str] | None,
+    train_names: Sequence[str] | None,
+    run_order: Order | None,
+    halve: bool,
+) -> dict[str, Any]:
+    """``diagnose`` on records of one coordinate; ``halve``: a record that alone shows the
+    gap may be judged half against half (``halves.py``)."""
+    say = progress or (lambda msg: None)
     t_names = (
         list(train_names or [])
         + [record_name(r, "train" if i == 0 else f"train{i + 1}") for i, r in enumerate(trains)][
@@ -142,6 +163,15 @@ def diagnose(
         alt = showing.answer_on_showing(singles, pairs, ctx, run.row_of)
         if alt is not None:
             ans, on_records = alt[0], [run.judged[i].name for i in alt[1]]
+    if ans.effect == rule.OUTSIDE and cross and linear_base and halve:
+        lone = showing.showing_records(ctx)
+        if len(lone) == 1 and len(run.judged) > 1:
+            again = _by_halves(
+                run.judged[lone[0]].name, trains, tests, t_names, names, seed, effects,
+                run_order, progress,
+            )  # fmt: skip
+            if again is not None:
+                return again
     say(f"answer: {ans.effect}" + (f" ({' or '.join(ans.between)})" if ans.between else ""))
     result = result_of(run, singles, pairs, ans, ctx, baseline, cross)
     result["delay_evidence"] = lag.as_dict()
@@ -180,3 +210,29 @@ def diagnose(
             "(every record is used by fitting on the others only with the linear baseline)."
         )
     return result
+
+
+def _by_halves(name, trains, tests, t_names, names, seed, effects, run_order, progress):
+    """The diagnosis again with the record ``name`` split in halves run as one session
+    (``halves.py``), or None when it cannot be split or its answer names nothing."""
+    say = progress or (lambda msg: None)
+    if not halves.can_split(dict(zip(t_names + names, trains + tests, strict=True))[name]):
+        return None
+    say(f"{name} alone shows a gap: judged again half against half (halves run as one session)")
+    tr, tr_names = halves.split_records(trains, t_names, name)
+    te, te_names = halves.split_records(tests, names, name)
+    order = halves.order_with_halves(run_order, name)
+    res = _diagnose_axis(
+        tr, te, LINEAR, progress, seed, te_names, True, effects, tr_names, order, halve=False
+    )
+    if res["effect"] in (rule.OUTSIDE, "none"):
+        say(f"half against half: {res['effect']}; the answer on whole records stands")
+        return None
+    res["named_on_records"] = [name + s for s in halves.SUFFIXES]
+    res["notes"].append(
+        f"{name} alone shows a gap: judged by fits on records without the effect, no "
+        f"candidate could close it there; split in two halves run as one session, each half "
+        f"judged by a fit on the other half and the other records, {res['effect']} "
+        "closes it."
+    )
+    return res

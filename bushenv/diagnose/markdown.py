@@ -64,6 +64,8 @@ def _which(data: dict[str, Any]) -> list[str]:
         f"{data.get('runner_up') or '-'}.",
         "",
     ]
+    if data.get("named_on_records"):  # named where the gap shows, not on all records
+        lines += ["Named on: " + ", ".join(f"`{n}`" for n in data["named_on_records"]) + ".", ""]
     if data.get("telling_test"):
         lines += [data["telling_test"] + ".", ""]
     if data.get("delay_evidence"):

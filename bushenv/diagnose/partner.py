@@ -12,7 +12,7 @@ side is taken at its best judged form: the other alone at the better of its rich
 usual forms, the member beside it at the better of the richest form and the pair itself (a
 richer form extrapolates worse to a judged record than the usual one as often as not; a
 partner that the usual pair needs is not refused because the richest form beside it
-extrapolates badly). A pair
+extrapolates badly); the other alone is taken where it fits (``rule.where_it_fits``). A pair
 without the best single effect (the *first*) must close the same share of what the first's
 richest form leaves: a pair is an answer only where the first's whole family is not.
 
@@ -30,7 +30,7 @@ from bushenv.diagnose.candidates import get_effect
 from bushenv.diagnose.effects.base import Combination
 from bushenv.diagnose.effects.rich import RichForm
 from bushenv.diagnose.evidence import cut_z
-from bushenv.diagnose.rule import CLEAR_CUT, Z_NAME, Context
+from bushenv.diagnose.rule import CLEAR_CUT, Z_NAME, Context, where_it_fits
 
 # A member closes at least this share of what the other's richest form leaves above the noise.
 BEYOND_RICH_MIN = 1.0 / 3.0
@@ -66,7 +66,7 @@ def member_beyond_rich(
     ``member`` beside it is beside the richest form or the usual ``pair``, the same way."""
     if other not in cache:
         cache[other] = row_of(Combination((_rich(other),)))
-    base, base_form = _better(cache[other], alone)
+    base, base_form = _better(where_it_fits(cache[other], ctx), alone and where_it_fits(alone, ctx))
     both, both_form = _better(row_of(Combination((_rich(other), get_effect(member)))), pair)
     z = float(cut_z(ctx.force, base["_pred"], both["_pred"], ctx.edges))
     share = float(ctx.closes(both["gap_after"], base["gap_after"]))
@@ -87,7 +87,7 @@ def pair_beyond_rich(pair: dict, first: str, row_of: RowOf, ctx: Context, cache:
     """How much the pair ``pair`` (without ``first``) adds to ``first``'s richest form."""
     if first not in cache:
         cache[first] = row_of(Combination((_rich(first),)))
-    base = cache[first]
+    base = where_it_fits(cache[first], ctx)
     z = float(cut_z(ctx.force, base["_pred"], pair["_pred"], ctx.edges))
     share = float(ctx.closes(pair["gap_after"], base["gap_after"]))
     return {

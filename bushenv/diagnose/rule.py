@@ -31,7 +31,9 @@ above the noise: ``excess(g) = sqrt(max(g^2 - gap_noise^2, 0))``.
    than ``PAIR_TRY_IF_LEFT`` of the null's gap (or none passes), the pair closes at least
    ``PAIR_GAIN_MIN`` of the best single's gap, and **each member passes given the other**:
    the pair's cut against the other member alone is significant in the same sense and
-   closes ``PARTNER_MIN`` of that member's excess gap.
+   closes ``PARTNER_MIN`` of that member's excess gap. The other member is taken where it
+   fits (``where_it_fits``: the null on a judged record where it alone fails to fit): a
+   partner is not credited for taming an extrapolation gone wild.
 4. The answer (``effect``): the best passing pair; else the best passing single -- unless the
    next passing single is a different effect the judged errors cannot tell from it (z
    within ``Z_TIE`` and gaps within ``TIE_GAP``), or a row with a delay fits as well or
@@ -54,6 +56,7 @@ import numpy as np
 
 from bushenv.diagnose.evidence import cut_z
 from bushenv.diagnose.lag import LagEvidence
+from bushenv.metrics import rms_ratio
 
 FAIL_RATIO = 1.25
 Z_NAME = 3.0
@@ -112,7 +115,8 @@ RULE_TEXT = (
     f"passes when it "
     f"passes so, "
     f"closes at least {100 * PAIR_GAIN_MIN:.0f} % of what the best single leaves, and each of "
-    f"its effects passes the same test given the other, closing at least "
+    f"its effects passes the same test given the other (taken where it fits: the null on a "
+    f"record where it alone fails to fit), closing at least "
     f"{100 * PARTNER_MIN:.0f} % of what the other leaves above the noise. Named: the best "
     f"passing pair, else the best passing single ('ambiguous' when the next passing single "
     f"cannot be told from it, or a delay fits as well but its lag is not seen); "
@@ -243,6 +247,22 @@ def mark_passes(rows: list[dict[str, Any]], ctx: Context) -> None:
         r["passes"] = bool(r["_passes_unless_lag"] and _lag_ok(r, ctx))
 
 
+def where_it_fits(r: dict[str, Any], ctx: Context) -> dict[str, Any]:
+    """``r`` with the null's prediction on each judged record where ``r`` fails to fit (its
+    gap there above ``FAIL_RATIO`` x the null's): what a partner is credited against. A
+    partner that only tames an effect's extrapolation to a record it does not fit adds
+    nothing to that effect."""
+    pred, out = r["_pred"], None
+    for a, b in ctx.records or []:
+        f = ctx.force[a:b]
+        if rms_ratio(f, pred[a:b]) > FAIL_RATIO * rms_ratio(f, ctx.null_pred[a:b]):
+            out = pred.copy() if out is None else out
+            out[a:b] = ctx.null_pred[a:b]
+    if out is None:
+        return r
+    return {**r, "_pred": out, "gap_after": rms_ratio(ctx.force, out)}
+
+
 def mark_pairs(singles: list[dict], pairs: list[dict], ctx: Context) -> None:
     """Rule 3 on every pair row: ``members_add`` and ``passes``."""
     by_name = {r["effect"]: r for r in singles}
@@ -252,7 +272,7 @@ def mark_pairs(singles: list[dict], pairs: list[dict], ctx: Context) -> None:
     for r in pairs:
         adds = []
         for m in r["members"]:
-            other = by_name[next(o for o in r["members"] if o != m)]
+            other = where_it_fits(by_name[next(o for o in r["members"] if o != m)], ctx)
             t = cut_z(ctx.force, other["_pred"], r["_pred"], ctx.edges)
             share = ctx.closes(r["gap_after"], other["gap_after"])
             adds.append((t >= Z_NAME or share >= CLEAR_CUT) and share >= PARTNER_MIN)

@@ -76,3 +76,55 @@ def test_a_partner_that_only_mends_the_usual_form_is_still_refused():
     )
     assert not got["adds"] and got["forms"][0] == "richest", got
     assert abs(got["share"]) < 0.05
+
+
+def _two_records():
+    """Two records of one specimen: a first effect (a slow wave) strong on record 0 and
+    weak on record 1 (a gentler programme); the noise 0.2 %."""
+    rng = np.random.default_rng(6)
+    t = np.arange(N) * DT
+    base = np.sin(2 * np.pi * 0.9 * t)
+    first = 0.3 * np.sin(2 * np.pi * 0.13 * t + 0.4)
+    force = np.concatenate([base + first, base + 0.1 * first]) + 0.002 * rng.normal(size=2 * N)
+    null = np.concatenate([base, base])
+    edges = block_edges([N, N], [DT, DT])
+    ctx = rule.Context(
+        force, null, edges, rms_ratio(force, null), 0.002, NO_LAG, records=[(0, N), (N, 2 * N)]
+    )
+    return ctx, base, first
+
+
+def test_a_record_an_effect_does_not_fit_is_judged_by_the_null_when_a_partner_is_weighed():
+    ctx, base, first = _two_records()
+    wild = 0.2 * np.sin(2 * np.pi * 0.05 * np.arange(N) * DT)  # extrapolated to record 1
+    r = _row("thermal", np.concatenate([base + first, base + 0.1 * first + wild]), ctx.force)
+    got = rule.where_it_fits(r, ctx)
+    assert np.array_equal(got["_pred"][:N], r["_pred"][:N])  # fits there: kept
+    assert np.array_equal(got["_pred"][N:], ctx.null_pred[N:])  # fails there: the null
+    assert got["gap_after"] < r["gap_after"]
+    fine = _row("thermal", np.concatenate([base + first, base + 0.1 * first]), ctx.force)
+    assert rule.where_it_fits(fine, ctx) is fine
+
+
+def test_a_partner_that_only_tames_a_failed_extrapolation_adds_nothing():
+    """Thermal fits record 0 and extrapolates wildly to record 1; a hardening beside it
+    tames the wild part (still worse than the null there) and adds nothing where thermal
+    fits. Weighed against thermal alone it would pass as a partner; weighed against thermal
+    where it fits and the null elsewhere it does not."""
+    ctx, base, first = _two_records()
+    wild = 0.2 * np.sin(2 * np.pi * 0.05 * np.arange(N) * DT)
+    thermal = np.concatenate([base + first, base + 0.1 * first + wild])
+    tamed = np.concatenate([base + first, base + 0.1 * first + 0.25 * wild])
+    singles = [
+        {**_row(n, p, ctx.force), "failed_to_fit": False, "passes": True}
+        for n, p in (("thermal", thermal), ("hardening", ctx.null_pred))
+    ]
+    pair = {**_row("hardening+thermal", tamed, ctx.force), "passes": True}
+    pair["_passes_unless_lag"] = True
+    # against thermal alone, the cut is significant and closes most of what it leaves
+    z = rule.cut_z(ctx.force, thermal, pair["_pred"], ctx.edges)
+    assert z >= rule.Z_NAME and ctx.closes(pair["gap_after"], singles[0]["gap_after"]) > 0.5
+    # and thermal beside the hardening closes most of what the hardening leaves
+    assert ctx.closes(pair["gap_after"], singles[1]["gap_after"]) > 0.5
+    rule.mark_pairs(singles, [pair], ctx)
+    assert not pair["members_add"] and not pair["passes"]

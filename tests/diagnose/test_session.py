@@ -119,7 +119,8 @@ def test_the_command_takes_a_run_order_and_refuses_a_bad_one_by_line(tmp_path, c
     assert main([*args, "--out", str(tmp_path / "out")]) == 0
     report = json.loads((tmp_path / "out" / "report.json").read_text())
     assert report["records"]["sessions"] == [["sweep", "train"]]
-    assert report["records"]["session_time_s"] == {"sweep": 0.0, "train": pytest.approx(66.0, abs=0.01)}
+    times = report["records"]["session_time_s"]
+    assert times == {"sweep": 0.0, "train": pytest.approx(66.0, abs=0.01)}
     md = (tmp_path / "out" / "report.md").read_text()
     assert "- run in one session, heat carried over: sweep -> train" in md
     assert "where_session.png" in report["plots"] and "![where_session.png]" in md

@@ -1,0 +1,83 @@
+"""A record that alone shows the gap is judged half against half, its halves one session."""
+
+import numpy as np
+
+from bushenv.diagnose import fit, halves, rule
+from bushenv.diagnose.fit import diagnose
+from bushenv.diagnose.markdown import markdown
+from tests.diagnose.synthetic import Rec, force, record
+from tests.diagnose.test_thermal_energy import _diagnose, _programmes, _thermal_forces
+
+DT = 1 / 204.8
+
+
+def _slow(seed: int, effect: str) -> Rec:
+    """A slow sine (0.3 Hz, 20 s): too slow to show a mass, a delay or a drift."""
+    t = np.arange(int(20 / DT)) * DT
+    x = 2e-3 * np.sin(2 * np.pi * 0.3 * t + seed)
+    f = force(x, DT, effect)
+    f = f + 0.005 * np.std(f) * np.random.default_rng(seed).normal(size=f.size)
+    return Rec(t, x, f, DT, f"slow{seed}")
+
+
+def test_halves_are_the_record_in_time_and_run_as_one_session():
+    rec = record(1, duration_s=10.0)
+    a, b = halves.halves_of(rec, "train")
+    assert (a.name, b.name) == ("train.half1", "train.half2")
+    assert np.array_equal(np.concatenate([a.force, b.force]), rec.force)
+    assert b.time[0] == rec.time[a.time.size]
+    assert halves.order_with_halves(None, "train") == [("train.half1", None), ("train.half2", 0.0)]
+    given = [("test1", "cold"), ("train", 30.0), ("test2", 5.0)]
+    assert halves.order_with_halves(given, "train") == [
+        ("test1", "cold"), ("train.half1", 30.0), ("train.half2", 0.0), ("test2", 5.0),
+    ]  # fmt: skip
+    recs, names = halves.split_records([rec, rec], ["train", "other"], "train")
+    assert names == ["train.half1", "train.half2", "other"] and recs[2] is rec
+
+
+def test_a_record_too_short_for_two_judged_halves_is_not_split():
+    assert not halves.can_split(record(1, duration_s=6.0))  # 3 s halves: 3 blocks
+    assert halves.can_split(record(1, duration_s=10.0))
+
+
+def test_an_effect_only_train_shows_is_named_on_its_halves():
+    """TRAIN's fast motion shows the mass; the slow TESTs do not. Judged on whole records the
+    mass is fitted only where it does not show: outside_candidates; half against half it is
+    named."""
+    train = record(1, "inertia", duration_s=30.0, name="train")
+    tests = [_slow(2, "inertia"), _slow(3, "inertia")]
+    whole = fit._diagnose_axis(
+        [train], tests, "linear", None, 0, None, None, None, None, None, halve=False
+    )
+    assert whole["effect"] == rule.OUTSIDE
+    r = diagnose(train, tests)
+    assert r["effect"] == "inertia"
+    assert r["named_on_records"] == ["train.half1", "train.half2"]
+    assert r["records"]["sessions"] == [["train.half1", "train.half2"]]
+    assert any("two halves run as one session" in n for n in r["notes"])
+    assert "Named on: `train.half1`, `train.half2`." in markdown({**r, "plots": []})
+
+
+def test_a_gap_no_candidate_closes_stays_outside_on_the_halves():
+    """A hum at 7 Hz in TRAIN's force, unrelated to the motion: no candidate closes it on
+    whole records or on halves."""
+    train = record(1, duration_s=30.0, name="train")
+    hum = 0.3 * np.std(train.force) * np.sin(2 * np.pi * 7.0 * train.time)
+    train = Rec(train.time, train.displacement, train.force + hum, DT, "train")
+    r = diagnose(train, [_slow(2, "none"), _slow(3, "none")])
+    assert r["effect"] == rule.OUTSIDE
+    assert r["named_on_records"] == []
+
+
+def test_a_partner_that_only_tames_a_wild_extrapolation_is_not_named_on_halves():
+    """A session of two records of the heated specimen, the broad one first and warm: only
+    the hot record shows the heat. Thermal fitted on the hot halves extrapolates to the broad
+    record 23 times worse than the null; a hardening beside it tames that and was named as a
+    partner (``hardening+thermal``). Weighed where thermal fits (``rule.where_it_fits``),
+    the answer is thermal, on the hot record's halves."""
+    progs = _programmes()
+    order = ("broad", "hot")
+    r = _diagnose(_thermal_forces(progs, order, warm=True), progs, order)
+    assert r["effect"] == "thermal", (r["effect"], r["top_two"])
+    assert r["named_on_records"] == ["hot.half1", "hot.half2"]
+    assert r["records"]["judged"] == ["broad", "hot.half1", "hot.half2"]
