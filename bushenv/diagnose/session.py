@@ -27,7 +27,22 @@ HEADER = ("record", "rest_before_s")
 Order = Sequence[tuple[str, float | str | None]]
 
 
-def read_order(path: str | Path) -> list[tuple[str, float | str | None]]:
+class OrderFile(list):
+    """A run order read from a file: its rows, and where each came from (for messages)."""
+
+    def __init__(self, rows, path: Path, lines: list[int]) -> None:
+        super().__init__(rows)
+        self.path, self.lines = path, lines
+
+
+def _where(order: Order, i: int) -> str:
+    """Row ``i`` of ``order`` in a message: its file and line if read from one."""
+    if isinstance(order, OrderFile):
+        return f"{order.path} line {order.lines[i]}"
+    return f"run order row {i + 1}"
+
+
+def read_order(path: str | Path) -> OrderFile:
     """The run order from a CSV file ``record,rest_before_s``: one row per record in the order
     run; an empty rest (or ``cold``) begins a session (unknown start, or at rest)."""
     path = Path(path)
@@ -42,6 +57,7 @@ def read_order(path: str | Path) -> list[tuple[str, float | str | None]]:
             "the order run; an empty rest begins a session)"
         )
     order: list[tuple[str, float | str | None]] = []
+    lines = [line for line, _ in rows[1:]]
     for line, row in rows[1:]:
         if len(row) != 2 or not row[0].strip():
             raise DiagnoseError(
@@ -60,7 +76,7 @@ def read_order(path: str | Path) -> list[tuple[str, float | str | None]]:
                     f"{path} line {line}: rest {rest!r} is not a number of seconds (or empty, "
                     f"or {COLD!r}, to begin a session)"
                 ) from None
-    return order
+    return OrderFile(order, path, lines)
 
 
 def link(preps: Sequence[Prepared], order: Order) -> list[list[str]]:
@@ -80,11 +96,11 @@ def link(preps: Sequence[Prepared], order: Order) -> list[list[str]]:
     for i, (name, rest) in enumerate(order):
         if name not in by_name:
             raise DiagnoseError(
-                f"run order row {i + 1}: no record named {name!r}; the records are "
+                f"{_where(order, i)}: no record named {name!r}; the records are "
                 + ", ".join(sorted(by_name))
             )
         if name in seen:
-            raise DiagnoseError(f"run order row {i + 1}: record {name!r} is listed twice")
+            raise DiagnoseError(f"{_where(order, i)}: record {name!r} is listed twice")
         seen.add(name)
         p = by_name[name]
         if rest is None or rest == COLD:
@@ -94,11 +110,11 @@ def link(preps: Sequence[Prepared], order: Order) -> list[list[str]]:
             continue
         if isinstance(rest, str) or not (np.isfinite(rest) and rest >= 0):
             raise DiagnoseError(
-                f"run order row {i + 1}: rest {rest!r} of {name!r} is not a time in s >= 0"
+                f"{_where(order, i)}: rest {rest!r} of {name!r} is not a time in s >= 0"
             )
         if prev is None or first is None:
             raise DiagnoseError(
-                f"run order row {i + 1}: {name!r} has a rest but no record before it; the "
+                f"{_where(order, i)}: {name!r} has a rest but no record before it; the "
                 f"first row begins a session (an empty rest, or {COLD!r})"
             )
         s, before = p.signals, prev.signals

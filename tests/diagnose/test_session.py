@@ -113,7 +113,8 @@ def test_the_command_takes_a_run_order_and_refuses_a_bad_one_by_line(tmp_path, c
     order.write_text("record,rest_before_s\nsweep,\ntrian,60\n")
     args = ["diagnose", str(train), str(test), "--run-order", str(order), "--quiet"]
     assert main([*args, "--out", str(tmp_path / "bad")]) == 2
-    assert "row 2: no record named 'trian'; the records are sweep, train" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "order.csv line 3: no record named 'trian'; the records are sweep, train" in err
     assert not (tmp_path / "bad").exists()
     order.write_text("record,rest_before_s\nsweep,\ntrain,60\n")
     assert main([*args, "--out", str(tmp_path / "out")]) == 0
