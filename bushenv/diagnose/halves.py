@@ -6,7 +6,9 @@ it is judged by comes from records without the effect: no candidate can close it
 and ``showing.py`` has no second record to judge on. The record is then split in two halves,
 run as one session (the second begins where the first ended: a heat is carried, no new start),
 and the diagnosis runs again: each half judged by a fit on the other half and the other
-records. What it names stands; if it names nothing, the first answer stands.
+records, each other record still judged by a fit on the rest (a record without a gap of its
+own is often what tells one effect from another: thermal from relaxation). What it names
+stands; if it names nothing, the first answer stands.
 """
 
 from __future__ import annotations

@@ -66,7 +66,8 @@ def member_beyond_rich(
     ``member`` beside it is beside the richest form or the usual ``pair``, the same way."""
     if other not in cache:
         cache[other] = row_of(Combination((_rich(other),)))
-    base, base_form = _better(where_it_fits(cache[other], ctx), alone and where_it_fits(alone, ctx))
+    usual = None if alone is None else where_it_fits(alone, ctx)
+    base, base_form = _better(where_it_fits(cache[other], ctx), usual)
     both, both_form = _better(row_of(Combination((_rich(other), get_effect(member)))), pair)
     z = float(cut_z(ctx.force, base["_pred"], both["_pred"], ctx.edges))
     share = float(ctx.closes(both["gap_after"], base["gap_after"]))
