@@ -32,10 +32,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 
+from bushenv.diagnose import halves
 from bushenv.diagnose.coordinate_answer import coordinate_result
 from bushenv.diagnose.coupling import COUPLING_BEATS, COUPLING_MIN, coupling_test
 from bushenv.diagnose.errors import DiagnoseError
@@ -99,6 +101,24 @@ class Setup:
         """Whether coordinate ``i`` moves in record ``name`` (not held at one value) under a
         force: what the one-axis diagnosis needs of a record."""
         return bool(np.ptp(self.q(name)[:, i]) > 0 and np.any(self.view(name, i).force != 0))
+
+
+def add_halves(setup: Setup, d: dict[str, Any]) -> None:
+    """The halves a coordinate's diagnosis judged a record on (``halves.py``) become records
+    of ``setup``: its q, f, time and cross terms cut the same way."""
+    used = {n for f in d["records"]["folds"] for n in f["identified_on"] + f["judged"]}
+    for n in sorted(used - set(setup.records)):
+        parent, i = halves.parent_of(n) or (None, 0)
+        if parent not in setup.records:
+            continue
+        rec = setup.records[parent]
+        a, b = halves.bounds(len(rec.time))[i]
+        setup.records[n] = SimpleNamespace(
+            time=np.asarray(rec.time, float)[a:b], q=setup.q(parent)[a:b],
+            f=setup.f(parent)[a:b], dt=setup.dt(parent),
+        )  # fmt: skip
+        setup.roles[n] = setup.roles[parent]
+        setup.cross[n] = setup.cross[parent][a:b]
 
 
 def coordinate_count(rec: Any) -> int:
@@ -276,6 +296,7 @@ def diagnose_coordinates(
             run_order=run_order,
         )
         d["coordinate"] = name
+        add_halves(setup, d)
         diagnoses[name] = d
         couplings[name] = _coupling(setup, i, d)
         say(f"{name}: coupling terms close {100 * couplings[name]['closes']:.0f} % beyond its own")

@@ -33,14 +33,26 @@ def can_split(rec: Any) -> bool:
     return n >= MIN_SAMPLES and n * float(rec.dt) >= HALF_BLOCKS * BLOCK_S
 
 
+def bounds(n: int) -> list[tuple[int, int]]:
+    """The samples of each half of a record of ``n`` samples."""
+    return [(0, n // 2), (n // 2, n)]
+
+
 def halves_of(rec: Any, name: str) -> list[Record]:
     """``rec``'s two halves in time, named ``name.half1`` and ``name.half2``."""
     t, x, f = (np.asarray(getattr(rec, k), float) for k in ("time", "displacement", "force"))
-    m = t.size // 2
     return [
         Record(t[a:b], x[a:b], f[a:b], name=name + s)
-        for (a, b), s in zip(((0, m), (m, t.size)), SUFFIXES, strict=True)
+        for (a, b), s in zip(bounds(t.size), SUFFIXES, strict=True)
     ]
+
+
+def parent_of(name: str) -> tuple[str, int] | None:
+    """(the record, 0 or 1) for a half's name, else None."""
+    for i, s in enumerate(SUFFIXES):
+        if name.endswith(s):
+            return name[: -len(s)], i
+    return None
 
 
 def split_records(

@@ -1,12 +1,18 @@
 """A record that alone shows the gap is judged half against half, its halves one session."""
 
+import json
+
 import numpy as np
 
+from bushenv.cli import main
 from bushenv.diagnose import fit, halves, rule
 from bushenv.diagnose.fit import diagnose
 from bushenv.diagnose.markdown import markdown
-from tests.diagnose.synthetic import Rec, force, record
-from tests.diagnose.test_thermal_energy import _diagnose, _programmes, _thermal_forces
+from bushenv.record_files import save_columns
+from bushenv.records import Record
+
+from .synthetic import Rec, force, motion, record
+from .test_thermal_energy import _diagnose, _programmes, _thermal_forces
 
 DT = 1 / 204.8
 
@@ -81,3 +87,33 @@ def test_a_partner_that_only_tames_a_wild_extrapolation_is_not_named_on_halves()
     assert r["effect"] == "thermal", (r["effect"], r["top_two"])
     assert r["named_on_records"] == ["hot.half1", "hot.half2"]
     assert r["records"]["judged"] == ["broad", "hot.half1", "hot.half2"]
+
+
+def _three_axis(x0: np.ndarray, f0: np.ndarray, seed: int, name: str) -> Record:
+    """A three-axis record: ``x0``, ``f0`` on the axial coordinate, a plain spring and damper
+    under gentle random motion on the other two."""
+    n, rng = x0.size, np.random.default_rng(seed)
+    xs = [x0] + [0.5 * motion(seed + k, n * DT, DT, steps=False)[:n] for k in (1, 2)]
+    fs = [f0] + [force(x, DT) for x in xs[1:]]
+    fs = [f + 0.005 * np.std(f) * rng.normal(size=n) for f in fs]
+    return Record(np.arange(n) * DT, np.stack(xs, 1), np.stack(fs, 1), name=name)
+
+
+def test_a_coordinate_named_on_halves_reports_them_in_a_three_axis_diagnosis(tmp_path):
+    """The axial mass shows only in TRAIN: that coordinate is named on TRAIN's halves, whose
+    three-axis forces (measured, baseline, augmented) are reported beside the records'."""
+    x0 = motion(1, 30.0, DT)
+    recs = [_three_axis(x0, force(x0, DT, "inertia"), 10, "train")]
+    for s in (2, 3):
+        slow = _slow(s, "inertia")
+        recs.append(_three_axis(slow.displacement, slow.force, 20 + s, f"slow{s}"))
+    paths = []
+    for r in recs:
+        paths.append(str(tmp_path / f"{r.name}.csv"))
+        save_columns(paths[-1], r.time, r.q, r.f)
+    assert main(["diagnose", *paths, "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    axial = json.loads((tmp_path / "out" / "axial" / "report.json").read_text())
+    assert axial["effect"] == "inertia"
+    assert axial["named_on_records"] == ["train.half1", "train.half2"]
+    for n in ("train", "train.half1", "train.half2", "slow2"):
+        assert (tmp_path / "out" / "predictions" / f"{n}.csv").is_file()
