@@ -4,7 +4,7 @@ fit on the other alone (the default mode with one TEST).
     python studies/2026-11-diagnosis-validation/diagnose_two_records.py [--out two.json] \
         [--run-order]
 
-The specimen of ``tests/diagnose/test_thermal_energy.py`` (heat fed by ``c v^2``, a 60 s leak,
+The specimen of ``bushenv/diagnose/validation/thermal_session.py`` (heat fed by ``c v^2``, a 60 s leak,
 a quarter of the stiffness and damping lost at the session's hottest; and the relaxing one,
 two Maxwell arms) runs every ordered pair of its four programmes (a strong 4 Hz sine, broad
 random motion, a slow small sine, slow random motion) as a session of two records, cold and
@@ -21,28 +21,26 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.append(str(Path(__file__).resolve().parents[2]))  # the tests' specimen
-
-from tests.diagnose.test_thermal_energy import (  # noqa: E402
-    _diagnose,
-    _programmes,
-    _relaxing_forces,
-    _thermal_forces,
+from bushenv.diagnose.validation.thermal_session import (
+    diagnose_session,
+    programmes,
+    relaxing_forces,
+    thermal_forces,
 )
 
 
 def run(run_order: bool = False) -> list[dict]:
-    progs = _programmes()
+    progs = programmes()
     sessions = [(a, b, w) for a, b in itertools.permutations(progs, 2) for w in (False, True)]
     sessions += [(a, b, None) for a, b in itertools.permutations(progs, 2)]
     rows, t0 = [], time.monotonic()
     for n, (a, b, warm) in enumerate(sessions):
         order = (a, b)
         if warm is None:
-            forces, label = _relaxing_forces(progs), "relaxation"
+            forces, label = relaxing_forces(progs), "relaxation"
         else:
-            forces, label = _thermal_forces(progs, order, warm), "thermal"
-        r = _diagnose(forces, progs, order, run_order)
+            forces, label = thermal_forces(progs, order, warm), "thermal"
+        r = diagnose_session(forces, progs, order, run_order)
         rows.append({"label": label, "order": list(order), "warm": warm,
                      "named": r["effect"], "top_two": r["top_two"]})  # fmt: skip
         eta = (time.monotonic() - t0) / (n + 1) * (len(sessions) - n - 1)

@@ -8,11 +8,15 @@ from bushenv.cli import main
 from bushenv.diagnose import fit, halves, rule
 from bushenv.diagnose.fit import diagnose
 from bushenv.diagnose.markdown import markdown
+from bushenv.diagnose.validation.thermal_session import (
+    diagnose_session,
+    programmes,
+    thermal_forces,
+)
 from bushenv.record_files import save_columns
 from bushenv.records import Record
 
 from .synthetic import Rec, force, motion, record
-from .test_thermal_energy import _diagnose, _programmes, _thermal_forces
 
 DT = 1 / 204.8
 
@@ -81,9 +85,9 @@ def test_a_partner_that_only_tames_a_wild_extrapolation_is_not_named_on_halves()
     record 23 times worse than the null; a hardening beside it tames that and was named as a
     partner (``hardening+thermal``). Weighed where thermal fits (``rule.where_it_fits``),
     the answer is thermal, on the hot record's halves."""
-    progs = _programmes()
+    progs = programmes()
     order = ("broad", "hot")
-    r = _diagnose(_thermal_forces(progs, order, warm=True), progs, order)
+    r = diagnose_session(thermal_forces(progs, order, warm=True), progs, order)
     assert r["effect"] == "thermal", (r["effect"], r["top_two"])
     assert r["named_on_records"] == ["hot.half1", "hot.half2"]
     assert r["records"]["judged"] == ["broad", "hot.half1", "hot.half2"]

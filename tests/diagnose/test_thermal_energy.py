@@ -2,107 +2,41 @@
 follows the energy the specimen dissipates, whatever order the programmes run in and however
 warm the specimen starts; relaxation follows the deflection history instead.
 
-One specimen runs four programmes as one session: a heat node fed by its own dissipated power
-``c v^2`` with a leak of 60 s (off the candidate's grid of time constants), the heat carried
-over 20 s rests, stiffness and damping lost in proportion to it. A strong 4 Hz sine heats it, a
-slow small sine lets it cool. The same programmes on a relaxing specimen (two Maxwell arms)
-must be named relaxation, not thermal.
+The specimen (``validation/thermal_session.py``) runs four programmes as one session, its heat
+fed by its own dissipated power; the same programmes on a relaxing specimen must be named
+relaxation, not thermal.
 """
 
 import numpy as np
 import pytest
-from scipy import signal
 
-from bushenv.diagnose.fit import diagnose
-from bushenv.records import Record
-
-DT = 1 / 200.0
-K, C = 2e5, 2e3  # N/m, N s/m
-DURATION_S = 30.0
-TAU_S, REST_S, LOSS = 60.0, 20.0, 0.25
-ORDERS = {
-    "hot first": ("hot", "broad", "slow", "mixed"),
-    "slow first": ("slow", "mixed", "hot", "broad"),
-}
-
-
-def _programmes() -> dict[str, np.ndarray]:
-    rng = np.random.default_rng(1)
-    t = np.arange(int(DURATION_S / DT)) * DT
-    ramp = np.minimum(1.0, t / 0.5)
-
-    def band(lo: float, hi: float, peak: float) -> np.ndarray:
-        b, a = signal.butter(2, [lo * 2 * DT, hi * 2 * DT], btype="band")
-        x = signal.lfilter(b, a, rng.normal(size=t.size))
-        return peak * x / np.max(np.abs(x)) * ramp
-
-    return {
-        "hot": 4e-3 * np.sin(2 * np.pi * 4.0 * t) * ramp,
-        "broad": band(0.3, 10.0, 3e-3),
-        "slow": 1.5e-3 * np.sin(2 * np.pi * 0.5 * t) * ramp,
-        "mixed": band(0.2, 4.0, 4e-3),
-    }
-
-
-def _heat(v: np.ndarray, start: float, law: str = "viscous") -> np.ndarray:
-    """theta' = P - theta / tau from ``start`` (J): P = c v^2 (viscous), or a friction's
-    F0 |v| with F0 = c x 0.1 m/s (hysteretic)."""
-    a = np.exp(-DT / TAU_S)
-    power = C * v * v if law == "viscous" else C * 0.1 * np.abs(v)
-    return signal.lfilter([DT], [1.0, -a], power, zi=[a * start])[0]
-
-
-def _thermal_forces(progs, order, warm: bool, law: str = "viscous") -> dict[str, np.ndarray]:
-    """The session's forces: the heat follows the dissipated energy through ``order``."""
-    top = max(float(np.max(_heat(np.gradient(x, DT), 0.0, law))) for x in progs.values())
-    heat = float(_heat(np.gradient(progs["hot"], DT), 0.0, law)[-1]) if warm else 0.0
-    out = {}
-    for name in order:
-        x = progs[name]
-        v = np.gradient(x, DT)
-        theta = _heat(v, heat, law)
-        soft = LOSS * theta / top
-        out[name] = (1.0 - soft) * (K * x + C * v)
-        heat = float(theta[-1]) * np.exp(-REST_S / TAU_S)
-    return out
-
-
-def _relaxing_forces(progs) -> dict[str, np.ndarray]:
-    out = {}
-    for name, x in progs.items():
-        f = K * x + C * np.gradient(x, DT)
-        for tau, share in ((0.3, 0.3), (5.0, 0.2)):
-            a = np.exp(-DT / tau)
-            f = f + share * K * (x - signal.lfilter([(1 - a) / 2, (1 - a) / 2], [1, -a], x))
-        out[name] = f
-    return out
-
-
-def _diagnose(forces, progs, order, run_order: bool = False) -> dict:
-    """``run_order``: the diagnosis is told the order and the rests (not the start)."""
-    rng = np.random.default_rng(7)
-    recs = []
-    for name in order:
-        f = forces[name] + 0.005 * np.std(forces[name]) * rng.normal(size=forces[name].size)
-        recs.append(Record.from_arrays(progs[name], f, DT, name=name))
-    given = [(order[0], None)] + [(n, REST_S) for n in order[1:]] if run_order else None
-    return diagnose(recs[0], recs[1:], run_order=given)
+from bushenv.diagnose.validation.thermal_session import (
+    DT,
+    ORDERS,
+    TAU_S,
+    C,
+    K,
+    diagnose_session,
+    programmes,
+    relaxing_forces,
+    thermal_forces,
+)
 
 
 @pytest.mark.parametrize(
     "order,warm", [("hot first", False), ("slow first", False), ("hot first", True)]
 )
 def test_a_drift_that_follows_the_dissipated_energy_is_named_thermal(order, warm):
-    progs = _programmes()
-    r = _diagnose(_thermal_forces(progs, ORDERS[order], warm), progs, ORDERS[order])
+    progs = programmes()
+    r = diagnose_session(thermal_forces(progs, ORDERS[order], warm), progs, ORDERS[order])
     assert r["effect"] == "thermal", (r["effect"], r["top_two"])
     assert r["shrink"] > 0.4
 
 
 @pytest.mark.parametrize("order", list(ORDERS))
 def test_a_memory_of_the_deflection_is_named_relaxation_not_thermal(order):
-    progs = _programmes()
-    r = _diagnose(_relaxing_forces(progs), progs, ORDERS[order])
+    progs = programmes()
+    r = diagnose_session(relaxing_forces(progs), progs, ORDERS[order])
     assert r["effect"] == "relaxation", (r["effect"], r["top_two"])
     assert "thermal" not in r["effect"].split("+")
 
@@ -116,8 +50,8 @@ def test_a_session_of_two_records_is_named_thermal(order, warm):
     where it needs one: under a steady power its heat is affine in the start's cooling, and a
     start fitted whole traded with the spring and the heating law (the first two were
     ``outside_candidates`` and ``hardening+thermal``); the third starts warm and needs it."""
-    progs = _programmes()
-    r = _diagnose(_thermal_forces(progs, order, warm), progs, order)
+    progs = programmes()
+    r = diagnose_session(thermal_forces(progs, order, warm), progs, order)
     assert r["effect"] == "thermal", (r["effect"], r["top_two"])
 
 
@@ -125,8 +59,10 @@ def test_a_session_of_two_records_is_named_thermal(order, warm):
 def test_a_heat_fed_by_friction_is_read_as_hysteretic(order):
     """A heat fed by ``|v|`` (a friction's dissipation) over a session of four programmes is
     named thermal with the hysteretic heating law."""
-    progs = _programmes()
-    r = _diagnose(_thermal_forces(progs, ORDERS[order], False, "hysteretic"), progs, ORDERS[order])
+    progs = programmes()
+    r = diagnose_session(
+        thermal_forces(progs, ORDERS[order], False, "hysteretic"), progs, ORDERS[order]
+    )
     assert r["effect"] == "thermal", (r["effect"], r["top_two"])
     assert r["parameters"]["thermal"]["heating"] == "hysteretic"
 
@@ -138,8 +74,8 @@ def test_a_run_order_carries_the_heat_from_record_to_record(order, warm):
     """Told the order and the rest, a record's start is what the one before left, cooled over
     the rest: no start of its own to trade with the spring. These sessions answered
     ``outside_candidates`` without the order."""
-    progs = _programmes()
-    r = _diagnose(_thermal_forces(progs, order, warm), progs, order, run_order=True)
+    progs = programmes()
+    r = diagnose_session(thermal_forces(progs, order, warm), progs, order, run_order=True)
     assert r["effect"] == "thermal", (r["effect"], r["top_two"])
     assert r["records"]["sessions"] == [list(order)]
 
@@ -148,9 +84,9 @@ def test_a_warm_session_gives_back_its_cold_spring_and_its_leak():
     """Every record after the first starts warm; the leak (60 s) lies between the grid's
     values. Read between them, the leak and the cold spring come back: a leak held at a grid
     value makes the warm starts take part of the spring (10 % high before)."""
-    progs = _programmes()
+    progs = programmes()
     order = ORDERS["hot first"]
-    r = _diagnose(_thermal_forces(progs, order, True), progs, order)
+    r = diagnose_session(thermal_forces(progs, order, True), progs, order)
     p = r["parameters"]
     assert r["effect"] == "thermal", r["effect"]
     assert abs(p["k_n_per_m"] / K - 1.0) < 0.02, p["k_n_per_m"]

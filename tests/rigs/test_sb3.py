@@ -9,6 +9,7 @@ import torch
 from gymnasium.vector import AutoresetMode
 from stable_baselines3 import PPO, SAC
 from stable_baselines3.common.evaluation import evaluate_policy
+from stable_baselines3.common.logger import Logger
 from stable_baselines3.common.vec_env import VecCheckNan, VecEnv, VecNormalize
 
 from bushenv.rigs.common import RigError
@@ -31,9 +32,12 @@ def test_ppo_and_sac_learn_on_the_vector_env_for_a_few_hundred_steps(env_id):
     venv = make_sb3_vec_env(env_id, 4, model="linear", max_episode_steps=50)
     assert isinstance(venv, VecEnv)
     ppo = PPO("MlpPolicy", venv, n_steps=64, batch_size=64, n_epochs=2, seed=0, device="cpu")
+    quiet = Logger(folder=None, output_formats=[])  # the default one leaves a folder in /tmp
+    ppo.set_logger(quiet)
     ppo.learn(512)
     assert ppo.num_timesteps >= 512
     sac = SAC("MlpPolicy", venv, learning_starts=64, batch_size=32, seed=0, device="cpu")
+    sac.set_logger(quiet)
     sac.learn(256)
     mean, _ = evaluate_policy(ppo, venv, n_eval_episodes=4)
     assert np.isfinite(mean)
