@@ -6,17 +6,23 @@ The records of ``scripts/bench.py --only diagnose`` (the reference rubber with a
 RPC-like random, the last TEST with a held step: 60, 40, 30 and 20 s) made at ``--rate`` Hz;
 prints the wall time, the CPU time and the load average before and after (the machine is
 shared: state the load beside the time). ``--run-order``: the records given as one session
-in their order, 60 s rests between (the heat carried from record to record).
+in their order, 60 s rests between (the heat carried from record to record). ``--lone``: the
+case where one record alone shows the gap and is judged again half against half
+(``diagnose/halves.py``): a spring-damper behind a fixture mass, the first record RPC-like
+random (the mass shows), the others slow small sines (it does not).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+import numpy as np
 
 from bushenv import excitation as ex
 from bushenv.cli import main as cli
@@ -25,12 +31,28 @@ from bushenv.reference.rubber import RubberBushing
 
 LENGTHS_S = (60.0, 40.0, 30.0, 20.0)
 N_INDEX = (1.0, 1.0, 1.3, 1.5)
+K, C, MASS = 2e5, 2e3, 2.0  # --lone: N/m, N s/m, kg (the mass: 16 % of k x at 20 Hz)
+
+
+def lone_record(i: int, seconds: float, dt: float) -> Record:
+    """``--lone``: record 0 random (the mass shows), the others 0.3 Hz sines (it does not)."""
+    t = np.arange(int(round(seconds / dt))) * dt
+    x = (
+        ex.random_rpc(1.0, seconds, dt, seed=i)
+        if i == 0
+        else 2e-3 * np.sin(2 * np.pi * 0.3 * t + i)
+    )
+    v = np.gradient(x, dt)
+    f = K * x + C * v + MASS * np.gradient(v, dt)
+    f = f + 0.005 * np.std(f) * np.random.default_rng(i).normal(size=f.size)
+    return Record.from_arrays(x, f, dt, name=f"rec{i}")
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rate", type=float, default=3000.0, help="sample rate (Hz)")
     ap.add_argument("--run-order", action="store_true", help="one session, 60 s rests")
+    ap.add_argument("--lone", action="store_true", help="one record alone shows the gap")
     a = ap.parse_args(argv)
     dt = 1.0 / a.rate
     ref = RubberBushing.preset("axial", dt=dt, seed=0)
@@ -38,11 +60,14 @@ def main(argv: list[str] | None = None) -> int:
         paths = []
         for i, (seconds, n) in enumerate(zip(LENGTHS_S, N_INDEX, strict=True)):
             print(f"record {i + 1}/4: {seconds:g} s at {a.rate:g} Hz", file=sys.stderr)
-            x = ex.random_rpc(n, seconds, dt, seed=i)
-            if i == 3:
-                x = ex.sequence(x, ex.step_hold(3e-3, 0.25 * seconds, dt, rise_s=0.05))
-            ref.reset()
-            rec = Record.from_arrays(x, ref.simulate(x), dt, name=f"rec{i}")
+            if a.lone:
+                rec = lone_record(i, seconds, dt)
+            else:
+                x = ex.random_rpc(n, seconds, dt, seed=i)
+                if i == 3:
+                    x = ex.sequence(x, ex.step_hold(3e-3, 0.25 * seconds, dt, rise_s=0.05))
+                ref.reset()
+                rec = Record.from_arrays(x, ref.simulate(x), dt, name=f"rec{i}")
             paths.append(str(save_csv(rec, Path(tmp) / f"rec{i}.csv")))
         order = Path(tmp) / "order.csv"
         order.write_text("record,rest_before_s\nrec0,\nrec1,60\nrec2,60\nrec3,60\n")
@@ -53,12 +78,15 @@ def main(argv: list[str] | None = None) -> int:
                     "--out", str(Path(tmp) / "out"), *more])  # fmt: skip
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         load1 = os.getloadavg()
+        report = json.loads((Path(tmp) / "out" / "report.json").read_text(encoding="utf-8"))
     if code != 0:
         print(f"bushenv diagnose exited {code}", file=sys.stderr)
         return code
     samples = sum(int(round(s * a.rate)) for s in LENGTHS_S)
     print(f"{a.rate:g} Hz, {samples} samples: {wall:.1f} s wall, {cpu:.1f} s CPU; load average "
-          f"(1 min) {load0[0]:.1f} before, {load1[0]:.1f} after")  # fmt: skip
+          f"(1 min) {load0[0]:.1f} before, {load1[0]:.1f} after; named {report['effect']}"
+          + (f" on {', '.join(report['named_on_records'])}" if report.get("named_on_records")
+             else ""))  # fmt: skip
     return 0
 
 
