@@ -76,6 +76,8 @@ EXPECTED = [
     "memory.batch_B1024_T512.peak",
     "records.load_csv_20k_over_loadtxt",
     "diagnose.cross.4_records.seconds",
+    "diagnose.3khz.4_records.seconds",
+    "diagnose.3khz_halves.4_records.seconds",
     *(
         f"planar.{f}"
         for f in (

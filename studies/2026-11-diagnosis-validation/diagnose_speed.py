@@ -2,14 +2,14 @@
 
     python studies/2026-11-diagnosis-validation/diagnose_speed.py --rate 3000 [--run-order]
 
-The records of ``scripts/bench.py --only diagnose`` (the reference rubber with all its effects,
-RPC-like random, the last TEST with a held step: 60, 40, 30 and 20 s) made at ``--rate`` Hz;
+The records of ``scripts/bench.py --only diagnose`` (``validation/timing_cases.py``: the
+reference rubber with all its effects, RPC-like random, the last TEST with a held step: 60, 40,
+30 and 20 s) made at ``--rate`` Hz;
 prints the wall time, the CPU time and the load average before and after (the machine is
 shared: state the load beside the time). ``--run-order``: the records given as one session
 in their order, 60 s rests between (the heat carried from record to record). ``--lone``: the
 case where one record alone shows the gap and is judged again half against half
-(``diagnose/halves.py``): a spring-damper behind a fixture mass, the first record RPC-like
-random (the mass shows), the others slow small sines (it does not).
+(``diagnose/halves.py``; ``timing_cases.lone_records``).
 """
 
 from __future__ import annotations
@@ -22,30 +22,11 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
-from bushenv import excitation as ex
 from bushenv.cli import main as cli
-from bushenv.records import Record, save_csv
-from bushenv.reference.rubber import RubberBushing
+from bushenv.diagnose.validation.timing_cases import lone_records, rubber_records
+from bushenv.records import save_csv
 
 LENGTHS_S = (60.0, 40.0, 30.0, 20.0)
-N_INDEX = (1.0, 1.0, 1.3, 1.5)
-K, C, MASS = 2e5, 2e3, 2.0  # --lone: N/m, N s/m, kg (the mass: 16 % of k x at 20 Hz)
-
-
-def lone_record(i: int, seconds: float, dt: float) -> Record:
-    """``--lone``: record 0 random (the mass shows), the others 0.3 Hz sines (it does not)."""
-    t = np.arange(int(round(seconds / dt))) * dt
-    x = (
-        ex.random_rpc(1.0, seconds, dt, seed=i)
-        if i == 0
-        else 2e-3 * np.sin(2 * np.pi * 0.3 * t + i)
-    )
-    v = np.gradient(x, dt)
-    f = K * x + C * v + MASS * np.gradient(v, dt)
-    f = f + 0.005 * np.std(f) * np.random.default_rng(i).normal(size=f.size)
-    return Record.from_arrays(x, f, dt, name=f"rec{i}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -55,20 +36,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--lone", action="store_true", help="one record alone shows the gap")
     a = ap.parse_args(argv)
     dt = 1.0 / a.rate
-    ref = RubberBushing.preset("axial", dt=dt, seed=0)
+    print(f"making 4 records at {a.rate:g} Hz", file=sys.stderr)
+    recs = (lone_records if a.lone else rubber_records)(LENGTHS_S, dt)
     with tempfile.TemporaryDirectory() as tmp:
-        paths = []
-        for i, (seconds, n) in enumerate(zip(LENGTHS_S, N_INDEX, strict=True)):
-            print(f"record {i + 1}/4: {seconds:g} s at {a.rate:g} Hz", file=sys.stderr)
-            if a.lone:
-                rec = lone_record(i, seconds, dt)
-            else:
-                x = ex.random_rpc(n, seconds, dt, seed=i)
-                if i == 3:
-                    x = ex.sequence(x, ex.step_hold(3e-3, 0.25 * seconds, dt, rise_s=0.05))
-                ref.reset()
-                rec = Record.from_arrays(x, ref.simulate(x), dt, name=f"rec{i}")
-            paths.append(str(save_csv(rec, Path(tmp) / f"rec{i}.csv")))
+        paths = [str(save_csv(r, Path(tmp) / f"{r.name}.csv")) for r in recs]
         order = Path(tmp) / "order.csv"
         order.write_text("record,rest_before_s\nrec0,\nrec1,60\nrec2,60\nrec3,60\n")
         more = ["--run-order", str(order)] if a.run_order else []
