@@ -153,8 +153,9 @@ def _diagnose_axis(
     dx = np.concatenate([p.signals.v * p.dt for p in run.judged])
     x = np.concatenate([p.signals.x for p in run.judged])
     records = rule.record_edges([p.n for p in run.judged])
+    runs = None if halve else halves.runs_of([p.name for p in run.judged])
     ctx = rule.Context(
-        run.force, null_pred, run.edges, run.gap_null, run.gap_noise, lag, dx, x, records
+        run.force, null_pred, run.edges, run.gap_null, run.gap_noise, lag, dx, x, records, runs
     )
     singles, pairs = judge_all(run, eff, say, ctx)
     ans = rule.answer(singles, pairs, ctx)

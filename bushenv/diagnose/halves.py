@@ -55,6 +55,14 @@ def parent_of(name: str) -> tuple[str, int] | None:
     return None
 
 
+def runs_of(names: Sequence[str]) -> list[int]:
+    """Each record's run, the two halves of a split record one run (one programme run
+    once: the median run of ``rule.Context.share`` counts it once)."""
+    roots = [parent_of(n)[0] if parent_of(n) else n for n in names]
+    first = list(dict.fromkeys(roots))
+    return [first.index(r) for r in roots]
+
+
 def split_records(
     recs: Sequence[Any], names: Sequence[str], name: str
 ) -> tuple[list[Any], list[str]]:

@@ -14,7 +14,8 @@ richer form extrapolates worse to a judged record than the usual one as often as
 partner that the usual pair needs is not refused because the richest form beside it
 extrapolates badly); the other alone is taken where it fits (``rule.where_it_fits``). A pair
 without the best single effect (the *first*) must close the same share of what the first's
-richest form leaves: a pair is an answer only where the first's whole family is not.
+richest form leaves: a pair is an answer only where the first's whole family is not. Shares
+are read as in the pair rule (``rule.Context.share``: pooled, or on the median run).
 
 The threshold ``BEYOND_RICH_MIN`` is calibrated on single-effect cases whose forms no
 candidate shares (``validation/partner_cases.py``); its false-positive rate is measured there
@@ -70,7 +71,7 @@ def member_beyond_rich(
     base, base_form = _better(where_it_fits(cache[other], ctx), usual)
     both, both_form = _better(row_of(Combination((_rich(other), get_effect(member)))), pair)
     z = float(cut_z(ctx.force, base["_pred"], both["_pred"], ctx.edges))
-    share = float(ctx.closes(both["gap_after"], base["gap_after"]))
+    share = float(ctx.share(both, base))
     adds = bool((z >= Z_NAME or share >= CLEAR_CUT) and share >= BEYOND_RICH_MIN)
     return {
         "member": member,
@@ -90,7 +91,7 @@ def pair_beyond_rich(pair: dict, first: str, row_of: RowOf, ctx: Context, cache:
         cache[first] = row_of(Combination((_rich(first),)))
     base = where_it_fits(cache[first], ctx)
     z = float(cut_z(ctx.force, base["_pred"], pair["_pred"], ctx.edges))
-    share = float(ctx.closes(pair["gap_after"], base["gap_after"]))
+    share = float(ctx.share(pair, base))
     return {
         "member": pair["effect"],
         "beside_richest": first,

@@ -33,7 +33,10 @@ above the noise: ``excess(g) = sqrt(max(g^2 - gap_noise^2, 0))``.
    the pair's cut against the other member alone is significant in the same sense and
    closes ``PARTNER_MIN`` of that member's excess gap. The other member is taken where it
    fits (``where_it_fits``: the null on a judged record where it alone fails to fit): a
-   partner is not credited for taming an extrapolation gone wild.
+   partner is not credited for taming an extrapolation gone wild. The pair's gain and both
+   shares are read pooled over the judged records or on the median run, whichever is larger
+   (``Context.share``, ``Context.ratio``; with ``MEDIAN_RUNS`` runs or more, the halves of a
+   split record one run): one run whose fit extrapolates far does not outweigh the others.
 4. The answer (``effect``): the best passing pair; else the best passing single -- unless the
    next passing single is a different effect the judged errors cannot tell from it (z
    within ``Z_TIE`` and gaps within ``TIE_GAP``), or a row with a delay fits as well or
@@ -66,6 +69,9 @@ PAIR_GAIN_MIN = 0.25
 PAIR_TRY_IF_LEFT = 0.10
 OUTSIDE_NOISE = 2.0
 MOSTLY_UNEXPLAINED = 0.5  # the named model leaves more than this share of the excess gap
+# A pair's shares are also read on the median run when this many runs are judged (``share``):
+# with two, one badly extrapolated run is half the evidence.
+MEDIAN_RUNS = 3
 Z_TIE = 2.0
 TIE_GAP = 0.05
 ADDS_MIN = 0.01  # a pair partner that cuts the first effect's gap by less adds nothing
@@ -117,7 +123,9 @@ RULE_TEXT = (
     f"closes at least {100 * PAIR_GAIN_MIN:.0f} % of what the best single leaves, and each of "
     f"its effects passes the same test given the other (taken where it fits: the null on a "
     f"record where it alone fails to fit), closing at least "
-    f"{100 * PARTNER_MIN:.0f} % of what the other leaves above the noise. Named: the best "
+    f"{100 * PARTNER_MIN:.0f} % of what the other leaves above the noise (the pair's gain "
+    f"and these shares pooled over the judged records or on the median run, whichever is "
+    f"larger, with {MEDIAN_RUNS} runs or more). Named: the best "
     f"passing pair, else the best passing single ('ambiguous' when the next passing single "
     f"cannot be told from it, or a delay fits as well but its lag is not seen); "
     f"if nothing passes, 'outside_candidates' when the gap stands clear of the noise "
@@ -138,6 +146,7 @@ class Context:
     dx: np.ndarray | None = None  # displacement increment per judged sample (m)
     x: np.ndarray | None = None  # displacement per judged sample (m)
     records: list[tuple[int, int]] | None = None  # each judged record's samples
+    runs: list[int] | None = None  # each judged record's run (the halves of one: one run)
 
     def excess(self, gap: float) -> float:
         return float(np.sqrt(max(gap * gap - self.gap_noise**2, 0.0)))
@@ -146,6 +155,43 @@ class Context:
         """Share of ``gap_ref``'s excess over the noise that ``gap_after`` closes."""
         ref = self.excess(gap_ref)
         return 1.0 - self.excess(gap_after) / ref if ref > 0 else 0.0
+
+    def run_gaps(self, pred: np.ndarray) -> list[float]:
+        """The gap of ``pred`` on each judged run; none with fewer than ``MEDIAN_RUNS``."""
+        if not self.records:
+            return []
+        ids = self.runs if self.runs is not None else list(range(len(self.records)))
+        gaps = []
+        for run in dict.fromkeys(ids):
+            idx = np.concatenate(
+                [np.arange(a, b) for (a, b), i in zip(self.records, ids, strict=True) if i == run]
+            )
+            gaps.append(rms_ratio(self.force[idx], pred[idx]))
+        return gaps if len(gaps) >= MEDIAN_RUNS else []
+
+    def share(self, after: dict[str, Any], ref: dict[str, Any]) -> float:
+        """Share of row ``ref``'s excess over the noise that row ``after`` closes: over all
+        judged samples, or on the median run, whichever is larger. One run judged by fits
+        that extrapolate far (a programme beyond the fitted ones: a heat grown past
+        anything they held) dominates the pooled gap; a partner that closes most of what
+        the other leaves on most runs is there all the same, while one that closes a small
+        share on every run stays small on the median run too."""
+        pooled = self.closes(after["gap_after"], ref["gap_after"])
+        a, b = self.run_gaps(after["_pred"]), self.run_gaps(ref["_pred"])
+        if not a:
+            return pooled
+        per_run = [self.closes(x, y) for x, y in zip(a, b, strict=True)]
+        return max(pooled, float(np.median(per_run)))
+
+    def ratio(self, after: dict[str, Any], ref: dict[str, Any]) -> float:
+        """Row ``after``'s gap over row ``ref``'s: pooled, or on the median run, whichever is
+        smaller (as ``share``)."""
+        pooled = after["gap_after"] / ref["gap_after"] if ref["gap_after"] > 0 else 1.0
+        a, b = self.run_gaps(after["_pred"]), self.run_gaps(ref["_pred"])
+        if not a:
+            return pooled
+        per_run = [x / y if y > 0 else 1.0 for x, y in zip(a, b, strict=True)]
+        return min(pooled, float(np.median(per_run)))
 
 
 def _block_work(ctx: Context, pred: np.ndarray) -> np.ndarray:
@@ -267,17 +313,19 @@ def mark_pairs(singles: list[dict], pairs: list[dict], ctx: Context) -> None:
     """Rule 3 on every pair row: ``members_add`` and ``passes``."""
     by_name = {r["effect"]: r for r in singles}
     ok = [r for r in singles if not r["failed_to_fit"]]
-    best_gap = ok[0]["gap_after"] if ok else ctx.gap_null
-    open_for_pairs = not (ok and ok[0]["passes"]) or best_gap > PAIR_TRY_IF_LEFT * ctx.gap_null
+    best = ok[0] if ok else {"gap_after": ctx.gap_null, "_pred": ctx.null_pred}
+    open_for_pairs = (
+        not (ok and ok[0]["passes"]) or best["gap_after"] > PAIR_TRY_IF_LEFT * ctx.gap_null
+    )
     for r in pairs:
         adds = []
         for m in r["members"]:
             other = where_it_fits(by_name[next(o for o in r["members"] if o != m)], ctx)
             t = cut_z(ctx.force, other["_pred"], r["_pred"], ctx.edges)
-            share = ctx.closes(r["gap_after"], other["gap_after"])
+            share = ctx.share(r, other)
             adds.append((t >= Z_NAME or share >= CLEAR_CUT) and share >= PARTNER_MIN)
         r["members_add"] = bool(all(adds))
-        closes = r["gap_after"] <= (1.0 - PAIR_GAIN_MIN) * best_gap
+        closes = ctx.ratio(r, best) <= 1.0 - PAIR_GAIN_MIN
         pair_ok = open_for_pairs and r["members_add"] and closes
         r["_passes_unless_lag"] = bool(pair_ok and r["_passes_unless_lag"])
         r["passes"] = bool(pair_ok and r["passes"])

@@ -49,9 +49,10 @@ def restricted(ctx: rule.Context, keep: list[int]) -> tuple[rule.Context, np.nda
         records.append((int(s), int(s + b - a)))
         edges += [(int(s + e0 - a), int(s + e1 - a)) for e0, e1 in ctx.edges if a <= e0 < b]
     force, null = ctx.force[idx], ctx.null_pred[idx]
+    runs = None if ctx.runs is None else [ctx.runs[i] for i in keep]
     sub = rule.Context(
         force, null, edges, rms_ratio(force, null), ctx.gap_noise, ctx.lag,
-        ctx.dx[idx], ctx.x[idx], records,
+        ctx.dx[idx], ctx.x[idx], records, runs,
     )  # fmt: skip
     return sub, idx
 
