@@ -11,6 +11,10 @@ leaves above the noise (the lost stiffness, not the row, explains most of what i
 at least ``SHRINK_MIN`` of the null's excess gap, as much as a single effect must close to be
 named (a sliver of a row that leaves all but noise is no evidence). Where the stiffness
 recovers (a Payne softening, a heat that cools) or nothing is lost, the column adds little.
+What it leaves is read pooled and on the median run, the smaller (``rule.Context.share``):
+a stiffness lost for good is the specimen's and shows beside the row on most runs; a column
+that mends the one run where the row's fit extrapolates far (a heat carried to a programme
+faster than those it was fitted on) refuses nothing.
 
 ``LASTS_MIN`` and ``SHRINK_MIN`` lean to keeping a real effect (the diagnosis-validation
 study, ninth revision): every answer on the own cases in forms no candidate shares and
@@ -40,7 +44,7 @@ def lasting_evidence(r: dict[str, Any], row_of: RowOf, ctx: Context) -> dict[str
     members[0] = LastingForm(members[0])  # one lost-for-good column beside the row
     lasting = row_of(Combination(tuple(members)))
     z = float(cut_z(ctx.force, r["_pred"], lasting["_pred"], ctx.edges))
-    share = float(ctx.closes(lasting["gap_after"], r["gap_after"]))
+    share = ctx.share(lasting, r, pick=min)
     gap, null = lasting["gap_after"], ctx.gap_null
     of_null = ctx.closes(gap, null) - ctx.closes(r["gap_after"], null)  # of the null's excess
     lasts = (z >= Z_NAME or share >= CLEAR_CUT) and share >= LASTS_MIN and of_null >= SHRINK_MIN

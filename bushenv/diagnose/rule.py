@@ -25,8 +25,8 @@ above the noise: ``excess(g) = sqrt(max(g^2 - gap_noise^2, 0))``.
    beyond one law per record (``law_drift``: a zero drifting in time, a stiffness lost for
    good, a stiffness lost to heat, fitted as a backbone or a friction). Any row is refused
    where a stiffness lost for good at the largest deflection, fitted beside it, explains most
-   of what it leaves and a part of the gap that counts (``lasting.py``: a Mullins softening
-   is no candidate).
+   of what it leaves (pooled and on the median run) and a part of the gap that counts
+   (``lasting.py``: a Mullins softening is no candidate).
 3. A **pair** ``{A, B}`` passes when it passes as a single would, the best single leaves more
    than ``PAIR_TRY_IF_LEFT`` of the null's gap (or none passes), the pair closes at least
    ``PAIR_GAIN_MIN`` of the best single's gap, and **each member passes given the other**:
@@ -117,7 +117,8 @@ RULE_TEXT = (
     f"third of every record explains more than {100 * LAW_DRIFT_MAX:.0f} % of its cut beyond "
     f"one law per record); any candidate is refused where a stiffness lost for good at the "
     f"largest deflection, fitted beside it, cuts significantly and closes at least half of "
-    f"what it leaves above the noise and {100 * SHRINK_MIN:.0f} % of the null's. A pair "
+    f"what it leaves above the noise (pooled and on the median run) and "
+    f"{100 * SHRINK_MIN:.0f} % of the null's. A pair "
     f"passes when it "
     f"passes so, "
     f"closes at least {100 * PAIR_GAIN_MIN:.0f} % of what the best single leaves, and each of "
@@ -169,19 +170,20 @@ class Context:
             gaps.append(rms_ratio(self.force[idx], pred[idx]))
         return gaps if len(gaps) >= MEDIAN_RUNS else []
 
-    def share(self, after: dict[str, Any], ref: dict[str, Any]) -> float:
+    def share(self, after: dict[str, Any], ref: dict[str, Any], pick=max) -> float:
         """Share of row ``ref``'s excess over the noise that row ``after`` closes: over all
-        judged samples, or on the median run, whichever is larger. One run judged by fits
-        that extrapolate far (a programme beyond the fitted ones: a heat grown past
-        anything they held) dominates the pooled gap; a partner that closes most of what
-        the other leaves on most runs is there all the same, while one that closes a small
-        share on every run stays small on the median run too."""
+        judged samples or on the median run, whichever ``pick`` takes. One run judged by
+        fits that extrapolate far (a programme beyond the fitted ones: a heat grown past
+        anything they held) dominates the pooled gap. A partner that closes most of what
+        the other leaves on most runs is there all the same (``max``), while one that closes
+        a small share on every run stays small on the median run too; a column that mends
+        that one run alone refuses nothing (``min``, ``lasting.py``)."""
         pooled = self.closes(after["gap_after"], ref["gap_after"])
         a, b = self.run_gaps(after["_pred"]), self.run_gaps(ref["_pred"])
         if not a:
             return pooled
         per_run = [self.closes(x, y) for x, y in zip(a, b, strict=True)]
-        return max(pooled, float(np.median(per_run)))
+        return float(pick(pooled, float(np.median(per_run))))
 
     def ratio(self, after: dict[str, Any], ref: dict[str, Any]) -> float:
         """Row ``after``'s gap over row ``ref``'s: pooled, or on the median run, whichever is

@@ -4,12 +4,13 @@ its name."""
 
 import numpy as np
 
-from bushenv.diagnose import lasting
+from bushenv.diagnose import lasting, rule
 from bushenv.diagnose.candidates import effect_names, get_effect
 from bushenv.diagnose.effects.base import LOST_SATURATION, Scales, Signals
 from bushenv.diagnose.fit import diagnose
 from bushenv.diagnose.rule import OUTSIDE
 from bushenv.diagnose.validation.outside_cases import make_outside_case
+from bushenv.diagnose.validation.partner_cases import make_partner_case
 from bushenv.diagnose.validation.widened_cases import make_widened_case
 
 from .synthetic import K, Rec, force, motion
@@ -84,3 +85,28 @@ def test_a_stiffness_lost_for_good_in_another_form_is_no_thermal_drift(monkeypat
     assert result["effect"] == OUTSIDE
     monkeypatch.setattr(lasting, "LASTS_MIN", np.inf)  # the check off
     assert diagnose(recs[0], recs[1:])["effect"] == "thermal"  # a heat that never cools
+
+
+def _session_order(case):
+    """The partner case's records in the order its session ran them, the rests between."""
+    names = [r.name for r in case.train + case.tests]
+    order, rests = case.drawn["order"], case.drawn["rests_s"]
+    return [(names[i], None if j == 0 else rests[j - 1]) for j, i in enumerate(order)]
+
+
+def test_a_column_that_mends_the_one_run_a_pair_extrapolates_to_refuses_nothing(monkeypatch):
+    """Own thermal + relaxation case (seed 5, case 11) with its run order: the heating law
+    fitted on the other runs extrapolates to the fast sweep, and a stiffness lost for good
+    fitted beside the pair mends that run -- pooled it closes most of what the pair leaves,
+    on the median run it does not. The pair is named; pooled alone it was refused."""
+    case = make_partner_case(5, 11, label=("relaxation", "thermal"))
+    order = _session_order(case)
+    got = diagnose(case.train, case.tests, run_order=order)
+    assert got["effect"] == "relaxation+thermal", got["effect"]
+    pair = next(r for r in got["pairs"] if r["effect"] == "relaxation+thermal")
+    assert not pair["lasting_softening"]["refuses"]
+    monkeypatch.setattr(rule, "MEDIAN_RUNS", 99)  # pooled only
+    pooled = diagnose(case.train, case.tests, run_order=order)
+    pair = next(r for r in pooled["pairs"] if r["effect"] == "relaxation+thermal")
+    assert pair["lasting_softening"]["refuses"] and pair["lasting_softening"]["share"] > 0.5
+    assert pooled["effect"] == "relaxation"
