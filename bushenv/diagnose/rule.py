@@ -69,8 +69,8 @@ PAIR_GAIN_MIN = 0.25
 PAIR_TRY_IF_LEFT = 0.10
 OUTSIDE_NOISE = 2.0
 MOSTLY_UNEXPLAINED = 0.5  # the named model leaves more than this share of the excess gap
-# A pair's shares are also read on the median run when this many runs are judged (``share``):
-# with two, one badly extrapolated run is half the evidence.
+# Shares (a pair's, the lasting test's) are also read on the median run when this many runs
+# are judged (``Context.share``): with two, one badly extrapolated run is half the evidence.
 MEDIAN_RUNS = 3
 Z_TIE = 2.0
 TIE_GAP = 0.05
