@@ -179,21 +179,26 @@ class Context:
         a small share on every run stays small on the median run too; a column that mends
         that one run alone refuses nothing (``min``, ``lasting.py``)."""
         pooled = self.closes(after["gap_after"], ref["gap_after"])
-        a, b = self.run_gaps(after["_pred"]), self.run_gaps(ref["_pred"])
-        if not a:
-            return pooled
-        per_run = [self.closes(x, y) for x, y in zip(a, b, strict=True)]
-        return float(pick(pooled, float(np.median(per_run))))
+        median = self._median_run(after, ref, self.closes)
+        return pooled if median is None else float(pick(pooled, median))
 
     def ratio(self, after: dict[str, Any], ref: dict[str, Any]) -> float:
         """Row ``after``'s gap over row ``ref``'s: pooled, or on the median run, whichever is
         smaller (as ``share``)."""
-        pooled = after["gap_after"] / ref["gap_after"] if ref["gap_after"] > 0 else 1.0
+
+        def ratio(x: float, y: float) -> float:
+            return x / y if y > 0 else 1.0
+
+        pooled = ratio(after["gap_after"], ref["gap_after"])
+        median = self._median_run(after, ref, ratio)
+        return pooled if median is None else min(pooled, median)
+
+    def _median_run(self, after: dict[str, Any], ref: dict[str, Any], per) -> float | None:
+        """``per(gap of after, gap of ref)`` on the median run; None below ``MEDIAN_RUNS``."""
         a, b = self.run_gaps(after["_pred"]), self.run_gaps(ref["_pred"])
         if not a:
-            return pooled
-        per_run = [x / y if y > 0 else 1.0 for x, y in zip(a, b, strict=True)]
-        return min(pooled, float(np.median(per_run)))
+            return None
+        return float(np.median([per(x, y) for x, y in zip(a, b, strict=True)]))
 
 
 def _block_work(ctx: Context, pred: np.ndarray) -> np.ndarray:
